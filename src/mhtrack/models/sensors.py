@@ -1,0 +1,122 @@
+"""Sensor models: a Cartesian position sensor (P1 §1.1, eq. 2) and a 2-D polar radar (P2).
+
+A polar radar measures range ``r`` and bearing ``b`` (clockwise from north, i.e. from the
++y axis, as radar azimuth is usually given) from its known position, with independent
+Gaussian errors ``σr`` and ``σb``. Its plots are turned into Cartesian positions by the
+**unbiased converted measurement** (UCM) with its measurement-conditioned covariance
+(Bar-Shalom, Li & Kirubarajan, *Estimation with Applications to Tracking and Navigation*,
+2001, §10.4.3; Mo, Song, Zhou, Sun & Bar-Shalom, IEEE T-AES 34(3), 1998). With
+``θ = π/2 − b`` the mathematical angle, ``λ = exp(−σθ²/2)`` and ``λ' = exp(−2σθ²)``::
+
+    x = λ⁻¹ r cos θ,   y = λ⁻¹ r sin θ        (debiased position, relative to the radar)
+    Rxx = (λ⁻² − 2) r² cos²θ + ½ (r² + σr²)(1 + λ' cos 2θ)
+    Ryy = (λ⁻² − 2) r² sin²θ + ½ (r² + σr²)(1 − λ' cos 2θ)
+    Rxy = (λ⁻² − 2) r² cosθ sinθ + ½ (r² + σr²) λ' sin 2θ
+
+The tracker then uses a linear Kalman update with the converted plot and this ``R``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class Observation:
+    """What a sensor reports for a set of positions: Cartesian plots ``z`` (n, 2), their
+    covariances ``R`` (n, 2, 2), and for polar sensors ``range_bearing`` (n, 2) in metres
+    and degrees."""
+
+    z: np.ndarray
+    R: np.ndarray
+    range_bearing: np.ndarray | None = None
+
+
+@dataclass(frozen=True)
+class CartesianSensor:
+    """Position sensor ``z = Hx + w``, ``w ~ N(0, σ² I₂)`` (P1 eq. 2; P1 uses σ² = 10⁴ m²)."""
+
+    id: int = 0
+    sigma: float = 100.0
+    kind: str = field(default="cartesian", init=False)
+
+    def __post_init__(self) -> None:
+        if not (np.isfinite(self.sigma) and self.sigma > 0):
+            raise ValueError(f"sensor {self.id}: sigma must be > 0, got {self.sigma}")
+
+    @property
+    def R(self) -> np.ndarray:
+        return np.eye(2) * self.sigma**2
+
+    def observe(self, rng: np.random.Generator, positions: np.ndarray) -> Observation:
+        """Noisy plots of true ``positions`` (n, 2)."""
+        p = np.asarray(positions, float).reshape(-1, 2)
+        z = p + rng.normal(scale=self.sigma, size=p.shape)
+        return Observation(z, np.broadcast_to(self.R, (len(p), 2, 2)).copy())
+
+    def place(self, z: np.ndarray) -> Observation:
+        """Report plots exactly at ``z`` (used for clutter, which has no 'true' position)."""
+        z = np.asarray(z, float).reshape(-1, 2)
+        return Observation(z.copy(), np.broadcast_to(self.R, (len(z), 2, 2)).copy())
+
+
+@dataclass(frozen=True)
+class PolarRadar:
+    """2-D radar at ``position`` measuring range (σ ``sigma_range`` m) and bearing
+    (σ ``sigma_bearing_deg`` degrees, clockwise from north). P2: σr = 20 m, σθ = 0.3°."""
+
+    id: int
+    position: tuple[float, float] = (0.0, 0.0)
+    sigma_range: float = 20.0
+    sigma_bearing_deg: float = 0.3
+    kind: str = field(default="polar", init=False)
+
+    def __post_init__(self) -> None:
+        if not (np.isfinite(self.sigma_range) and self.sigma_range > 0):
+            raise ValueError(f"sensor {self.id}: sigma_range must be > 0")
+        if not (np.isfinite(self.sigma_bearing_deg) and self.sigma_bearing_deg > 0):
+            raise ValueError(f"sensor {self.id}: sigma_bearing_deg must be > 0")
+        object.__setattr__(self, "position", tuple(float(v) for v in self.position))
+
+    def to_polar(self, positions: np.ndarray) -> np.ndarray:
+        """Exact ``(range m, bearing deg)`` of Cartesian ``positions`` (n, 2)."""
+        d = np.asarray(positions, float).reshape(-1, 2) - np.asarray(self.position)
+        r = np.hypot(d[:, 0], d[:, 1])
+        b = np.degrees(np.arctan2(d[:, 0], d[:, 1])) % 360.0
+        return np.column_stack((r, b))
+
+    def convert(self, range_bearing: np.ndarray) -> Observation:
+        """Unbiased converted measurement and its covariance (module docstring formulas)."""
+        rb = np.asarray(range_bearing, float).reshape(-1, 2)
+        r = rb[:, 0]
+        th = np.pi / 2 - np.radians(rb[:, 1])
+        s2 = np.radians(self.sigma_bearing_deg) ** 2
+        lam = np.exp(-s2 / 2)
+        lam2 = np.exp(-2 * s2)
+        c, s = np.cos(th), np.sin(th)
+        z = np.column_stack((r * c, r * s)) / lam + np.asarray(self.position)
+        a = (lam**-2 - 2) * r**2
+        b = 0.5 * (r**2 + self.sigma_range**2)
+        R = np.empty((len(r), 2, 2))
+        R[:, 0, 0] = a * c**2 + b * (1 + lam2 * np.cos(2 * th))
+        R[:, 1, 1] = a * s**2 + b * (1 - lam2 * np.cos(2 * th))
+        R[:, 0, 1] = R[:, 1, 0] = a * c * s + b * lam2 * np.sin(2 * th)
+        return Observation(z, R, rb)
+
+    def observe(self, rng: np.random.Generator, positions: np.ndarray) -> Observation:
+        """Noisy range/bearing of true ``positions``, converted to Cartesian."""
+        rb = self.to_polar(positions)
+        rb[:, 0] += rng.normal(scale=self.sigma_range, size=len(rb))
+        rb[:, 1] += rng.normal(scale=self.sigma_bearing_deg, size=len(rb))
+        rb[:, 0] = np.abs(rb[:, 0])
+        rb[:, 1] %= 360.0
+        return self.convert(rb)
+
+    def place(self, z: np.ndarray) -> Observation:
+        """Report plots whose measured range/bearing point exactly at ``z`` (clutter)."""
+        return self.convert(self.to_polar(z))
+
+
+Sensor = CartesianSensor | PolarRadar

@@ -1,0 +1,246 @@
+"""Immutable records of arrays that flow between the layers of mhtrack.
+
+Data flows one way: scenario → :class:`PlotTable` (scans of plots) → tracker →
+:class:`TrackTable` → metrics. Every record is a small frozen dataclass of NumPy arrays,
+one row per plot / truth state / track state; nothing here knows how it was produced.
+
+Conventions (all layers):
+
+* positions in metres in a local east-north frame, ``x`` east and ``y`` north;
+* a state vector is ``[x, vx, y, vy]`` (P1 §1.1);
+* scan indices are integers, times in seconds, non-decreasing with the scan index;
+* ``origin`` of a plot is the id of the target that produced it, or ``-1`` for clutter;
+* ``plot`` of a track state is the **row index in the plot table** (0-based, the order of
+  the rows in the plots file) of the plot the track used at that scan, or ``-1`` on a miss.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from dataclasses import dataclass, field
+
+import numpy as np
+
+CLUTTER = -1
+NO_PLOT = -1
+
+
+def _f8(a: object) -> np.ndarray:
+    return np.ascontiguousarray(a, dtype=np.float64)
+
+
+def _i8(a: object) -> np.ndarray:
+    return np.ascontiguousarray(a, dtype=np.int64)
+
+
+def scan_slices(scan: np.ndarray) -> Iterator[tuple[int, slice]]:
+    """Yield ``(scan_index, slice)`` for each run of equal values in a sorted ``scan`` array."""
+    if scan.size == 0:
+        return
+    cuts = np.flatnonzero(np.diff(scan)) + 1
+    starts = np.concatenate(([0], cuts))
+    stops = np.concatenate((cuts, [scan.size]))
+    for a, b in zip(starts.tolist(), stops.tolist(), strict=True):
+        yield int(scan[a]), slice(a, b)
+
+
+@dataclass(frozen=True, slots=True)
+class Scan:
+    """All plots reported at one scan.
+
+    Attributes
+    ----------
+    index, time : scan number and its time (s).
+    z : (n, 2) Cartesian plot positions (m).
+    sensor : (n,) sensor id of each plot.
+    rows : (n,) row index of each plot in its :class:`PlotTable` (what tracks refer to).
+    R : (n, 2, 2) measurement covariance of each plot, or ``None`` when the tracker's own
+        Cartesian ``R`` applies (Cartesian sensors).
+    origin : (n,) target id or ``-1`` for clutter; ``None`` when unknown (real data).
+    """
+
+    index: int
+    time: float
+    z: np.ndarray
+    sensor: np.ndarray
+    rows: np.ndarray
+    R: np.ndarray | None = None
+    origin: np.ndarray | None = None
+
+    def __len__(self) -> int:
+        return int(self.z.shape[0])
+
+    @classmethod
+    def from_positions(
+        cls, index: int, time: float, z: np.ndarray, *, sensor: int = 0
+    ) -> Scan:
+        """A scan of Cartesian plots from one sensor (convenience for library users)."""
+        z = _f8(z).reshape(-1, 2)
+        n = z.shape[0]
+        return cls(int(index), float(time), z, np.full(n, sensor, np.int64), np.arange(n))
+
+
+@dataclass(frozen=True)
+class PlotTable:
+    """Plots of many scans, one row per plot, sorted by scan.
+
+    Columns follow the plots file schema (``docs/file-formats.md``):
+    ``scan, time, sensor, x, y`` and, for polar sensors, ``range`` (m) and ``bearing``
+    (degrees clockwise from north, NaN for Cartesian-sensor rows); ``origin`` when known.
+    ``R`` holds each plot's Cartesian measurement covariance when the sensors are polar
+    (computed by the sensor model, not stored in files).
+
+    ``scan_times`` optionally lists ``(scan, time)`` of every scan, including scans with
+    no plot; :meth:`scans` uses it so an empty scan still reaches the tracker.
+    """
+
+    scan: np.ndarray
+    time: np.ndarray
+    sensor: np.ndarray
+    x: np.ndarray
+    y: np.ndarray
+    range: np.ndarray | None = None
+    bearing: np.ndarray | None = None
+    origin: np.ndarray | None = None
+    R: np.ndarray | None = None
+    scan_times: tuple[np.ndarray, np.ndarray] | None = field(default=None, repr=False)
+
+    def __post_init__(self) -> None:
+        n = len(self.scan)
+        for name in ("time", "sensor", "x", "y", "range", "bearing", "origin", "R"):
+            v = getattr(self, name)
+            if v is not None and len(v) != n:
+                raise ValueError(f"PlotTable column {name!r} has {len(v)} rows, expected {n}")
+
+    def __len__(self) -> int:
+        return len(self.scan)
+
+    @property
+    def z(self) -> np.ndarray:
+        """(n, 2) plot positions."""
+        return np.column_stack((self.x, self.y))
+
+    @property
+    def n_scans(self) -> int:
+        return len(self.all_scan_times()[0])
+
+    def all_scan_times(self) -> tuple[np.ndarray, np.ndarray]:
+        """``(scan indices, times)`` of every scan, empty ones included.
+
+        From ``scan_times`` when given; otherwise the scans present in the table, with the
+        missing indices between them filled in and their times interpolated linearly.
+        """
+        if self.scan_times is not None:
+            return self.scan_times
+        if len(self.scan) == 0:
+            return np.zeros(0, np.int64), np.zeros(0)
+        present, first = np.unique(self.scan, return_index=True)
+        idx = np.arange(present[0], present[-1] + 1)
+        return idx, np.interp(idx, present, self.time[first])
+
+    def scans(self) -> Iterator[Scan]:
+        """Yield one :class:`Scan` per scan index, empty scans included, in order."""
+        idx, times = self.all_scan_times()
+        bounds = dict(scan_slices(self.scan))
+        empty = slice(0, 0)
+        for k, t in zip(idx.tolist(), times.tolist(), strict=True):
+            s = bounds.get(k, empty)
+            yield Scan(
+                index=k,
+                time=t,
+                z=np.column_stack((self.x[s], self.y[s])),
+                sensor=self.sensor[s],
+                rows=np.arange(s.start, s.stop, dtype=np.int64),
+                R=None if self.R is None else self.R[s],
+                origin=None if self.origin is None else self.origin[s],
+            )
+
+    @classmethod
+    def from_scans(cls, scans: list[Scan]) -> PlotTable:
+        """Stack scans (e.g. from a simulator) into one table; rows are renumbered."""
+        if not scans:
+            e = np.zeros(0)
+            return cls(np.zeros(0, np.int64), e, np.zeros(0, np.int64), e, e)
+        n = [len(s) for s in scans]
+        z = np.concatenate([s.z for s in scans]).reshape(-1, 2)
+        has_r = any(s.R is not None for s in scans)
+        has_o = all(s.origin is not None for s in scans)
+        return cls(
+            scan=_i8(np.repeat([s.index for s in scans], n)),
+            time=_f8(np.repeat([s.time for s in scans], n)),
+            sensor=_i8(np.concatenate([s.sensor for s in scans])),
+            x=_f8(z[:, 0]),
+            y=_f8(z[:, 1]),
+            origin=_i8(np.concatenate([s.origin for s in scans])) if has_o else None,
+            R=np.concatenate(
+                [s.R if s.R is not None else np.full((len(s), 2, 2), np.nan) for s in scans]
+            )
+            if has_r
+            else None,
+            scan_times=(_i8([s.index for s in scans]), _f8([s.time for s in scans])),
+        )
+
+
+@dataclass(frozen=True)
+class TruthTable:
+    """True target states, one row per (scan, live target): ``scan, time, target_id, x, y,
+    vx, vy``, sorted by scan then target id."""
+
+    scan: np.ndarray
+    time: np.ndarray
+    target_id: np.ndarray
+    x: np.ndarray
+    y: np.ndarray
+    vx: np.ndarray
+    vy: np.ndarray
+
+    def __len__(self) -> int:
+        return len(self.scan)
+
+    @property
+    def positions(self) -> np.ndarray:
+        return np.column_stack((self.x, self.y))
+
+
+@dataclass(frozen=True)
+class TrackTable:
+    """Tracker output, one row per (scan, reported track): ``scan, time, track_id, x, y, vx,
+    vy, plot`` (``plot`` = plot-table row used at that scan, ``-1`` on a miss), optionally
+    the track ``score`` (log-likelihood ratio) and state covariance ``P`` (n, 4, 4)."""
+
+    scan: np.ndarray
+    time: np.ndarray
+    track_id: np.ndarray
+    x: np.ndarray
+    y: np.ndarray
+    vx: np.ndarray
+    vy: np.ndarray
+    plot: np.ndarray
+    score: np.ndarray | None = None
+    P: np.ndarray | None = None
+
+    def __len__(self) -> int:
+        return len(self.scan)
+
+    @property
+    def positions(self) -> np.ndarray:
+        return np.column_stack((self.x, self.y))
+
+    @classmethod
+    def empty(cls) -> TrackTable:
+        e = np.zeros(0)
+        i = np.zeros(0, np.int64)
+        return cls(i, e, i, e, e, e, e, i)
+
+    @classmethod
+    def concat(cls, parts: list[TrackTable]) -> TrackTable:
+        """Concatenate per-scan outputs, in order."""
+        parts = [p for p in parts if len(p)]
+        if not parts:
+            return cls.empty()
+
+        def cat(name: str) -> np.ndarray | None:
+            vals = [getattr(p, name) for p in parts]
+            return None if any(v is None for v in vals) else np.concatenate(vals)
+
+        return cls(**{f: cat(f) for f in cls.__dataclass_fields__})  # type: ignore[arg-type]

@@ -1,8 +1,8 @@
 """mhtrack — multiple-target tracking in unknown, varying clutter.
 
 Layers (each a sub-package; none imports a later one):
-``records`` → ``models`` → ``scenario`` → ``clutter`` → ``mht`` → ``initiation`` →
-``metrics`` → ``experiments`` → ``io`` → ``plotting`` → ``cli``.
+``records``/``errors`` → ``models`` → ``scenario`` → ``clutter`` → ``mht`` →
+``initiation`` → ``metrics`` → ``io`` → ``experiments`` → ``plotting`` → ``cli``.
 """
 
 from mhtrack.records import PlotTable, Scan, TrackTable, TruthTable

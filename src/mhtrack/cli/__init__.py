@@ -1,1 +1,1 @@
-"""cli"""
+"""Command-line interface (thin: parse, call the library, print)."""

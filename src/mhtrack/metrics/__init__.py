@@ -1,1 +1,41 @@
-"""metrics"""
+"""Metrics of tracking performance (SPEC §5): pure functions, arrays in, small results out.
+
+* :func:`ospa`, :func:`ospa_per_scan` — OSPA (Schuhmacher, Vo & Vo 2008);
+* :func:`gospa`, :func:`gospa_per_scan` — GOSPA with α = 2 (Rahmathullah et al. 2017);
+* :func:`cardinality_per_scan` — number of tracks vs number of targets per scan;
+* :func:`clear_mot` — MOTA, MOTP, identity switches, fragmentations (Bernardin &
+  Stiefelhagen 2008);
+* :func:`evaluate` — all of the above for one run.
+
+Definitions and conventions: ``docs/metrics.md``.
+"""
+
+from mhtrack.metrics.cardinality import CardinalityPerScan, cardinality_per_scan
+from mhtrack.metrics.clearmot import (
+    DEFAULT_MATCH_DISTANCE,
+    CLEARMOTResult,
+    MOTMatching,
+    clear_mot,
+)
+from mhtrack.metrics.evaluate import Evaluation, evaluate
+from mhtrack.metrics.gospa import GOSPAPerScan, GOSPAResult, gospa, gospa_per_scan
+from mhtrack.metrics.ospa import OSPAPerScan, OSPAResult, ospa, ospa_per_scan
+
+__all__ = [
+    "DEFAULT_MATCH_DISTANCE",
+    "CLEARMOTResult",
+    "CardinalityPerScan",
+    "Evaluation",
+    "GOSPAPerScan",
+    "GOSPAResult",
+    "MOTMatching",
+    "OSPAPerScan",
+    "OSPAResult",
+    "cardinality_per_scan",
+    "clear_mot",
+    "evaluate",
+    "gospa",
+    "gospa_per_scan",
+    "ospa",
+    "ospa_per_scan",
+]

@@ -1,0 +1,85 @@
+"""Options and helpers shared by several commands."""
+
+from __future__ import annotations
+
+import json
+import math
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import click
+import numpy as np
+
+
+def scenario_options(f: Callable[..., Any]) -> Callable[..., Any]:
+    """``SCENARIO`` (preset name or TOML file) and the common overrides."""
+    for opt in reversed(
+        [
+            click.argument("scenario"),
+            click.option("--seed", type=int, default=0, show_default=True,
+                         help="Random seed; same seed, same output."),
+            click.option("--clutter", type=click.Choice(["uniform", "gmm"]), default=None,
+                         help="Replace the scenario's clutter density."),
+            click.option("--clutter-rate", type=click.FloatRange(min=0), default=None,
+                         help="Mean clutter plots per scan (per sensor)."),
+            click.option("--pd", type=click.FloatRange(0, 1), default=None,
+                         help="Detection probability of every sensor."),
+            click.option("--scans", type=click.IntRange(min=1), default=None,
+                         help="Number of scans to simulate."),
+        ]
+    ):
+        f = opt(f)
+    return f
+
+
+def load_scenario_arg(
+    scenario: str, clutter: str | None, clutter_rate: float | None, pd: float | None,
+    scans: int | None,
+) -> Any:
+    """A preset by name, or a scenario TOML file, with the command-line overrides."""
+    from mhtrack.scenario import PRESETS, apply_overrides, load_scenario, preset
+
+    overrides = {"clutter": clutter, "clutter_rate": clutter_rate, "pd": pd, "scans": scans}
+    overrides = {k: v for k, v in overrides.items() if v is not None}
+    if scenario in PRESETS:
+        return preset(scenario, **overrides)
+    path = Path(scenario)
+    if path.suffix.lower() == ".toml" or path.exists():
+        if not path.is_file():
+            raise click.BadParameter(f"no such scenario file: {path}", param_hint="SCENARIO")
+        return apply_overrides(load_scenario(path), **overrides)
+    names = ", ".join(sorted(PRESETS))
+    raise click.BadParameter(
+        f"unknown scenario {scenario!r}: give a preset ({names}) or a .toml file",
+        param_hint="SCENARIO",
+    )
+
+
+def _jsonable(o: Any) -> Any:
+    if isinstance(o, dict):
+        return {str(k): _jsonable(v) for k, v in o.items()}
+    if isinstance(o, list | tuple):
+        return [_jsonable(v) for v in o]
+    if isinstance(o, np.ndarray):
+        return _jsonable(o.tolist())
+    if isinstance(o, np.integer):
+        return int(o)
+    if isinstance(o, np.floating | float):
+        f = float(o)
+        return f if math.isfinite(f) else None
+    return o
+
+
+def echo_json(obj: Any) -> None:
+    """Print one JSON object (NaN/inf become null so any JSON parser reads it)."""
+    click.echo(json.dumps(_jsonable(obj), allow_nan=False))
+
+
+def table_path(directory: Path, stem: str) -> Path | None:
+    """``DIR/stem.csv`` or ``DIR/stem.parquet``, whichever exists."""
+    for ext in (".csv", ".parquet"):
+        p = directory / f"{stem}{ext}"
+        if p.is_file():
+            return p
+    return None

@@ -1,0 +1,95 @@
+"""``simulate``, ``evaluate`` and ``plot``: scenarios, files and metrics."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import click
+
+from mhtrack.cli.common import echo_json, load_scenario_arg, scenario_options, table_path
+
+
+@click.command()
+@scenario_options
+@click.option("--out", "out", type=click.Path(file_okay=False, path_type=Path), required=True,
+              help="Output directory (created).")
+@click.option("--format", "fmt", type=click.Choice(["csv", "parquet"]), default="csv",
+              show_default=True, help="File format of plots and truth.")
+def simulate(scenario: str, seed: int, clutter: str | None, clutter_rate: float | None,
+             pd: float | None, scans: int | None, out: Path, fmt: str) -> None:
+    """Simulate SCENARIO (a preset or a TOML file) and write DIR/plots, DIR/truth and the
+    full parameters in DIR/scenario.toml."""
+    from mhtrack.io import write_plots, write_scenario_toml, write_truth
+    from mhtrack.scenario import simulate as run_simulation
+
+    sc = load_scenario_arg(scenario, clutter, clutter_rate, pd, scans)
+    sim = run_simulation(sc, seed=seed)
+    out.mkdir(parents=True, exist_ok=True)
+    write_plots(sim.plots, out / f"plots.{fmt}")
+    write_truth(sim.truth, out / f"truth.{fmt}")
+    write_scenario_toml({"seed": seed, **sc.to_dict()}, out / "scenario.toml")
+    n_scans = sim.plots.n_scans
+    n_clutter = int((sim.plots.origin < 0).sum()) if sim.plots.origin is not None else 0
+    click.echo(
+        f"{sc.name}: {n_scans} scans, {len(sim.plots)} plots ({n_clutter} clutter), "
+        f"{len(set(sim.truth.target_id.tolist()))} targets -> {out}"
+    )
+
+
+@click.command()
+@click.argument("tracks", type=click.Path(dir_okay=False, path_type=Path))
+@click.argument("truth", type=click.Path(dir_okay=False, path_type=Path))
+@click.option("--plots", type=click.Path(dir_okay=False, path_type=Path), default=None,
+              help="Plots file (adds the scans it covers and plot-based metrics).")
+@click.option("--cutoff", type=click.FloatRange(min=0, min_open=True), default=500.0,
+              show_default=True, help="OSPA/GOSPA cut-off c (m).")
+@click.option("--order", type=click.FloatRange(min=1), default=2.0, show_default=True,
+              help="OSPA/GOSPA order p.")
+@click.option("--match-distance", type=click.FloatRange(min=0, min_open=True), default=None,
+              help="Track-to-truth matching distance for CLEAR-MOT (m) [default: cut-off].")
+@click.option("--json", "as_json", is_flag=True, help="Print one JSON object.")
+def evaluate(tracks: Path, truth: Path, plots: Path | None, cutoff: float, order: float,
+             match_distance: float | None, as_json: bool) -> None:
+    """Score TRACKS against TRUTH: OSPA, GOSPA, cardinality, CLEAR-MOT."""
+    from mhtrack.io import read_plots, read_tracks, read_truth
+    from mhtrack.metrics import evaluate as run_evaluation
+
+    tr = read_tracks(tracks)
+    gt = read_truth(truth)
+    pl = read_plots(plots) if plots is not None else None
+    ev = run_evaluation(tr, gt, plots=pl, cutoff=cutoff, order=order,
+                        match_distance=match_distance)
+    if as_json:
+        echo_json(ev.to_dict())
+    else:
+        click.echo(ev.to_table())
+
+
+@click.command()
+@click.argument("directory", type=click.Path(exists=True, file_okay=False, path_type=Path))
+@click.option("-o", "--output", type=click.Path(dir_okay=False, path_type=Path), default=None,
+              help="Image file [default: DIR/scene.png].")
+@click.option("--title", default=None, help="Figure title [default: the directory name].")
+def plot(directory: Path, output: Path | None, title: str | None) -> None:
+    """Draw DIR's truth, plots (clutter grey) and tracks, whichever are present."""
+    from mhtrack.io import read_plots, read_toml, read_tracks, read_truth
+    from mhtrack.plotting.scene import plot_scene, save_figure
+
+    paths = {s: table_path(directory, s) for s in ("plots", "truth", "tracks")}
+    if not any(paths.values()):
+        raise click.ClickException(f"{directory} holds no plots, truth or tracks file")
+    if title is None:
+        title = directory.name
+        if (directory / "scenario.toml").is_file():
+            title = str(read_toml(directory / "scenario.toml").get("name", title))
+    fig = plot_scene(
+        plots=read_plots(paths["plots"]) if paths["plots"] else None,
+        truth=read_truth(paths["truth"]) if paths["truth"] else None,
+        tracks=read_tracks(paths["tracks"]) if paths["tracks"] else None,
+        title=title,
+    )
+    path = save_figure(fig, output or directory / "scene.png")
+    click.echo(f"wrote {path}")
+
+
+COMMANDS = [simulate, evaluate, plot]

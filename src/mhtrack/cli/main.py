@@ -1,0 +1,59 @@
+"""The ``mhtrack`` command line: parse, call the library, print. Nothing else lives here.
+
+Every command is reachable from Python through the library functions it calls. Bad input
+gives exit status 1 and one line on stderr (set ``MHTRACK_DEBUG=1`` for the traceback).
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+
+import click
+
+from mhtrack import __version__
+
+#: Errors that are the user's input, not a bug: reported as one line, no traceback.
+USER_ERRORS: tuple[type[BaseException], ...] = (ValueError, OSError, KeyError)
+
+
+class Group(click.Group):
+    """A click group that turns user errors into one clear line on stderr."""
+
+    def invoke(self, ctx: click.Context) -> object:
+        try:
+            return super().invoke(ctx)
+        except (click.ClickException, click.exceptions.Exit, click.Abort):
+            raise
+        except USER_ERRORS as exc:
+            if os.environ.get("MHTRACK_DEBUG"):
+                raise
+            msg = str(exc) or type(exc).__name__
+            if isinstance(exc, KeyError):
+                msg = f"missing key {msg}"
+            raise click.ClickException(msg) from None
+
+
+@click.group(cls=Group, context_settings={"help_option_names": ["-h", "--help"]})
+@click.version_option(__version__, prog_name="mhtrack")
+@click.option("-v", "--verbose", count=True, help="More log output (-vv for debug).")
+def cli(verbose: int) -> None:
+    """Multiple-target tracking in unknown, varying clutter (MHT, MHT-GMM, MHT-AGMM) and
+    multi-radar track initiation."""
+    level = logging.WARNING - 10 * min(verbose, 2)
+    logging.basicConfig(level=level, format="mhtrack: %(levelname)s: %(message)s")
+
+
+def _register() -> None:
+    from mhtrack.cli import data_commands
+
+    for command in data_commands.COMMANDS:
+        cli.add_command(command)
+
+
+_register()
+
+
+def main() -> None:
+    """Console-script entry point."""
+    cli(prog_name="mhtrack")

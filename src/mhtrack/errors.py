@@ -1,0 +1,47 @@
+"""The one exception raised for bad input files.
+
+Every reader in :mod:`mhtrack.io`, and every other boundary that reads user input, turns a
+problem with a user's file into an :class:`InputError` whose message says where the
+problem is, in the form::
+
+    plots.csv, line 17, column 'x': value 'nan' is not finite
+    plots.parquet, row 15 (0-based), column 'x': value 'nan' is not finite
+    plots.csv: missing required column(s) 'y'
+    scenario.toml, line 3, column 9: Expected '=' after a key in a key/value pair
+
+CSV line numbers are those a text editor shows (the header is line 1); Parquet rows are
+0-based, the same indices that the ``plot`` column of a tracks file uses. The CLI catches
+:class:`InputError` and prints its message instead of a traceback.
+
+This module imports nothing from mhtrack, so any layer may import it cheaply.
+"""
+
+from __future__ import annotations
+
+
+class InputError(ValueError):
+    """A user-supplied file (or path) is missing, unreadable or malformed.
+
+    Parameters
+    ----------
+    message : the full message, already naming the file and the place.
+    file : the path as the user gave it.
+    line : 1-based CSV line, or TOML line (``None`` when not about one line).
+    row : 0-based data-row index (CSV and Parquet), when about one row.
+    column : the CSV/Parquet column name, when about one column.
+    """
+
+    def __init__(
+        self,
+        message: str,
+        *,
+        file: str | None = None,
+        line: int | None = None,
+        row: int | None = None,
+        column: str | None = None,
+    ) -> None:
+        super().__init__(message)
+        self.file = file
+        self.line = line
+        self.row = row
+        self.column = column

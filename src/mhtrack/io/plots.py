@@ -1,0 +1,194 @@
+"""Plots files: ``scan, time, sensor, x, y`` [, ``range, bearing``] [, ``origin``].
+
+One row per plot, in non-decreasing scan order; the row order is the plot numbering that
+tracks files refer to (0-based). See ``docs/file-formats.md``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+import numpy as np
+import pyarrow as pa
+
+from mhtrack.io._tabular import (
+    FLOAT,
+    INT,
+    Frame,
+    PathArg,
+    check_scan_order,
+    float_array,
+    int_array,
+    num,
+    read_frame,
+    write_frame,
+)
+from mhtrack.models.sensors import CartesianSensor, PolarRadar
+from mhtrack.records import PlotTable
+
+REQUIRED = ("scan", "time", "sensor", "x", "y")
+COLUMNS = {
+    "scan": INT,
+    "time": FLOAT,
+    "sensor": INT,
+    "x": FLOAT,
+    "y": FLOAT,
+    "range": FLOAT,
+    "bearing": FLOAT,
+    "origin": INT,
+}
+
+SensorRegistry = Mapping[int, CartesianSensor | PolarRadar]
+
+
+def read_plots(path: PathArg, sensors: SensorRegistry | None = None) -> PlotTable:
+    """Read and validate a plots file (``.csv`` or ``.parquet``).
+
+    Parameters
+    ----------
+    path : the file; its extension chooses the format.
+    sensors : optional registry ``sensor id -> CartesianSensor | PolarRadar``. When given,
+        every row's sensor must be in it; ``range``/``bearing`` may be empty (NaN) on the
+        rows of Cartesian sensors; and the per-plot covariance ``R`` is computed — by
+        ``PolarRadar.convert`` for polar rows, ``CartesianSensor.R`` for the others —
+        unless every row comes from Cartesian sensors sharing one σ (then ``R`` is
+        ``None`` and the tracker's own ``R = σ² I`` applies, as in the simulator).
+
+    Returns
+    -------
+    PlotTable with ``x, y`` as written in the file; ``scan_times`` is left ``None`` (scans
+    with no plot are filled in by :meth:`PlotTable.all_scan_times`).
+
+    Raises
+    ------
+    InputError : on any problem with the file, naming file, line/row and column.
+    """
+    f = read_frame(path, COLUMNS, REQUIRED, "plots")
+    if f.n == 0:
+        f.fail("no rows (a plots file needs at least one plot)")
+    scan = f.ints("scan")
+    time = f.floats("time")
+    sensor = f.ints("sensor")
+    x = f.floats("x")
+    y = f.floats("y")
+    check_scan_order(f, scan, time)
+    origin = None
+    if f.has("origin"):
+        origin = f.ints("origin")
+        f.check(
+            origin < -1,
+            "origin",
+            lambda r: f"origin {num(origin[r])} is invalid (a target id >= 0, or -1 for clutter)",
+        )
+    polar = np.zeros(len(scan), bool)
+    if sensors is not None:
+        polar = _check_sensors(f, sensor, sensors)
+    rng, bearing = _range_bearing(f, sensor, polar, cartesian_may_be_empty=sensors is not None)
+    R = None
+    if sensors is not None and _needs_covariances(sensor, sensors):
+        R = _covariances(sensor, rng, bearing, sensors)
+        f.check(
+            ~np.isfinite(R).all(axis=(1, 2)),
+            "range",
+            lambda r: f"range {num(rng[r])} is too large (its covariance overflows)",
+        )
+    return PlotTable(
+        scan=scan, time=time, sensor=sensor, x=x, y=y,
+        range=rng, bearing=bearing, origin=origin, R=R,
+    )  # fmt: skip
+
+
+def _check_sensors(f: Frame, sensor: np.ndarray, sensors: SensorRegistry) -> np.ndarray:
+    """Unknown sensor ids are an error; returns the mask of polar-sensor rows."""
+    for key, s in sensors.items():
+        if not isinstance(s, CartesianSensor | PolarRadar):
+            raise TypeError(f"sensor registry entry {key!r} is {type(s).__name__}, not a sensor")
+    known = np.fromiter(sensors.keys(), np.int64, len(sensors))
+    listed = ", ".join(str(k) for k in sorted(sensors)) or "none"
+    f.check(
+        ~np.isin(sensor, known),
+        "sensor",
+        lambda r: f"unknown sensor {num(sensor[r])} (known sensors: {listed})",
+    )
+    polar_ids = np.array([k for k, s in sensors.items() if isinstance(s, PolarRadar)], np.int64)
+    return np.isin(sensor, polar_ids)
+
+
+def _range_bearing(
+    f: Frame, sensor: np.ndarray, polar: np.ndarray, *, cartesian_may_be_empty: bool
+) -> tuple[np.ndarray | None, np.ndarray | None]:
+    have = [c for c in ("range", "bearing") if f.has(c)]
+    if len(have) == 1:
+        other = "bearing" if have[0] == "range" else "range"
+        f.fail(f"column {have[0]!r} is present without column {other!r}; give both or neither")
+    if not have:
+        if polar.any():
+            ids = ", ".join(str(i) for i in np.unique(sensor[polar]))
+            f.fail(f"missing column(s) 'range', 'bearing', needed by polar sensor(s) {ids}")
+        return None, None
+    out = []
+    for name in ("range", "bearing"):
+        v = f.floats(name, nullable=True, finite=False)
+        nulls = f.nulls(name)
+        # Rows that must hold a measurement: all of them, unless the registry says Cartesian.
+        must = polar if cartesian_may_be_empty else np.ones(v.size, bool)
+        f.check(must & nulls, name, lambda r: _missing(sensor, polar, r))
+        bad = ~np.isfinite(v) & ~nulls & (must | ~np.isnan(v))  # NaN ok where not needed
+        f.check(bad, name, lambda r, name=name: f"value {f.text(name, r)!r} is not finite")
+        out.append(v)
+    rng, bearing = out
+    f.check(rng < 0, "range", lambda r: f"range {num(rng[r])} is negative")
+    return rng, bearing
+
+
+def _missing(sensor: np.ndarray, polar: np.ndarray, r: int) -> str:
+    if polar[r]:
+        return f"value is missing (sensor {num(sensor[r])} is a polar radar)"
+    return (
+        "value is missing (range and bearing may be empty only on rows of Cartesian "
+        "sensors, when a sensor registry is given)"
+    )
+
+
+def _needs_covariances(sensor: np.ndarray, sensors: SensorRegistry) -> bool:
+    """Per-plot ``R`` unless every row is from a Cartesian sensor and they share one σ (then
+    the tracker's own ``R = σ² I`` applies) — the simulator's rule."""
+    used = [sensors[i] for i in np.unique(sensor).tolist()]
+    if any(isinstance(s, PolarRadar) for s in used):
+        return True
+    return len({s.sigma for s in used if isinstance(s, CartesianSensor)}) > 1
+
+
+def _covariances(
+    sensor: np.ndarray, rng: np.ndarray, bearing: np.ndarray, sensors: SensorRegistry
+) -> np.ndarray:
+    R = np.empty((sensor.size, 2, 2))
+    for sid in np.unique(sensor).tolist():
+        rows = sensor == sid
+        s = sensors[sid]
+        if isinstance(s, PolarRadar):
+            with np.errstate(over="ignore", invalid="ignore"):  # absurd ranges: checked after
+                R[rows] = s.convert(np.column_stack((rng[rows], bearing[rows]))).R
+        else:
+            R[rows] = s.R
+    return R
+
+
+def write_plots(table: PlotTable, path: PathArg) -> None:
+    """Write ``table`` to a ``.csv`` or ``.parquet`` file (``R`` and ``scan_times`` are not
+    stored; NaN ``range``/``bearing`` are written as empty cells / nulls)."""
+    if (table.range is None) != (table.bearing is None):
+        raise ValueError("PlotTable has only one of range/bearing; both or neither are needed")
+    cols: dict[str, pa.Array] = {
+        "scan": int_array(table.scan),
+        "time": float_array(table.time),
+        "sensor": int_array(table.sensor),
+        "x": float_array(table.x),
+        "y": float_array(table.y),
+    }
+    if table.range is not None and table.bearing is not None:
+        cols["range"] = float_array(table.range, nan_as_null=True)
+        cols["bearing"] = float_array(table.bearing, nan_as_null=True)
+    if table.origin is not None:
+        cols["origin"] = int_array(table.origin)
+    write_frame(path, cols)

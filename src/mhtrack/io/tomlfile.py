@@ -1,0 +1,98 @@
+"""TOML files for the CLI: scenario and configuration dictionaries.
+
+Read with :mod:`tomllib`; written with ``tomli-w``. Floats are written in shortest
+round-trip form, so a written scenario reads back exactly.
+"""
+
+from __future__ import annotations
+
+import re
+import tomllib
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import tomli_w
+
+from mhtrack.errors import InputError
+from mhtrack.io._tabular import PathArg
+
+_AT = re.compile(r"\s*\(at line (\d+), column (\d+)\)\s*$")
+
+
+def read_toml(path: PathArg) -> dict[str, Any]:
+    """Read a TOML file into a dict.
+
+    Raises
+    ------
+    InputError : the file is missing, unreadable, not UTF-8, or not valid TOML — the
+        message names the file and, for syntax errors, ``line L, column C``.
+    """
+    name = str(path)
+    p = Path(path)
+    if not p.exists():
+        raise InputError(f"{name}: no such file", file=name)
+    if p.is_dir():
+        raise InputError(f"{name}: is a directory, not a file", file=name)
+    try:
+        data = p.read_bytes()
+    except OSError as e:
+        raise InputError(f"{name}: cannot read ({e.strerror or e})", file=name) from None
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError as e:
+        line = text_line(data, e.start)
+        raise InputError(
+            f"{name}, line {line}: not valid UTF-8 text", file=name, line=line
+        ) from None
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as e:
+        message = str(e)
+        m = _AT.search(message)
+        if m:
+            line = int(m[1])
+            message = message[: m.start()]
+            raise InputError(
+                f"{name}, line {line}, column {m[2]}: {message}", file=name, line=line
+            ) from None
+        message = message.replace(" (at end of document)", "")
+        raise InputError(f"{name}, end of file: {message}", file=name) from None
+
+
+def text_line(data: bytes, offset: int) -> int:
+    """1-based line holding byte ``offset`` of ``data``."""
+    return data.count(b"\n", 0, offset) + 1
+
+
+def _plain(value: Any, key: str) -> Any:
+    """NumPy scalars/arrays and tuples to plain Python; ``None`` (no TOML null) is an error."""
+    if value is None:
+        raise ValueError(f"scenario key {key!r} is None; TOML has no null value")
+    if isinstance(value, Mapping):
+        return {str(k): _plain(v, f"{key}.{k}" if key else str(k)) for k, v in value.items()}
+    if isinstance(value, np.ndarray):
+        value = value.tolist()
+    if isinstance(value, list | tuple):
+        return [_plain(v, f"{key}[{i}]") for i, v in enumerate(value)]
+    if isinstance(value, np.generic):
+        return value.item()
+    return value
+
+
+def write_scenario_toml(data: Mapping[str, Any], path: PathArg) -> None:
+    """Write ``data`` (nested dicts, lists, numbers, strings, booleans; NumPy values are
+    converted) to the TOML file ``path``.
+
+    Raises
+    ------
+    ValueError : a value is ``None`` (TOML has no null).
+    TypeError : a value has a type TOML cannot hold.
+    InputError : the file cannot be written.
+    """
+    text = tomli_w.dumps(_plain(data, ""))
+    try:
+        Path(path).write_text(text, encoding="utf-8")
+    except OSError as e:
+        raise InputError(f"{path}: cannot write ({e.strerror or e})", file=str(path)) from None

@@ -1,0 +1,71 @@
+"""Truth files: ``scan, time, target_id, x, y, vx, vy`` — one row per live target and scan,
+in non-decreasing scan order and, within a scan, increasing target id (the order of
+:class:`~mhtrack.records.TruthTable`). See ``docs/file-formats.md``."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from mhtrack.io._tabular import (
+    FLOAT,
+    INT,
+    PathArg,
+    check_scan_order,
+    check_unique,
+    float_array,
+    int_array,
+    num,
+    read_frame,
+    write_frame,
+)
+from mhtrack.records import TruthTable
+
+REQUIRED = ("scan", "time", "target_id", "x", "y", "vx", "vy")
+COLUMNS = dict.fromkeys(REQUIRED, FLOAT) | {"scan": INT, "target_id": INT}
+
+
+def read_truth(path: PathArg) -> TruthTable:
+    """Read and validate a truth file (``.csv`` or ``.parquet``).
+
+    A file with a header and no rows is valid (a scenario with no target) and gives an
+    empty table.
+
+    Raises
+    ------
+    InputError : on any problem with the file, naming file, line/row and column.
+    """
+    f = read_frame(path, COLUMNS, REQUIRED, "truth")
+    scan = f.ints("scan")
+    time = f.floats("time")
+    tid = f.ints("target_id")
+    f.check(tid < 0, "target_id", lambda r: f"target_id {num(tid[r])} is negative")
+    cols = {c: f.floats(c) for c in ("x", "y", "vx", "vy")}
+    check_scan_order(f, scan, time)
+    check_unique(f, scan, tid, "target_id")
+    same = np.concatenate(([False], scan[1:] == scan[:-1]))
+    back = np.concatenate(([False], tid[1:] < tid[:-1]))
+    f.check(
+        same & back,
+        "target_id",
+        lambda r: (
+            f"target_id {num(tid[r])} after {num(tid[r - 1])} in scan {num(scan[r])}; "
+            "rows of a scan must be in increasing target_id order"
+        ),
+    )
+    return TruthTable(scan=scan, time=time, target_id=tid, **cols)
+
+
+def write_truth(table: TruthTable, path: PathArg) -> None:
+    """Write ``table`` to a ``.csv`` or ``.parquet`` file."""
+    write_frame(
+        path,
+        {
+            "scan": int_array(table.scan),
+            "time": float_array(table.time),
+            "target_id": int_array(table.target_id),
+            "x": float_array(table.x),
+            "y": float_array(table.y),
+            "vx": float_array(table.vx),
+            "vy": float_array(table.vy),
+        },
+    )

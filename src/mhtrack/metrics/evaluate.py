@@ -1,0 +1,239 @@
+"""One call that scores a tracker's output against the truth with every metric.
+
+:func:`evaluate` aligns tracks and truth on scan indices and runs OSPA, GOSPA,
+cardinality and CLEAR-MOT; :class:`Evaluation` holds the results and renders them as a
+JSON-able dict or a plain-text table.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+from mhtrack.metrics._common import (
+    check_cutoff,
+    check_match_distance,
+    check_order,
+    check_scans,
+    check_tables,
+    plot_scans,
+    scan_union,
+)
+from mhtrack.metrics.cardinality import CardinalityPerScan, cardinality_per_scan
+from mhtrack.metrics.clearmot import CLEARMOTResult, clear_mot
+from mhtrack.metrics.gospa import GOSPAPerScan, gospa_per_scan
+from mhtrack.metrics.ospa import OSPAPerScan, ospa_per_scan
+from mhtrack.records import PlotTable, TrackTable, TruthTable
+
+
+@dataclass(frozen=True)
+class Evaluation:
+    """All metrics of one run (see :func:`evaluate`).
+
+    Attributes
+    ----------
+    cutoff, order, match_distance : float
+        OSPA/GOSPA ``c`` (m) and ``p``; CLEAR-MOT ``d_match`` (m).
+    scans : (K,) int array
+        Scan indices evaluated (union of truth, tracks, plots and explicit scans).
+    ospa, gospa, cardinality : per-scan results on ``scans``.
+    clear_mot : CLEARMOTResult
+    n_tracks, n_targets : int
+        Distinct track ids and distinct target ids.
+    """
+
+    cutoff: float
+    order: float
+    match_distance: float
+    scans: np.ndarray
+    ospa: OSPAPerScan
+    gospa: GOSPAPerScan
+    cardinality: CardinalityPerScan
+    clear_mot: CLEARMOTResult
+    n_tracks: int
+    n_targets: int
+
+    @property
+    def ospa_mean(self) -> float:
+        """Mean OSPA over the evaluated scans (m); NaN when there is no scan."""
+        return _mean(self.ospa.distance)
+
+    @property
+    def gospa_mean(self) -> float:
+        """Mean GOSPA over the evaluated scans (m); NaN when there is no scan."""
+        return _mean(self.gospa.distance)
+
+    @property
+    def cardinality_error_mean(self) -> float:
+        """Mean ``|n̂ − n|`` over the evaluated scans; NaN when there is no scan."""
+        return _mean(self.cardinality.error)
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain-Python (JSON-serialisable) summary; NaN becomes ``None``.
+
+        Scalars: ``cutoff, order, match_distance, n_scans, n_tracks, n_targets,
+        ospa_mean, ospa_localisation_mean, ospa_cardinality_mean, gospa_mean,
+        cardinality_error_mean, mota, motp, id_switches, fragmentations, n_matches,
+        n_misses, n_false, n_truth``. Per-scan lists (aligned with ``scans``):
+        ``scans, ospa, gospa, cardinality`` (number of tracks), ``cardinality_true``.
+        """
+        m = self.clear_mot
+        return {
+            "cutoff": self.cutoff,
+            "order": self.order,
+            "match_distance": _num(self.match_distance),
+            "n_scans": len(self.scans),
+            "n_tracks": self.n_tracks,
+            "n_targets": self.n_targets,
+            "ospa_mean": _num(self.ospa_mean),
+            "ospa_localisation_mean": _num(_mean(self.ospa.localisation)),
+            "ospa_cardinality_mean": _num(_mean(self.ospa.cardinality)),
+            "gospa_mean": _num(self.gospa_mean),
+            "cardinality_error_mean": _num(self.cardinality_error_mean),
+            "mota": _num(m.mota),
+            "motp": _num(m.motp),
+            "id_switches": m.id_switches,
+            "fragmentations": m.fragmentations,
+            "n_matches": m.n_matches,
+            "n_misses": m.n_misses,
+            "n_false": m.n_false,
+            "n_truth": m.n_truth,
+            "scans": [int(s) for s in self.scans],
+            "ospa": [float(v) for v in self.ospa.distance],
+            "gospa": [float(v) for v in self.gospa.distance],
+            "cardinality": [int(v) for v in self.cardinality.n_tracks],
+            "cardinality_true": [int(v) for v in self.cardinality.n_true],
+        }
+
+    def to_table(self, *, per_scan: bool = False) -> str:
+        """Plain-text (ASCII) table of the summary metrics, for a terminal.
+
+        With ``per_scan=True`` a second table lists, per scan, the true and estimated
+        cardinalities, OSPA and GOSPA.
+        """
+        m = self.clear_mot
+        c, p = _fmt(self.cutoff), _fmt(self.order)
+        rows = [
+            ("scans", str(len(self.scans))),
+            ("true targets (distinct ids)", str(self.n_targets)),
+            ("tracks (distinct ids)", str(self.n_tracks)),
+            (f"OSPA mean (c={c} m, p={p})", _fmt(self.ospa_mean, " m")),
+            ("  localisation part", _fmt(_mean(self.ospa.localisation), " m")),
+            ("  cardinality part", _fmt(_mean(self.ospa.cardinality), " m")),
+            (f"GOSPA mean (alpha=2, c={c} m, p={p})", _fmt(self.gospa_mean, " m")),
+            ("cardinality error mean |n_est - n|", _fmt(self.cardinality_error_mean)),
+            (f"MOTA (match distance {_fmt(self.match_distance)} m)", _fmt(m.mota)),
+            ("MOTP (mean matched distance)", _fmt(m.motp, " m")),
+            ("identity switches", str(m.id_switches)),
+            ("fragmentations", str(m.fragmentations)),
+            (
+                "matches / misses / false / truth",
+                f"{m.n_matches} / {m.n_misses} / {m.n_false} / {m.n_truth}",
+            ),
+        ]
+        out = _render(("metric", "value"), rows)
+        if per_scan:
+            scan_rows = [
+                (str(s), str(nt), str(nk), _fmt(o), _fmt(g))
+                for s, nt, nk, o, g in zip(
+                    self.scans.tolist(),
+                    self.cardinality.n_true.tolist(),
+                    self.cardinality.n_tracks.tolist(),
+                    self.ospa.distance.tolist(),
+                    self.gospa.distance.tolist(),
+                    strict=True,
+                )
+            ]
+            out += "\n\n" + _render(("scan", "n_true", "n_tracks", "OSPA", "GOSPA"), scan_rows)
+        return out
+
+
+def evaluate(
+    tracks: TrackTable,
+    truth: TruthTable,
+    *,
+    plots: PlotTable | None = None,
+    cutoff: float = 500.0,
+    order: float = 2.0,
+    match_distance: float | None = None,
+    scans: npt.ArrayLike | None = None,
+) -> Evaluation:
+    """Score ``tracks`` against ``truth``: OSPA, GOSPA (α = 2), cardinality, CLEAR-MOT.
+
+    Scans evaluated are the sorted union of the truth's scans, the tracks' scans, every
+    scan of ``plots`` (empty scans included) and ``scans``; a scan with neither truth nor
+    tracks has OSPA = GOSPA = 0 and cardinality error 0. Means are over these scans.
+
+    Parameters
+    ----------
+    tracks : TrackTable
+        Tracker output.
+    truth : TruthTable
+        True target states.
+    plots : PlotTable, optional
+        The run's plots; only their scan indices are used for now.
+    cutoff : float, default 500.0
+        OSPA/GOSPA cut-off ``c`` (m), finite and ``> 0``.
+    order : float, default 2.0
+        OSPA/GOSPA order ``p``, finite and ``>= 1``.
+    match_distance : float, optional
+        CLEAR-MOT matching distance ``d_match`` (m); defaults to ``cutoff``.
+    scans : array_like of int, optional
+        Extra scan indices (e.g. every scan of the run).
+
+    Returns
+    -------
+    Evaluation
+    """
+    tracks, truth = check_tables(tracks, truth)
+    c = check_cutoff(cutoff, "cutoff")
+    p = check_order(order, "order")
+    d_match = (
+        c if match_distance is None else check_match_distance(match_distance, "match_distance")
+    )
+    idx = scan_union(truth.scan, tracks.scan, plot_scans(plots), check_scans(scans))
+    return Evaluation(
+        cutoff=c,
+        order=p,
+        match_distance=d_match,
+        scans=idx,
+        ospa=ospa_per_scan(tracks, truth, c, p, scans=idx),
+        gospa=gospa_per_scan(tracks, truth, c, p, scans=idx),
+        cardinality=cardinality_per_scan(tracks, truth, scans=idx),
+        clear_mot=clear_mot(tracks, truth, match_distance=d_match),
+        n_tracks=len(np.unique(tracks.track_id)),
+        n_targets=len(np.unique(truth.target_id)),
+    )
+
+
+def _mean(a: np.ndarray) -> float:
+    return float(np.mean(a)) if len(a) else float("nan")
+
+
+def _num(v: float) -> float | None:
+    """JSON-safe float: NaN and ±inf become ``None``."""
+    return float(v) if math.isfinite(v) else None
+
+
+def _fmt(v: float, unit: str = "") -> str:
+    if not math.isfinite(v):
+        return "n/a" if math.isnan(v) else str(v)
+    return f"{v:.1f}{unit}" if abs(v) >= 1000 else f"{v:.4g}{unit}"
+
+
+def _render(header: tuple[str, ...], rows: list[tuple[str, ...]]) -> str:
+    widths = [max(len(r[i]) for r in [header, *rows]) for i in range(len(header))]
+
+    # first column left-aligned (labels), the others right-aligned (numbers)
+    def line(r: tuple[str, ...]) -> str:
+        cells = [r[0].ljust(widths[0])] + [
+            x.rjust(w) for x, w in zip(r[1:], widths[1:], strict=True)
+        ]
+        return "  ".join(cells).rstrip()
+
+    rule = "  ".join("-" * w for w in widths)
+    return "\n".join([line(header), rule, *(line(r) for r in rows)])

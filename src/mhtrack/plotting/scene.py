@@ -1,0 +1,114 @@
+"""Pictures of a scene: truth, plots (clutter grey) and tracks, in the local frame (m).
+
+Follows P1 Figs. 2–4: truth trajectories with ``o`` at the start and ``x`` at the end,
+plots as dots (clutter grey, target-originated coloured when ``origin`` is known), tracks
+as coloured lines labelled with their id.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")  # files only; no display needed
+import matplotlib.pyplot as plt
+import numpy as np
+from matplotlib.axes import Axes
+from matplotlib.figure import Figure
+
+from mhtrack.records import PlotTable, TrackTable, TruthTable
+
+TRUTH_STYLE = {"color": "black", "lw": 1.2, "alpha": 0.8}
+
+
+def _segments(ids: np.ndarray, scan: np.ndarray) -> list[np.ndarray]:
+    """Row indices of each id's trajectory, in scan order."""
+    order = np.lexsort((scan, ids))
+    ids_sorted = ids[order]
+    cuts = np.flatnonzero(np.diff(ids_sorted)) + 1
+    return np.split(order, cuts)
+
+
+def draw_plots(ax: Axes, plots: PlotTable, *, max_points: int = 200_000) -> None:
+    """Scatter the plots; clutter grey, target plots in colour when ``origin`` is known."""
+    x, y = plots.x, plots.y
+    if len(x) > max_points:  # keep huge files drawable; thin deterministically
+        keep = np.linspace(0, len(x) - 1, max_points).astype(int)
+        x, y = x[keep], y[keep]
+        origin = None if plots.origin is None else plots.origin[keep]
+    else:
+        origin = plots.origin
+    if origin is None:
+        ax.scatter(x, y, s=2, c="0.55", lw=0, label="plots", rasterized=True)
+        return
+    clutter = origin < 0
+    ax.scatter(x[clutter], y[clutter], s=2, c="0.7", lw=0, label="clutter", rasterized=True)
+    ax.scatter(x[~clutter], y[~clutter], s=4, c="tab:blue", lw=0, alpha=0.6,
+               label="target plots", rasterized=True)
+
+
+def draw_truth(ax: Axes, truth: TruthTable) -> None:
+    """Truth trajectories: line, ``o`` at birth, ``x`` at death (P1 Fig. 2)."""
+    first = True
+    for rows in _segments(truth.target_id, truth.scan):
+        ax.plot(truth.x[rows], truth.y[rows], **TRUTH_STYLE, label="truth" if first else None)
+        ax.plot(truth.x[rows[0]], truth.y[rows[0]], "o", mfc="none", color="black", ms=5)
+        ax.plot(truth.x[rows[-1]], truth.y[rows[-1]], "x", color="black", ms=5)
+        first = False
+
+
+def draw_tracks(ax: Axes, tracks: TrackTable, *, label_ids: bool = True) -> None:
+    """Tracks as coloured lines, one colour per track id, labelled at their end."""
+    cmap = plt.get_cmap("tab10")
+    first = True
+    for rows in _segments(tracks.track_id, tracks.scan):
+        tid = int(tracks.track_id[rows[0]])
+        color = cmap(tid % 10)
+        ax.plot(tracks.x[rows], tracks.y[rows], "-", color=color, lw=1.6,
+                label="tracks" if first else None)
+        if label_ids and len(rows) > 1:
+            ax.annotate(str(tid), (tracks.x[rows[-1]], tracks.y[rows[-1]]), color=color,
+                        fontsize=7, xytext=(3, 3), textcoords="offset points")
+        first = False
+
+
+def plot_scene(
+    plots: PlotTable | None = None,
+    truth: TruthTable | None = None,
+    tracks: TrackTable | None = None,
+    *,
+    title: str = "",
+    ax: Axes | None = None,
+) -> Figure:
+    """One picture of whatever is given: plots, truth and tracks, equal axes in metres."""
+    if ax is None:
+        fig, ax = plt.subplots(figsize=(7.5, 7))
+    else:
+        fig = ax.figure
+    if plots is not None and len(plots):
+        draw_plots(ax, plots)
+    if truth is not None and len(truth):
+        draw_truth(ax, truth)
+    if tracks is not None and len(tracks):
+        draw_tracks(ax, tracks)
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.set_xlabel("x east (m)")
+    ax.set_ylabel("y north (m)")
+    ax.ticklabel_format(style="plain", useOffset=False)
+    ax.grid(True, lw=0.3, alpha=0.5)
+    if title:
+        ax.set_title(title)
+    if ax.get_legend_handles_labels()[0]:
+        ax.legend(loc="best", fontsize=8, markerscale=3)
+    return fig
+
+
+def save_figure(fig: Figure, path: str | Path, *, dpi: int = 130) -> Path:
+    """Write ``fig`` to ``path`` (format from the extension) and close it."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.tight_layout()
+    fig.savefig(path, dpi=dpi)
+    plt.close(fig)
+    return path

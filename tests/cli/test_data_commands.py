@@ -1,0 +1,137 @@
+"""``simulate``, ``evaluate`` and ``plot`` end to end through the CLI (click's runner)."""
+
+import csv
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+from mhtrack.cli.main import cli
+
+
+def invoke(*args: str) -> tuple[int, str, str]:
+    r = CliRunner().invoke(cli, list(args))
+    return r.exit_code, r.stdout, r.stderr
+
+
+@pytest.fixture(scope="module")
+def crossing(tmp_path_factory) -> Path:
+    out = tmp_path_factory.mktemp("c1")
+    code, _stdout, stderr = invoke("simulate", "crossing", "--seed", "1", "--out", str(out))
+    assert code == 0, stderr
+    return out
+
+
+def _rows(path: Path) -> list[dict[str, str]]:
+    with path.open() as f:
+        return list(csv.DictReader(f))
+
+
+def test_simulate_crossing_counts(crossing):
+    plots = _rows(crossing / "plots.csv")
+    truth = _rows(crossing / "truth.csv")
+    assert {r["scan"] for r in truth} == {str(k) for k in range(1, 91)}
+    clutter = sum(r["origin"] == "-1" for r in plots)
+    # Poisson(40) per scan over 90 scans: mean within 40 ± 4 sd of the mean
+    assert abs(clutter / 90 - 40) < 4 * np.sqrt(40 / 90)
+    detected = len(plots) - clutter
+    n, p = len(truth), 0.9
+    assert abs(detected - p * n) < 4 * np.sqrt(n * p * (1 - p))
+    assert (crossing / "scenario.toml").is_file()
+
+
+def test_simulate_writes_reloadable_scenario(crossing, tmp_path):
+    code, _, stderr = invoke("simulate", str(crossing / "scenario.toml"), "--seed", "1",
+                             "--out", str(tmp_path))
+    assert code == 0, stderr
+    assert (tmp_path / "plots.csv").read_bytes() == (crossing / "plots.csv").read_bytes()
+
+
+def test_evaluate_truth_against_itself(crossing):
+    t = str(crossing / "truth.csv")
+    code, stdout, stderr = invoke("evaluate", t, t, "--json")
+    assert code == 0, stderr
+    d = json.loads(stdout)
+    assert d["ospa_mean"] == 0 and d["mota"] == 1 and d["id_switches"] == 0
+    for key in ("gospa_mean", "cardinality_error_mean", "motp", "fragmentations", "n_tracks",
+                "ospa", "cardinality"):
+        assert key in d
+    assert len(d["ospa"]) == 90
+
+
+def test_evaluate_one_target_removed_matches_hand_ospa(crossing, tmp_path):
+    truth = _rows(crossing / "truth.csv")
+    kept = [r for r in truth if r["target_id"] != "2"]
+    tracks = tmp_path / "tracks.csv"
+    with tracks.open("w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(["scan", "time", "track_id", "x", "y", "vx", "vy", "plot"])
+        for r in kept:
+            w.writerow([r["scan"], r["time"], r["target_id"], r["x"], r["y"], r["vx"], r["vy"], ""])
+    code, stdout, stderr = invoke("evaluate", str(tracks), str(crossing / "truth.csv"),
+                                  "--json", "--cutoff", "500", "--order", "2")
+    assert code == 0, stderr
+    d = json.loads(stdout)
+    # Hand computation: at a scan with m live targets, one of them (target 2) unmatched and
+    # the others matched exactly, OSPA = (c^p (n - m... ) / m)^(1/p) = (500² / m)^(1/2);
+    # scans where target 2 is not alive have OSPA 0.
+    live: dict[str, set[str]] = {}
+    for r in truth:
+        live.setdefault(r["scan"], set()).add(r["target_id"])
+    expected = [np.sqrt(500.0**2 / len(ids)) if "2" in ids else 0.0
+                for _, ids in sorted(live.items(), key=lambda kv: int(kv[0]))]
+    assert np.allclose(d["ospa"], expected)
+    assert d["ospa_mean"] == pytest.approx(np.mean(expected))
+    assert d["mota"] < 1
+
+
+def test_plot_writes_png(crossing, tmp_path):
+    out = tmp_path / "scene.png"
+    code, _stdout, stderr = invoke("plot", str(crossing), "-o", str(out))
+    assert code == 0, stderr
+    assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert out.stat().st_size > 10_000
+
+
+@pytest.mark.parametrize(
+    ("args", "needle"),
+    [
+        (["simulate", "nowhere", "--out", "X"], "unknown scenario 'nowhere'"),
+        (["simulate", "crossing", "--pd", "2", "--out", "X"], "--pd"),
+        (["simulate", "missing.toml", "--out", "X"], "no such scenario file"),
+        (["evaluate", "no.csv", "no2.csv"], "no.csv"),
+        (["plot", "."], "holds no plots"),
+    ],
+)
+def test_bad_input_is_one_clear_line(args, needle, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    code, _stdout, stderr = invoke(*args)
+    assert code != 0
+    assert needle in stderr
+    assert "Traceback" not in stderr
+
+
+def test_malformed_plots_file_names_line_and_column(crossing, tmp_path):
+    bad = tmp_path / "plots.csv"
+    lines = (crossing / "plots.csv").read_text().splitlines()
+    parts = lines[5].split(",")
+    parts[3] = "nan"
+    lines[5] = ",".join(parts)
+    bad.write_text("\n".join(lines) + "\n")
+    t = str(crossing / "truth.csv")
+    code, _, stderr = invoke("evaluate", t, t, "--plots", str(bad))
+    assert code != 0
+    assert "plots.csv, line 6, column 'x'" in stderr
+    assert "Traceback" not in stderr
+
+
+def test_bad_scenario_toml_names_the_key(crossing, tmp_path):
+    text = (crossing / "scenario.toml").read_text()
+    assert "\nT = 1.0\n" in text
+    src = tmp_path / "s.toml"
+    src.write_text(text.replace("\nT = 1.0\n", "\nT = -1.0\n"))
+    code, _, stderr = invoke("simulate", str(src), "--out", str(tmp_path / "o"))
+    assert code != 0 and "Traceback" not in stderr
+    assert "s.toml" in stderr and "T:" in stderr

@@ -9,7 +9,7 @@ formats are described in ``docs/file-formats.md``.
 from mhtrack.errors import InputError
 from mhtrack.io.plots import read_plots, write_plots
 from mhtrack.io.tomlfile import read_toml, write_scenario_toml
-from mhtrack.io.tracks import read_tracks, write_tracks
+from mhtrack.io.tracks import read_tracks, tracks_from_truth, write_tracks
 from mhtrack.io.truth import read_truth, write_truth
 
 __all__ = [
@@ -18,6 +18,7 @@ __all__ = [
     "read_toml",
     "read_tracks",
     "read_truth",
+    "tracks_from_truth",
     "write_plots",
     "write_scenario_toml",
     "write_tracks",

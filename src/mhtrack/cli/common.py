@@ -56,13 +56,13 @@ def load_scenario_arg(
     )
 
 
-def _jsonable(o: Any) -> Any:
+def jsonable(o: Any) -> Any:
     if isinstance(o, dict):
-        return {str(k): _jsonable(v) for k, v in o.items()}
+        return {str(k): jsonable(v) for k, v in o.items()}
     if isinstance(o, list | tuple):
-        return [_jsonable(v) for v in o]
+        return [jsonable(v) for v in o]
     if isinstance(o, np.ndarray):
-        return _jsonable(o.tolist())
+        return jsonable(o.tolist())
     if isinstance(o, np.integer):
         return int(o)
     if isinstance(o, np.floating | float):
@@ -73,7 +73,7 @@ def _jsonable(o: Any) -> Any:
 
 def echo_json(obj: Any) -> None:
     """Print one JSON object (NaN/inf become null so any JSON parser reads it)."""
-    click.echo(json.dumps(_jsonable(obj), allow_nan=False))
+    click.echo(json.dumps(jsonable(obj), allow_nan=False))
 
 
 def table_path(directory: Path, stem: str) -> Path | None:

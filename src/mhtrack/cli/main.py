@@ -45,10 +45,11 @@ def cli(verbose: int) -> None:
 
 
 def _register() -> None:
-    from mhtrack.cli import data_commands
+    from mhtrack.cli import data_commands, track_commands
 
-    for command in data_commands.COMMANDS:
-        cli.add_command(command)
+    for module in (data_commands, track_commands):
+        for command in module.COMMANDS:
+            cli.add_command(command)
 
 
 _register()

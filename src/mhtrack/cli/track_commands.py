@@ -1,0 +1,162 @@
+"""``track`` and ``run``: a tracker on a plots file, or simulate → track → evaluate → plot."""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import click
+
+from mhtrack.cli.common import echo_json, load_scenario_arg, scenario_options
+
+
+def tracker_options(pd_flag: str) -> Callable[[Callable[..., Any]], Callable[..., Any]]:
+    """The tracker and its main parameters (defaults from P1 §3); ``pd_flag`` names the
+    option of the tracker's detection probability."""
+    return lambda f: _tracker_options(f, pd_flag)
+
+
+def _tracker_options(f: Callable[..., Any], pd_flag: str) -> Callable[..., Any]:
+    from mhtrack.experiments import TRACKERS
+
+    opts = [
+        click.option("--tracker", type=click.Choice(sorted(TRACKERS)), default="mht",
+                     show_default=True, help="Tracker (and its clutter estimator)."),
+        click.option(pd_flag, "tracker_pd", type=click.FloatRange(0, 1, min_open=True,
+                     max_open=True), default=None,
+                     help="Detection probability assumed by the tracker [0.9; with run, the "
+                     "scenario's --pd when given]."),
+        click.option("--meas-sigma", type=click.FloatRange(min=0, min_open=True), default=None,
+                     help="Measurement noise σw (m) of Cartesian plots [100]."),
+        click.option("--accel-sigma", type=click.FloatRange(min=0), default=None,
+                     help="Process noise σv (m/s²) [10]."),
+        click.option("--clutter-density", type=click.FloatRange(min=0, min_open=True),
+                     default=None, help="Known clutter intensity κ (per m² per scan) for "
+                     "--tracker mht [1e-9]."),
+        click.option("--birth-density", type=click.FloatRange(min=0, min_open=True),
+                     default=None, help="New-target density λv (per m²) [1e-7]."),
+        click.option("--nscan", type=click.IntRange(min=1), default=None,
+                     help="N-scan pruning depth [3]."),
+    ]
+    for opt in reversed(opts):
+        f = opt(f)
+    return f
+
+
+def _config(tracker_pd: float | None, meas_sigma: float | None, accel_sigma: float | None,
+            birth_density: float | None, nscan: int | None) -> Any:
+    from mhtrack.experiments import config_with
+
+    return config_with(p_detection=tracker_pd, sigma_w=meas_sigma, sigma_v=accel_sigma,
+                       new_target_density=birth_density, n_scan=nscan)
+
+
+@click.command()
+@click.argument("plots", type=click.Path(exists=True, dir_okay=False, path_type=Path))
+@tracker_options("--pd")
+@click.option("--out", type=click.Path(dir_okay=False, path_type=Path), required=True,
+              help="Tracks file to write (.csv or .parquet).")
+@click.option("--scenario", "scenario_file", type=click.Path(exists=True, dir_okay=False,
+              path_type=Path), default=None,
+              help="Scenario TOML giving the sensors (needed for polar plots) and all scan "
+              "times [default: scenario.toml beside PLOTS, if any].")
+@click.option("--progress/--no-progress", default=True, help="Progress bar on stderr.")
+def track(plots: Path, tracker: str, tracker_pd: float | None, meas_sigma: float | None,
+          accel_sigma: float | None, clutter_density: float | None,
+          birth_density: float | None, nscan: int | None, out: Path,
+          scenario_file: Path | None, progress: bool) -> None:
+    """Run a tracker on a PLOTS file and write its tracks."""
+    from mhtrack.experiments import make_tracker
+    from mhtrack.experiments import track as run_tracker
+    from mhtrack.io import read_plots, write_tracks
+    from mhtrack.scenario import load_scenario
+
+    if scenario_file is None and (plots.parent / "scenario.toml").is_file():
+        scenario_file = plots.parent / "scenario.toml"
+    sensors = None
+    scenario = None
+    if scenario_file is not None:
+        scenario = load_scenario(scenario_file)
+        sensors = {s.id: s for s in scenario.sensors}
+    table = read_plots(plots, sensors=sensors)
+    if scenario is not None:
+        table = dataclasses.replace(
+            table, scan_times=(scenario.scan_indices(), scenario.scan_times())
+        )
+    cfg = _config(tracker_pd, meas_sigma, accel_sigma, birth_density, nscan)
+    trk = make_tracker(tracker, cfg, clutter_density=clutter_density)
+    result = run_tracker(trk, table, name=tracker, progress=progress)
+    write_tracks(result.tracks, out)
+    n_ids = len(set(result.tracks.track_id.tolist()))
+    caps = f", caps acted: {result.caps}" if result.caps else ""
+    click.echo(f"{tracker}: {len(result.stats)} scans, {n_ids} tracks, "
+               f"{1e3 * result.t_avg:.2f} ms/scan{caps} -> {out}")
+
+
+@click.command()
+@scenario_options
+@tracker_options("--tracker-pd")
+@click.option("--out", type=click.Path(file_okay=False, path_type=Path), default=None,
+              help="Directory for plots, truth, tracks, metrics and figures "
+              "[default: out/SCENARIO-TRACKER-SEED].")
+@click.option("--cutoff", type=click.FloatRange(min=0, min_open=True), default=500.0,
+              show_default=True, help="OSPA/GOSPA cut-off c (m).")
+@click.option("--order", type=click.FloatRange(min=1), default=2.0, show_default=True,
+              help="OSPA/GOSPA order p.")
+@click.option("--json", "as_json", is_flag=True, help="Print one JSON object.")
+@click.option("--progress/--no-progress", default=True, help="Progress bar on stderr.")
+def run(scenario: str, seed: int, clutter: str | None, clutter_rate: float | None,
+        pd: float | None, scans: int | None, tracker: str, tracker_pd: float | None,
+        meas_sigma: float | None, accel_sigma: float | None, clutter_density: float | None,
+        birth_density: float | None, nscan: int | None, out: Path | None, cutoff: float,
+        order: float, as_json: bool, progress: bool) -> None:
+    """Simulate SCENARIO, track, evaluate and plot, in one go.
+
+    Writes plots, truth, tracks, scenario.toml, metrics.json, scene.png (truth, plots,
+    tracks) and metrics.png (OSPA and cardinality per scan) to the output directory.
+    """
+    from mhtrack.experiments import run_scenario
+    from mhtrack.io import write_plots, write_scenario_toml, write_tracks, write_truth
+    from mhtrack.plotting.metrics import plot_ospa_cardinality
+    from mhtrack.plotting.scene import plot_scene, save_figure
+
+    sc = load_scenario_arg(scenario, clutter, clutter_rate, pd, scans)
+    tracker_pd = tracker_pd if tracker_pd is not None else pd
+    cfg = _config(tracker_pd, meas_sigma, accel_sigma, birth_density, nscan)
+    result = run_scenario(sc, seed, tracker, cfg, clutter_density=clutter_density,
+                          cutoff=cutoff, order=order, progress=progress)
+    out = out if out is not None else Path("out") / f"{sc.name}-{tracker}-{seed}"
+    out.mkdir(parents=True, exist_ok=True)
+    sim = result.simulation
+    write_plots(sim.plots, out / "plots.csv")
+    write_truth(sim.truth, out / "truth.csv")
+    write_tracks(result.run.tracks, out / "tracks.csv")
+    write_scenario_toml({"seed": seed, **sc.to_dict()}, out / "scenario.toml")
+    summary = result.summary()
+    (out / "metrics.json").write_text(_json_text(summary))
+    title = f"{sc.name}, {tracker}, seed {seed}"
+    save_figure(plot_scene(sim.plots, sim.truth, result.run.tracks, title=title),
+                out / "scene.png")
+    save_figure(plot_ospa_cardinality({tracker: summary}, cutoff=cutoff, title=title),
+                out / "metrics.png")
+    if as_json:
+        echo_json(summary)
+        return
+    click.echo(result.evaluation.to_table())
+    click.echo(f"tracker time: {1e3 * result.run.t_avg:.2f} ms/scan (mean)")
+    if result.run.caps:
+        click.echo(f"hard caps acted: {result.run.caps}")
+    click.echo(f"wrote {out}/ (plots, truth, tracks, metrics.json, scene.png, metrics.png)")
+
+
+def _json_text(obj: Any) -> str:
+    import json
+
+    from mhtrack.cli.common import jsonable
+
+    return json.dumps(jsonable(obj), allow_nan=False, indent=1)
+
+
+COMMANDS = [track, run]

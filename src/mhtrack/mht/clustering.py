@@ -1,0 +1,94 @@
+"""Clustering: trees that share a plot (directly or through a chain of trees) form a
+cluster; the global hypothesis splits into one independent problem per cluster
+(P1 §1.3; Blackman & Popoli 1999 §16.3).
+
+Two leaves *conflict* when they belong to the same tree or use the same plot at the same
+scan. A plot is identified by ``(window column, plot id)``, so plot ids need only be
+unique within a scan.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.sparse import coo_matrix
+from scipy.sparse.csgraph import connected_components
+
+from mhtrack.mht.tree import NO_PLOT
+
+
+def plot_keys(window: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Flatten the plots used in ``window`` (L, W) to ``(leaf, key)`` pairs with one
+    integer key per distinct ``(column, plot id)``, misses left out. Keys are dense
+    ``0 … K−1`` in sorted ``(column, plot)`` order."""
+    leaf, col = np.nonzero(window != NO_PLOT)
+    if leaf.size == 0:
+        e = np.zeros(0, np.int64)
+        return e, e
+    plot = window[leaf, col]
+    span = int(plot.max()) + 1
+    raw = col.astype(np.int64) * span + plot
+    _, key = np.unique(raw, return_inverse=True)
+    return leaf.astype(np.int64), key.reshape(-1).astype(np.int64)
+
+
+def cluster_trees(tree: np.ndarray, window: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Connected components of the graph whose nodes are trees and plots and whose edges
+    join a tree to each plot one of its leaves uses.
+
+    Parameters
+    ----------
+    tree : (L,) tree id of each leaf.
+    window : (L, W) plot ids per scan of each leaf (``-1``: none).
+
+    Returns
+    -------
+    tree_index : (L,) index of each leaf's tree in ``np.unique(tree)``.
+    tree_cluster : (T,) cluster label of each unique tree; labels are ``0 … C−1``
+        numbered in order of each cluster's smallest tree id (deterministic).
+    """
+    uniq, tree_index = np.unique(tree, return_inverse=True)
+    tree_index = tree_index.reshape(-1).astype(np.int64)
+    n_trees = uniq.size
+    leaf, key = plot_keys(window)
+    if leaf.size == 0:
+        return tree_index, np.arange(n_trees, dtype=np.int64)
+    label = _min_label_components(tree_index[leaf], key, n_trees)
+    if label is None:  # pathological chain: let scipy do it
+        n_keys = int(key.max()) + 1
+        n = n_trees + n_keys
+        graph = coo_matrix(
+            (np.ones(leaf.size, np.int8), (tree_index[leaf], n_trees + key)), shape=(n, n)
+        )
+        label = connected_components(graph, directed=False)[1][:n_trees]
+    # number clusters by their smallest tree (first appearance in tree order)
+    _, first, inv = np.unique(label, return_index=True, return_inverse=True)
+    rank = np.empty(first.size, np.int64)
+    rank[np.argsort(first, kind="stable")] = np.arange(first.size)
+    return tree_index, rank[inv.reshape(-1)]
+
+
+def _min_label_components(
+    tree: np.ndarray, key: np.ndarray, n_trees: int, max_iter: int = 64
+) -> np.ndarray | None:
+    """Connected components of the bipartite tree–plot graph with edges ``(tree, key)``
+    by min-label propagation with pointer jumping: every tree ends labelled with the
+    smallest tree index of its component. ``None`` if not converged in ``max_iter``."""
+    by_key = np.lexsort((tree, key))
+    k_sorted, t_by_key = key[by_key], tree[by_key]
+    k_starts = np.flatnonzero(np.r_[True, k_sorted[1:] != k_sorted[:-1]])
+    k_of_edge = np.cumsum(np.r_[True, k_sorted[1:] != k_sorted[:-1]]) - 1
+    by_tree = np.argsort(t_by_key, kind="stable")
+    t_sorted = t_by_key[by_tree]
+    t_starts = np.flatnonzero(np.r_[True, t_sorted[1:] != t_sorted[:-1]])
+    t_ids = t_sorted[t_starts]
+    label = np.arange(n_trees, dtype=np.int64)
+    for _ in range(max_iter):
+        key_min = np.minimum.reduceat(label[t_by_key], k_starts)
+        tree_min = np.minimum.reduceat(key_min[k_of_edge][by_tree], t_starts)
+        new = label.copy()
+        new[t_ids] = np.minimum(label[t_ids], tree_min)
+        new = new[new]  # pointer jumping: label[i] <= i always
+        if np.array_equal(new, label):
+            return label
+        label = new
+    return None

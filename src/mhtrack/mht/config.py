@@ -1,0 +1,132 @@
+"""Parameters of the track-oriented MHT, each with its default and where it comes from.
+
+Values that P1 §3 gives are taken from it; the rest are our documented choices (see
+``docs/mht.md`` for the reasoning behind each).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import asdict, dataclass, fields
+from typing import Any
+
+
+@dataclass(frozen=True)
+class MHTConfig:
+    """Configuration of :class:`~mhtrack.mht.tracker.MHTTracker`.
+
+    Parameters
+    ----------
+    p_detection : ``P_D``, probability that a target yields a plot per scan. Default 0.9
+        (P1 §3).
+    new_target_density : ``λ_v``, density of new targets (per m² per scan) in the score
+        denominator ``κ̂ + λ_v`` (P1 eq. 5) and the birth score. Default 1e−7 (P1 §3).
+    sigma_w : Cartesian measurement noise std (m), ``R = σw² I`` for plots without their
+        own covariance. Default 100 (P1 §3, ``σw² = 10⁴``).
+    sigma_v : process (acceleration) noise std of the constant-velocity model (m/s²).
+        Default 10 (P1 §3, ``σv² = 100``).
+    gate_probability : ``P_G``, probability a target's plot falls in the χ² (2 d.o.f.)
+        gate. Default 0.999 (our choice: γ ≈ 13.8, a true plot is almost never lost).
+    miss_uses_gate_probability : score a miss as ``ln(1 − P_D·P_G)`` (exact when a plot
+        outside the gate is possible) instead of P1 eq. 5's ``ln(1 − P_D)``. Default
+        False (P1).
+    v_max : largest target speed (m/s); a new tree starts with velocity 0 and velocity
+        variance ``(v_max/2)²`` per axis. Default 300 (our choice: covers airliners; the
+        P1/P2 targets move at ≤ 200 m/s, within 1.4 σ).
+    n_scan : depth ``N`` of N-scan pruning; leaves remember their plots over the last
+        ``N + 1`` scans. Default 3 (P1 §3).
+    alpha : SPRT false-confirmation probability. Default 0.01 (our choice: with the true
+        κ of the crossing scenario, few false tracks and a median confirmation 3–7 scans
+        after birth; see ``docs/mht.md``).
+    beta : SPRT true-deletion probability. Default 1e−4 (our choice). Confirm at
+        ``L ≥ ln((1−β)/α)`` ≈ 4.6, delete at ``L − L_peak ≤ ln(β/(1−α))`` ≈ −9.2, i.e. four
+        consecutive misses at ``P_D = 0.9`` (Wald 1947; Blackman & Popoli 1999 §6.2).
+    prune_drop : a leaf more than this below its tree's best leaf is pruned before the
+        global hypothesis is solved. Default 12 (a likelihood ratio of e¹² ≈ 1.6·10⁵).
+    max_leaves_per_tree : hard cap on the leaves of one tree (best scores kept).
+        Default 300 (above the largest trees, ~290 leaves, of the crossing scenario with
+        40 uniform clutter plots per scan and the true κ).
+    max_leaves : hard cap on all leaves (confirmed trees' leaves first, then best scores).
+        Default 20 000 (≈ 7× the leaves of the crossing scenario).
+    max_trees : hard cap on trees (trees in the best hypothesis and confirmed trees first,
+        then highest best-leaf score). Default 5 000.
+    max_gated_pairs : at most this many leaf–plot pairs are tested in the gates per scan;
+        beyond it, leaves of confirmed trees and then the best-scoring leaves are gated
+        first and the rest only get a miss child. Default 300 000.
+    max_births_per_scan : at most this many plots of a scan start trees (plots outside
+        confirmed tracks' gates first, then highest birth score). Default 2 000.
+    max_cluster_size : clusters with more candidate (positive-score) leaves than this are
+        solved greedily instead of exactly. Default 2 000.
+    milp_time_limit : seconds HiGHS may spend on one cluster's integer programme; then
+        its best answer so far (or greedy's, if better) is used. Default 0.5.
+    min_clutter_density : floor on the estimator's ``κ̂(z)`` (per m²), so that a density
+        estimate that underflows to 0 far from its components cannot give an infinite
+        score. Default 1e−12 (our choice: 1000× below P1's plain-MHT κ = 1e−9).
+    """
+
+    p_detection: float = 0.9
+    new_target_density: float = 1e-7
+    sigma_w: float = 100.0
+    sigma_v: float = 10.0
+    gate_probability: float = 0.999
+    miss_uses_gate_probability: bool = False
+    v_max: float = 300.0
+    n_scan: int = 3
+    alpha: float = 1e-2
+    beta: float = 1e-4
+    prune_drop: float = 12.0
+    max_leaves_per_tree: int = 300
+    max_leaves: int = 20_000
+    max_trees: int = 5_000
+    max_gated_pairs: int = 300_000
+    max_births_per_scan: int = 2_000
+    max_cluster_size: int = 2_000
+    milp_time_limit: float = 0.5
+    min_clutter_density: float = 1e-12
+
+    def __post_init__(self) -> None:
+        def check(name: str, ok: bool, what: str) -> None:
+            if not ok:
+                raise ValueError(f"MHTConfig.{name} must be {what}, got {getattr(self, name)!r}")
+
+        for name in ("p_detection", "gate_probability", "alpha", "beta"):
+            v = getattr(self, name)
+            check(name, isinstance(v, int | float) and 0.0 < v < 1.0, "in (0, 1)")
+        check("alpha", self.alpha + self.beta < 1.0, "such that alpha + beta < 1")
+        for name in ("new_target_density", "sigma_w", "v_max", "prune_drop",
+                     "milp_time_limit", "min_clutter_density"):
+            v = getattr(self, name)
+            check(name, isinstance(v, int | float) and math.isfinite(v) and v > 0, "finite > 0")
+        check(
+            "sigma_v",
+            isinstance(self.sigma_v, int | float) and math.isfinite(self.sigma_v)
+            and self.sigma_v >= 0,
+            "finite >= 0",
+        )
+        check("miss_uses_gate_probability", isinstance(self.miss_uses_gate_probability, bool),
+              "a bool")
+        check("n_scan", _is_int(self.n_scan) and self.n_scan >= 1, "an integer >= 1")
+        for name in ("max_leaves_per_tree", "max_leaves", "max_trees", "max_gated_pairs",
+                     "max_births_per_scan", "max_cluster_size"):
+            v = getattr(self, name)
+            check(name, _is_int(v) and v >= 1, "an integer >= 1")
+        check("max_leaves", self.max_leaves > self.max_births_per_scan,
+              "larger than max_births_per_scan")
+
+    def to_json(self) -> str:
+        """The configuration as a JSON string (exact round trip with :meth:`from_json`)."""
+        return json.dumps(asdict(self), sort_keys=True)
+
+    @classmethod
+    def from_json(cls, text: str) -> MHTConfig:
+        data: dict[str, Any] = json.loads(text)
+        known = {f.name for f in fields(cls)}
+        unknown = sorted(set(data) - known)
+        if unknown:
+            raise ValueError(f"unknown MHTConfig fields: {unknown}")
+        return cls(**data)
+
+
+def _is_int(v: object) -> bool:
+    return isinstance(v, int) and not isinstance(v, bool)

@@ -1,0 +1,58 @@
+"""Track score: the log-likelihood ratio of a track hypothesis against all-clutter.
+
+``L(k) = L(k−1) + ΔL(k)`` (P1 eq. 4) with (P1 eqs. 5, 15)::
+
+    ΔL = ln(1 − P_D)                                  on a miss
+    ΔL = ln[ p(z|T) · P_D / (κ̂(z) + λ_v) ]            on an update with plot z
+
+``p(z|T)`` is the Kalman innovation likelihood ``N(ν; 0, S)``, ``κ̂(z)`` the clutter
+intensity from the clutter estimator and ``λ_v`` the new-target density. A tree born from
+plot ``z`` starts at ``L₀ = ln(λ_v · P_D / κ̂(z))`` (Blackman & Popoli 1999 §6.2).
+Track management is Wald's sequential probability ratio test on that score.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+
+def miss_increment(p_detection: float, gate_probability: float | None = None) -> float:
+    """Score increment of a missed detection.
+
+    ``ΔL = ln(1 − P_D)`` (P1 eq. 5). With ``gate_probability`` ``P_G`` given, the exact
+    form ``ln(1 − P_D·P_G)``: the target may have been detected outside the gate
+    (Blackman & Popoli 1999 §6.2; Bar-Shalom et al. 2009, PDAF miss term).
+    """
+    pg = 1.0 if gate_probability is None else gate_probability
+    return math.log1p(-p_detection * pg)
+
+
+def update_increment(
+    loglik: np.ndarray, kappa: np.ndarray, p_detection: float, new_target_density: float
+) -> np.ndarray:
+    """Score increment of updating with a plot, P1 eqs. 5 / 15:
+    ``ΔL = ln p(z|T) + ln P_D − ln(κ̂(z) + λ_v)``, with ``loglik = ln p(z|T)``."""
+    return loglik + (math.log(p_detection) - np.log(kappa + new_target_density))
+
+
+def birth_score(kappa: np.ndarray, p_detection: float, new_target_density: float) -> np.ndarray:
+    """Initial score of a tree started by plot ``z``: the likelihood ratio of a new target
+    against clutter, ``L₀ = ln(λ_v · P_D / κ̂(z))`` (Blackman & Popoli 1999 §6.2,
+    ``LR(1) = P_D β_NT / β_FT`` with new-target density ``β_NT = λ_v`` and false-target
+    density ``β_FT = κ̂``)."""
+    return math.log(new_target_density * p_detection) - np.log(kappa)
+
+
+def sprt_thresholds(alpha: float, beta: float) -> tuple[float, float]:
+    """Wald's SPRT thresholds ``(confirm, delete)`` on the log-likelihood ratio.
+
+    ``confirm = ln((1 − β)/α)``, ``delete = ln(β/(1 − α))`` with ``α`` the probability of
+    confirming a false track and ``β`` of deleting a true one (Wald 1947; Blackman &
+    Popoli 1999 §6.2). The tracker confirms when ``L ≥ confirm`` and deletes a leaf when
+    its drop from its own peak ``L − L_peak ≤ delete``.
+    """
+    if not (0 < alpha < 1 and 0 < beta < 1 and alpha + beta < 1):
+        raise ValueError(f"need 0 < alpha, beta and alpha + beta < 1, got {alpha}, {beta}")
+    return math.log((1 - beta) / alpha), math.log(beta / (1 - alpha))

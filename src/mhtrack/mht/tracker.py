@@ -1,0 +1,513 @@
+"""The track-oriented MHT (P1 §1.3, Fig. 1): one call of :meth:`MHTTracker.step` per scan.
+
+The tracking cycle, each step one function::
+
+    predict          kalman.predict_cv              all leaves to the scan time
+    gate and score   kalman.gate_sweep              every leaf against every plot
+    clutter          clutter.update / intensity     κ̂(z) of the scan's plots
+    extend trees     tree.propose_children          miss + one child per gated plot
+                     pruning.sprt_keep, ...         delete/prune children (cheap, before
+                     tree.grow_children               their Kalman update)
+                     tree.birth_leaves              every plot starts a tree
+    global hyp.      hypothesis.best_hypothesis     clusters → best compatible leaves
+    N-scan pruning   pruning.n_scan_keep            decide scan k − N
+    caps             pruning.cap_trees
+    confirm          SPRT on the chosen leaves      stable track ids
+    report           TrackTable of confirmed tracks in the best hypothesis
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import time
+from collections.abc import Iterable
+from dataclasses import dataclass, field, replace
+from os import PathLike
+from typing import Any
+
+import numpy as np
+
+from mhtrack.clutter.base import ClutterEstimator
+from mhtrack.clutter.known import KnownClutter
+from mhtrack.mht.config import MHTConfig
+from mhtrack.mht.hypothesis import best_hypothesis
+from mhtrack.mht.pruning import (
+    cap_leaves,
+    cap_leaves_per_tree,
+    cap_trees,
+    n_scan_keep,
+    score_drop_keep,
+    sprt_keep,
+)
+from mhtrack.mht.scoring import birth_score, miss_increment, sprt_thresholds, update_increment
+from mhtrack.mht.tree import Children, Leaves, birth_leaves, grow_children, propose_children
+from mhtrack.models import kalman
+from mhtrack.models.motion import ConstantVelocity
+from mhtrack.records import PlotTable, Scan, TrackTable
+
+logger = logging.getLogger(__name__)
+
+FORMAT = "mhtrack.mht.MHTTracker/1"
+
+
+@dataclass(frozen=True)
+class StepStats:
+    """What one :meth:`MHTTracker.step` did.
+
+    ``caps`` maps each hard cap that acted to how many leaves (``max_leaves_per_tree``,
+    ``max_leaves``), trees (``max_trees``), plots (``max_births_per_scan``) or clusters
+    (``max_cluster_size``) it cut; empty when none acted.
+    """
+
+    scan: int
+    n_plots: int
+    n_leaves: int
+    n_trees: int
+    n_clusters: int
+    largest_cluster: int
+    n_confirmed: int
+    time_s: float
+    caps: dict[str, int] = field(default_factory=dict)
+
+
+class MHTTracker:
+    """Track-oriented multiple hypothesis tracker with a pluggable clutter estimator.
+
+    Parameters
+    ----------
+    config : tracker parameters (:class:`MHTConfig`; defaults from P1 §3).
+    clutter : the clutter estimator giving ``κ̂(z)``; default a known constant
+        ``κ = 1e−9`` per m² (P1's plain MHT).
+
+    Examples
+    --------
+    >>> trk = MHTTracker(MHTConfig(), KnownClutter(6.25e-7))
+    >>> tracks = trk.run(plot_table)          # doctest: +SKIP
+    >>> out = trk.step(scan); trk.last_stats  # doctest: +SKIP
+    """
+
+    def __init__(
+        self, config: MHTConfig | None = None, clutter: ClutterEstimator | None = None
+    ) -> None:
+        self.config = MHTConfig() if config is None else config
+        self.clutter: ClutterEstimator = KnownClutter() if clutter is None else clutter
+        cfg = self.config
+        self._motion = ConstantVelocity(cfg.sigma_v)
+        self._R = np.eye(2) * cfg.sigma_w**2
+        self._gamma = kalman.gate_threshold(cfg.gate_probability)
+        self._miss_dl = miss_increment(
+            cfg.p_detection, cfg.gate_probability if cfg.miss_uses_gate_probability else None
+        )
+        self.confirm_threshold, self.delete_threshold = sprt_thresholds(cfg.alpha, cfg.beta)
+        self._leaves = Leaves.empty(cfg.n_scan + 1)
+        self._last_time: float | None = None
+        self._last_index: int | None = None
+        self._next_tree = 0
+        self._next_track = 0
+        self.last_stats: StepStats | None = None
+
+    # ------------------------------------------------------------------ public API
+    @property
+    def leaves(self) -> Leaves:
+        """The current hypothesis store (read-only view for inspection and tests)."""
+        return self._leaves
+
+    def step(self, scan: Scan) -> TrackTable:
+        """Process one scan; return the confirmed tracks of the best global hypothesis.
+
+        Statistics of the step are left in :attr:`last_stats`; a warning is logged (once)
+        when a hard cap acted.
+        """
+        t0 = time.perf_counter()
+        cfg = self.config
+        z, R, rows = self._validate(scan)
+        caps: dict[str, int] = {}
+        leaves = self._leaves
+        previous = _Reported.of(leaves)
+
+        xp, Pp = self._predict(leaves, scan)
+        gated = self._gate(leaves, xp, Pp, z, R, caps)
+        in_gates = _plots_in_confirmed_gates(leaves, gated, len(z))
+        kappa = self._clutter_intensity(scan, z, in_gates)
+
+        update_dl = update_increment(
+            gated.loglik, kappa[gated.plot], cfg.p_detection, cfg.new_target_density
+        )
+        children = propose_children(leaves, gated, self._miss_dl, update_dl)
+        births = self._births(scan, z, R, rows, kappa, in_gates, caps)
+        children = self._prune_children(leaves, children, len(births), caps)
+        leaves = Leaves.concat(grow_children(leaves, xp, Pp, children, z, R, rows), births)
+
+        hyp = best_hypothesis(
+            leaves.score, leaves.tree, leaves.window, cfg.max_cluster_size, cfg.milp_time_limit
+        )
+        if hyp.n_greedy:
+            caps["max_cluster_size"] = hyp.n_greedy
+        if hyp.n_time_limited:
+            caps["milp_time_limit"] = hyp.n_time_limited
+        leaves = self._prune_after_solve(leaves, hyp.leaves, caps)
+        leaves = self._manage_tracks(leaves, previous)
+        self._leaves = leaves
+        self._last_time, self._last_index = float(scan.time), int(scan.index)
+
+        out = self._report(scan, leaves)
+        self.last_stats = StepStats(
+            scan=int(scan.index),
+            n_plots=len(z),
+            n_leaves=len(leaves),
+            n_trees=leaves.n_trees,
+            n_clusters=hyp.n_clusters,
+            largest_cluster=hyp.largest_cluster,
+            n_confirmed=len(out),
+            time_s=time.perf_counter() - t0,
+            caps=caps,
+        )
+        if caps:
+            logger.warning("MHT scan %d: hard caps acted: %s", scan.index, caps)
+        return out
+
+    def run(
+        self, scans: Iterable[Scan] | PlotTable, stats: list[StepStats] | None = None
+    ) -> TrackTable:
+        """Step through ``scans`` (or all scans of a :class:`PlotTable`) and concatenate the
+        outputs; per-scan statistics are appended to ``stats`` when given."""
+        if isinstance(scans, PlotTable):
+            scans = scans.scans()
+        parts = []
+        for scan in scans:
+            parts.append(self.step(scan))
+            if stats is not None and self.last_stats is not None:
+                stats.append(self.last_stats)
+        return TrackTable.concat(parts)
+
+    # ------------------------------------------------------------------ cycle steps
+    def _validate(self, scan: Scan) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Check the scan at the library boundary; return ``z``, ``R`` and row ids."""
+        z = np.asarray(scan.z, dtype=float).reshape(-1, 2)
+        n = len(z)
+        rows = np.asarray(scan.rows, dtype=np.int64).reshape(-1)
+        if rows.size != n:
+            raise ValueError(f"scan {scan.index}: {rows.size} row ids for {n} plots")
+        if not np.isfinite(scan.time):
+            raise ValueError(f"scan {scan.index}: time {scan.time} is not finite")
+        if self._last_time is not None and not scan.time > self._last_time:
+            raise ValueError(
+                f"scan {scan.index}: time {scan.time} s is not after the previous scan "
+                f"({self._last_index}, {self._last_time} s); dt must be > 0"
+            )
+        bad = ~np.isfinite(z).all(axis=1)
+        if bad.any():
+            i = int(np.flatnonzero(bad)[0])
+            raise ValueError(
+                f"scan {scan.index}: plot row {int(rows[i])} has a non-finite position "
+                f"{z[i].tolist()}"
+            )
+        if n > 1 and np.unique(rows).size != n:
+            raise ValueError(f"scan {scan.index}: plot row ids are not unique")
+        if scan.R is None:
+            return z, self._R, rows
+        R = np.asarray(scan.R, dtype=float)
+        if R.shape != (n, 2, 2):
+            raise ValueError(f"scan {scan.index}: R has shape {R.shape}, expected ({n}, 2, 2)")
+        unset = np.isnan(R).all(axis=(1, 2))  # PlotTable.from_scans: "use the tracker's R"
+        if unset.any():
+            R = R.copy()
+            R[unset] = self._R
+        det = R[:, 0, 0] * R[:, 1, 1] - R[:, 0, 1] * R[:, 1, 0]
+        bad = ~(np.isfinite(R).all(axis=(1, 2)) & (R[:, 0, 0] > 0) & (det > 0))
+        if bad.any():
+            i = int(np.flatnonzero(bad)[0])
+            raise ValueError(
+                f"scan {scan.index}: plot row {int(rows[i])} has an invalid covariance "
+                f"{R[i].tolist()}"
+            )
+        return z, R, rows
+
+    def _predict(self, leaves: Leaves, scan: Scan) -> tuple[np.ndarray, np.ndarray]:
+        """All leaves to the scan time with the CV model, ``dt`` = time since last scan."""
+        if len(leaves) == 0 or self._last_time is None:
+            return leaves.x, leaves.P
+        dt = float(scan.time) - self._last_time
+        return kalman.predict_cv(leaves.x, leaves.P, dt, self._motion.Q(dt))
+
+    def _gate(
+        self,
+        leaves: Leaves,
+        xp: np.ndarray,
+        Pp: np.ndarray,
+        z: np.ndarray,
+        R: np.ndarray,
+        caps: dict[str, int],
+    ) -> kalman.Gated:
+        """Gate every predicted leaf against every plot (χ², 2 d.o.f.).
+
+        Bounded work: when the leaves' gate boxes hold more than ``max_gated_pairs``
+        candidate pairs (a clutter burst), leaves of confirmed trees and then the
+        best-scoring leaves are gated first until the budget is spent; the others only
+        get a miss child this scan."""
+        budget = self.config.max_gated_pairs
+        if len(leaves) * len(z) <= budget:
+            return kalman.gate_sweep(xp, Pp, z, R, self._gamma)
+        counts = kalman.gate_candidate_counts(xp, Pp, z, R, self._gamma)
+        if counts.sum() <= budget:
+            return kalman.gate_sweep(xp, Pp, z, R, self._gamma)
+        order = np.lexsort((-leaves.score, leaves.track < 0))
+        sel = np.sort(order[np.cumsum(counts[order]) <= budget])
+        caps["max_gated_pairs"] = len(leaves) - sel.size
+        g = kalman.gate_sweep(xp[sel], Pp[sel], z, R, self._gamma)
+        return kalman.Gated(sel[g.track], g.plot, g.d2, g.loglik)
+
+    def _clutter_intensity(
+        self, scan: Scan, z: np.ndarray, in_gates: np.ndarray | None
+    ) -> np.ndarray:
+        """Feed the estimator, then ``κ̂(z)`` of every plot (floored, see MHTConfig)."""
+        self.clutter.update(scan, in_gates)
+        kappa = np.asarray(self.clutter.intensity(z), dtype=float).reshape(-1)
+        if kappa.shape != (len(z),) or not np.isfinite(kappa).all() or (kappa < 0).any():
+            raise ValueError(
+                f"scan {scan.index}: clutter estimator {self.clutter.name!r} returned an "
+                f"invalid intensity (need {len(z)} finite values >= 0)"
+            )
+        return np.maximum(kappa, self.config.min_clutter_density)
+
+    def _births(
+        self,
+        scan: Scan,
+        z: np.ndarray,
+        R: np.ndarray,
+        rows: np.ndarray,
+        kappa: np.ndarray,
+        in_gates: np.ndarray | None,
+        caps: dict[str, int],
+    ) -> Leaves:
+        """Every plot starts a tree with the birth score ``ln(λ_v P_D / κ̂)``. Over
+        ``max_births_per_scan`` plots, those outside confirmed tracks' gates go first,
+        then those with the highest birth score (then scan order)."""
+        cfg = self.config
+        score = birth_score(kappa, cfg.p_detection, cfg.new_target_density)
+        sel = np.arange(len(z))
+        if len(z) > cfg.max_births_per_scan:
+            gated_first = np.zeros(len(z), bool) if in_gates is None else in_gates
+            order = np.lexsort((-score, gated_first))
+            sel = np.sort(order[: cfg.max_births_per_scan])
+            caps["max_births_per_scan"] = len(z) - sel.size
+        Rb = R if R.ndim == 2 else R[sel]
+        out = birth_leaves(z[sel], Rb, rows[sel], score[sel], self._next_tree, int(scan.index),
+                           cfg.v_max, cfg.n_scan + 1)
+        self._next_tree += sel.size
+        return out
+
+    def _prune_children(
+        self, leaves: Leaves, children: Children, n_births: int, caps: dict[str, int]
+    ) -> Children:
+        """Before the (costly) Kalman update: SPRT deletion, score-drop pruning within a
+        tree, then the caps on leaves per tree and on all leaves."""
+        cfg = self.config
+        keep = sprt_keep(children.score, children.peak, self.delete_threshold)
+        children = children.take(keep)
+        tree = leaves.tree[children.parent]
+        keep = score_drop_keep(tree, children.score, cfg.prune_drop)
+        children, tree = children.take(keep), tree[keep]
+        keep, cut = cap_leaves_per_tree(tree, children.score, cfg.max_leaves_per_tree)
+        if cut:
+            caps["max_leaves_per_tree"] = cut
+            children, tree = children.take(keep), tree[keep]
+        budget = max(cfg.max_leaves - n_births, 0)
+        confirmed = leaves.track[children.parent] >= 0
+        keep, cut = cap_leaves(children.score, confirmed, budget)
+        if cut:
+            caps["max_leaves"] = cut
+            children = children.take(keep)
+        return children
+
+    def _prune_after_solve(
+        self, leaves: Leaves, chosen: np.ndarray, caps: dict[str, int]
+    ) -> Leaves:
+        """N-scan pruning around the best hypothesis, then the cap on trees; marks the
+        surviving chosen leaves."""
+        is_chosen = np.zeros(len(leaves), bool)
+        is_chosen[chosen] = True
+        keep = n_scan_keep(leaves.tree, leaves.window[:, 0], chosen)
+        protected = is_chosen | (leaves.track >= 0)
+        keep_t, cut = cap_trees(leaves.tree[keep], leaves.score[keep], protected[keep],
+                                self.config.max_trees)
+        if cut:
+            caps["max_trees"] = cut
+            keep[np.flatnonzero(keep)[~keep_t]] = False
+        out = leaves.take(keep)
+        return replace(out, chosen=is_chosen[keep])
+
+    def _manage_tracks(self, leaves: Leaves, previous: _Reported) -> Leaves:
+        """Track identity and SPRT confirmation on the chosen leaves.
+
+        1. *Hand-over*: a tentative tree whose chosen leaf shares a plot (within the
+           window) with a track reported at the previous scan that the best hypothesis no
+           longer carries takes over that track's id — the track follows its plots, not
+           its tree (most shared plots first, then lower tree and track id).
+        2. *Confirmation*: a tentative tree whose chosen leaf has ``L ≥ ln((1−β)/α)``
+           gets the next track id, in tree-id order; ids are never reused (Wald 1947;
+           Blackman & Popoli 1999 §6.2).
+        """
+        track = leaves.track
+        chosen = np.flatnonzero(leaves.chosen)
+        carried = track[chosen]
+        lost = ~np.isin(previous.track, carried[carried >= 0])
+        cand = chosen[carried < 0]
+        if lost.any() and cand.size:
+            track = track.copy()
+            lost_ids, lost_win = previous.track[lost], previous.window[lost]
+            win = leaves.window[cand, :-1]
+            shared = ((win[:, None, :] == lost_win[None, :, :]) & (win[:, None, :] >= 0)).sum(2)
+            ci, li = np.nonzero(shared)
+            order = np.lexsort((lost_ids[li], leaves.tree[cand[ci]], -shared[ci, li]))
+            taken_c, taken_l = np.zeros(cand.size, bool), np.zeros(lost_ids.size, bool)
+            for c, k in zip(ci[order].tolist(), li[order].tolist(), strict=True):
+                if taken_c[c] or taken_l[k]:
+                    continue
+                taken_c[c] = taken_l[k] = True
+                tid = lost_ids[k]
+                track[track == tid] = -1  # the old tree gives the id up
+                track[leaves.tree == leaves.tree[cand[c]]] = tid
+        new = leaves.chosen & (track < 0) & (leaves.score >= self.confirm_threshold)
+        if new.any():
+            track = track.copy()
+            trees = leaves.tree[new]  # one chosen leaf per tree, ascending
+            ids = np.arange(self._next_track, self._next_track + trees.size, dtype=np.int64)
+            self._next_track += trees.size
+            j = np.minimum(np.searchsorted(trees, leaves.tree), trees.size - 1)
+            hit = trees[j] == leaves.tree
+            track[hit] = ids[j[hit]]
+        return leaves if track is leaves.track else replace(leaves, track=track)
+
+    def _report(self, scan: Scan, leaves: Leaves) -> TrackTable:
+        """Confirmed tracks of the best hypothesis, ordered by track id."""
+        sel = np.flatnonzero(leaves.chosen & (leaves.track >= 0))
+        sel = sel[np.argsort(leaves.track[sel], kind="stable")]
+        x = leaves.x[sel]
+        n = sel.size
+        return TrackTable(
+            scan=np.full(n, int(scan.index), np.int64),
+            time=np.full(n, float(scan.time)),
+            track_id=leaves.track[sel],
+            x=x[:, 0].copy(),
+            y=x[:, 2].copy(),
+            vx=x[:, 1].copy(),
+            vy=x[:, 3].copy(),
+            plot=leaves.window[sel, -1].copy(),
+            score=leaves.score[sel].copy(),
+            P=leaves.P[sel].copy(),
+        )
+
+    # ------------------------------------------------------------------ persistence
+    def save(self, path: str | PathLike[str]) -> None:
+        """Write the full state to one ``.npz`` (no pickle): the leaf arrays, the
+        bookkeeping and configuration as a JSON string, and the clutter estimator's
+        ``get_state()`` (its arrays stored as arrays)."""
+        arrays: dict[str, np.ndarray] = {
+            f"leaves__{k}": v for k, v in self._leaves.arrays().items()
+        }
+        clutter_state = _encode(self.clutter.get_state(), arrays)
+        meta = {
+            "format": FORMAT,
+            "config": json.loads(self.config.to_json()),
+            "clutter_name": self.clutter.name,
+            "clutter_state": clutter_state,
+            "last_time": self._last_time,
+            "last_index": self._last_index,
+            "next_tree": self._next_tree,
+            "next_track": self._next_track,
+        }
+        arrays["meta"] = np.array(json.dumps(meta, sort_keys=True))
+        with open(path, "wb") as f:
+            np.savez(f, **arrays)  # type: ignore[arg-type]
+
+    @classmethod
+    def load(
+        cls, path: str | PathLike[str], clutter: ClutterEstimator | None = None
+    ) -> MHTTracker:
+        """Restore a tracker written by :meth:`save`. ``clutter`` is an estimator of the
+        same kind (its state is overwritten); it may be omitted for the ``known`` one."""
+        with np.load(path, allow_pickle=False) as data:
+            arrays = {k: data[k] for k in data.files}
+        meta = json.loads(str(arrays.pop("meta")))
+        if meta.get("format") != FORMAT:
+            raise ValueError(f"{path}: not an MHT tracker state ({meta.get('format')!r})")
+        if clutter is None:
+            if meta["clutter_name"] != KnownClutter.name:
+                raise ValueError(
+                    f"{path}: saved with clutter estimator {meta['clutter_name']!r}; "
+                    "pass one of that kind as clutter="
+                )
+            clutter = KnownClutter()
+        elif clutter.name != meta["clutter_name"]:
+            raise ValueError(
+                f"{path}: saved with clutter estimator {meta['clutter_name']!r}, "
+                f"got {clutter.name!r}"
+            )
+        clutter.set_state(_decode(meta["clutter_state"], arrays))
+        trk = cls(MHTConfig.from_json(json.dumps(meta["config"])), clutter)
+        trk._leaves = Leaves.from_arrays(
+            {k.removeprefix("leaves__"): v for k, v in arrays.items() if k.startswith("leaves__")}
+        )
+        trk._last_time = meta["last_time"]
+        trk._last_index = meta["last_index"]
+        trk._next_tree = int(meta["next_tree"])
+        trk._next_track = int(meta["next_track"])
+        return trk
+
+
+@dataclass(frozen=True, slots=True)
+class _Reported:
+    """Track ids reported at the previous scan and their plots at scans ``k−N … k−1``
+    (window shifted to the current scan's columns ``0 … N−1``)."""
+
+    track: np.ndarray
+    window: np.ndarray
+
+    @classmethod
+    def of(cls, leaves: Leaves) -> _Reported:
+        rep = leaves.chosen & (leaves.track >= 0)
+        return cls(leaves.track[rep], leaves.window[rep, 1:])
+
+
+def _plots_in_confirmed_gates(
+    leaves: Leaves, gated: kalman.Gated, n_plots: int
+) -> np.ndarray | None:
+    """Mask of plots inside the gate of a confirmed track reported at the last scan, or
+    ``None`` when there is none (the clutter estimator's ``in_track_gates``)."""
+    reported = leaves.chosen & (leaves.track >= 0)
+    if not reported.any():
+        return None
+    mask = np.zeros(n_plots, bool)
+    mask[gated.plot[reported[gated.track]]] = True
+    return mask
+
+
+def _encode(obj: Any, arrays: dict[str, np.ndarray]) -> Any:
+    """JSON-able copy of ``obj`` with every ndarray moved into ``arrays``."""
+    if isinstance(obj, np.ndarray):
+        if obj.dtype.hasobject:
+            raise ValueError("clutter state arrays must not hold Python objects")
+        key = f"clutter__{len(arrays)}"
+        arrays[key] = obj
+        return {"__ndarray__": key}
+    if isinstance(obj, dict):
+        if not all(isinstance(k, str) for k in obj):
+            raise ValueError("clutter state dict keys must be strings")
+        return {k: _encode(v, arrays) for k, v in obj.items()}
+    if isinstance(obj, list | tuple):
+        return [_encode(v, arrays) for v in obj]
+    if isinstance(obj, np.generic):
+        return obj.item()
+    return obj
+
+
+def _decode(obj: Any, arrays: dict[str, np.ndarray]) -> Any:
+    if isinstance(obj, dict):
+        if set(obj) == {"__ndarray__"}:
+            return arrays[obj["__ndarray__"]]
+        return {k: _decode(v, arrays) for k, v in obj.items()}
+    if isinstance(obj, list):
+        return [_decode(v, arrays) for v in obj]
+    return obj

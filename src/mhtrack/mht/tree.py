@@ -1,0 +1,214 @@
+"""The hypothesis store: the leaves of all track trees as stacked arrays.
+
+A *track tree* grows from one plot; each of its *leaves* is one track hypothesis (the
+chain of plots or misses from the root to now). Each scan every leaf spawns a miss child
+and one child per plot in its gate, and every plot starts a new tree (P1 §1.3, Fig. 1).
+
+Leaves are kept sorted by tree id, so a tree is a contiguous segment and per-tree
+reductions are ``np.maximum.reduceat`` over segment starts. Nothing here holds a Python
+object per leaf.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, fields
+
+import numpy as np
+
+from mhtrack.models import kalman
+from mhtrack.models.motion import POS, VEL
+
+NO_PLOT = -1
+
+
+@dataclass(frozen=True, slots=True)
+class Leaves:
+    """All leaves, one row each, sorted by ``tree``.
+
+    Attributes
+    ----------
+    x, P : (L, 4), (L, 4, 4) state ``[x, vx, y, vy]`` and covariance at the last scan.
+    score : (L,) track score ``L(k)`` (log-likelihood ratio, P1 eq. 4).
+    peak : (L,) highest score along the leaf's branch (for SPRT deletion by score drop).
+    tree : (L,) tree id (consecutive, never reused).
+    track : (L,) track id of the tree once confirmed, ``-1`` while tentative.
+    birth : (L,) scan index at which the tree was started.
+    n_updates : (L,) number of plots on the branch (the root plot included).
+    window : (L, N+1) plot row ids used at scans ``k−N … k`` (``-1`` for a miss or before
+        the tree existed); column 0 is the scan N-scan pruning decides.
+    chosen : (L,) leaf is in the current best global hypothesis.
+    """
+
+    x: np.ndarray
+    P: np.ndarray
+    score: np.ndarray
+    peak: np.ndarray
+    tree: np.ndarray
+    track: np.ndarray
+    birth: np.ndarray
+    n_updates: np.ndarray
+    window: np.ndarray
+    chosen: np.ndarray
+
+    def __len__(self) -> int:
+        return int(self.score.shape[0])
+
+    @classmethod
+    def empty(cls, width: int) -> Leaves:
+        i = np.zeros(0, np.int64)
+        f = np.zeros(0)
+        return cls(np.zeros((0, 4)), np.zeros((0, 4, 4)), f, f, i, i, i, i,
+                   np.zeros((0, width), np.int64), np.zeros(0, bool))
+
+    def take(self, idx: np.ndarray) -> Leaves:
+        """Rows ``idx`` (an index array or boolean mask), in that order."""
+        return Leaves(*(getattr(self, f.name)[idx] for f in fields(self)))
+
+    @classmethod
+    def concat(cls, a: Leaves, b: Leaves) -> Leaves:
+        return cls(*(np.concatenate((getattr(a, f.name), getattr(b, f.name)))
+                     for f in fields(cls)))
+
+    def arrays(self) -> dict[str, np.ndarray]:
+        """The columns by name (for saving)."""
+        return {f.name: getattr(self, f.name) for f in fields(self)}
+
+    @classmethod
+    def from_arrays(cls, arrays: dict[str, np.ndarray]) -> Leaves:
+        return cls(**{f.name: np.asarray(arrays[f.name]) for f in fields(cls)})
+
+    @property
+    def n_trees(self) -> int:
+        return int(segment_starts(self.tree).size)
+
+
+def segment_starts(sorted_keys: np.ndarray) -> np.ndarray:
+    """Start index of each run of equal values in ``sorted_keys`` (empty for no rows)."""
+    if sorted_keys.size == 0:
+        return np.zeros(0, np.int64)
+    return np.flatnonzero(np.r_[True, sorted_keys[1:] != sorted_keys[:-1]])
+
+
+def segment_ids(sorted_keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``(starts, seg)``: segment starts and, per row, the index of its segment."""
+    starts = segment_starts(sorted_keys)
+    seg = np.zeros(sorted_keys.size, np.int64)
+    if starts.size > 1:
+        seg[starts[1:]] = 1
+        np.cumsum(seg, out=seg)
+    return starts, seg
+
+
+def segment_max(values: np.ndarray, starts: np.ndarray, seg: np.ndarray) -> np.ndarray:
+    """Per row, the maximum of ``values`` over its segment."""
+    if values.size == 0:
+        return values.copy()
+    return np.maximum.reduceat(values, starts)[seg]
+
+
+@dataclass(frozen=True, slots=True)
+class Children:
+    """Candidate children of the leaves before their Kalman update (cheap to prune).
+
+    ``parent`` indexes the parent leaf, ``plot`` the plot within the scan (``-1``: miss);
+    rows are ordered by parent, the miss first, then plots in scan order.
+    """
+
+    parent: np.ndarray
+    plot: np.ndarray
+    score: np.ndarray
+    peak: np.ndarray
+
+    def __len__(self) -> int:
+        return int(self.parent.shape[0])
+
+    def take(self, idx: np.ndarray) -> Children:
+        return Children(self.parent[idx], self.plot[idx], self.score[idx], self.peak[idx])
+
+
+def propose_children(
+    leaves: Leaves, gated: kalman.Gated, miss_dl: float, update_dl: np.ndarray
+) -> Children:
+    """Each leaf spawns a miss child (``L + ΔL_miss``) and one child per gated plot
+    (``L + ΔL_update``), P1 eqs. 4–5. ``update_dl`` is per gated pair."""
+    n = len(leaves)
+    parent = np.concatenate((np.arange(n, dtype=np.int64), gated.track))
+    plot = np.concatenate((np.full(n, NO_PLOT, np.int64), gated.plot))
+    score = np.concatenate((leaves.score + miss_dl, leaves.score[gated.track] + update_dl))
+    # gated pairs are sorted by (leaf, plot); a stable sort on the parent puts the miss
+    # first and keeps the plot order.
+    order = np.argsort(parent, kind="stable")
+    parent, plot, score = parent[order], plot[order], score[order]
+    return Children(parent, plot, score, np.maximum(leaves.peak[parent], score))
+
+
+def grow_children(
+    leaves: Leaves,
+    xp: np.ndarray,
+    Pp: np.ndarray,
+    children: Children,
+    z: np.ndarray,
+    R: np.ndarray,
+    rows: np.ndarray,
+) -> Leaves:
+    """Materialise ``children`` as leaves: misses keep the prediction ``(xp, Pp)``, updates
+    get the Kalman update with their plot (``R`` shared (2, 2) or per plot (n, 2, 2))."""
+    par, plot = children.parent, children.plot
+    x = xp[par]
+    P = Pp[par]
+    upd = np.flatnonzero(plot >= 0)
+    if upd.size:
+        pj = plot[upd]
+        Ru = R if R.ndim == 2 else R[pj]
+        x[upd], P[upd] = kalman.update_position(x[upd], P[upd], z[pj], Ru)
+    new_col = np.where(plot >= 0, rows[np.maximum(plot, 0)] if rows.size else NO_PLOT, NO_PLOT)
+    window = np.concatenate((leaves.window[par, 1:], new_col[:, None]), axis=1)
+    return Leaves(
+        x=x,
+        P=P,
+        score=children.score,
+        peak=children.peak,
+        tree=leaves.tree[par],
+        track=leaves.track[par],
+        birth=leaves.birth[par],
+        n_updates=leaves.n_updates[par] + (plot >= 0),
+        window=window,
+        chosen=np.zeros(len(par), bool),
+    )
+
+
+def birth_leaves(
+    z: np.ndarray,
+    R: np.ndarray,
+    rows: np.ndarray,
+    score: np.ndarray,
+    first_tree: int,
+    scan_index: int,
+    v_max: float,
+    width: int,
+) -> Leaves:
+    """One new tree per plot: one-point initialisation ``x = [zx, 0, zy, 0]`` with position
+    covariance the plot's ``R`` and velocity variance ``(v_max/2)²`` per axis (the
+    velocity is unknown but bounded by ``v_max`` at 2σ); initial score ``score``
+    (the birth score, Blackman & Popoli 1999 §6.2). Tree ids ``first_tree, first_tree+1, …``.
+    """
+    n = len(z)
+    x = np.zeros((n, 4))
+    x[:, POS] = z
+    P = np.zeros((n, 4, 4))
+    P[:, POS[:, None], POS[None, :]] = R
+    P[:, VEL, VEL] = (0.5 * v_max) ** 2
+    window = np.full((n, width), NO_PLOT, np.int64)
+    window[:, -1] = rows
+    return Leaves(
+        x=x,
+        P=P,
+        score=np.asarray(score, float),
+        peak=np.asarray(score, float).copy(),
+        tree=np.arange(first_tree, first_tree + n, dtype=np.int64),
+        track=np.full(n, -1, np.int64),
+        birth=np.full(n, scan_index, np.int64),
+        n_updates=np.ones(n, np.int64),
+        window=window,
+        chosen=np.zeros(n, bool),
+    )

@@ -1,0 +1,80 @@
+"""``track`` and ``run`` end to end through the CLI."""
+
+import json
+from pathlib import Path
+
+import pytest
+from click.testing import CliRunner
+
+from mhtrack.cli.main import cli
+from mhtrack.io import read_tracks
+
+
+def invoke(*args: str) -> tuple[int, str, str]:
+    r = CliRunner().invoke(cli, list(args))
+    return r.exit_code, r.stdout, r.stderr
+
+
+RUN = ["run", "crossing", "--seed", "3", "--clutter", "uniform", "--clutter-rate", "10",
+       "--clutter-density", "1.5625e-7", "--scans", "40", "--no-progress"]
+
+
+@pytest.fixture(scope="module")
+def run_dir(tmp_path_factory) -> tuple[Path, dict]:
+    out = tmp_path_factory.mktemp("run")
+    code, stdout, stderr = invoke(*RUN, "--out", str(out), "--json")
+    assert code == 0, stderr
+    return out, json.loads(stdout)
+
+
+def test_run_writes_everything(run_dir):
+    out, summary = run_dir
+    for name in ("plots.csv", "truth.csv", "tracks.csv", "scenario.toml", "metrics.json",
+                 "scene.png", "metrics.png"):
+        assert (out / name).is_file(), name
+    assert summary["tracker"] == "mht"
+    assert 0 < summary["t_avg"] < 1.0
+    assert len(summary["ospa"]) == 40
+    assert json.loads((out / "metrics.json").read_text())["ospa_mean"] == summary["ospa_mean"]
+
+
+def test_run_finds_the_targets(run_dir):
+    _, s = run_dir
+    # 40 scans: targets 1 and 4 live all along, target 3 from scan 30; with 10 uniform
+    # clutter plots per scan and the true density, the MHT should follow them.
+    assert s["ospa_mean"] < 200
+    assert s["n_tracks"] >= 3
+
+
+def test_run_is_deterministic(run_dir, tmp_path):
+    out, _ = run_dir
+    code, _, stderr = invoke(*RUN, "--out", str(tmp_path), "--json")
+    assert code == 0, stderr
+    assert (tmp_path / "tracks.csv").read_bytes() == (out / "tracks.csv").read_bytes()
+
+
+def test_track_on_plots_file_matches_run(run_dir, tmp_path):
+    out, _ = run_dir
+    dst = tmp_path / "tracks.csv"
+    code, stdout, stderr = invoke("track", str(out / "plots.csv"), "--out", str(dst),
+                                  "--clutter-density", "1.5625e-7", "--no-progress")
+    assert code == 0, stderr
+    assert "tracks" in stdout
+    assert dst.read_bytes() == (out / "tracks.csv").read_bytes()
+    t = read_tracks(dst)
+    assert len(t) > 0 and (t.plot >= -1).all()
+
+
+def test_track_polar_plots_uses_scenario_sensors(tmp_path):
+    code, _, stderr = invoke("simulate", "multiradar", "--seed", "2", "--scans", "6",
+                             "--clutter-rate", "5", "--out", str(tmp_path))
+    assert code == 0, stderr
+    code, _stdout, stderr = invoke("track", str(tmp_path / "plots.csv"), "--out",
+                                  str(tmp_path / "tracks.csv"), "--no-progress")
+    assert code == 0, stderr
+    assert read_tracks(tmp_path / "tracks.csv") is not None
+
+
+def test_unknown_tracker_is_a_usage_error():
+    code, _, stderr = invoke("run", "crossing", "--tracker", "nope")
+    assert code == 2 and "nope" in stderr

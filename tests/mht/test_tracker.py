@@ -220,3 +220,40 @@ def test_config_is_validated_and_round_trips():
     assert MHTConfig.from_json(cfg.to_json()) == cfg
     with pytest.raises(ValueError, match="unknown"):
         MHTConfig.from_json('{"nope": 1}')
+
+
+def _target_scans(pattern: list[int], seed: int = 5) -> list[Scan]:
+    """One target moving at (100, −80) m/s; a plot at scan k iff ``pattern[k−1]``."""
+    rng = np.random.default_rng(seed)
+    x = np.array([0.0, 100.0, 0.0, -80.0])
+    out = []
+    for k, hit in enumerate(pattern, start=1):
+        z = x[[0, 2]] + rng.normal(scale=100.0, size=2)
+        out.append(Scan.from_positions(k, float(k), z[None] if hit else np.zeros((0, 2))))
+        x = x + np.array([100.0, 0.0, -80.0, 0.0])
+    return out
+
+
+def test_logic_confirmation_needs_hits_and_a_positive_score():
+    """Plots at scans 1, 3, 4, 5 (a miss at 2), true-density clutter κ = 1.5625e−7: the
+    SPRT alone has not confirmed by scan 5 (tree of scan 1: −0.55 − 2.30 + …; tree of scan
+    3: −0.55 + ≈2.2 + ≈1.9 < 4.6), the 3-of-4 logic with L > 0 has, on the tree of scan 3 —
+    and a score floor above that tree's score holds it back."""
+    scans = _target_scans([1, 0, 1, 1, 1])
+    sprt = MHTTracker(MHTConfig(), KnownClutter(1.5625e-7))
+    logic = MHTTracker(dataclasses.replace(MHTConfig(), confirm_hits=3),
+                       KnownClutter(1.5625e-7))
+    out_sprt = [len(sprt.step(s)) for s in scans]
+    out_logic = [len(logic.step(s)) for s in scans]
+    best = logic.leaves.score.max()
+    assert out_sprt == [0, 0, 0, 0, 0]
+    assert out_logic == [0, 0, 0, 0, 1]
+    assert 0 < best < sprt.confirm_threshold
+    floor_cfg = dataclasses.replace(MHTConfig(), confirm_hits=3, confirm_min_score=best + 0.1)
+    high_floor = MHTTracker(floor_cfg, KnownClutter(1.5625e-7))
+    assert [len(high_floor.step(s)) for s in scans] == [0, 0, 0, 0, 0]
+
+
+def test_confirm_hits_is_validated():
+    with pytest.raises(ValueError, match="confirm_hits"):
+        MHTConfig(confirm_hits=5, n_scan=3)

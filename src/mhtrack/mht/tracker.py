@@ -346,8 +346,10 @@ class MHTTracker:
            longer carries takes over that track's id — the track follows its plots, not
            its tree (most shared plots first, then lower tree and track id).
         2. *Confirmation*: a tentative tree whose chosen leaf has ``L ≥ ln((1−β)/α)``
-           gets the next track id, in tree-id order; ids are never reused (Wald 1947;
-           Blackman & Popoli 1999 §6.2).
+           (SPRT; Wald 1947; Blackman & Popoli 1999 §6.2), or has used plots in at least
+           ``confirm_hits`` of the ``N + 1`` scans of its window with
+           ``L > confirm_min_score`` (M-of-N logic), gets the next track id, in tree-id
+           order; ids are never reused.
         """
         track = leaves.track
         chosen = np.flatnonzero(leaves.chosen)
@@ -369,7 +371,12 @@ class MHTTracker:
                 tid = lost_ids[k]
                 track[track == tid] = -1  # the old tree gives the id up
                 track[leaves.tree == leaves.tree[cand[c]]] = tid
-        new = leaves.chosen & (track < 0) & (leaves.score >= self.confirm_threshold)
+        cfg = self.config
+        confirm = leaves.score >= self.confirm_threshold
+        if cfg.confirm_hits > 0:
+            hits = (leaves.window >= 0).sum(axis=1)
+            confirm |= (hits >= cfg.confirm_hits) & (leaves.score > cfg.confirm_min_score)
+        new = leaves.chosen & (track < 0) & confirm
         if new.any():
             track = track.copy()
             trees = leaves.tree[new]  # one chosen leaf per tree, ascending

@@ -106,6 +106,7 @@ class MHTTracker:
         self._next_tree = 0
         self._next_track = 0
         self.last_stats: StepStats | None = None
+        self._caps_warned: set[str] = set()
 
     # ------------------------------------------------------------------ public API
     @property
@@ -164,7 +165,14 @@ class MHTTracker:
             caps=caps,
         )
         if caps:
-            logger.warning("MHT scan %d: hard caps acted: %s", scan.index, caps)
+            new = sorted(set(caps) - self._caps_warned)
+            if new:  # a warning the first time each cap acts; every scan's counts at DEBUG
+                self._caps_warned.update(new)
+                logger.warning(
+                    "MHT scan %d: hard caps acted: %s (first time for %s; per-scan counts are "
+                    "in StepStats.caps)", scan.index, caps, ", ".join(new))
+            else:
+                logger.debug("MHT scan %d: hard caps acted: %s", scan.index, caps)
         return out
 
     def run(

@@ -45,9 +45,14 @@ def cli(verbose: int) -> None:
 
 
 def _register() -> None:
-    from mhtrack.cli import data_commands, track_commands
+    from mhtrack.cli import (
+        clutter_commands,
+        data_commands,
+        initiation_commands,
+        track_commands,
+    )
 
-    for module in (data_commands, track_commands):
+    for module in (data_commands, track_commands, clutter_commands, initiation_commands):
         for command in module.COMMANDS:
             cli.add_command(command)
 

@@ -15,6 +15,7 @@ import numpy as np
 from tqdm.auto import tqdm
 
 from mhtrack.clutter import ClutterEstimator, KnownClutter
+from mhtrack.clutter.registry import agmm_for_tracker, gmm_for_tracker
 from mhtrack.metrics import Evaluation, evaluate
 from mhtrack.mht import MHTConfig, MHTTracker, StepStats
 from mhtrack.records import PlotTable, Scan, TrackTable
@@ -33,6 +34,8 @@ def _known(config: MHTConfig, clutter_density: float | None) -> ClutterEstimator
 #: fixed deletion threshold / P1's adaptive GMM (``docs/clutter.md``).
 TRACKERS: dict[str, Callable[[MHTConfig, float | None], ClutterEstimator]] = {
     "mht": _known,
+    "mht-gmm": gmm_for_tracker,
+    "mht-agmm": agmm_for_tracker,
 }
 
 

@@ -1,0 +1,379 @@
+"""EM for a 2-D Gaussian mixture with an optional uniform background (P1 eqs. 6–11).
+
+The mixture density of a plot ``z`` is
+
+    c(z) = π₀ u(z) + Σ_{j=1..K} π_j N(z; μ_j, Σ_j),      π₀ + Σ π_j = 1,       (P1 eq. 6)
+
+where ``u(z) = 1/A`` on an axis-aligned box of area ``A`` (0 outside) is an optional
+uniform *background* component with a learned weight ``π₀`` (our addition; with
+``background_box=None`` the model is P1's plain GMM and ``π₀ = 0``).
+
+One EM iteration, as in scikit-learn's ``GaussianMixture`` (``sklearn/mixture/
+_gaussian_mixture.py``), with optional sample weights ``s_i``:
+
+* E-step (P1 eq. 9): ``log r_ij = log π_j + log f_j(z_i) − logsumexp_j(log π_j + log f_j(z_i))``
+  (log-sum-exp responsibilities, never a ratio of tiny densities);
+* M-step (P1 eqs. 10–11): ``n_j = Σ_i s_i r_ij``, ``π_j = n_j / Σ_j n_j``,
+  ``μ_j = Σ_i s_i r_ij z_i / n_j``, ``Σ_j = Σ_i s_i r_ij (z_i − μ_j)(z_i − μ_j)ᵀ / n_j + reg·I``
+  (``reg_covar`` as in scikit-learn); the background's ``u`` is fixed, only ``π₀`` is learned,
+  constrained to ``π₀ ≥ background_floor`` (the constrained maximiser of ``Σ n_j log π_j``);
+* optionally a *pruning* rule after the M-step (P1 step c: eq. 12 for the AGMM, a fixed
+  weight threshold for the GMM), deletion of components with fewer than ``min_points``
+  effective plots (``n_j``), which could only collapse onto a plot or two, and of
+  components whose peak density is under ``min_contrast`` times the background's;
+* stop when ``|L_i − L_{i−1}| < tol·|L_{i−1}|`` (P1 step 3) with no component deleted in the
+  iteration, or after ``max_iter`` iterations.
+
+``L`` is the (sample-weighted) mean log-likelihood ``(1/Σs) Σ_i s_i log c(z_i)`` — the
+objective of P1 eq. 7, which EM never decreases — rather than P1's ``Q`` (eq. 10): at the
+E-step they differ by the entropy of the responsibilities, and ``L`` is what scikit-learn
+monitors (and returns from ``score``), so the two codes can be checked against each other.
+
+All arithmetic is closed-form 2×2 (determinant, inverse) on whole ``(n, K)`` arrays.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+LOG_2PI = float(np.log(2.0 * np.pi))
+_EPS10 = 10.0 * np.finfo(float).eps  # sklearn adds this to n_j so that no n_j is 0
+
+#: A pruning rule: normalised Gaussian weights (K,) → mask of the components to keep.
+PruneRule = Callable[[np.ndarray], np.ndarray]
+
+
+@dataclass(frozen=True)
+class Mixture:
+    """Gaussian mixture in 2-D with an optional uniform background component.
+
+    Attributes
+    ----------
+    weights : (K,) Gaussian weights ``π_j``; ``weights.sum() + background_weight == 1``.
+    means : (K, 2) means ``μ_j`` (m).
+    covariances : (K, 2, 2) covariances ``Σ_j`` (m²).
+    background_weight : ``π₀`` (0 without a background).
+    background_box : ``(xmin, xmax, ymin, ymax)`` of the uniform background, or ``None``.
+    """
+
+    weights: np.ndarray
+    means: np.ndarray
+    covariances: np.ndarray
+    background_weight: float = 0.0
+    background_box: tuple[float, float, float, float] | None = None
+
+    @property
+    def n_components(self) -> int:
+        """Number of Gaussian components ``K``."""
+        return len(self.weights)
+
+    @property
+    def background_area(self) -> float:
+        """Area ``A`` of the background box (m²); ``inf`` without one."""
+        if self.background_box is None:
+            return float("inf")
+        x0, x1, y0, y1 = self.background_box
+        return (x1 - x0) * (y1 - y0)
+
+    def log_background(self, z: np.ndarray) -> np.ndarray:
+        """``log u(z)``: ``−log A`` inside the box, ``−inf`` outside (or without a box)."""
+        if self.background_box is None:
+            return np.full(len(z), -np.inf)
+        x0, x1, y0, y1 = self.background_box
+        inside = (z[:, 0] >= x0) & (z[:, 0] <= x1) & (z[:, 1] >= y0) & (z[:, 1] <= y1)
+        return np.where(inside, -np.log(self.background_area), -np.inf)
+
+    def weighted_log_prob(self, z: np.ndarray) -> np.ndarray:
+        """(n, K+1) ``log π_j + log f_j(z)``; column 0 the background (``−inf`` if none)."""
+        out = np.empty((len(z), self.n_components + 1))
+        with np.errstate(divide="ignore"):
+            out[:, 0] = np.log(self.background_weight) + self.log_background(z)
+            out[:, 1:] = np.log(self.weights) + gaussian_log_pdf(z, self.means, self.covariances)
+        return out
+
+    def log_pdf(self, z: np.ndarray) -> np.ndarray:
+        """``log c(z)`` (P1 eqs. 6, 13) at (n, 2) positions."""
+        return logsumexp_rows(self.weighted_log_prob(z))
+
+    def pdf(self, z: np.ndarray) -> np.ndarray:
+        """``c(z)`` (P1 eq. 13), per m², at (n, 2) positions; 0 where it underflows.
+
+        For many positions (maps, quadrature) each Gaussian is evaluated only inside the
+        axis-aligned box ``|Δx| ≤ r√Σxx, |Δy| ≤ r√Σyy`` with ``r² = 1490``: outside it
+        ``exp(−½ dᵀΣ⁻¹d) < e⁻⁷⁴⁵`` underflows to 0 anyway, so the result is the same.
+        """
+        z = np.asarray(z, dtype=float)
+        if len(z) * max(self.n_components, 1) <= 65_536:
+            return np.exp(self.log_pdf(z))
+        out = self.background_weight * np.exp(self.log_background(z))
+        a, b, c = (self.covariances[:, 0, 0], self.covariances[:, 0, 1],
+                   self.covariances[:, 1, 1])
+        det = a * c - b * b
+        norm = self.weights / (2.0 * np.pi * np.sqrt(det))
+        r = np.sqrt(1490.0)
+        for j in range(self.n_components):
+            dx = z[:, 0] - self.means[j, 0]
+            dy = z[:, 1] - self.means[j, 1]
+            sel = np.flatnonzero((np.abs(dx) <= r * np.sqrt(a[j]))
+                                 & (np.abs(dy) <= r * np.sqrt(c[j])))
+            x, y = dx[sel], dy[sel]
+            q = (c[j] * x * x - 2.0 * b[j] * x * y + a[j] * y * y) / det[j]
+            out[sel] += norm[j] * np.exp(-0.5 * q)
+        return out
+
+    def to_state(self) -> dict[str, object]:
+        """JSON-able values and arrays (inverse: :meth:`from_state`)."""
+        return {
+            "weights": self.weights.copy(),
+            "means": self.means.copy(),
+            "covariances": self.covariances.copy(),
+            "background_weight": float(self.background_weight),
+            "background_box": None if self.background_box is None
+            else [float(v) for v in self.background_box],
+        }
+
+    @classmethod
+    def from_state(cls, s: dict[str, object]) -> Mixture:
+        """Rebuild a mixture from :meth:`to_state`'s output."""
+        box = s["background_box"]
+        return cls(
+            np.asarray(s["weights"], float).reshape(-1),
+            np.asarray(s["means"], float).reshape(-1, 2),
+            np.asarray(s["covariances"], float).reshape(-1, 2, 2),
+            float(s["background_weight"]),  # type: ignore[arg-type]
+            None if box is None else tuple(float(v) for v in box),  # type: ignore[arg-type]
+        )
+
+
+@dataclass(frozen=True)
+class EMResult:
+    """Outcome of :func:`fit_em`.
+
+    ``log_likelihood`` is the mean log-likelihood ``L`` at the final parameters (what
+    ``GaussianMixture.score`` returns); ``n_iter`` the EM iterations run; ``converged``
+    whether the relative-change rule stopped it; ``n_pruned`` the components deleted.
+    """
+
+    mixture: Mixture
+    log_likelihood: float
+    n_iter: int
+    converged: bool
+    n_pruned: int
+
+
+def logsumexp_rows(a: np.ndarray) -> np.ndarray:
+    """``log Σ_j exp(a_ij)`` per row, stable; ``−inf`` for a row of ``−inf``."""
+    if a.shape[1] == 0:
+        return np.full(a.shape[0], -np.inf)
+    m = a.max(axis=1)
+    m_safe = np.where(np.isfinite(m), m, 0.0)
+    with np.errstate(divide="ignore"):
+        return np.log(np.exp(a - m_safe[:, None]).sum(axis=1)) + m_safe
+
+
+def gaussian_log_pdf(z: np.ndarray, means: np.ndarray, covariances: np.ndarray) -> np.ndarray:
+    """(n, K) ``log N(z_i; μ_j, Σ_j)`` in closed form for 2×2 covariances:
+    ``−log 2π − ½ log|Σ| − ½ dᵀΣ⁻¹d`` with ``Σ⁻¹ = [[c, −b], [−b, a]] / (ac − b²)``."""
+    a = covariances[:, 0, 0]
+    b = covariances[:, 0, 1]
+    c = covariances[:, 1, 1]
+    det = a * c - b * b
+    dx = z[:, 0:1] - means[:, 0]
+    dy = z[:, 1:2] - means[:, 1]
+    maha = (c * dx * dx - 2.0 * b * dx * dy + a * dy * dy) / det
+    return -LOG_2PI - 0.5 * np.log(det) - 0.5 * maha
+
+
+def mahalanobis2(z: np.ndarray, means: np.ndarray, covariances: np.ndarray) -> np.ndarray:
+    """(n, K) squared Mahalanobis distances ``dᵀΣ_j⁻¹d``."""
+    a, b, c = covariances[:, 0, 0], covariances[:, 0, 1], covariances[:, 1, 1]
+    dx = z[:, 0:1] - means[:, 0]
+    dy = z[:, 1:2] - means[:, 1]
+    return (c * dx * dx - 2.0 * b * dx * dy + a * dy * dy) / (a * c - b * b)
+
+
+def e_step(
+    z: np.ndarray, mix: Mixture, sample_weight: np.ndarray | None = None
+) -> tuple[float, np.ndarray]:
+    """P1 eq. 9. Returns the mean log-likelihood ``L`` and the (n, K+1) responsibilities
+    (column 0 the background), computed as ``exp(log π_j f_j − logsumexp)``."""
+    wlp = mix.weighted_log_prob(z)
+    norm = logsumexp_rows(wlp)
+    resp = np.exp(wlp - norm[:, None])
+    if sample_weight is None:
+        ll = float(norm.mean())
+    else:
+        ll = float(sample_weight @ norm / sample_weight.sum())
+    return ll, resp
+
+
+def m_step(
+    z: np.ndarray,
+    resp: np.ndarray,
+    background_box: tuple[float, float, float, float] | None,
+    *,
+    sample_weight: np.ndarray | None = None,
+    reg_covar: float = 1e-6,
+    background_floor: float = 0.0,
+) -> tuple[Mixture, np.ndarray]:
+    """P1 eqs. 10–11 (scikit-learn's ``_estimate_gaussian_parameters``, full covariances).
+
+    Returns the new mixture and the effective counts ``n_j`` of the Gaussians.
+    """
+    r = resp if sample_weight is None else resp * sample_weight[:, None]
+    nk_all = r.sum(axis=0) + _EPS10
+    total = nk_all.sum()
+    nk = nk_all[1:]
+    rg = r[:, 1:]
+    means = (rg.T @ z) / nk[:, None]
+    dx = z[:, 0:1] - means[:, 0]
+    dy = z[:, 1:2] - means[:, 1]
+    cov = np.empty((len(nk), 2, 2))
+    cov[:, 0, 0] = (rg * dx * dx).sum(axis=0) / nk + reg_covar
+    cov[:, 1, 1] = (rg * dy * dy).sum(axis=0) / nk + reg_covar
+    cov[:, 0, 1] = cov[:, 1, 0] = (rg * dx * dy).sum(axis=0) / nk
+    if background_box is None:
+        w0 = 0.0
+        w = nk / nk.sum()
+    else:
+        w0 = max(nk_all[0] / total, background_floor)
+        g = nk.sum()
+        w = (1.0 - w0) * nk / g if g > 0 else nk * 0.0
+    return Mixture(w, means, cov, float(w0), background_box), nk
+
+
+def _drop(mix: Mixture, keep: np.ndarray) -> Mixture:
+    """Keep the Gaussians in ``keep``; renormalise them to ``1 − π₀`` (P1 after eq. 12)."""
+    w = mix.weights[keep]
+    s = w.sum()
+    if s > 0:
+        w = w * (1.0 - mix.background_weight) / s
+    bg = mix.background_weight if len(w) else (1.0 if mix.background_box is not None else 0.0)
+    return Mixture(w, mix.means[keep], mix.covariances[keep], bg, mix.background_box)
+
+
+def fit_em(
+    z: np.ndarray,
+    init: Mixture,
+    *,
+    sample_weight: np.ndarray | None = None,
+    reg_covar: float = 1e-6,
+    tol: float = 1e-4,
+    max_iter: int = 100,
+    prune: PruneRule | None = None,
+    min_points: float = 0.0,
+    background_floor: float = 0.0,
+    min_contrast: float = 0.0,
+) -> EMResult:
+    """Run EM (P1 eqs. 9–11, plus optional pruning, P1 step c) from ``init``.
+
+    Parameters
+    ----------
+    z : (n, 2) data, n ≥ 1, finite (not checked here: callers validate at their edge).
+    init : starting mixture (its ``background_box`` is kept fixed).
+    sample_weight : (n,) non-negative weights ``s_i`` or ``None`` (all 1).
+    reg_covar : added to the covariance diagonals (m²), as scikit-learn.
+    tol : relative tolerance ``ε`` of P1 step 3, ``|ΔL| < ε|L|``; 0 runs ``max_iter``.
+    max_iter : most EM iterations (one E-step and one M-step each, as scikit-learn).
+    prune : rule applied to the normalised Gaussian weights after each M-step.
+    min_points : delete Gaussians with ``n_j`` below this after each M-step.
+    background_floor : lower bound on ``π₀`` (with a background box).
+    min_contrast : with a background, delete Gaussians whose peak density
+        ``π_j / (2π√|Σ_j|)`` is below ``min_contrast · π₀ / A`` after each M-step.
+
+    With ``prune=None``, ``min_points=0``, no background and no sample weights, this is
+    scikit-learn's ``GaussianMixture(covariance_type="full")`` EM from the same
+    initialisation: after ``max_iter`` iterations ``log_likelihood`` equals its ``score``.
+    """
+    mix = init
+    prev = -np.inf
+    converged = False
+    n_pruned = 0
+    n_iter = 0
+    for n_iter in range(1, max_iter + 1):  # noqa: B007
+        ll, resp = e_step(z, mix, sample_weight)
+        mix, nk = m_step(z, resp, mix.background_box, sample_weight=sample_weight,
+                         reg_covar=reg_covar, background_floor=background_floor)
+        keep = nk >= min_points
+        if min_contrast > 0 and mix.background_box is not None:
+            c = mix.covariances
+            det = c[:, 0, 0] * c[:, 1, 1] - c[:, 0, 1] * c[:, 1, 0]
+            peak = mix.weights / (2.0 * np.pi * np.sqrt(det))
+            keep &= peak >= min_contrast * mix.background_weight / mix.background_area
+        if prune is not None and keep.any():
+            w = np.where(keep, mix.weights, 0.0)
+            keep &= prune(w / w.sum())
+        deleted = int((~keep).sum())
+        if deleted and not (keep.any() or mix.background_box is not None):
+            deleted = 0  # nothing would be left: keep the components, not an empty model
+        if deleted:
+            mix = _drop(mix, keep)
+            n_pruned += deleted
+        if mix.n_components == 0:
+            break
+        if not deleted and abs(ll - prev) < tol * abs(prev):
+            converged = True
+            break
+        prev = ll
+    final = float(np.average(mix.log_pdf(z), weights=sample_weight))
+    return EMResult(mix, final, n_iter, converged, n_pruned)
+
+
+# ------------------------------------------------------------------ initialisation
+def kmeanspp_centres(
+    z: np.ndarray, k: int, rng: np.random.Generator, existing: np.ndarray | None = None
+) -> np.ndarray:
+    """Up to ``k`` new centres drawn from the rows of ``z`` by k-means++ ``D²`` sampling
+    (Arthur & Vassilvitskii 2007; the first one uniformly unless ``existing`` centres are
+    given, to which distances are then measured). Stops early when every remaining plot
+    sits on a centre (``D² = 0``), so identical plots give one centre."""
+    chosen: list[np.ndarray] = []
+    if existing is not None and len(existing):
+        d2 = ((z[:, None, :] - existing[None, :, :]) ** 2).sum(axis=2).min(axis=1)
+    else:
+        first = z[int(rng.integers(len(z)))]
+        chosen.append(first)
+        d2 = ((z - first) ** 2).sum(axis=1)
+    while len(chosen) < k:
+        total = d2.sum()
+        if not total > 0:
+            break
+        i = int(np.searchsorted(np.cumsum(d2), rng.random() * total, side="right"))
+        c = z[min(i, len(z) - 1)]
+        chosen.append(c)
+        d2 = np.minimum(d2, ((z - c) ** 2).sum(axis=1))
+    return np.array(chosen, float).reshape(-1, 2)
+
+
+def mixture_from_centres(
+    z: np.ndarray,
+    centres: np.ndarray,
+    *,
+    reg_covar: float,
+    background_box: tuple[float, float, float, float] | None = None,
+    background_weight: float = 0.0,
+) -> Mixture:
+    """A starting mixture: each plot goes to its nearest centre (a hard E-step), then one
+    M-step. A centre with fewer than 3 plots (too few for a 2×2 covariance) gets the
+    data's covariance divided by the number of centres (+ ``reg_covar``); a centre with no
+    plot keeps its position with a tiny weight."""
+    k = len(centres)
+    d2 = ((z[:, None, :] - centres[None, :, :]) ** 2).sum(axis=2)
+    lab = d2.argmin(axis=1)
+    counts = np.bincount(lab, minlength=k).astype(float)
+    data_cov = np.cov(z.T, bias=True).reshape(2, 2) if len(z) > 1 else np.zeros((2, 2))
+    broad = data_cov / k + reg_covar * np.eye(2)
+    means = centres.astype(float).copy()
+    cov = np.repeat(broad[None], k, axis=0)
+    for j in np.flatnonzero(counts >= 1):
+        pts = z[lab == j]
+        means[j] = pts.mean(axis=0)
+        if len(pts) >= 3:
+            d = pts - means[j]
+            cov[j] = d.T @ d / len(pts) + reg_covar * np.eye(2)
+    w = np.maximum(counts, 1e-3)
+    w = (1.0 - background_weight) * w / w.sum()
+    return Mixture(w, means, cov, float(background_weight), background_box)

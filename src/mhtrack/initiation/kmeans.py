@@ -1,0 +1,652 @@
+"""Multi-radar plot fusion by clustering: standard and adaptive K-means (P2 §1).
+
+At one scan the plots of ``N_s`` radars lie in tight blobs round the targets (P2 §1). A
+clustering groups them, one cluster per target, and each cluster becomes one *fused plot*.
+
+Standard K-means (P2 §1.1; Lloyd): given ``k`` initial centres, repeat — assign every
+plot to its nearest centre (Euclidean ``d(x, c) = ‖x − c‖``), move every centre to the
+mean ``c_j = (1/n_j) Σ_{x∈C_j} x`` of its plots — until the labels stop changing.
+:class:`KMeansFusion` draws the ``k`` initial centres at random among the plots (seeded).
+
+Adaptive K-means (P2 §1.2, steps 1–6), as implemented here:
+
+1. ``D`` = all ``C(n, 2)`` pairwise plot distances sorted ascending (``pdist``).
+2. Dissimilarity threshold for ``k`` clusters: ``ε(k) = D[k·C(N_s, 2)]`` read **1-based**
+   as P2 prints it (``D(1)`` the smallest), i.e. ``D[k·C(N_s,2) − 1]`` 0-based, clipped to
+   ``[0, len(D) − 1]``. Why: ``k`` clusters of ``N_s`` plots hold ``k·C(N_s, 2)``
+   within-cluster pairs; when the clusters are apart these are the ``k·C(N_s, 2)``
+   smallest distances, so the ``(k·C(N_s,2))``-th smallest is the largest within-cluster
+   distance — P2 Fig. 1's threshold ``d₁``. ``N_s`` = number of distinct radars in the scan.
+3. Start with ``k = 1`` centre; 4. a plot whose distance to every (allowed) centre exceeds
+   ``ε(k)`` opens a new cluster (``k += 1``, ``ε`` updated), otherwise it joins the
+   nearest centre; centres are updated to their members' means; 5. until every plot is
+   placed; 6. refine with standard K-means from these centres.
+
+The order in which plots are visited is ours (P2 picks the first centre at random and
+leaves the order open): radar by radar, the radar with the most plots first (ties: lower
+id). Because a cluster holds at most one plot per radar (P2 §1.2, §3.1), every plot of
+the first radar opens its own cluster, so *which* of its plots is the first centre does
+not change the result — the method is deterministic. The plots of each later radar are
+placed together: each joins an *allowed* centre that holds no plot of its radar, one plot
+per centre, by an optimal assignment (``linear_sum_assignment``); plots left over open
+new clusters, ``k`` grows and ``ε(k)`` is re-read before the next radar. When no two
+plots of the radar compete for a centre this is exactly P2's "join the nearest".
+
+Our additions (each one documented, overridable parameter of
+:class:`AdaptiveKMeansFusion`), needed because P2's ``ε(k)`` equals the largest
+within-cluster distance only when the targets are farther apart than their plots' spread
+— on P2's own geometry (targets 100–300 m apart, plots σ ≈ 50 m cross-range) it often is
+too small, and in clutter it is far too large:
+
+* **Covariance gate** (``merge_probability = 0.9999``, when the plots carry ``R``): a pair
+  plot–centre is also allowed when ``d² = (z − c)ᵀ (R + R̄_c)⁻¹ (z − c) ≤ γ``, ``γ`` the
+  χ²₂ quantile (``−2 ln(1 − p)`` = 18.4), ``R̄_c = (1/n²) Σ R_i`` the covariance of the
+  centre; the assignment then minimises ``Σ min(d², γ)`` (plain ``Σ ‖z − c‖²`` without
+  ``R``), leaving a plot alone costing ``γ`` (``ε²``).
+* **Threshold cap** (``max_threshold = "auto"``): ``ε ≤ √(γ · 2 · max_i λmax(R_i))``, the
+  largest distance at which two plots of one target can still pass the gate; keeps clutter
+  (which inflates ``D``'s upper part) from joining target clusters.
+* **Merge** (after the refinement and the rule below): two clusters holding no plot of a
+  common radar are merged when their centres pass the gate
+  ``Δᵀ (R̄_a + R̄_b)⁻¹ Δ ≤ γ`` (``‖Δ‖ ≤ ε`` without ``R``), reciprocal nearest pairs
+  first, until none is left (:func:`merge_compatible_clusters`).
+
+With ``merge_probability=None, max_threshold=None`` (or plots without ``R``; then the
+merge uses ``ε``) only P2's Euclidean threshold is used.
+
+One plot per radar (P2 §1.2, §3.1). The K-means refinement ignores radars and may put two
+plots of one radar in a cluster. Such clusters are repaired, radar by radar: the plots of
+that radar in offending clusters are re-assigned optimally (same assignment as above) to
+those clusters and to clusters holding no plot of that radar; a plot with no allowed
+centre left opens its own cluster (a split). One pass suffices; the labels that did not
+break the rule are kept (:func:`enforce_one_plot_per_sensor`). :class:`KMeansFusion`
+(random initial centres) gets the same repair with ``ε(k)`` of its own ``k``, but no
+merge.
+
+Fused plot: the cluster centre ``z̄ = (1/n) Σ z_i`` with ``R̄ = (1/n²) Σ R_i`` (the
+covariance of a mean of independent plots) — P2's choice — or, with
+``weighting="information"``, ``P = (Σ R_i⁻¹)⁻¹``, ``z = P Σ R_i⁻¹ z_i``. A cluster of one
+plot is that plot, unchanged. Origin of a fused plot (simulations): the target id with the
+most plots in the cluster (ties: the lower id) unless clutter plots are strictly more
+numerous, then ``−1`` (clutter-dominated).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.optimize import linear_sum_assignment
+from scipy.spatial import cKDTree
+from scipy.spatial.distance import pdist
+
+from mhtrack.records import CLUTTER, Scan
+
+#: ``Scan.sensor`` value of a fused plot made of two or more radars' plots.
+FUSED = -1
+WEIGHTINGS = ("mean", "information")
+
+
+# ---------------------------------------------------------------------- building blocks
+def sorted_distances(z: np.ndarray) -> np.ndarray:
+    """All pairwise distances ``‖z_i − z_j‖``, ``i < j``, sorted ascending (P2 §1.2 step 2)."""
+    return np.sort(pdist(np.asarray(z, float).reshape(-1, 2)))
+
+
+def dissimilarity_threshold(D: np.ndarray, k: int, n_sensors: int) -> float:
+    """``ε(k) = D(k·C(N_s, 2))`` of P2 §1.2 step 3, ``D`` sorted ascending and indexed
+    1-based as printed (0-based index ``k·C(N_s,2) − 1``), clipped to ``D``'s range.
+
+    ``0`` when there is one radar (``C(1, 2) = 0``: nothing to fuse) or at most one plot.
+    """
+    pairs = n_sensors * (n_sensors - 1) // 2
+    if pairs == 0 or len(D) == 0:
+        return 0.0
+    return float(D[int(np.clip(k * pairs - 1, 0, len(D) - 1))])
+
+
+def _means(z: np.ndarray, labels: np.ndarray, k: int) -> tuple[np.ndarray, np.ndarray]:
+    """Centre ``(1/n_j) Σ x`` of each label ``0..k−1`` and the counts ``n_j``."""
+    n = np.bincount(labels, minlength=k)
+    c = np.column_stack(
+        (np.bincount(labels, z[:, 0], minlength=k), np.bincount(labels, z[:, 1], minlength=k))
+    )
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return c / n[:, None], n
+
+
+def _compact(labels: np.ndarray) -> np.ndarray:
+    """Relabel to ``0..k−1`` keeping the order of the old labels (drops unused ones)."""
+    _, inv = np.unique(labels, return_inverse=True)
+    return inv.astype(np.int64)
+
+
+def _cluster_cov(R: np.ndarray, labels: np.ndarray, k: int) -> np.ndarray:
+    """Covariance of each cluster's mean, ``R̄ = (1/n²) Σ R_i`` (independent plots)."""
+    n = np.bincount(labels, minlength=k)
+    Rc = np.zeros((k, 2, 2))
+    np.add.at(Rc, labels, R)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return Rc / (n**2)[:, None, None]
+
+
+def _mahalanobis2(delta: np.ndarray, S: np.ndarray) -> np.ndarray:
+    """``Δᵀ S⁻¹ Δ`` over stacked 2-vectors and symmetric 2×2 matrices."""
+    a, b, d = S[..., 0, 0], S[..., 0, 1], S[..., 1, 1]
+    x, y = delta[..., 0], delta[..., 1]
+    return (d * x * x - 2 * b * x * y + a * y * y) / (a * d - b * b)
+
+
+def _lmax(S: np.ndarray) -> np.ndarray:
+    """Largest eigenvalue of stacked symmetric 2×2 matrices."""
+    tr = S[..., 0, 0] + S[..., 1, 1]
+    det = S[..., 0, 0] * S[..., 1, 1] - S[..., 0, 1] ** 2
+    return 0.5 * tr + np.sqrt(np.maximum(0.25 * tr * tr - det, 0.0))
+
+
+def _gated_assignment(
+    z: np.ndarray,
+    centres: np.ndarray,
+    eps: float,
+    R: np.ndarray | None = None,
+    Rc: np.ndarray | None = None,
+    gamma: float | None = None,
+) -> np.ndarray:
+    """One-to-one assignment of plots ``z`` to ``centres`` (P2 §1.2 step 4 with the
+    one-plot-per-radar rule). Returns the centre index per plot, or ``−1`` for a plot
+    that opens a new cluster.
+
+    A pair is *allowed* when ``‖z − c‖ ≤ eps`` (P2) or, with plot covariances ``R``,
+    centre covariances ``Rc`` and a gate ``gamma``, when ``(z − c)ᵀ (R + R̄c)⁻¹ (z − c) ≤ γ``
+    (ours). Among allowed pairs the assignment minimises the total cost
+    (``linear_sum_assignment``), leaving a plot unassigned costing ``stay``: without
+    covariances cost ``‖z − c‖²`` and ``stay = eps²``; with them cost ``min(d², γ⁻)`` and
+    ``stay = γ`` (``γ⁻`` just below ``γ``: a pair allowed by ``ε`` alone joins only when
+    it takes no better pair's centre). A plot joins when an allowed centre is left for it.
+    """
+    m = len(z)
+    out = np.full(m, -1, np.int64)
+    if m == 0 or len(centres) == 0:
+        return out
+    stat = R is not None and Rc is not None and gamma is not None
+    radius = eps
+    if stat:
+        radius = max(eps, float(np.sqrt(gamma * (_lmax(R).max() + _lmax(Rc).max()))))
+    near = cKDTree(centres).query_ball_point(z, radius * (1 + 1e-12) + 1e-9)
+    cols = np.unique(np.fromiter((j for h in near for j in h), np.int64))
+    if cols.size == 0:
+        return out
+    delta = z[:, None, :] - centres[None, cols, :]
+    d2 = (delta**2).sum(-1)
+    allowed = d2 <= eps * eps
+    if stat:
+        dm = _mahalanobis2(delta, R[:, None] + Rc[None, cols])  # type: ignore[index]
+        allowed |= dm <= gamma
+        stay = float(gamma)  # type: ignore[arg-type]
+        cost = np.minimum(dm, stay * (1 - 1e-9))  # allowed by ε only: just below "stay"
+    else:
+        cost = d2
+        stay = eps * eps
+    if not allowed.any():
+        return out
+    big = 2.0 * stay + 1.0
+    full = np.full((m, len(cols) + m), big)
+    full[:, : len(cols)] = np.where(allowed, cost, big)
+    full[np.arange(m), len(cols) + np.arange(m)] = stay  # "open a new cluster"
+    r, c = linear_sum_assignment(full)
+    hit = (c < len(cols)) & (full[r, c] < big)
+    out[r[hit]] = cols[c[hit]]
+    return out
+
+
+def _sensor_order(sensor: np.ndarray) -> np.ndarray:
+    """Radar ids, the one with the most plots first (ties: lower id)."""
+    ids, counts = np.unique(sensor, return_counts=True)
+    return ids[np.lexsort((ids, -counts))]
+
+
+def adaptive_initial_centres(
+    z: np.ndarray,
+    sensor: np.ndarray,
+    *,
+    R: np.ndarray | None = None,
+    gamma: float | None = None,
+    max_threshold: float | None = None,
+) -> tuple[np.ndarray, np.ndarray, float]:
+    """P2 §1.2 steps 1–6: the number of clusters and their initial centres.
+
+    Radar by radar (most plots first), each plot joins an allowed centre or opens a
+    cluster (:func:`_gated_assignment`: ``‖z − c‖ ≤ ε(k)``, or the Mahalanobis gate
+    ``γ`` when ``R`` and ``gamma`` are given); ``ε(k) = D(k·C(N_s, 2))`` is re-read from
+    the sorted distances as ``k`` grows (capped at ``max_threshold`` when given); centres
+    are the means of their plots. Returns ``(centres (k, 2), labels (n,), ε(k))``.
+    """
+    z = np.asarray(z, float).reshape(-1, 2)
+    sensor = np.asarray(sensor).reshape(-1)
+    n = len(z)
+    labels = np.full(n, -1, np.int64)
+    if n == 0:
+        return np.zeros((0, 2)), labels, 0.0
+    order = _sensor_order(sensor)
+    D = sorted_distances(z)
+    ns = len(order)
+
+    def eps(k: int) -> float:
+        e = dissimilarity_threshold(D, k, ns)
+        return e if max_threshold is None else min(e, max_threshold)
+
+    first = np.flatnonzero(sensor == order[0])
+    labels[first] = np.arange(len(first))
+    k = len(first)
+    centres = z[first].copy()
+    Rc = None if R is None else R[first].copy()
+    for s in order[1:]:
+        idx = np.flatnonzero(sensor == s)
+        a = _gated_assignment(z[idx], centres, eps(k), None if R is None else R[idx], Rc, gamma)
+        new = a < 0
+        a[new] = k + np.arange(int(new.sum()))
+        labels[idx] = a
+        k += int(new.sum())
+        placed = labels >= 0
+        centres, _ = _means(z[placed], labels[placed], k)
+        if R is not None:
+            Rc = _cluster_cov(R[placed], labels[placed], k)
+    return centres, labels, eps(k)
+
+
+def kmeans_lloyd(
+    z: np.ndarray, centres: np.ndarray, *, max_iter: int = 300
+) -> tuple[np.ndarray, np.ndarray, int]:
+    """Standard K-means (P2 §1.1; Lloyd's algorithm) from the given initial ``centres``.
+
+    Repeat: ``label_i = argmin_j ‖z_i − c_j‖``, ``c_j = mean{z_i : label_i = j}``, until
+    the labels do not change (or ``max_iter`` assignments). A centre left with no plot is
+    dropped (scikit-learn moves it to a far plot instead; with centres drawn from the plots
+    this is rare). Returns ``(centres, labels, n_iter)``; centres are the means of the
+    final labels. Equals ``sklearn.cluster.KMeans(init=centres, n_init=1, tol=0)``
+    when no cluster empties.
+    """
+    z = np.asarray(z, float).reshape(-1, 2)
+    c = np.asarray(centres, float).reshape(-1, 2).copy()
+    if len(z) == 0 or len(c) == 0:
+        return c[:0], np.zeros(len(z), np.int64), 0
+    prev: np.ndarray | None = None
+    n_iter = 0
+    while n_iter < max_iter:
+        n_iter += 1
+        labels = cKDTree(c).query(z)[1].astype(np.int64)
+        if prev is not None and np.array_equal(labels, prev):
+            break
+        c, cnt = _means(z, labels, len(c))
+        if (cnt == 0).any():
+            labels = _compact(labels)
+            c, _ = _means(z, labels, int(labels.max()) + 1)
+        prev = labels
+    labels = _compact(labels)
+    c, _ = _means(z, labels, int(labels.max()) + 1)
+    return c, labels, n_iter
+
+
+def enforce_one_plot_per_sensor(
+    z: np.ndarray,
+    sensor: np.ndarray,
+    labels: np.ndarray,
+    eps: float,
+    R: np.ndarray | None = None,
+    gamma: float | None = None,
+) -> np.ndarray:
+    """Labels in which no cluster holds two plots of one radar (P2 §1.2, §3.1).
+
+    For each radar with offending clusters, its plots in those clusters are re-assigned by
+    :func:`_gated_assignment` (one plot per centre, minimal total cost, within ``eps`` or
+    the Mahalanobis gate ``gamma``) to the offending clusters and to the clusters holding
+    no plot of that radar; a plot left over opens its own cluster (a split). Other labels
+    are kept. Returns compact labels ``0..k−1``.
+    """
+    z = np.asarray(z, float).reshape(-1, 2)
+    sensor = np.asarray(sensor).reshape(-1)
+    labels = np.asarray(labels, np.int64).copy()
+    if len(z) == 0:
+        return labels
+    labels = _compact(labels)
+    k = int(labels.max()) + 1
+    centres, _ = _means(z, labels, k)
+    Rc = None if R is None else _cluster_cov(R, labels, k)
+    for s in np.unique(sensor):
+        mine = sensor == s
+        per = np.bincount(labels[mine], minlength=k)
+        bad = per > 1
+        if not bad.any():
+            continue
+        idx = np.flatnonzero(mine & bad[labels])
+        targets = np.flatnonzero(bad | (per == 0))
+        a = _gated_assignment(
+            z[idx], centres[targets], eps,
+            None if R is None else R[idx], None if Rc is None else Rc[targets], gamma,
+        )
+        new = a < 0
+        lab = np.where(new, -1, targets[np.maximum(a, 0)])
+        lab[new] = k + np.arange(int(new.sum()))
+        k += int(new.sum())
+        labels[idx] = lab
+        centres = np.vstack((centres, z[idx[new]]))
+        if Rc is not None and R is not None:
+            Rc = np.concatenate((Rc, R[idx[new]]))
+    return _compact(labels)
+
+
+def merge_compatible_clusters(
+    z: np.ndarray,
+    sensor: np.ndarray,
+    labels: np.ndarray,
+    eps: float,
+    R: np.ndarray | None = None,
+    gamma: float | None = None,
+) -> np.ndarray:
+    """Merge clusters that hold no plot of a common radar and look like one target (ours).
+
+    P2's threshold ``ε(k)`` is the largest within-cluster distance only when targets are
+    farther apart than their plots' spread; otherwise it is too small and a plot opens a
+    cluster of its own beside its target's. Two *compatible* clusters (no common radar:
+    their union still has one plot per radar) are merged when their centres pass
+
+    * with the plots' covariances ``R`` and a gate ``gamma``: the Mahalanobis test
+      ``d² = Δᵀ (R̄_a + R̄_b)⁻¹ Δ ≤ γ`` (``Δ`` the centre difference, ``R̄ = (1/n²) Σ R_i``
+      the covariance of a cluster mean; ``d²`` is χ²₂ when both are one target);
+    * otherwise: ``‖Δ‖ ≤ eps``.
+
+    Each round merges the pairs that are each other's nearest (in that test's distance)
+    compatible partner — reciprocal nearest neighbours, candidates from a k-d tree — and
+    rounds repeat until none is left. Returns compact labels.
+    """
+    z = np.asarray(z, float).reshape(-1, 2)
+    labels = np.asarray(labels, np.int64).copy()
+    maha = R is not None and gamma is not None
+    if len(labels) == 0 or (not maha and eps <= 0):
+        return labels
+    ids, s_idx = np.unique(np.asarray(sensor).reshape(-1), return_inverse=True)
+    if maha:
+        R = np.asarray(R, float).reshape(-1, 2, 2)
+    while True:
+        labels = _compact(labels)
+        k = int(labels.max()) + 1
+        centres, _ = _means(z, labels, k)
+        has = np.zeros((k, len(ids)), bool)
+        has[labels, s_idx] = True
+        if maha:
+            Rc = _cluster_cov(R, labels, k)  # type: ignore[arg-type]
+            # d² ≤ γ needs ‖Δ‖² ≤ γ·λmax(R̄a + R̄b) ≤ γ·2·max λmax(R̄)
+            radius = float(np.sqrt(gamma * 2.0 * _lmax(Rc).max()))  # type: ignore[operator]
+        else:
+            radius = eps
+        pairs = cKDTree(centres).query_pairs(radius, output_type="ndarray")
+        if len(pairs):
+            pairs = pairs[~(has[pairs[:, 0]] & has[pairs[:, 1]]).any(axis=1)]
+        if len(pairs):
+            delta = centres[pairs[:, 0]] - centres[pairs[:, 1]]
+            if maha:
+                d = _mahalanobis2(delta, Rc[pairs[:, 0]] + Rc[pairs[:, 1]])
+                keep = d <= gamma
+            else:
+                d = np.hypot(delta[:, 0], delta[:, 1])
+                keep = d <= eps
+            pairs, d = pairs[keep], d[keep]
+        if len(pairs) == 0:
+            return labels
+        a = np.concatenate((pairs[:, 0], pairs[:, 1]))
+        b = np.concatenate((pairs[:, 1], pairs[:, 0]))
+        o = np.lexsort((b, np.tile(d, 2), a))  # per cluster a: nearest partner first
+        a, b = a[o], b[o]
+        first = np.r_[True, a[1:] != a[:-1]]
+        nn = np.full(k, -1, np.int64)
+        nn[a[first]] = b[first]
+        ar = np.arange(k)
+        mutual = (nn >= 0) & (nn[np.maximum(nn, 0)] == ar) & (ar < nn)
+        if not mutual.any():  # exact ties only: merge the closest pair
+            i, j = sorted(pairs[int(np.argmin(d))].tolist())
+            mutual[i], nn[i] = True, j
+        into = ar.copy()
+        into[nn[mutual]] = ar[mutual]
+        labels = into[labels]
+
+
+# ---------------------------------------------------------------------- fused output
+def fuse_clusters(
+    z: np.ndarray,
+    labels: np.ndarray,
+    R: np.ndarray | None = None,
+    *,
+    weighting: str = "mean",
+) -> tuple[np.ndarray, np.ndarray | None]:
+    """One fused plot per cluster ``0..k−1`` and its covariance.
+
+    ``"mean"`` (P2): ``z̄ = (1/n) Σ z_i``, ``R̄ = (1/n²) Σ R_i``. ``"information"``:
+    ``P = (Σ R_i⁻¹)⁻¹``, ``z = P Σ R_i⁻¹ z_i`` (needs ``R``). A one-plot cluster gives that
+    plot and its ``R`` exactly in both cases.
+    """
+    if weighting not in WEIGHTINGS:
+        raise ValueError(f"weighting must be one of {WEIGHTINGS}, got {weighting!r}")
+    z = np.asarray(z, float).reshape(-1, 2)
+    labels = np.asarray(labels, np.int64)
+    k = int(labels.max()) + 1 if len(labels) else 0
+    zc, n = _means(z, labels, k)
+    if R is None:
+        if weighting == "information":
+            raise ValueError("information weighting needs the plots' covariances R")
+        return zc, None
+    R = np.asarray(R, float).reshape(-1, 2, 2)
+    if weighting == "mean":
+        Rs = np.zeros((k, 2, 2))
+        np.add.at(Rs, labels, R)
+        Rc = Rs / (n**2)[:, None, None]
+    else:
+        W = np.linalg.inv(R)
+        Wsum = np.zeros((k, 2, 2))
+        np.add.at(Wsum, labels, W)
+        wz = np.zeros((k, 2))
+        np.add.at(wz, labels, np.einsum("nij,nj->ni", W, z))
+        Rc = np.linalg.inv(Wsum)
+        zc = np.einsum("kij,kj->ki", Rc, wz)
+    single = n == 1
+    if single.any():  # exactly the plot: no rounding from inverting twice
+        first = np.full(k, -1, np.int64)
+        first[labels[::-1]] = np.arange(len(labels))[::-1]
+        zc[single] = z[first[single]]
+        Rc[single] = R[first[single]]
+    return zc, 0.5 * (Rc + np.swapaxes(Rc, 1, 2))
+
+
+def majority_origin(origin: np.ndarray, labels: np.ndarray, k: int) -> np.ndarray:
+    """Origin of each fused plot: the target id with the most plots in the cluster (ties:
+    the lower id), or ``−1`` when its clutter plots are strictly more numerous."""
+    origin = np.asarray(origin, np.int64)
+    out = np.full(k, CLUTTER, np.int64)
+    if len(origin) == 0:
+        return out
+    n_clutter = np.bincount(labels[origin < 0], minlength=k)
+    t = origin >= 0
+    if t.any():
+        pairs, counts = np.unique(
+            np.column_stack((labels[t], origin[t])), axis=0, return_counts=True
+        )
+        # per label: max count, ties to the lower id → sort by (label, −count, id)
+        o = np.lexsort((pairs[:, 1], -counts, pairs[:, 0]))
+        pairs, counts = pairs[o], counts[o]
+        first = np.r_[True, pairs[1:, 0] != pairs[:-1, 0]]
+        lab, oid, cnt = pairs[first, 0], pairs[first, 1], counts[first]
+        win = cnt >= n_clutter[lab]
+        out[lab[win]] = oid[win]
+    return out
+
+
+# ---------------------------------------------------------------------- estimators
+@dataclass(frozen=True, slots=True)
+class FusedScan:
+    """Result of fusing one scan.
+
+    ``scan`` holds one plot per cluster: ``z`` the fused position, ``R`` its covariance,
+    ``sensor`` the radar id for a one-plot cluster or :data:`FUSED` (−1), ``rows`` the
+    index of the fused plot in this scan (``0..k−1``; the input plots are mapped by
+    ``labels``), ``origin`` the majority origin (:func:`majority_origin`) when known.
+    ``labels[i]`` is the cluster of input plot ``i``; ``threshold`` the final ``ε``.
+    """
+
+    scan: Scan
+    labels: np.ndarray
+    threshold: float
+
+    @property
+    def n_clusters(self) -> int:
+        return len(self.scan)
+
+
+class _Fusion:
+    """Shared ``fit`` output handling and :meth:`fuse` (scikit-learn style)."""
+
+    weighting: str
+    max_iter: int
+    cluster_centers_: np.ndarray
+    labels_: np.ndarray
+    threshold_: float
+    n_iter_: int
+
+    def _check(self, z: object, sensor: object) -> tuple[np.ndarray, np.ndarray]:
+        if self.weighting not in WEIGHTINGS:
+            raise ValueError(f"weighting must be one of {WEIGHTINGS}, got {self.weighting!r}")
+        if not (isinstance(self.max_iter, int) and self.max_iter >= 1):
+            raise ValueError(f"max_iter must be an integer >= 1, got {self.max_iter!r}")
+        za = np.asarray(z, float)
+        if za.size == 0:
+            za = za.reshape(0, 2)
+        if za.ndim != 2 or za.shape[1] != 2:
+            raise ValueError(f"plots must have shape (n, 2), got {za.shape}")
+        if not np.isfinite(za).all():
+            raise ValueError("plots contain non-finite coordinates")
+        s = np.zeros(len(za), np.int64) if sensor is None else np.asarray(sensor).reshape(-1)
+        if len(s) != len(za):
+            raise ValueError(f"sensor has {len(s)} entries for {len(za)} plots")
+        return za, s
+
+    def _finish(self, z: np.ndarray, sensor: np.ndarray, labels: np.ndarray, eps: float,
+                n_iter: int, adaptive: bool, R: np.ndarray | None = None,
+                gamma: float | None = None) -> None:
+        if len(z):
+            labels = enforce_one_plot_per_sensor(z, sensor, labels, eps, R, gamma)
+            if adaptive:
+                labels = merge_compatible_clusters(z, sensor, labels, eps, R, gamma)
+        k = int(labels.max()) + 1 if len(labels) else 0
+        self.cluster_centers_, _ = _means(z, labels, k)
+        self.labels_ = labels
+        self.threshold_ = float(eps)
+        self.n_iter_ = n_iter
+
+    @property
+    def n_clusters_(self) -> int:
+        return len(self.cluster_centers_)
+
+    def fit(self, z: np.ndarray, sensor: np.ndarray | None = None,
+            R: np.ndarray | None = None) -> _Fusion:
+        raise NotImplementedError
+
+    def fuse(self, scan: Scan) -> FusedScan:
+        """Cluster ``scan``'s plots and return the fused scan (see :class:`FusedScan`)."""
+        self.fit(scan.z, scan.sensor, scan.R)
+        labels = self.labels_
+        k = self.n_clusters_
+        z, R = fuse_clusters(scan.z, labels, scan.R, weighting=self.weighting)
+        n = np.bincount(labels, minlength=k)
+        sensor = np.full(k, FUSED, np.int64)
+        single = n == 1
+        sensor[labels[single[labels]]] = scan.sensor[single[labels]]
+        origin = None if scan.origin is None else majority_origin(scan.origin, labels, k)
+        fused = Scan(scan.index, scan.time, z, sensor, np.arange(k, dtype=np.int64), R, origin)
+        return FusedScan(fused, labels, self.threshold_)
+
+
+class AdaptiveKMeansFusion(_Fusion):
+    """P2 §1.2 adaptive K-means plot fusion (module docstring): the number of clusters and
+    the initial centres from the sorted distances ``D``, then standard K-means, then the
+    one-plot-per-radar repair, then the merge of compatible clusters.
+
+    Parameters
+    ----------
+    weighting : ``"mean"`` (P2: the cluster centre) or ``"information"``.
+    merge_probability : probability ``p`` of the covariance gate ``γ = −2 ln(1 − p)``
+        (ours, 0.9999); ``None``: Euclidean ``ε`` only.
+    max_threshold : cap (m) on ``ε``; ``"auto"`` (ours): ``√(γ · 2 · max λmax(R))`` when
+        the plots carry ``R``; ``None``: P2's ``ε`` uncapped.
+    max_iter : K-means iterations at most.
+
+    Attributes (after :meth:`fit`)
+    ----------
+    initial_centers_, cluster_centers_ : (k₀, 2) adaptive initial and (k, 2) final centres.
+    labels_ : cluster of each plot. threshold_ : final ``ε``. n_iter_ : K-means iterations.
+    n_clusters_ : ``k``. threshold_cap_ : the cap applied to ``ε`` (or None).
+    """
+
+    def __init__(self, *, weighting: str = "mean", merge_probability: float | None = 0.9999,
+                 max_threshold: float | str | None = "auto", max_iter: int = 300) -> None:
+        self.weighting = weighting
+        self.merge_probability = merge_probability
+        self.max_threshold = max_threshold
+        self.max_iter = max_iter
+
+    def fit(self, z: np.ndarray, sensor: np.ndarray | None = None,
+            R: np.ndarray | None = None) -> AdaptiveKMeansFusion:
+        """Cluster plots ``z`` (n, 2) of radars ``sensor`` (n,) (all one radar if None)
+        with covariances ``R`` (n, 2, 2) (optional; used by the merge test)."""
+        za, s = self._check(z, sensor)
+        p = self.merge_probability
+        if p is not None and not 0.0 < p < 1.0:
+            raise ValueError(f"merge_probability must be in (0, 1) or None, got {p!r}")
+        gamma = None if p is None else float(-2.0 * np.log1p(-p))  # χ²₂ quantile
+        Ra = None if R is None else np.asarray(R, float).reshape(len(za), 2, 2)
+        cap = self.max_threshold
+        if cap == "auto":
+            # two plots of one target differ by N(0, R_i + R_j): farther than
+            # sqrt(γ·2·max λmax(R)) fails the gate whatever their direction
+            cap = None if Ra is None or gamma is None or not len(za) else float(
+                np.sqrt(gamma * 2.0 * _lmax(Ra).max()))
+        elif cap is not None and not (isinstance(cap, int | float) and cap > 0):
+            raise ValueError(f"max_threshold must be > 0, 'auto' or None, got {cap!r}")
+        self.threshold_cap_ = cap
+        c0, _, eps = adaptive_initial_centres(za, s, R=Ra, gamma=gamma, max_threshold=cap)
+        self.initial_centers_ = c0
+        _, labels, it = kmeans_lloyd(za, c0, max_iter=self.max_iter)
+        self._finish(za, s, labels, eps, it, adaptive=True, R=Ra, gamma=gamma)
+        return self
+
+
+class KMeansFusion(_Fusion):
+    """Standard K-means plot fusion (P2 §1.1): ``n_clusters`` initial centres drawn at
+    random among the plots (without replacement, ``numpy.random.default_rng(random_state)``),
+    then Lloyd iterations, then the one-plot-per-radar repair with the threshold
+    ``ε(k) = D(k·C(N_s, 2))`` of the adaptive method (module docstring).
+
+    ``n_clusters`` larger than the number of plots is reduced to it. Attributes as
+    :class:`AdaptiveKMeansFusion` (``initial_centers_`` are the drawn plots).
+    """
+
+    def __init__(self, n_clusters: int, *, random_state: int | Sequence[int] | None = None,
+                 weighting: str = "mean", max_iter: int = 300) -> None:
+        self.n_clusters = n_clusters
+        self.random_state = random_state
+        self.weighting = weighting
+        self.max_iter = max_iter
+
+    def fit(self, z: np.ndarray, sensor: np.ndarray | None = None,
+            R: np.ndarray | None = None) -> KMeansFusion:
+        """Cluster plots ``z`` (n, 2) of radars ``sensor`` (n,) (all one radar if None);
+        ``R`` is accepted for a common interface and not used."""
+        za, s = self._check(z, sensor)
+        if not (isinstance(self.n_clusters, int | np.integer) and self.n_clusters >= 1):
+            raise ValueError(f"n_clusters must be an integer >= 1, got {self.n_clusters!r}")
+        rng = np.random.default_rng(self.random_state)
+        k = min(int(self.n_clusters), len(za))
+        c0 = za[rng.choice(len(za), size=k, replace=False)] if k else np.zeros((0, 2))
+        self.initial_centers_ = c0
+        c, labels, it = kmeans_lloyd(za, c0, max_iter=self.max_iter)
+        eps = dissimilarity_threshold(sorted_distances(za), len(c), len(np.unique(s)))
+        self._finish(za, s, labels, eps, it, adaptive=False)
+        return self

@@ -1,0 +1,172 @@
+"""M/N logic track initiation and P2's modified logic with an angle constraint (P2 §2.1).
+
+Over a window of ``N`` scans (P2: 4) a track is started when plots at ``≥ M`` of them
+(P2: 3) line up (the "3/4 logic", P2 ref. [1]). As implemented, scan by scan (slots
+``0 … N−1`` of the window, times ``t_s``):
+
+* **start**: every plot of a slot ``s ≤ N − M`` opens a partial track (its earlier slots
+  are misses);
+* **second plot** (velocity gate): a partial track with one plot ``z_a`` takes every plot
+  ``z`` of the next slot with ``v_min ≤ ‖z − z_a‖ / (t − t_a) ≤ v_max``;
+* **later plots** (position gate): with its last two plots ``z_p, z_q`` the track predicts
+  ``ẑ = z_q + (z_q − z_p)(t − t_q)/(t_q − t_p)`` and takes every plot with ``‖z − ẑ‖ ≤ r``
+  (P2: ``r = 300 m``, the same radius whatever the number of missed scans);
+* **modified logic** (P2 §2.1, after Su & Wang, P2 ref. [7]): a later plot is taken only
+  if the angle between the new leg ``z − z_q`` and the previous leg ``z_q − z_p`` is
+  ``α ≤ θ`` (P2: ``θ = 20°``), ``cos α = (z − z_q)·(z_q − z_p) / (‖z − z_q‖ ‖z_q − z_p‖)``;
+  this rejects V-shaped tracks;
+* a partial track branches on **every** plot in its gate; it records a miss only when its
+  gate is empty, and is dropped after more than ``N − M`` misses;
+* at the end, tracks with ``≥ M`` plots are initiated, except duplicates and tracks whose
+  plots are all in another initiated track (:func:`~mhtrack.initiation.window.remove_dominated`).
+
+``v_min = 50``, ``v_max = 400`` m/s are our defaults for P2's 200 m/s targets (P2 gives
+none). Every step works on arrays of partial tracks; candidates come from a k-d tree ball
+query on the slot's plots. The initial state is the least-squares line fit of
+:mod:`mhtrack.initiation.window`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from itertools import chain
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from mhtrack.initiation.window import (
+    NO_PLOT,
+    InitiatedTracks,
+    Window,
+    last_slot,
+    least_squares_state,
+    previous_plot,
+    remove_dominated,
+)
+from mhtrack.records import Scan
+
+
+def check_common(n_scans: int, min_plots: int, v_min: float, v_max: float) -> None:
+    """Validate the window and velocity-gate parameters shared by the initiators."""
+    if not (isinstance(n_scans, int) and n_scans >= 2):
+        raise ValueError(f"n_scans must be an integer >= 2, got {n_scans!r}")
+    if not (isinstance(min_plots, int) and 2 <= min_plots <= n_scans):
+        raise ValueError(f"min_plots must be an integer in [2, n_scans], got {min_plots!r}")
+    if not (0 <= v_min < v_max and np.isfinite(v_max)):
+        raise ValueError(f"need 0 <= v_min < v_max < inf, got v_min={v_min}, v_max={v_max}")
+
+
+def leg_angle(new: np.ndarray, prev: np.ndarray) -> np.ndarray:
+    """Angle (rad, in ``[0, π]``) between leg vectors ``new`` and ``prev`` (…, 2):
+    ``α = arccos(new·prev / (‖new‖ ‖prev‖))``; ``π`` when a leg has zero length."""
+    dot = (new * prev).sum(-1)
+    nn = np.hypot(new[..., 0], new[..., 1]) * np.hypot(prev[..., 0], prev[..., 1])
+    with np.errstate(invalid="ignore", divide="ignore"):
+        c = np.where(nn > 0, dot / nn, -1.0)
+    return np.arccos(np.clip(c, -1.0, 1.0))
+
+
+def _ball(tree: cKDTree, centres: np.ndarray, radius: np.ndarray | float,
+          ) -> tuple[np.ndarray, np.ndarray]:
+    """(query row, hit) pairs of a ball query, flattened."""
+    if len(centres) == 0 or tree.n == 0:
+        e = np.zeros(0, np.int64)
+        return e, e
+    hits = tree.query_ball_point(centres, radius)
+    counts = np.fromiter((len(h) for h in hits), np.int64, count=len(hits))
+    q = np.repeat(np.arange(len(hits), dtype=np.int64), counts)
+    j = np.fromiter(chain.from_iterable(hits), np.int64, count=int(counts.sum()))
+    return q, j
+
+
+class LogicInitiator:
+    """M/N logic initiation, plain (P2's 3/4 logic) or modified with the angle constraint
+    ``α ≤ θ`` (P2 §2.1) — see the module docstring.
+
+    Parameters
+    ----------
+    angle_limit_deg : ``θ`` in degrees for the modified logic (P2: 20); ``None`` = plain.
+    gate_radius : ``r`` (m) of the position gate (P2: 300).
+    v_min, v_max : velocity gate (m/s) of the second plot (ours: 50, 400).
+    n_scans, min_plots : ``N`` and ``M`` (P2: 4 and 3).
+    """
+
+    def __init__(self, *, angle_limit_deg: float | None = None, gate_radius: float = 300.0,
+                 v_min: float = 50.0, v_max: float = 400.0, n_scans: int = 4,
+                 min_plots: int = 3) -> None:
+        self.angle_limit_deg = angle_limit_deg
+        self.gate_radius = gate_radius
+        self.v_min = v_min
+        self.v_max = v_max
+        self.n_scans = n_scans
+        self.min_plots = min_plots
+
+    def _validate(self) -> None:
+        check_common(self.n_scans, self.min_plots, self.v_min, self.v_max)
+        if not self.gate_radius > 0:
+            raise ValueError(f"gate_radius must be > 0, got {self.gate_radius!r}")
+        a = self.angle_limit_deg
+        if a is not None and not 0 <= a <= 180:
+            raise ValueError(f"angle_limit_deg must be in [0, 180] or None, got {a!r}")
+
+    def initiate(self, scans: Sequence[Scan] | Window) -> InitiatedTracks:
+        """Tracks started in the window of ``scans`` (``n_scans`` scans, in time order)."""
+        self._validate()
+        w = scans if isinstance(scans, Window) else Window.from_scans(scans)
+        if w.n_scans != self.n_scans:
+            raise ValueError(f"window has {w.n_scans} scans, expected {self.n_scans}")
+        flat = self._tracks(w)
+        keep = remove_dominated(flat)
+        flat = flat[keep]
+        x, P = least_squares_state(w, flat)
+        plots = np.where(flat >= 0, w.index[np.maximum(flat, 0)], NO_PLOT)
+        return InitiatedTracks(w.scans, float(w.times[-1]), plots, flat, x, P)
+
+    def _tracks(self, w: Window) -> np.ndarray:
+        N, M = self.n_scans, self.min_plots
+        max_miss = N - M
+        z, t = w.z, w.times
+        # partial tracks: path (P, N) of flat indices; last, prev hit; hits; misses
+        path = np.full((0, N), NO_PLOT, np.int64)
+        for c in range(N):
+            rows = w.rows(c)
+            if len(path):
+                last = path[np.arange(len(path)), last_slot(path)]
+                prev = previous_plot(path)
+                hits = (path >= 0).sum(axis=1)
+                miss = c - hits  # slots 0..c−1 are decided: each a plot or a miss
+                tree = cKDTree(z[rows]) if len(rows) else None
+                q_all, j_all = [], []
+                one = np.flatnonzero(hits == 1)
+                if len(one) and tree is not None:
+                    dt = t[c] - t[w.slot[last[one]]]
+                    q, j = _ball(tree, z[last[one]], self.v_max * dt)
+                    d = np.hypot(*(z[rows[j]] - z[last[one[q]]]).T)
+                    ok = d >= self.v_min * dt[q]
+                    q_all.append(one[q[ok]])
+                    j_all.append(rows[j[ok]])
+                more = np.flatnonzero(hits >= 2)
+                if len(more) and tree is not None:
+                    a, b = prev[more], last[more]
+                    step = (t[c] - t[w.slot[b]]) / (t[w.slot[b]] - t[w.slot[a]])
+                    leg = z[b] - z[a]
+                    pred = z[b] + leg * step[:, None]
+                    q, j = _ball(tree, pred, self.gate_radius)
+                    if self.angle_limit_deg is not None and len(q):
+                        new = z[rows[j]] - z[b[q]]
+                        ok = leg_angle(new, leg[q]) <= np.radians(self.angle_limit_deg)
+                        q, j = q[ok], j[ok]
+                    q_all.append(more[q])
+                    j_all.append(rows[j])
+                q = np.concatenate(q_all) if q_all else np.zeros(0, np.int64)
+                j = np.concatenate(j_all) if j_all else np.zeros(0, np.int64)
+                extended = path[q].copy()
+                extended[:, c] = j
+                empty = np.bincount(q, minlength=len(path)) == 0
+                missed = path[empty & (miss + 1 <= max_miss)]
+                path = np.concatenate((extended, missed))
+            if c <= max_miss and len(rows):
+                born = np.full((len(rows), N), NO_PLOT, np.int64)
+                born[:, c] = rows
+                path = np.concatenate((path, born))
+        return path[(path >= 0).sum(axis=1) >= M]

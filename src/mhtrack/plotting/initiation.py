@@ -1,0 +1,188 @@
+"""Figures of multi-radar plot fusion and track initiation (P2 Figs. 2, 10–15).
+
+* :func:`clustering_figure` — one panel per clustering method: the scan's plots coloured
+  by cluster (marker by radar) and the cluster centres as circles (P2 Fig. 2: random vs
+  adaptive initial centres);
+* :func:`initiation_figure` — the raw plots of one 4-scan window (P2 Fig. 10), the fused
+  plots (Fig. 11), and the tracks each method initiates (Figs. 12–15): true tracks green,
+  false ones red (``docs/initiation.md`` for "true").
+
+``clustering_figure_for`` / ``initiation_figure_for`` simulate the first run of a
+``--seed`` (as the CLI does) and draw it. Axes zoom on the targets (truth box + margin).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Any
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt
+import numpy as np
+from matplotlib.axes import Axes
+from matplotlib.figure import Figure
+
+from mhtrack.initiation import (
+    INITIATORS,
+    FusedScan,
+    InitiatedTracks,
+    Window,
+    make_initiator,
+    sliding_windows,
+)
+from mhtrack.initiation.runs import fuse, fused_scans, run_seeds
+from mhtrack.metrics.initiation import track_targets
+from mhtrack.records import Scan, TruthTable
+from mhtrack.scenario import Scenario, simulate
+
+MARKERS = "o^sDvP*X"
+SCAN_COLOURS = ("tab:blue", "tab:orange", "tab:green", "tab:purple", "tab:brown", "tab:cyan")
+
+
+def _zoom(ax: Axes, truth_xy: np.ndarray | None, margin: float = 800.0) -> None:
+    if truth_xy is None or len(truth_xy) == 0:
+        return
+    lo, hi = truth_xy.min(axis=0) - margin, truth_xy.max(axis=0) + margin
+    ax.set_xlim(lo[0], hi[0])
+    ax.set_ylim(lo[1], hi[1])
+
+
+def _finish(ax: Axes, title: str) -> None:
+    ax.set_aspect("equal", adjustable="box")
+    ax.set_xlabel("x east (m)")
+    ax.set_ylabel("y north (m)")
+    ax.grid(True, lw=0.3, alpha=0.5)
+    ax.set_title(title, fontsize=9)
+
+
+def draw_clusters(ax: Axes, scan: Scan, fused: FusedScan) -> None:
+    """Plots coloured by cluster, marker by radar; centres as open circles."""
+    cmap = plt.get_cmap("tab20")
+    radars = np.unique(scan.sensor)
+    for r_i, r in enumerate(radars):
+        m = scan.sensor == r
+        ax.scatter(scan.z[m, 0], scan.z[m, 1], s=14, c=[cmap(v % 20) for v in fused.labels[m]],
+                   marker=MARKERS[r_i % len(MARKERS)], lw=0, label=f"radar {r}")
+    c = fused.scan.z
+    ax.scatter(c[:, 0], c[:, 1], s=120, facecolors="none", edgecolors="k", lw=0.8,
+               label=f"{len(c)} cluster centres")
+
+
+def clustering_figure(scan: Scan, fused: Mapping[str, FusedScan],
+                      truth_xy: np.ndarray | None = None, *, title: str = "") -> Figure:
+    """One panel per method of ``fused`` (name → :class:`FusedScan` of ``scan``)."""
+    n = len(fused)
+    fig, axes = plt.subplots(1, n, figsize=(6 * n, 5.6), squeeze=False)
+    for ax, (name, f) in zip(axes[0], fused.items(), strict=True):
+        draw_clusters(ax, scan, f)
+        if truth_xy is not None:
+            ax.plot(truth_xy[:, 0], truth_xy[:, 1], "k+", ms=9, label="truth")
+        _zoom(ax, truth_xy)
+        _finish(ax, f"{name}: k = {f.n_clusters}")
+        ax.legend(fontsize=7, loc="upper right")
+    if title:
+        fig.suptitle(title)
+    return fig
+
+
+def draw_window(ax: Axes, window: Window, *, clutter_grey: bool = True) -> None:
+    """The window's plots, one colour per scan; clutter (origin −1) grey when known."""
+    for s in range(window.n_scans):
+        r = window.rows(s)
+        z = window.z[r]
+        col = SCAN_COLOURS[s % len(SCAN_COLOURS)]
+        if window.origin is not None and clutter_grey:
+            cl = window.origin[r] < 0
+            ax.scatter(z[cl, 0], z[cl, 1], s=6, c="0.65", lw=0,
+                       label="clutter" if s == 0 else None)
+            z = z[~cl]
+        ax.scatter(z[:, 0], z[:, 1], s=14, c=col, marker=MARKERS[s % len(MARKERS)], lw=0,
+                   label=f"scan {window.scans[s]}")
+
+
+def draw_tracks(ax: Axes, window: Window, tracks: InitiatedTracks) -> None:
+    """Initiated tracks: polylines through their plots; true green, false red."""
+    true = (track_targets(tracks.origins(window)) >= 0 if window.origin is not None
+            else np.ones(len(tracks), bool))
+    for ok in (False, True):  # false first so true tracks are drawn on top
+        for row in tracks.flat[true == ok]:
+            p = window.z[row[row >= 0]]
+            ax.plot(p[:, 0], p[:, 1], "-", color="tab:green" if ok else "tab:red",
+                    lw=1.4 if ok else 0.6, alpha=0.9 if ok else 0.5)
+    n_true = int(true.sum())
+    ax.plot([], [], "-", color="tab:green", label=f"true tracks ({n_true})")
+    ax.plot([], [], "-", color="tab:red", label=f"false tracks ({len(tracks) - n_true})")
+
+
+def initiation_figure(raw: Window, fused: Window, results: Mapping[str, InitiatedTracks],
+                      truth_xy: np.ndarray | None = None, *, title: str = "") -> Figure:
+    """Raw and fused plots of one window, then one panel per method (P2 Figs. 10–15)."""
+    n = 2 + len(results)
+    cols = 3
+    rows = -(-n // cols)
+    fig, axes = plt.subplots(rows, cols, figsize=(5.2 * cols, 5.0 * rows), squeeze=False)
+    flat_axes = list(axes.ravel())
+    draw_window(flat_axes[0], raw)
+    draw_window(flat_axes[1], fused)
+    for ax, name in ((flat_axes[0], "plots of the window"), (flat_axes[1], "fused plots")):
+        _zoom(ax, truth_xy)
+        _finish(ax, name)
+        ax.legend(fontsize=7, loc="upper right", markerscale=1.5)
+    for ax, (name, tr) in zip(flat_axes[2:], results.items(), strict=False):
+        draw_window(ax, fused)
+        draw_tracks(ax, fused, tr)
+        _zoom(ax, truth_xy)
+        _finish(ax, name)
+        handles, labels = ax.get_legend_handles_labels()
+        keep = [i for i, lab in enumerate(labels) if "tracks" in lab]
+        ax.legend([handles[i] for i in keep], [labels[i] for i in keep], fontsize=7,
+                  loc="upper right")
+    for ax in flat_axes[n:]:
+        ax.axis("off")
+    if title:
+        fig.suptitle(title)
+    return fig
+
+
+def _truth_at(truth: TruthTable, scans: np.ndarray) -> np.ndarray:
+    return truth.positions[np.isin(truth.scan, scans)]
+
+
+def clustering_figure_for(scenario: Scenario, seed: int, *, scan_number: int = 0) -> Figure:
+    """Adaptive vs random K-means on one scan of the first run of ``seed``."""
+    rs = run_seeds(seed, 1)[0]
+    sim = simulate(scenario, rs)
+    scan = list(sim.plots.scans())[scan_number]
+    fused = {m: fuse(scan, m, run_seed=rs) for m in ("random", "adaptive")}
+    names = {"random": "K-means, random initial centres",
+             "adaptive": "adaptive K-means (P2 §1.2)"}
+    return clustering_figure(scan, {names[k]: v for k, v in fused.items()},
+                             _truth_at(sim.truth, np.array([scan.index])),
+                             title=f"{scenario.name}, scan {scan.index}")
+
+
+def initiation_figure_for(scenario: Scenario, seed: int, *, fusion: str = "adaptive-kmeans",
+                          theta_deg: float = 20.0, window_number: int = 0,
+                          gate_radius: float = 300.0, v_min: float = 50.0,
+                          v_max: float = 400.0) -> Figure:
+    """Every method on one window of the first run of ``seed``, with the CLI's settings
+    (Hough accumulators over the scenario's region)."""
+    rs = run_seeds(seed, 1)[0]
+    sim = simulate(scenario, rs)
+    raw = list(sim.plots.scans())
+    fused, _ = fused_scans(raw, fusion, run_seed=rs)
+    raw_w = Window.from_scans(list(sliding_windows(raw))[window_number])
+    win = Window.from_scans(list(sliding_windows(fused))[window_number])
+    results = {}
+    for m in INITIATORS:
+        p: dict[str, Any] = {"v_min": v_min, "v_max": v_max}
+        if m.endswith("logic"):
+            p["gate_radius"] = gate_radius
+        else:
+            p["region"] = scenario.region.as_tuple()
+        results[m] = make_initiator(m, theta_deg=theta_deg, **p).initiate(win)
+    return initiation_figure(raw_w, win, results, _truth_at(sim.truth, win.scans),
+                             title=f"{scenario.name}, scans {win.scans[0]}–{win.scans[-1]}, "
+                             f"fusion {fusion}, θ = {theta_deg:g}°")

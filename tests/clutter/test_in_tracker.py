@@ -1,0 +1,61 @@
+"""The estimators inside the MHT and the ``mhtrack clutter`` command."""
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+from mhtrack.cli.clutter_commands import clutter
+from mhtrack.clutter import AGMMClutter, GMMClutter
+from mhtrack.experiments.pipeline import TRACKERS, make_tracker
+from mhtrack.mht import MHTConfig, MHTTracker
+from mhtrack.scenario import preset, simulate
+
+
+def test_registered_trackers() -> None:
+    assert isinstance(make_tracker("mht-gmm").clutter, GMMClutter)
+    assert isinstance(make_tracker("mht-agmm").clutter, AGMMClutter)
+    assert {"mht", "mht-gmm", "mht-agmm"} <= set(TRACKERS)
+
+
+def test_tracker_state_with_agmm_round_trips(tmp_path: Path) -> None:
+    sim = simulate(preset("crossing", scans=8), seed=1)
+    scans = list(sim.plots.scans())
+    trk = MHTTracker(MHTConfig(), AGMMClutter())
+    for s in scans[:5]:
+        trk.step(s)
+    trk.save(tmp_path / "state.npz")
+    back = MHTTracker.load(tmp_path / "state.npz", clutter=AGMMClutter())
+    z = scans[5].z
+    np.testing.assert_array_equal(back.clutter.intensity(z), trk.clutter.intensity(z))
+    for s in scans[5:]:
+        a, b = trk.step(s), back.step(s)
+        np.testing.assert_array_equal(a.positions, b.positions)
+    np.testing.assert_array_equal(back.clutter.intensity(z), trk.clutter.intensity(z))
+
+
+@pytest.mark.parametrize("estimator", ["known", "agmm"])
+def test_cli_json_and_figure(tmp_path: Path, estimator: str) -> None:
+    out = tmp_path / estimator
+    res = CliRunner().invoke(clutter, [
+        "crossing", "--estimator", estimator, "--seed", "1", "--scans", "6",
+        "--resolution", "100", "--json", "--out", str(out),
+    ])
+    assert res.exit_code == 0, res.output
+    d = json.loads(res.output)
+    assert len(d["iae"]) == len(d["count_error"]) == 6
+    assert d["iae_mean"] == pytest.approx(np.mean(d["iae"]))
+    assert (out / "clutter.png").stat().st_size > 10_000
+    assert json.loads((out / "clutter.json").read_text())["iae_mean"] == d["iae_mean"]
+    if estimator == "known":  # S·λ/A: 40 plots over 64 km²
+        assert d["clutter_density"] == pytest.approx(40 / 64e6)
+        assert d["count_error_mean"] == pytest.approx(0.0, abs=1e-9)
+
+
+def test_cli_rejects_a_scan_outside_the_run(tmp_path: Path) -> None:
+    res = CliRunner().invoke(clutter, ["crossing", "--scans", "3", "--map-scan", "50",
+                                       "--out", str(tmp_path)])
+    assert res.exit_code != 0
+    assert "--map-scan" in res.output

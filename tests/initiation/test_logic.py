@@ -1,0 +1,103 @@
+"""3/4 logic and P2's modified logic (angle constraint) on hand-made 4-scan windows."""
+
+import numpy as np
+import pytest
+
+from mhtrack.initiation import LogicInitiator, Window, leg_angle, make_initiator
+from mhtrack.records import Scan
+
+FAR = np.array([[5000.0, -5000.0], [-6000.0, 7000.0]])  # clutter nowhere near
+
+
+def window(points, R=None, far=True):
+    """One scan per entry of ``points`` (a point or None), t = 1, 2, 3, 4 s."""
+    scans = []
+    for k, p in enumerate(points):
+        z = np.zeros((0, 2)) if p is None else np.atleast_2d(np.asarray(p, float))
+        if far:
+            z = np.vstack((z, FAR + np.array([3000.0 * k, 0.0])))  # 3 km/s: no track
+        n = len(z)
+        RR = np.broadcast_to(np.eye(2) * 400.0 if R is None else R, (n, 2, 2)).copy()
+        scans.append(Scan(k + 1, float(k + 1), z, np.zeros(n, np.int64), np.arange(n), RR))
+    return scans
+
+
+def test_straight_line_is_initiated_by_both_logics_with_exact_state():
+    line = [(0.0, 0.0), (200.0, 0.0), (400.0, 0.0), (600.0, 0.0)]
+    for method in ("logic", "modified-logic"):
+        tr = make_initiator(method).initiate(window(line))
+        assert len(tr) == 1, method  # its 3-plot sub-tracks are not reported again
+        np.testing.assert_array_equal(tr.plots[0], [0, 0, 0, 0])
+        # noise-free line: least squares gives the state at the last scan exactly
+        np.testing.assert_allclose(tr.x[0], [600.0, 200.0, 0.0, 0.0], atol=1e-9)
+        assert tr.time == 4.0
+        # P of a 4-point fit with R = 400 I: var(x_4) = 400·(7/10) (regression at an end)
+        np.testing.assert_allclose(tr.P[0, 0, 0], 400.0 * 0.7)
+        np.testing.assert_allclose(tr.P[0, 1, 1], 400.0 / 5.0)  # σ²/Σ(t − t̄)²
+
+
+def test_v_shape_is_rejected_only_by_the_modified_logic():
+    # legs (200, 0) then (100, 173.2): turn of 60° by hand (cos α = 100·200/(200·200))
+    z3 = (300.0, 100.0 * np.sqrt(3.0))
+    pts = [(0.0, 0.0), (200.0, 0.0), z3, None]
+    alpha = np.degrees(leg_angle(np.subtract(z3, (200.0, 0.0)), np.array([200.0, 0.0])))
+    assert alpha == pytest.approx(60.0)
+    # z3 is 200 m from the prediction (400, 0): inside the 300 m gate
+    assert np.hypot(400.0 - z3[0], z3[1]) == pytest.approx(200.0)
+    plain = make_initiator("logic").initiate(window(pts))
+    assert len(plain) == 1
+    np.testing.assert_array_equal(plain.plots[0], [0, 0, 0, -1])
+    assert len(make_initiator("modified-logic", theta_deg=20).initiate(window(pts))) == 0
+    assert len(make_initiator("modified-logic", theta_deg=61).initiate(window(pts))) == 1
+
+
+def test_small_turn_passes_the_modified_logic():
+    turn = np.radians(15.0)
+    z3 = (200.0 + 200.0 * np.cos(turn), 200.0 * np.sin(turn))
+    tr = make_initiator("modified-logic", theta_deg=20).initiate(
+        window([(0.0, 0.0), (200.0, 0.0), z3, None]))
+    assert len(tr) == 1
+
+
+def test_velocity_gate():
+    slow = [(0.0, 0.0), (20.0, 0.0), (40.0, 0.0), (60.0, 0.0)]  # 20 m/s < v_min = 50
+    fast = [(0.0, 0.0), (500.0, 0.0), (1000.0, 0.0), (1500.0, 0.0)]  # 500 > v_max = 400
+    for pts in (slow, fast):
+        assert len(make_initiator("logic").initiate(window(pts))) == 0
+    assert len(LogicInitiator(v_min=10.0).initiate(window(slow))) == 1
+    assert len(LogicInitiator(v_max=600.0).initiate(window(fast))) == 1
+
+
+def test_three_of_four_with_a_missed_scan():
+    pts = [(0.0, 0.0), (200.0, 0.0), None, (600.0, 0.0)]
+    tr = make_initiator("modified-logic").initiate(window(pts))
+    assert len(tr) == 1
+    np.testing.assert_array_equal(tr.plots[0], [0, 0, -1, 0])
+    np.testing.assert_allclose(tr.x[0, [1, 3]], [200.0, 0.0], atol=1e-9)
+    # two plots only: no track
+    assert len(make_initiator("logic").initiate(window([(0.0, 0.0), None, None,
+                                                        (600.0, 0.0)]))) == 0
+
+
+def test_branching_on_every_plot_in_the_gate():
+    # two candidates at scan 3, both inside the gate and straight enough for plain logic
+    pts = [(0.0, 0.0), (200.0, 0.0), [(400.0, 0.0), (400.0, 100.0)], None]
+    tr = make_initiator("logic").initiate(window(pts))
+    assert len(tr) == 2
+    assert sorted(tr.plots[:, 2].tolist()) == [0, 1]
+
+
+def test_window_size_and_parameters_are_checked():
+    with pytest.raises(ValueError, match="window has 3 scans"):
+        make_initiator("logic").initiate(window([(0, 0)] * 3))
+    with pytest.raises(ValueError, match="v_min"):
+        LogicInitiator(v_min=500.0, v_max=400.0).initiate(window([(0, 0)] * 4))
+    with pytest.raises(ValueError, match="unknown initiation method"):
+        make_initiator("magic")
+
+
+def test_window_stacks_scans():
+    w = Window.from_scans(window([(0.0, 0.0), None, (1.0, 1.0), (2.0, 2.0)], far=False))
+    np.testing.assert_array_equal(w.start, [0, 1, 1, 2, 3])
+    np.testing.assert_array_equal(w.slot, [0, 2, 3])
+    np.testing.assert_allclose(w.R_inv[0], np.eye(2) / 400.0)

@@ -29,6 +29,7 @@ def _as_tracks(truth: TruthTable, keep: np.ndarray | None = None) -> TrackTable:
 REQUIRED_KEYS = {
     "ospa_mean", "gospa_mean", "cardinality_error_mean", "mota", "motp", "id_switches",
     "fragmentations", "n_tracks", "ospa", "gospa", "cardinality", "cardinality_true", "scans",
+    "rcc", "rmc", "rfg", "l_min", "l_avg", "l_max",
 }  # fmt: skip
 
 
@@ -109,6 +110,9 @@ def test_to_dict_is_json_and_consistent(random_run):
     assert d["cardinality_error_mean"] == pytest.approx(err.mean())
     assert d["n_tracks"] == len(np.unique(tracks.track_id))
     assert d["mota"] == ev.clear_mot.mota and d["id_switches"] == ev.clear_mot.id_switches
+    # no plots: no association rates; breaks and track life come from the matching alone
+    assert d["rcc"] is None and d["rmc"] is None
+    assert d["rfg"] is not None and 0 <= d["l_min"] <= d["l_avg"] <= d["l_max"]
 
 
 def test_to_dict_without_truth_has_nulls():
@@ -116,6 +120,7 @@ def test_to_dict_without_truth_has_nulls():
     d = evaluate(TrackTable.empty(), empty_truth).to_dict()
     assert d["mota"] is None and d["motp"] is None and d["ospa_mean"] is None
     assert d["scans"] == [] and d["n_tracks"] == 0
+    assert all(d[k] is None for k in ("rcc", "rmc", "rfg", "l_min", "l_avg", "l_max"))
     json.dumps(d, allow_nan=False)
 
 

@@ -48,11 +48,14 @@ def _register() -> None:
     from mhtrack.cli import (
         clutter_commands,
         data_commands,
+        experiment_commands,
         initiation_commands,
         track_commands,
     )
 
-    for module in (data_commands, track_commands, clutter_commands, initiation_commands):
+    modules = (data_commands, track_commands, clutter_commands, initiation_commands,
+               experiment_commands)
+    for module in modules:
         for command in module.COMMANDS:
             cli.add_command(command)
 

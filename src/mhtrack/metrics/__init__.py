@@ -5,11 +5,13 @@
 * :func:`cardinality_per_scan` — number of tracks vs number of targets per scan;
 * :func:`clear_mot` — MOTA, MOTP, identity switches, fragmentations (Bernardin &
   Stiefelhagen 2008);
+* :func:`association_metrics` — P1 Table 3's Rcc, Rmc, Rfg and track life Lmin/Lavg/Lmax;
 * :func:`evaluate` — all of the above for one run.
 
 Definitions and conventions: ``docs/metrics.md``.
 """
 
+from mhtrack.metrics.association import AssociationResult, association_metrics
 from mhtrack.metrics.cardinality import CardinalityPerScan, cardinality_per_scan
 from mhtrack.metrics.clearmot import (
     DEFAULT_MATCH_DISTANCE,
@@ -23,6 +25,7 @@ from mhtrack.metrics.ospa import OSPAPerScan, OSPAResult, ospa, ospa_per_scan
 
 __all__ = [
     "DEFAULT_MATCH_DISTANCE",
+    "AssociationResult",
     "CLEARMOTResult",
     "CardinalityPerScan",
     "Evaluation",
@@ -31,6 +34,7 @@ __all__ = [
     "MOTMatching",
     "OSPAPerScan",
     "OSPAResult",
+    "association_metrics",
     "cardinality_per_scan",
     "clear_mot",
     "evaluate",

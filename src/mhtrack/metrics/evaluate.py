@@ -1,8 +1,8 @@
 """One call that scores a tracker's output against the truth with every metric.
 
 :func:`evaluate` aligns tracks and truth on scan indices and runs OSPA, GOSPA,
-cardinality and CLEAR-MOT; :class:`Evaluation` holds the results and renders them as a
-JSON-able dict or a plain-text table.
+cardinality, CLEAR-MOT and P1 Table 3's association metrics; :class:`Evaluation` holds the
+results and renders them as a JSON-able dict or a plain-text table.
 """
 
 from __future__ import annotations
@@ -23,6 +23,7 @@ from mhtrack.metrics._common import (
     plot_scans,
     scan_union,
 )
+from mhtrack.metrics.association import AssociationResult, association_metrics
 from mhtrack.metrics.cardinality import CardinalityPerScan, cardinality_per_scan
 from mhtrack.metrics.clearmot import CLEARMOTResult, clear_mot
 from mhtrack.metrics.gospa import GOSPAPerScan, gospa_per_scan
@@ -44,6 +45,9 @@ class Evaluation:
     clear_mot : CLEARMOTResult
     n_tracks, n_targets : int
         Distinct track ids and distinct target ids.
+    association : AssociationResult or None
+        P1 Table 3's Rcc, Rmc, Rfg, Lmin/Lavg/Lmax on the CLEAR-MOT matching (``rcc`` and
+        ``rmc`` are NaN unless the plots with their ``origin`` were given).
     """
 
     cutoff: float
@@ -56,6 +60,7 @@ class Evaluation:
     clear_mot: CLEARMOTResult
     n_tracks: int
     n_targets: int
+    association: AssociationResult | None = None
 
     @property
     def ospa_mean(self) -> float:
@@ -78,8 +83,11 @@ class Evaluation:
         Scalars: ``cutoff, order, match_distance, n_scans, n_tracks, n_targets,
         ospa_mean, ospa_localisation_mean, ospa_cardinality_mean, gospa_mean,
         cardinality_error_mean, mota, motp, id_switches, fragmentations, n_matches,
-        n_misses, n_false, n_truth``. Per-scan lists (aligned with ``scans``):
-        ``scans, ospa, gospa, cardinality`` (number of tracks), ``cardinality_true``.
+        n_misses, n_false, n_truth`` and P1 Table 3's ``rcc, rmc, rfg, l_min, l_avg,
+        l_max`` (always present; ``rcc``/``rmc`` are ``None`` without plot origins, all six
+        ``None`` when undefined — see :func:`association_metrics`). Per-scan lists (aligned
+        with ``scans``): ``scans, ospa, gospa, cardinality`` (number of tracks),
+        ``cardinality_true``.
         """
         m = self.clear_mot
         return {
@@ -102,12 +110,20 @@ class Evaluation:
             "n_misses": m.n_misses,
             "n_false": m.n_false,
             "n_truth": m.n_truth,
+            **self._association_dict(),
             "scans": [int(s) for s in self.scans],
             "ospa": [float(v) for v in self.ospa.distance],
             "gospa": [float(v) for v in self.gospa.distance],
             "cardinality": [int(v) for v in self.cardinality.n_tracks],
             "cardinality_true": [int(v) for v in self.cardinality.n_true],
         }
+
+    def _association_dict(self) -> dict[str, float | None]:
+        a = self.association
+        keys = ("rcc", "rmc", "rfg", "l_min", "l_avg", "l_max")
+        if a is None:
+            return dict.fromkeys(keys)
+        return {k: _num(getattr(a, k)) for k in keys}
 
     def to_table(self, *, per_scan: bool = False) -> str:
         """Plain-text (ASCII) table of the summary metrics, for a terminal.
@@ -135,6 +151,17 @@ class Evaluation:
                 f"{m.n_matches} / {m.n_misses} / {m.n_false} / {m.n_truth}",
             ),
         ]
+        a = self.association
+        if a is not None:
+            rows += [
+                ("Rcc correct association rate", _fmt(a.rcc)),
+                ("Rmc mis-association rate", _fmt(a.rmc)),
+                ("Rfg track breaks per target", _fmt(a.rfg)),
+                (
+                    "track life Lmin / Lavg / Lmax",
+                    f"{_fmt(a.l_min)} / {_fmt(a.l_avg)} / {_fmt(a.l_max)} s",
+                ),
+            ]
         out = _render(("metric", "value"), rows)
         if per_scan:
             scan_rows = [
@@ -162,7 +189,8 @@ def evaluate(
     match_distance: float | None = None,
     scans: npt.ArrayLike | None = None,
 ) -> Evaluation:
-    """Score ``tracks`` against ``truth``: OSPA, GOSPA (α = 2), cardinality, CLEAR-MOT.
+    """Score ``tracks`` against ``truth``: OSPA, GOSPA (α = 2), cardinality, CLEAR-MOT and
+    P1 Table 3's Rcc, Rmc, Rfg, Lmin/Lavg/Lmax (:func:`association_metrics`).
 
     Scans evaluated are the sorted union of the truth's scans, the tracks' scans, every
     scan of ``plots`` (empty scans included) and ``scans``; a scan with neither truth nor
@@ -175,7 +203,9 @@ def evaluate(
     truth : TruthTable
         True target states.
     plots : PlotTable, optional
-        The run's plots; only their scan indices are used for now.
+        The run's plots: their scans are evaluated, their scan times give the scan period
+        of the track life, and their ``origin`` (when known) with the tracks' ``plot``
+        column gives Rcc and Rmc (NaN otherwise).
     cutoff : float, default 500.0
         OSPA/GOSPA cut-off ``c`` (m), finite and ``> 0``.
     order : float, default 2.0
@@ -196,6 +226,7 @@ def evaluate(
         c if match_distance is None else check_match_distance(match_distance, "match_distance")
     )
     idx = scan_union(truth.scan, tracks.scan, plot_scans(plots), check_scans(scans))
+    mot = clear_mot(tracks, truth, match_distance=d_match)
     return Evaluation(
         cutoff=c,
         order=p,
@@ -204,9 +235,10 @@ def evaluate(
         ospa=ospa_per_scan(tracks, truth, c, p, scans=idx),
         gospa=gospa_per_scan(tracks, truth, c, p, scans=idx),
         cardinality=cardinality_per_scan(tracks, truth, scans=idx),
-        clear_mot=clear_mot(tracks, truth, match_distance=d_match),
+        clear_mot=mot,
         n_tracks=len(np.unique(tracks.track_id)),
         n_targets=len(np.unique(truth.target_id)),
+        association=association_metrics(tracks, truth, plots, matching=mot.matching),
     )
 
 

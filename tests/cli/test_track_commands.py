@@ -78,3 +78,56 @@ def test_track_polar_plots_uses_scenario_sensors(tmp_path):
 def test_unknown_tracker_is_a_usage_error():
     code, _, stderr = invoke("run", "crossing", "--tracker", "nope")
     assert code == 2 and "nope" in stderr
+
+
+def test_run_multiradar_with_modified_logic_birth(tmp_path):
+    code, stdout, stderr = invoke("run", "multiradar", "--seed", "1", "--tracker", "mht-agmm",
+                                  "--birth", "modified-logic", "--json", "--no-progress",
+                                  "--out", str(tmp_path))
+    assert code == 0, stderr
+    s = json.loads(stdout)
+    assert len(s["ospa"]) == 10 and s["ospa"][-1] < 100  # fused plots (default, 3 radars)
+    t = read_tracks(tmp_path / "tracks.csv")
+    assert len(t) > 0 and (t.plot >= -1).all()
+
+
+def test_run_multiradar_default_tracker_with_birth_and_explicit_fusion(tmp_path):
+    code, stdout, stderr = invoke("run", "multiradar", "--seed", "1", "--birth",
+                                  "modified-logic", "--fusion", "adaptive-kmeans", "--json",
+                                  "--no-progress", "--out", str(tmp_path))
+    assert code == 0, stderr
+    assert 0 < json.loads(stdout)["ospa_mean"] <= 500
+
+
+def test_run_crossing_agmm_with_logic_birth(tmp_path):
+    code, stdout, stderr = invoke("run", "crossing", "--tracker", "mht-agmm", "--birth",
+                                  "logic", "--scans", "12", "--seed", "1", "--json",
+                                  "--no-progress", "--out", str(tmp_path))
+    assert code == 0, stderr
+    s = json.loads(stdout)
+    assert len(s["ospa"]) == 12 and s["tracker"] == "mht-agmm"
+
+
+def test_track_with_birth_and_fusion_options(run_dir, tmp_path):
+    out, _ = run_dir
+    dst = tmp_path / "tracks.csv"
+    code, _, stderr = invoke("track", str(out / "plots.csv"), "--out", str(dst),
+                             "--clutter-density", "1.5625e-7", "--birth", "logic",
+                             "--fusion", "none", "--no-progress")
+    assert code == 0, stderr
+    t = read_tracks(dst)
+    assert len(t) > 0 and len(set(t.track_id.tolist())) >= 2
+    # the default (every-plot, one sensor: no fusion) still matches run's tracks
+    dst2 = tmp_path / "default.csv"
+    code, _, stderr = invoke("track", str(out / "plots.csv"), "--out", str(dst2),
+                             "--clutter-density", "1.5625e-7", "--birth", "every-plot",
+                             "--no-progress")
+    assert code == 0, stderr
+    assert dst2.read_bytes() == (out / "tracks.csv").read_bytes()
+
+
+def test_unknown_birth_or_fusion_is_a_usage_error():
+    code, _, stderr = invoke("run", "crossing", "--birth", "nope")
+    assert code == 2 and "nope" in stderr
+    code, _, stderr = invoke("run", "crossing", "--fusion", "kmeans")
+    assert code == 2 and "kmeans" in stderr

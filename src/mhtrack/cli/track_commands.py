@@ -45,6 +45,28 @@ def _tracker_options(f: Callable[..., Any], pd_flag: str) -> Callable[..., Any]:
     return f
 
 
+def birth_options(f: Callable[..., Any]) -> Callable[..., Any]:
+    """``--birth``, ``--birth-theta`` and ``--fusion`` (birth process and plot fusion of
+    the MHT; ``docs/mht.md``)."""
+    from mhtrack.experiments.pipeline import FUSIONS
+    from mhtrack.mht.config import BIRTHS
+
+    opts = [
+        click.option("--birth", type=click.Choice(BIRTHS), default="every-plot",
+                     show_default=True, help="Which plots start new track trees: every plot "
+                     "(P1), or tracks initiated by a P2 initiator over the last 4 scans."),
+        click.option("--birth-theta", "birth_theta", type=click.FloatRange(0, 180),
+                     default=20.0, show_default=True,
+                     help="Angle limit θ (degrees) of the modified initiators."),
+        click.option("--fusion", type=click.Choice(FUSIONS), default=None,
+                     help="Fuse each scan's plots before tracking [adaptive-kmeans with "
+                     "more than one sensor, else none]."),
+    ]
+    for opt in reversed(opts):
+        f = opt(f)
+    return f
+
+
 def _config(tracker_pd: float | None, meas_sigma: float | None, accel_sigma: float | None,
             birth_density: float | None, nscan: int | None) -> Any:
     from mhtrack.experiments import config_with
@@ -62,14 +84,18 @@ def _config(tracker_pd: float | None, meas_sigma: float | None, accel_sigma: flo
               path_type=Path), default=None,
               help="Scenario TOML giving the sensors (needed for polar plots) and all scan "
               "times [default: scenario.toml beside PLOTS, if any].")
+@birth_options
 @click.option("--progress/--no-progress", default=True, help="Progress bar on stderr.")
 def track(plots: Path, tracker: str, tracker_pd: float | None, meas_sigma: float | None,
           accel_sigma: float | None, clutter_density: float | None,
           birth_density: float | None, nscan: int | None, out: Path,
-          scenario_file: Path | None, progress: bool) -> None:
+          scenario_file: Path | None, birth: str, birth_theta: float, fusion: str | None,
+          progress: bool) -> None:
     """Run a tracker on a PLOTS file and write its tracks."""
-    from mhtrack.experiments import make_tracker
-    from mhtrack.experiments import track as run_tracker
+    import numpy as np
+
+    from mhtrack.experiments.pipeline import default_fusion, make_tracker
+    from mhtrack.experiments.pipeline import track as run_tracker
     from mhtrack.io import read_plots, write_tracks
     from mhtrack.scenario import load_scenario
 
@@ -85,9 +111,14 @@ def track(plots: Path, tracker: str, tracker_pd: float | None, meas_sigma: float
         table = dataclasses.replace(
             table, scan_times=(scenario.scan_indices(), scenario.scan_times())
         )
+    if fusion is None:
+        n_sensors = (len(scenario.sensors) if scenario is not None
+                     else len(np.unique(table.sensor)))
+        fusion = default_fusion(n_sensors)
     cfg = _config(tracker_pd, meas_sigma, accel_sigma, birth_density, nscan)
-    trk = make_tracker(tracker, cfg, clutter_density=clutter_density)
-    result = run_tracker(trk, table, name=tracker, progress=progress)
+    trk = make_tracker(tracker, cfg, clutter_density=clutter_density, birth=birth,
+                       theta_deg=birth_theta)
+    result = run_tracker(trk, table, name=tracker, progress=progress, fusion=fusion)
     write_tracks(result.tracks, out)
     n_ids = len(set(result.tracks.track_id.tolist()))
     caps = f", caps acted: {result.caps}" if result.caps else ""
@@ -100,24 +131,27 @@ def track(plots: Path, tracker: str, tracker_pd: float | None, meas_sigma: float
 @tracker_options("--tracker-pd")
 @click.option("--out", type=click.Path(file_okay=False, path_type=Path), default=None,
               help="Directory for plots, truth, tracks, metrics and figures "
-              "[default: out/SCENARIO-TRACKER-SEED].")
+              "[default: out/SCENARIO-TRACKER-SEED, out/SCENARIO-TRACKER-BIRTH-SEED with "
+              "--birth other than every-plot].")
 @click.option("--cutoff", type=click.FloatRange(min=0, min_open=True), default=500.0,
               show_default=True, help="OSPA/GOSPA cut-off c (m).")
 @click.option("--order", type=click.FloatRange(min=1), default=2.0, show_default=True,
               help="OSPA/GOSPA order p.")
 @click.option("--json", "as_json", is_flag=True, help="Print one JSON object.")
+@birth_options
 @click.option("--progress/--no-progress", default=True, help="Progress bar on stderr.")
 def run(scenario: str, seed: int, clutter: str | None, clutter_rate: float | None,
         pd: float | None, scans: int | None, tracker: str, tracker_pd: float | None,
         meas_sigma: float | None, accel_sigma: float | None, clutter_density: float | None,
         birth_density: float | None, nscan: int | None, out: Path | None, cutoff: float,
-        order: float, as_json: bool, progress: bool) -> None:
+        order: float, as_json: bool, birth: str, birth_theta: float, fusion: str | None,
+        progress: bool) -> None:
     """Simulate SCENARIO, track, evaluate and plot, in one go.
 
     Writes plots, truth, tracks, scenario.toml, metrics.json, scene.png (truth, plots,
     tracks) and metrics.png (OSPA and cardinality per scan) to the output directory.
     """
-    from mhtrack.experiments import run_scenario
+    from mhtrack.experiments.pipeline import run_scenario
     from mhtrack.io import write_plots, write_scenario_toml, write_tracks, write_truth
     from mhtrack.plotting.metrics import plot_ospa_cardinality
     from mhtrack.plotting.scene import plot_scene, save_figure
@@ -126,8 +160,10 @@ def run(scenario: str, seed: int, clutter: str | None, clutter_rate: float | Non
     tracker_pd = tracker_pd if tracker_pd is not None else pd
     cfg = _config(tracker_pd, meas_sigma, accel_sigma, birth_density, nscan)
     result = run_scenario(sc, seed, tracker, cfg, clutter_density=clutter_density,
-                          cutoff=cutoff, order=order, progress=progress)
-    out = out if out is not None else Path("out") / f"{sc.name}-{tracker}-{seed}"
+                          cutoff=cutoff, order=order, progress=progress, birth=birth,
+                          theta_deg=birth_theta, fusion=fusion)
+    suffix = "" if birth == "every-plot" else f"-{birth}"
+    out = out if out is not None else Path("out") / f"{sc.name}-{tracker}{suffix}-{seed}"
     out.mkdir(parents=True, exist_ok=True)
     sim = result.simulation
     write_plots(sim.plots, out / "plots.csv")

@@ -2,6 +2,14 @@
 
 The CLI's ``track`` and ``run`` and the Monte-Carlo runner all go through here, so a
 tracker is configured, timed and evaluated the same way everywhere.
+
+Birth process (``birth``, ``theta_deg``): which plots start new track trees
+(``MHTConfig.birth``, ``docs/mht.md``). Fusion (``fusion``): the MHT assumes at most one
+plot per target per scan, so with several sensors each scan is first fused by
+:class:`~mhtrack.initiation.AdaptiveKMeansFusion` (P2 §1.2) — the default when the scenario
+has more than one sensor (:func:`default_fusion`). A fused plot's row id (the ``plot``
+column of the tracks) is the plot-table row of the first plot of its cluster (in scan
+order), so it stays a valid plot-table row.
 """
 
 from __future__ import annotations
@@ -16,6 +24,7 @@ from tqdm.auto import tqdm
 
 from mhtrack.clutter import ClutterEstimator, KnownClutter
 from mhtrack.clutter.registry import agmm_for_tracker, gmm_for_tracker
+from mhtrack.initiation import AdaptiveKMeansFusion
 from mhtrack.metrics import Evaluation, evaluate
 from mhtrack.mht import MHTConfig, MHTTracker, StepStats
 from mhtrack.records import PlotTable, Scan, TrackTable
@@ -39,14 +48,52 @@ TRACKERS: dict[str, Callable[[MHTConfig, float | None], ClutterEstimator]] = {
 }
 
 
+#: Plot fusion methods of :func:`track` / :func:`run_scenario`.
+FUSIONS: tuple[str, ...] = ("none", "adaptive-kmeans")
+
+
 def make_tracker(
-    name: str, config: MHTConfig | None = None, *, clutter_density: float | None = None
+    name: str,
+    config: MHTConfig | None = None,
+    *,
+    clutter_density: float | None = None,
+    birth: str | None = None,
+    theta_deg: float | None = None,
 ) -> MHTTracker:
-    """A fresh tracker by name (see :data:`TRACKERS`)."""
+    """A fresh tracker by name (see :data:`TRACKERS`). ``birth`` (``"every-plot"``,
+    ``"logic"``, ``"modified-logic"``, ``"hough"``, ``"modified-hough"``) and ``theta_deg``
+    override ``config.birth`` / ``config.birth_theta_deg`` when given."""
     if name not in TRACKERS:
         raise ValueError(f"unknown tracker {name!r} (expected one of {', '.join(TRACKERS)})")
-    config = MHTConfig() if config is None else config
+    config = config_with(config, birth=birth, birth_theta_deg=theta_deg)
     return MHTTracker(config, TRACKERS[name](config, clutter_density))
+
+
+def default_fusion(n_sensors: int) -> str:
+    """``"adaptive-kmeans"`` with more than one sensor, else ``"none"``."""
+    return "adaptive-kmeans" if n_sensors > 1 else "none"
+
+
+def fuse_scan(scan: Scan, fuser: AdaptiveKMeansFusion | None = None) -> Scan:
+    """``scan`` fused by adaptive K-means (P2 §1.2): one plot per cluster, with its fused
+    ``R`` and, as row id, the row of the cluster's first plot (module docstring)."""
+    if len(scan) == 0:
+        return scan
+    f = (AdaptiveKMeansFusion() if fuser is None else fuser).fuse(scan)
+    k = len(f.scan)
+    first = np.full(k, -1, np.int64)
+    first[f.labels[::-1]] = np.arange(len(f.labels))[::-1]
+    return dataclasses.replace(f.scan, rows=np.asarray(scan.rows, np.int64)[first])
+
+
+def fused(scans: Iterable[Scan], fusion: str) -> Iterable[Scan]:
+    """``scans`` unchanged (``"none"``) or each fused (``"adaptive-kmeans"``)."""
+    if fusion not in FUSIONS:
+        raise ValueError(f"unknown fusion {fusion!r} (expected {', '.join(FUSIONS)})")
+    if fusion == "none":
+        return scans
+    fuser = AdaptiveKMeansFusion()
+    return (fuse_scan(s, fuser) for s in scans)
 
 
 @dataclass(frozen=True)
@@ -79,13 +126,15 @@ class TrackingRun:
 
 def track(
     tracker: MHTTracker, scans: PlotTable | Iterable[Scan], *, name: str = "mht",
-    progress: bool = False,
+    progress: bool = False, fusion: str = "none",
 ) -> TrackingRun:
-    """Run ``tracker`` over ``scans`` (a :class:`PlotTable` or scans), one step per scan."""
+    """Run ``tracker`` over ``scans`` (a :class:`PlotTable` or scans), one step per scan;
+    with ``fusion="adaptive-kmeans"`` each scan is fused first (module docstring)."""
     total = None
     if isinstance(scans, PlotTable):
         total = scans.n_scans
         scans = scans.scans()
+    scans = fused(scans, fusion)
     parts: list[TrackTable] = []
     stats: list[StepStats] = []
     for scan in tqdm(scans, total=total, desc=name, unit="scan", disable=not progress,
@@ -124,11 +173,20 @@ def run_scenario(
     cutoff: float = 500.0,
     order: float = 2.0,
     progress: bool = False,
+    birth: str | None = None,
+    theta_deg: float | None = None,
+    fusion: str | None = None,
 ) -> ScenarioRun:
-    """Simulate ``scenario`` with ``seed``, run tracker ``tracker`` on it and evaluate."""
+    """Simulate ``scenario`` with ``seed``, run tracker ``tracker`` on it and evaluate.
+
+    ``birth`` / ``theta_deg``: see :func:`make_tracker`; ``fusion``: ``"none"`` or
+    ``"adaptive-kmeans"``, default :func:`default_fusion` of the scenario's sensors."""
     sim = simulate(scenario, seed=seed)
-    trk = make_tracker(tracker, config, clutter_density=clutter_density)
-    run = track(trk, sim.plots, name=tracker, progress=progress)
+    trk = make_tracker(tracker, config, clutter_density=clutter_density, birth=birth,
+                       theta_deg=theta_deg)
+    if fusion is None:
+        fusion = default_fusion(len(scenario.sensors))
+    run = track(trk, sim.plots, name=tracker, progress=progress, fusion=fusion)
     ev = evaluate(run.tracks, sim.truth, plots=sim.plots, cutoff=cutoff, order=order)
     return ScenarioRun(sim, run, ev)
 

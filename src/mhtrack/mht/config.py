@@ -11,6 +11,9 @@ import math
 from dataclasses import asdict, dataclass, fields
 from typing import Any
 
+#: Birth processes by name (:attr:`MHTConfig.birth`; ``mhtrack.mht.birth``).
+BIRTHS: tuple[str, ...] = ("every-plot", "logic", "modified-logic", "hough", "modified-hough")
+
 
 @dataclass(frozen=True)
 class MHTConfig:
@@ -73,6 +76,12 @@ class MHTConfig:
         solved greedily instead of exactly. Default 2 000.
     milp_time_limit : seconds HiGHS may spend on one cluster's integer programme; then
         its best answer so far (or greedy's, if better) is used. Default 0.5.
+    birth : which plots start new trees (``mhtrack.mht.birth``). ``"every-plot"`` (default,
+        P1 Fig. 1): every plot, one-point initialisation. ``"logic"``, ``"modified-logic"``,
+        ``"hough"``, ``"modified-hough"``: P2's initiator over a sliding window of the last
+        4 scans; a tree starts only from each newly initiated track, seeded with its
+        least-squares state, scored by the log-likelihood ratio of its plots.
+    birth_theta_deg : angle limit ``θ`` of the modified initiators. Default 20 (P2 §2.2).
     min_clutter_density : floor on the estimator's ``κ̂(z)`` (per m²), so that a density
         estimate that underflows to 0 far from its components cannot give an infinite
         score. Default 1e−12 (our choice: 1000× below P1's plain-MHT κ = 1e−9).
@@ -99,6 +108,8 @@ class MHTConfig:
     max_cluster_size: int = 2_000
     milp_time_limit: float = 0.5
     min_clutter_density: float = 1e-12
+    birth: str = "every-plot"
+    birth_theta_deg: float = 20.0
 
     def __post_init__(self) -> None:
         def check(name: str, ok: bool, what: str) -> None:
@@ -130,6 +141,9 @@ class MHTConfig:
                      "max_births_per_scan", "max_cluster_size"):
             v = getattr(self, name)
             check(name, _is_int(v) and v >= 1, "an integer >= 1")
+        check("birth", self.birth in BIRTHS, f"one of {', '.join(BIRTHS)}")
+        check("birth_theta_deg", isinstance(self.birth_theta_deg, int | float)
+              and 0 <= self.birth_theta_deg <= 180, "in [0, 180]")
         check("max_leaves", self.max_leaves > self.max_births_per_scan,
               "larger than max_births_per_scan")
 

@@ -8,7 +8,8 @@ The tracking cycle, each step one function::
     extend trees     tree.propose_children          miss + one child per gated plot
                      pruning.sprt_keep, ...         delete/prune children (cheap, before
                      tree.grow_children               their Kalman update)
-                     tree.birth_leaves              every plot starts a tree
+                     tree.birth_leaves              every plot starts a tree, or
+                     birth.InitiatorBirth             a P2 initiator over the last 4 scans
     global hyp.      hypothesis.best_hypothesis     clusters → best compatible leaves
     N-scan pruning   pruning.n_scan_keep            decide scan k − N
     caps             pruning.cap_trees
@@ -30,6 +31,7 @@ import numpy as np
 
 from mhtrack.clutter.base import ClutterEstimator
 from mhtrack.clutter.known import KnownClutter
+from mhtrack.mht.birth import EVERY_PLOT, BirthCandidates, InitiatorBirth
 from mhtrack.mht.config import MHTConfig
 from mhtrack.mht.hypothesis import best_hypothesis
 from mhtrack.mht.pruning import (
@@ -56,8 +58,9 @@ class StepStats:
     """What one :meth:`MHTTracker.step` did.
 
     ``caps`` maps each hard cap that acted to how many leaves (``max_leaves_per_tree``,
-    ``max_leaves``), trees (``max_trees``), plots (``max_births_per_scan``) or clusters
-    (``max_cluster_size``) it cut; empty when none acted.
+    ``max_leaves``), trees (``max_trees``), plots or initiated tracks
+    (``max_births_per_scan``) or clusters (``max_cluster_size``) it cut; empty when none
+    acted. ``n_births`` counts the trees started at this scan.
     """
 
     scan: int
@@ -69,6 +72,7 @@ class StepStats:
     n_confirmed: int
     time_s: float
     caps: dict[str, int] = field(default_factory=dict)
+    n_births: int = 0
 
 
 class MHTTracker:
@@ -107,12 +111,24 @@ class MHTTracker:
         self._next_track = 0
         self.last_stats: StepStats | None = None
         self._caps_warned: set[str] = set()
+        self._birth: InitiatorBirth | None = None
+        if cfg.birth != EVERY_PLOT:
+            self._birth = InitiatorBirth(
+                cfg.birth, theta_deg=cfg.birth_theta_deg, width=cfg.n_scan + 1,
+                p_detection=cfg.p_detection, new_target_density=cfg.new_target_density,
+                miss_dl=self._miss_dl, v_max=cfg.v_max, sigma_v=cfg.sigma_v,
+                floor=self.delete_threshold)
 
     # ------------------------------------------------------------------ public API
     @property
     def leaves(self) -> Leaves:
         """The current hypothesis store (read-only view for inspection and tests)."""
         return self._leaves
+
+    @property
+    def birth_process(self) -> InitiatorBirth | None:
+        """The initiator birth process and its window, ``None`` for ``every-plot``."""
+        return self._birth
 
     def step(self, scan: Scan) -> TrackTable:
         """Process one scan; return the confirmed tracks of the best global hypothesis.
@@ -136,9 +152,17 @@ class MHTTracker:
             gated.loglik, kappa[gated.plot], cfg.p_detection, cfg.new_target_density
         )
         children = propose_children(leaves, gated, self._miss_dl, update_dl)
-        births = self._births(scan, z, R, rows, kappa, in_gates, caps)
-        children = self._prune_children(leaves, children, len(births), caps)
-        leaves = Leaves.concat(grow_children(leaves, xp, Pp, children, z, R, rows), births)
+        if self._birth is None:
+            births = self._births(scan, z, R, rows, kappa, in_gates, caps)
+            n_births = len(births)
+        else:
+            cand = self._initiated(scan, z, R, rows, kappa, caps)
+            n_births = len(cand)
+        children = self._prune_children(leaves, children, n_births, caps)
+        grown = grow_children(leaves, xp, Pp, children, z, R, rows)
+        if self._birth is not None:
+            births = self._seed(scan, *self._birth.select(cand, grown.window), caps)
+        leaves = Leaves.concat(grown, births)
 
         hyp = best_hypothesis(
             leaves.score, leaves.tree, leaves.window, cfg.max_cluster_size, cfg.milp_time_limit
@@ -149,6 +173,8 @@ class MHTTracker:
             caps["milp_time_limit"] = hyp.n_time_limited
         leaves = self._prune_after_solve(leaves, hyp.leaves, caps)
         leaves = self._manage_tracks(leaves, previous)
+        if self._birth is not None:
+            self._birth.forget_used(leaves.window[leaves.chosen & (leaves.track >= 0)])
         self._leaves = leaves
         self._last_time, self._last_index = float(scan.time), int(scan.index)
 
@@ -163,6 +189,7 @@ class MHTTracker:
             n_confirmed=len(out),
             time_s=time.perf_counter() - t0,
             caps=caps,
+            n_births=int(np.unique(births.tree).size),
         )
         if caps:
             new = sorted(set(caps) - self._caps_warned)
@@ -306,6 +333,54 @@ class MHTTracker:
         self._next_tree += sel.size
         return out
 
+    def _initiated(
+        self,
+        scan: Scan,
+        z: np.ndarray,
+        R: np.ndarray,
+        rows: np.ndarray,
+        kappa: np.ndarray,
+        caps: dict[str, int],
+    ) -> BirthCandidates:
+        """Initiator birth process: the tracks initiated over the last scans with a plot
+        at this one (``mhtrack.mht.birth``); over ``max_births_per_scan``, the highest
+        birth scores (then initiator order)."""
+        assert self._birth is not None
+        cand = self._birth.propose(scan, z, R, rows, kappa)
+        cap = self.config.max_births_per_scan
+        if len(cand) > cap:
+            caps["max_births_per_scan"] = len(cand) - cap
+            cand = cand.take(np.sort(np.argsort(-cand.score, kind="stable")[:cap]))
+        return cand
+
+    def _seed(self, scan: Scan, cand: BirthCandidates, group: np.ndarray,
+              caps: dict[str, int]) -> Leaves:
+        """New trees from initiated tracks: one tree per plot of this scan that ends
+        initiated tracks, its leaves those tracks (state, covariance, score, plots), pruned
+        as children are (score drop within the tree, leaves per tree)."""
+        cfg = self.config
+        keep = score_drop_keep(group, cand.score, cfg.prune_drop)
+        cand, group = cand.take(keep), group[keep]
+        keep, cut = cap_leaves_per_tree(group, cand.score, cfg.max_leaves_per_tree)
+        if cut:
+            caps["max_leaves_per_tree"] = caps.get("max_leaves_per_tree", 0) + cut
+            cand, group = cand.take(keep), group[keep]
+        n = len(cand)
+        first = self._next_tree
+        self._next_tree += int(group.max()) + 1 if n else 0
+        return Leaves(
+            x=cand.x,
+            P=cand.P,
+            score=cand.score,
+            peak=cand.peak,
+            tree=first + group,
+            track=np.full(n, -1, np.int64),
+            birth=np.full(n, int(scan.index), np.int64),
+            n_updates=cand.n_updates,
+            window=cand.window,
+            chosen=np.zeros(n, bool),
+        )
+
     def _prune_children(
         self, leaves: Leaves, children: Children, n_births: int, caps: dict[str, int]
     ) -> Children:
@@ -422,6 +497,8 @@ class MHTTracker:
         arrays: dict[str, np.ndarray] = {
             f"leaves__{k}": v for k, v in self._leaves.arrays().items()
         }
+        if self._birth is not None:
+            arrays.update({f"birth__{k}": v for k, v in self._birth.arrays().items()})
         clutter_state = _encode(self.clutter.get_state(), arrays)
         meta = {
             "format": FORMAT,
@@ -469,6 +546,10 @@ class MHTTracker:
         trk._last_index = meta["last_index"]
         trk._next_tree = int(meta["next_tree"])
         trk._next_track = int(meta["next_track"])
+        if trk._birth is not None:
+            trk._birth.set_arrays(
+                {k.removeprefix("birth__"): v for k, v in arrays.items() if k.startswith("birth__")}
+            )
         return trk
 
 

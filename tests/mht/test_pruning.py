@@ -133,3 +133,30 @@ def test_clusters_match_scipy_connected_components():
         # labels numbered by first appearance
         _, first = np.unique(cl, return_index=True)
         assert np.all(np.diff(first) > 0)
+
+
+def test_tentative_keep_is_walds_absolute_lower_threshold():
+    from mhtrack.mht.pruning import tentative_keep
+
+    score = np.array([-10.0, -9.0, -10.0, 3.0])
+    tentative = np.array([True, True, False, True])
+    # ln(β/(1−α)) with α = 0.01, β = 1e−4: −9.2: only the tentative leaf at −10 goes;
+    # the confirmed leaf at −10 is judged by its drop from the peak instead.
+    assert tentative_keep(score, tentative, np.log(1e-4 / 0.99)).tolist() == [
+        False, True, True, True]
+
+
+def test_hopeless_births_are_not_started():
+    """κ̂ = 1e−2 per m² (a dense clutter clump): birth score ln(1e−7·0.9/1e−2) ≈ −11.6,
+    below the deletion threshold −9.2, so no tree starts; at κ̂ = 1e−9 all three start."""
+    from mhtrack.clutter import KnownClutter
+    from mhtrack.mht import MHTConfig, MHTTracker
+    from mhtrack.records import Scan
+
+    scan = Scan.from_positions(1, 1.0, np.array([[0.0, 0.0], [10.0, 5.0], [3.0, -4.0]]))
+    dense = MHTTracker(MHTConfig(), KnownClutter(1e-2))
+    dense.step(scan)
+    assert len(dense.leaves) == 0
+    sparse = MHTTracker(MHTConfig(), KnownClutter(1e-9))
+    sparse.step(scan)
+    assert len(sparse.leaves) == 3

@@ -41,6 +41,7 @@ from mhtrack.mht.pruning import (
     n_scan_keep,
     score_drop_keep,
     sprt_keep,
+    tentative_keep,
 )
 from mhtrack.mht.scoring import birth_score, miss_increment, sprt_thresholds, update_increment
 from mhtrack.mht.tree import Children, Leaves, birth_leaves, grow_children, propose_children
@@ -316,17 +317,19 @@ class MHTTracker:
         in_gates: np.ndarray | None,
         caps: dict[str, int],
     ) -> Leaves:
-        """Every plot starts a tree with the birth score ``ln(λ_v P_D / κ̂)``. Over
-        ``max_births_per_scan`` plots, those outside confirmed tracks' gates go first,
-        then those with the highest birth score (then scan order)."""
+        """Every plot whose birth score ``ln(λ_v P_D / κ̂)`` is above the SPRT deletion
+        threshold starts a tree (a tentative tree at or below it would be deleted at
+        once, :func:`~mhtrack.mht.pruning.tentative_keep`). Over ``max_births_per_scan``
+        plots, those outside confirmed tracks' gates go first, then those with the highest
+        birth score (then scan order)."""
         cfg = self.config
         score = birth_score(kappa, cfg.p_detection, cfg.new_target_density)
-        sel = np.arange(len(z))
-        if len(z) > cfg.max_births_per_scan:
+        sel = np.flatnonzero(score > self.delete_threshold)
+        if sel.size > cfg.max_births_per_scan:
             gated_first = np.zeros(len(z), bool) if in_gates is None else in_gates
-            order = np.lexsort((-score, gated_first))
+            order = sel[np.lexsort((-score[sel], gated_first[sel]))]
+            caps["max_births_per_scan"] = sel.size - cfg.max_births_per_scan
             sel = np.sort(order[: cfg.max_births_per_scan])
-            caps["max_births_per_scan"] = len(z) - sel.size
         Rb = R if R.ndim == 2 else R[sel]
         out = birth_leaves(z[sel], Rb, rows[sel], score[sel], self._next_tree, int(scan.index),
                            cfg.v_max, cfg.n_scan + 1)
@@ -388,6 +391,8 @@ class MHTTracker:
         tree, then the caps on leaves per tree and on all leaves."""
         cfg = self.config
         keep = sprt_keep(children.score, children.peak, self.delete_threshold)
+        keep &= tentative_keep(children.score, leaves.track[children.parent] < 0,
+                               self.delete_threshold)
         children = children.take(keep)
         tree = leaves.tree[children.parent]
         keep = score_drop_keep(tree, children.score, cfg.prune_drop)

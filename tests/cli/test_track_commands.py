@@ -16,7 +16,8 @@ def invoke(*args: str) -> tuple[int, str, str]:
 
 
 RUN = ["run", "crossing", "--seed", "3", "--clutter", "uniform", "--clutter-rate", "10",
-       "--clutter-density", "1.5625e-7", "--scans", "40", "--no-progress"]
+       "--tracker", "mht", "--clutter-density", "1.5625e-7", "--scans", "40",
+       "--no-progress"]
 
 
 @pytest.fixture(scope="module")
@@ -57,7 +58,8 @@ def test_track_on_plots_file_matches_run(run_dir, tmp_path):
     out, _ = run_dir
     dst = tmp_path / "tracks.csv"
     code, stdout, stderr = invoke("track", str(out / "plots.csv"), "--out", str(dst),
-                                  "--clutter-density", "1.5625e-7", "--no-progress")
+                                  "--tracker", "mht", "--clutter-density", "1.5625e-7",
+                                  "--no-progress")
     assert code == 0, stderr
     assert "tracks" in stdout
     assert dst.read_bytes() == (out / "tracks.csv").read_bytes()
@@ -112,7 +114,8 @@ def test_track_with_birth_and_fusion_options(run_dir, tmp_path):
     out, _ = run_dir
     dst = tmp_path / "tracks.csv"
     code, _, stderr = invoke("track", str(out / "plots.csv"), "--out", str(dst),
-                             "--clutter-density", "1.5625e-7", "--birth", "logic",
+                             "--tracker", "mht", "--clutter-density", "1.5625e-7",
+                             "--birth", "logic",
                              "--fusion", "none", "--no-progress")
     assert code == 0, stderr
     t = read_tracks(dst)
@@ -120,7 +123,8 @@ def test_track_with_birth_and_fusion_options(run_dir, tmp_path):
     # the default (every-plot, one sensor: no fusion) still matches run's tracks
     dst2 = tmp_path / "default.csv"
     code, _, stderr = invoke("track", str(out / "plots.csv"), "--out", str(dst2),
-                             "--clutter-density", "1.5625e-7", "--birth", "every-plot",
+                             "--tracker", "mht", "--clutter-density", "1.5625e-7",
+                             "--birth", "every-plot",
                              "--no-progress")
     assert code == 0, stderr
     assert dst2.read_bytes() == (out / "tracks.csv").read_bytes()
@@ -131,3 +135,9 @@ def test_unknown_birth_or_fusion_is_a_usage_error():
     assert code == 2 and "nope" in stderr
     code, _, stderr = invoke("run", "crossing", "--fusion", "kmeans")
     assert code == 2 and "kmeans" in stderr
+
+
+def test_clutter_density_needs_the_known_clutter_tracker():
+    code, _, stderr = invoke("run", "crossing", "--clutter-density", "1e-7", "--scans", "3")
+    assert code == 2
+    assert "--clutter-density" in stderr and "mht-agmm" in stderr

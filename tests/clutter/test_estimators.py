@@ -247,3 +247,29 @@ def test_intensity_always_finite(scans: list[np.ndarray], cls: type, background:
             kappa = est.intensity(q)
             assert kappa.shape == (len(q),)
             assert np.isfinite(kappa).all() and (kappa >= 0).all()
+
+
+@pytest.mark.parametrize("cls", [GMMClutter, AGMMClutter])
+def test_plots_in_confirmed_gates_leave_the_background(cls: type) -> None:
+    """Same plots, but two per scan flagged as inside confirmed tracks' gates: the
+    background's count drops by exactly two plots per scan (κ̂ far from every clump falls
+    by 2/A), the clumps' intensity is unchanged, and the integral falls by 2."""
+    scans = _scans(6)
+    plain = _feed(cls(region=REGION), scans)
+    gated = cls(region=REGION)
+    for s in scans:
+        mask = np.zeros(len(s), bool)
+        mask[:2] = True
+        gated.update(s, mask)
+    far = np.array([[3500.0, 3500.0]])
+    clump = np.array([[-2000.0, 1000.0]])
+    assert plain.intensity(far)[0] - gated.intensity(far)[0] == pytest.approx(
+        2.0 / REGION.area, rel=1e-9)
+    assert gated.intensity(clump)[0] == pytest.approx(
+        plain.intensity(clump)[0] - 2.0 / REGION.area, rel=1e-9)
+    g, cell = REGION.grid(400)
+    assert gated.intensity(g).sum() * cell == pytest.approx(gated.count_ - 2.0, rel=3e-3)
+    state = json.loads(json.dumps(gated.get_state(), default=lambda a: a.tolist()))
+    restored = cls(region=REGION)
+    restored.set_state(state)
+    assert np.array_equal(restored.intensity(g), gated.intensity(g))

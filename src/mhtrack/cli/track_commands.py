@@ -22,7 +22,7 @@ def _tracker_options(f: Callable[..., Any], pd_flag: str) -> Callable[..., Any]:
     from mhtrack.experiments import TRACKERS
 
     opts = [
-        click.option("--tracker", type=click.Choice(sorted(TRACKERS)), default="mht",
+        click.option("--tracker", type=click.Choice(sorted(TRACKERS)), default="mht-agmm",
                      show_default=True, help="Tracker (and its clutter estimator)."),
         click.option(pd_flag, "tracker_pd", type=click.FloatRange(0, 1, min_open=True,
                      max_open=True), default=None,
@@ -65,6 +65,14 @@ def birth_options(f: Callable[..., Any]) -> Callable[..., Any]:
     for opt in reversed(opts):
         f = opt(f)
     return f
+
+
+def _check_clutter_density(tracker: str, clutter_density: float | None) -> None:
+    if clutter_density is not None and tracker != "mht":
+        raise click.UsageError(
+            f"--clutter-density sets the known clutter intensity of --tracker mht; "
+            f"--tracker {tracker} estimates it online"
+        )
 
 
 def _config(tracker_pd: float | None, meas_sigma: float | None, accel_sigma: float | None,
@@ -116,6 +124,7 @@ def track(plots: Path, tracker: str, tracker_pd: float | None, meas_sigma: float
                      else len(np.unique(table.sensor)))
         fusion = default_fusion(n_sensors)
     cfg = _config(tracker_pd, meas_sigma, accel_sigma, birth_density, nscan)
+    _check_clutter_density(tracker, clutter_density)
     trk = make_tracker(tracker, cfg, clutter_density=clutter_density, birth=birth,
                        theta_deg=birth_theta)
     result = run_tracker(trk, table, name=tracker, progress=progress, fusion=fusion)
@@ -159,6 +168,7 @@ def run(scenario: str, seed: int, clutter: str | None, clutter_rate: float | Non
     sc = load_scenario_arg(scenario, clutter, clutter_rate, pd, scans)
     tracker_pd = tracker_pd if tracker_pd is not None else pd
     cfg = _config(tracker_pd, meas_sigma, accel_sigma, birth_density, nscan)
+    _check_clutter_density(tracker, clutter_density)
     result = run_scenario(sc, seed, tracker, cfg, clutter_density=clutter_density,
                           cutoff=cutoff, order=order, progress=progress, birth=birth,
                           theta_deg=birth_theta, fusion=fusion)

@@ -157,6 +157,7 @@ class MixtureClutter:
 
     def _reset(self) -> None:
         self._window: deque[np.ndarray] = deque(maxlen=self.window)
+        self._gated: deque[int] = deque(maxlen=self.window)  # plots in confirmed gates
         self.mixture_: Mixture | None = None
         self.count_ = 0.0
         self.n_iter_ = 0
@@ -192,6 +193,7 @@ class MixtureClutter:
         rng = np.random.default_rng(np.random.SeedSequence(self.seed, spawn_key=(self.n_updates_,)))
         self.n_updates_ += 1
         self._window.append(z.copy())
+        self._gated.append(0 if in_track_gates is None else int(np.count_nonzero(in_track_gates)))
         self.count_ = float(np.mean([len(w) for w in self._window]))  # Poisson ML
         pooled = np.concatenate(self._window) if len(self._window) > 1 else self._window[0]
         if len(pooled) == 0:
@@ -224,7 +226,19 @@ class MixtureClutter:
             raise ValueError("intensity: positions must be finite")
         if self.mixture_ is None or self.count_ == 0.0:
             return np.zeros(len(z))
-        return self.count_ * self.mixture_.pdf(z)
+        m = self.mixture_
+        if m.background_box is None or not self._gated:
+            return self.count_ * m.pdf(z)
+        # The uniform background also absorbs the targets' own plots; take out of its count
+        # those that confirmed tracks explain (plots in their gates), keeping at least the
+        # background floor's share: κ̂ = M̂·Σπⱼ𝒩ⱼ + max(M̂π₀ − ḡ, M̂·floor)/A.
+        g = float(np.mean(self._gated))
+        background = max(self.count_ * m.background_weight - g,
+                         self.count_ * self.background_floor)
+        inside = np.exp(m.log_background(z)) * m.background_area  # 1 inside the box, else 0
+        gauss = self.count_ * m.pdf(z) - self.count_ * m.background_weight * inside / \
+            m.background_area
+        return np.maximum(gauss, 0.0) + background * inside / m.background_area
 
     def density(self, z: np.ndarray) -> np.ndarray:
         """``ĉ_k(z)`` (P1 eq. 13), per m²; 0 before any plot was seen."""
@@ -235,6 +249,7 @@ class MixtureClutter:
         """The learned state (window, fit, counters) as JSON-able values and arrays."""
         return {
             "window": [w.copy() for w in self._window],
+            "gated": list(self._gated),
             "mixture": None if self.mixture_ is None else self.mixture_.to_state(),
             "count": self.count_,
             "n_iter": self.n_iter_,
@@ -250,6 +265,8 @@ class MixtureClutter:
         self._reset()
         for w in state["window"]:
             self._window.append(np.asarray(w, dtype=float).reshape(-1, 2))
+        for n in state.get("gated", []):
+            self._gated.append(int(n))
         m = state["mixture"]
         self.mixture_ = None if m is None else Mixture.from_state(m)
         self.count_ = float(state["count"])

@@ -1,0 +1,17 @@
+"""The README's Python example runs as written (so the front page cannot rot)."""
+
+import re
+from pathlib import Path
+
+README = Path(__file__).resolve().parents[1] / "README.md"
+
+
+def test_readme_python_example_runs(tmp_path, monkeypatch, capsys):
+    text = README.read_text()
+    block = re.search(r"## From Python\n\n```python\n(.*?)```", text, re.S)
+    assert block, "README has no Python example"
+    monkeypatch.chdir(tmp_path)
+    exec(compile(block.group(1), "README.md", "exec"), {})
+    out = capsys.readouterr().out
+    assert "OSPA mean" in out and "Rcc" in out
+    assert (tmp_path / "state.npz").is_file()

@@ -1,0 +1,155 @@
+"""``reproduce p1``: the P1 §3 study, Table 3 beside the paper, report and Figs. 2–6."""
+
+import json
+import math
+import re
+import struct
+
+import pytest
+from click.testing import CliRunner
+
+from mhtrack.cli.reproduce_commands import COMMANDS, reproduce
+from mhtrack.experiments import reproduce_p1 as rp
+from mhtrack.experiments.montecarlo import run_seed
+from mhtrack.scenario import preset
+
+PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
+FILES = ("table3.md", "table3.json", "report.md", *rp.FIGURES.values())
+
+
+@pytest.fixture(scope="module")
+def repro(tmp_path_factory):
+    out = tmp_path_factory.mktemp("p1")
+    return rp.reproduce_p1(out, runs=2, seed=3, scenario=preset("crossing", scans=15),
+                           workers=1)
+
+
+def png_size(path) -> tuple[int, int]:
+    data = path.read_bytes()
+    assert data[:8] == PNG_MAGIC, path
+    assert data[12:16] == b"IHDR"
+    return struct.unpack(">II", data[16:24])
+
+
+def test_files_exist(repro):
+    for name in FILES:
+        assert (repro.out_dir / name).is_file(), name
+    mc = repro.out_dir / "montecarlo"
+    assert (mc / "montecarlo.json").is_file()
+    assert (mc / "summary.md").is_file()
+    for t in rp.P1_TRACKERS:
+        for i in range(2):
+            assert (mc / "runs" / t / f"run-{i}.parquet").is_file()
+    assert repro.result.ok
+
+
+def test_figures_are_png(repro):
+    for key, name in rp.FIGURES.items():
+        w, h = png_size(repro.out_dir / name)
+        assert w >= 400 and h >= 300, (name, w, h)
+        assert repro.figures[key] == repro.out_dir / name
+    w, h = png_size(repro.out_dir / rp.FIGURES["fig4"])
+    assert w > 2 * h  # three panels side by side
+
+
+def test_table_holds_paper_and_ours(repro):
+    md = (repro.out_dir / "table3.md").read_text()
+    s = repro.result.summary()
+    for t in rp.P1_TRACKERS:
+        label = rp.TRACKER_LABELS[t]
+        paper_row = next(line for line in md.splitlines() if line.startswith(f"| {label} | P1 |"))
+        ours_row = next(line for line in md.splitlines()
+                        if line.startswith(f"| {label} | ours (2 runs) |"))
+        paper_cells = [c.strip() for c in paper_row.strip("|").split("|")][2:]
+        ours_cells = [c.strip() for c in ours_row.strip("|").split("|")][2:]
+        assert len(paper_cells) == len(ours_cells) == len(rp.TABLE3_METRICS)
+        for m, pc, oc in zip(rp.TABLE3_METRICS, paper_cells, ours_cells, strict=True):
+            if m.key in rp.PAPER_TABLE3[t]:
+                assert pc == rp.fmt(m.key, rp.PAPER_TABLE3[t][m.key])
+            else:
+                assert pc == "–"
+            mean, std = s[t][m.key], s[t]["std"][m.key]
+            assert oc == f"{rp.fmt(m.key, mean)} ± {rp.fmt(m.key, std)}", (t, m.key)
+    assert "0.9703" in md and "64.44" in md  # P1's MHT-AGMM Rcc and Lavg
+
+
+def test_numbers_equal_summary_means(repro):
+    s = repro.result.summary()
+    js = json.loads((repro.out_dir / "table3.json").read_text())
+    for t in rp.P1_TRACKERS:
+        for m in rp.TABLE3_METRICS:
+            mean = s[t][m.key]
+            assert repro.table[t][m.key]["mean"] == mean or (
+                math.isnan(mean) and math.isnan(repro.table[t][m.key]["mean"]))
+            stored = js["table"][t][m.key]["mean"]
+            assert (stored is None and math.isnan(mean)) or stored == mean
+            # the means are those of the run files
+            vals = [r[m.key] for r in repro.result.records[t]]
+            assert mean == pytest.approx(sum(vals) / len(vals), rel=1e-12)
+
+
+def test_run0_recomputed_with_runner_seed(repro):
+    assert repro.run0_seed == run_seed(3, 0)
+    for t in rp.P1_TRACKERS:
+        rec = next(r for r in repro.result.records[t] if r["run"] == 0)
+        assert rec["seed"] == repro.run0_seed
+        got = repro.run0[t].summary()
+        for k in ("rcc", "rfg", "l_avg", "ospa_mean", "n_tracks"):
+            assert got[k] == pytest.approx(rec[k], nan_ok=True), (t, k)
+
+
+def test_report(repro):
+    text = repro.report_path.read_text()
+    for name in rp.FIGURES.values():
+        assert f"]({name})" in text
+    assert "## Settings" in text and "λ = 40" in text and "κ = 1e-09" in text
+    assert "Where our numbers differ" in text
+    assert "Known reasons" in text
+    # generated comparison: one verdict line per tracker and P1 metric
+    for t in rp.P1_TRACKERS:
+        assert f"**{rp.TRACKER_LABELS[t]}**" in text
+    verdicts = re.findall(r"^\* (Rcc|Rmc|Rfg|Tavg \(s\)|Lmin \(s\)|Lavg \(s\)|Lmax \(s\)): ours ",
+                          text, flags=re.M)
+    assert len(verdicts) == 7 * 3
+    rcc = repro.table["mht-agmm"]["rcc"]["mean"]
+    assert f"Rcc: ours {rp.fmt('rcc', rcc)}" in text
+
+
+def test_resume_computes_nothing(repro):
+    again = rp.reproduce_p1(repro.out_dir, runs=2, seed=3,
+                            scenario=preset("crossing", scans=15), workers=1)
+    assert again.result.computed == 0 and again.result.skipped == 6
+    assert again.table_md == repro.table_md  # Tavg too is read back from the run files
+
+
+def test_compare_text_ranks_ties():
+    row = {m.key: {"mean": 1.0, "std": 0.0, "paper": math.nan} for m in rp.TABLE3_METRICS}
+    table = {"mht": row, "mht-gmm": dict(row), "mht-agmm": dict(row)}
+    text = rp.compare_text(table)
+    assert "MHT = MHT-GMM = MHT-AGMM" in text
+    assert "Identical accuracy" in text
+
+
+def test_cli_help():
+    assert [reproduce] == COMMANDS
+    r = CliRunner().invoke(reproduce, ["p1", "--help"])
+    assert r.exit_code == 0
+    for opt in ("--runs", "--out", "--seed", "--workers", "--dask-scheduler", "--no-progress"):
+        assert opt in r.output
+
+
+def test_cli_runs(tmp_path, monkeypatch):
+    monkeypatch.setattr(rp, "p1_scenario", lambda: preset("crossing", scans=8))
+    r = CliRunner().invoke(reproduce, ["p1", "--runs", "1", "--workers", "1", "--out",
+                                       str(tmp_path), "--no-progress"])
+    assert r.exit_code == 0, r.output
+    assert "| MHT-AGMM | P1 |" in r.stdout and "| MHT-AGMM | ours (1 run) |" in r.stdout
+    assert str(tmp_path / "report.md") in r.stdout
+    for name in FILES:
+        assert (tmp_path / name).is_file()
+
+
+def test_cli_rejects_both_executors(tmp_path):
+    r = CliRunner().invoke(reproduce, ["p1", "--workers", "1", "--dask-scheduler",
+                                       "tcp://x:1", "--out", str(tmp_path)])
+    assert r.exit_code != 0 and "not both" in r.output

@@ -234,3 +234,12 @@ def test_an_interruption_loses_no_finished_run(spec, inline, tmp_path):
     resumed = run_montecarlo(spec, tmp_path, workers=1)
     assert resumed.computed == 4 and resumed.skipped == 2
     assert comparable(resumed) == comparable(inline)
+
+
+def test_runs_with_caps_counts_runs_where_a_cap_acted(tmp_path):
+    from mhtrack.experiments.montecarlo import MonteCarloResult
+
+    spec = MonteCarloSpec(preset("crossing", scans=5), ["mht"], 3, 0)
+    recs = [{"caps": "{}"}, {"caps": '{"max_leaves": 4}'}, {"caps": '{"max_trees": 1}'}]
+    res = MonteCarloResult(spec, tmp_path, {"mht": recs}, {"mht": {}})
+    assert res.runs_with_caps() == {"mht": 2}

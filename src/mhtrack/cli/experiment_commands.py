@@ -131,6 +131,11 @@ def montecarlo(scenario: str, clutter: str | None, clutter_rate: float | None,
         click.echo(result.to_markdown(), nl=False)
         click.echo(f"{result.computed} runs computed, {result.skipped} already done; "
                    f"wrote {out}/ (runs/, montecarlo.json, summary.md, ospa_cardinality.png)")
+    capped = {t: n for t, n in result.runs_with_caps().items() if n}
+    if capped:
+        listed = ", ".join(f"{t}: {n} of {len(result.records[t])} runs" for t, n in capped.items())
+        click.echo(f"mhtrack montecarlo: hard caps of the MHT acted ({listed}); per-run "
+                   f"counts in the 'caps' column of {out}/runs/", err=True)
     failed = [(t, i) for t, f in result.failures.items() for i in sorted(f)]
     if failed or result.missing:
         shown = ", ".join(f"{t} run {i}" for t, i in failed[:10])

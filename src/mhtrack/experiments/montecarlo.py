@@ -36,6 +36,7 @@ import contextlib
 import dataclasses
 import hashlib
 import json
+import logging
 import math
 import os
 import sys
@@ -227,7 +228,17 @@ def run_job(job: Mapping[str, Any]) -> dict[str, Any]:
 
     scenario = Scenario.from_dict(job["scenario"])
     config = config_with(**job["config"]) if job["config"] else None
-    result = run_scenario(scenario, job["seed"], job["tracker"], config, **job["run_kwargs"])
+    # Every job builds a new tracker, whose first-time cap warnings would repeat for every
+    # run; the caps that acted are kept in the record (``caps``) and counted per tracker
+    # by :meth:`MonteCarloResult.runs_with_caps` instead.
+    tracker_log = logging.getLogger("mhtrack.mht.tracker")
+    level = tracker_log.level
+    tracker_log.setLevel(logging.ERROR)
+    try:
+        result = run_scenario(scenario, job["seed"], job["tracker"], config,
+                              **job["run_kwargs"])
+    finally:
+        tracker_log.setLevel(level)
     summary = result.summary()
     record: dict[str, Any] = {
         "tracker": job["tracker"],
@@ -358,6 +369,11 @@ class MonteCarloResult:
     missing: list[tuple[str, int]] = field(default_factory=list)
     computed: int = 0
     skipped: int = 0
+
+    def runs_with_caps(self) -> dict[str, int]:
+        """Per tracker, the number of successful runs in which a hard cap of the MHT acted."""
+        return {t: sum(1 for r in recs if json.loads(r.get("caps") or "{}"))
+                for t, recs in self.records.items()}
 
     @property
     def ok(self) -> bool:

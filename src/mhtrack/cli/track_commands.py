@@ -75,11 +75,11 @@ def _check_clutter_density(tracker: str, clutter_density: float | None) -> None:
         )
 
 
-def _config(tracker_pd: float | None, meas_sigma: float | None, accel_sigma: float | None,
-            birth_density: float | None, nscan: int | None) -> Any:
+def _config(base: Any, tracker_pd: float | None, meas_sigma: float | None,
+            accel_sigma: float | None, birth_density: float | None, nscan: int | None) -> Any:
     from mhtrack.experiments import config_with
 
-    return config_with(p_detection=tracker_pd, sigma_w=meas_sigma, sigma_v=accel_sigma,
+    return config_with(base, p_detection=tracker_pd, sigma_w=meas_sigma, sigma_v=accel_sigma,
                        new_target_density=birth_density, n_scan=nscan)
 
 
@@ -102,7 +102,7 @@ def track(plots: Path, tracker: str, tracker_pd: float | None, meas_sigma: float
     """Run a tracker on a PLOTS file and write its tracks."""
     import numpy as np
 
-    from mhtrack.experiments.pipeline import default_fusion, make_tracker
+    from mhtrack.experiments.pipeline import default_config, default_fusion, make_tracker
     from mhtrack.experiments.pipeline import track as run_tracker
     from mhtrack.io import read_plots, write_tracks
     from mhtrack.scenario import load_scenario
@@ -123,7 +123,12 @@ def track(plots: Path, tracker: str, tracker_pd: float | None, meas_sigma: float
         n_sensors = (len(scenario.sensors) if scenario is not None
                      else len(np.unique(table.sensor)))
         fusion = default_fusion(n_sensors)
-    cfg = _config(tracker_pd, meas_sigma, accel_sigma, birth_density, nscan)
+    if scenario is not None:
+        base = default_config(scenario)
+    else:  # no scenario: the plots' bounding box is the surveillance area
+        span = max(float(np.ptp(table.x)), 1.0) * max(float(np.ptp(table.y)), 1.0)
+        base = default_config(area=span) if len(table) > 1 else default_config()
+    cfg = _config(base, tracker_pd, meas_sigma, accel_sigma, birth_density, nscan)
     _check_clutter_density(tracker, clutter_density)
     trk = make_tracker(tracker, cfg, clutter_density=clutter_density, birth=birth,
                        theta_deg=birth_theta)
@@ -160,14 +165,15 @@ def run(scenario: str, seed: int, clutter: str | None, clutter_rate: float | Non
     Writes plots, truth, tracks, scenario.toml, metrics.json, scene.png (truth, plots,
     tracks) and metrics.png (OSPA and cardinality per scan) to the output directory.
     """
-    from mhtrack.experiments.pipeline import run_scenario
+    from mhtrack.experiments.pipeline import default_config, run_scenario
     from mhtrack.io import write_plots, write_scenario_toml, write_tracks, write_truth
     from mhtrack.plotting.metrics import plot_ospa_cardinality
     from mhtrack.plotting.scene import plot_scene, save_figure
 
     sc = load_scenario_arg(scenario, clutter, clutter_rate, pd, scans)
     tracker_pd = tracker_pd if tracker_pd is not None else pd
-    cfg = _config(tracker_pd, meas_sigma, accel_sigma, birth_density, nscan)
+    cfg = _config(default_config(sc), tracker_pd, meas_sigma, accel_sigma, birth_density,
+                  nscan)
     _check_clutter_density(tracker, clutter_density)
     result = run_scenario(sc, seed, tracker, cfg, clutter_density=clutter_density,
                           cutoff=cutoff, order=order, progress=progress, birth=birth,

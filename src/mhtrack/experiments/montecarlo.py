@@ -223,11 +223,11 @@ def job_hash(job: Mapping[str, Any]) -> str:
 def run_job(job: Mapping[str, Any]) -> dict[str, Any]:
     """Run one job (see :meth:`MonteCarloSpec.job`) and return its record: every scalar of
     ``summary()`` plus bookkeeping, and the per-scan lists. Plain data only."""
-    from mhtrack.experiments.pipeline import config_with, run_scenario
+    from mhtrack.experiments.pipeline import config_with, default_config, run_scenario
     from mhtrack.scenario import Scenario
 
     scenario = Scenario.from_dict(job["scenario"])
-    config = config_with(**job["config"]) if job["config"] else None
+    config = config_with(default_config(scenario), **job["config"])
     # Every job builds a new tracker, whose first-time cap warnings would repeat for every
     # run; the caps that acted are kept in the record (``caps``) and counted per tracker
     # by :meth:`MonteCarloResult.runs_with_caps` instead.

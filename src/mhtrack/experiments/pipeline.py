@@ -182,6 +182,7 @@ def run_scenario(
     ``birth`` / ``theta_deg``: see :func:`make_tracker`; ``fusion``: ``"none"`` or
     ``"adaptive-kmeans"``, default :func:`default_fusion` of the scenario's sensors."""
     sim = simulate(scenario, seed=seed)
+    config = default_config(scenario) if config is None else config
     trk = make_tracker(tracker, config, clutter_density=clutter_density, birth=birth,
                        theta_deg=theta_deg)
     if fusion is None:
@@ -189,6 +190,31 @@ def run_scenario(
     run = track(trk, sim.plots, name=tracker, progress=progress, fusion=fusion)
     ev = evaluate(run.tracks, sim.truth, plots=sim.plots, cutoff=cutoff, order=order)
     return ScenarioRun(sim, run, ev)
+
+
+#: New targets per scan that P1's λv = 1e−7 per m² means over P1's 8 km × 8 km region
+#: (P1 §3): 6.4. :func:`default_config` keeps this rate and scales the density to the
+#: surveillance area at hand, so that P1's value is used on P1's region and a 500 km
+#: air-surveillance picture does not expect 29 000 new targets per scan.
+P1_BIRTHS_PER_SCAN = 1e-7 * 8000.0**2
+
+
+def birth_density_for_area(area: float) -> float:
+    """``λv = 6.4 / A`` per m² per scan: P1's new-target rate over an area of ``A`` m²."""
+    if not (np.isfinite(area) and area > 0):
+        raise ValueError(f"surveillance area must be finite and > 0, got {area}")
+    return P1_BIRTHS_PER_SCAN / area
+
+
+def default_config(scenario: Scenario | None = None, *, area: float | None = None) -> MHTConfig:
+    """The tracker defaults (:class:`MHTConfig`, P1 §3) with the new-target density scaled to
+    the surveillance area: the scenario's region, or ``area`` (e.g. the bounding box of a
+    plots file), by :func:`birth_density_for_area`. P1's crossing region gives P1's 1e−7."""
+    if scenario is not None:
+        area = scenario.region.area
+    if area is None:
+        return MHTConfig()
+    return MHTConfig(new_target_density=birth_density_for_area(area))
 
 
 def config_with(config: MHTConfig | None = None, **changes: Any) -> MHTConfig:

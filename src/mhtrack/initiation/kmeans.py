@@ -73,6 +73,7 @@ numerous, then ``−1`` (clutter-dominated).
 
 from __future__ import annotations
 
+import abc
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -501,8 +502,9 @@ class FusedScan:
         return len(self.scan)
 
 
-class _Fusion:
-    """Shared ``fit`` output handling and :meth:`fuse` (scikit-learn style)."""
+class _Fusion(abc.ABC):
+    """Shared ``fit`` output handling and :meth:`fuse` (scikit-learn style); subclasses
+    implement :meth:`fit`."""
 
     weighting: str
     max_iter: int
@@ -545,9 +547,10 @@ class _Fusion:
     def n_clusters_(self) -> int:
         return len(self.cluster_centers_)
 
+    @abc.abstractmethod
     def fit(self, z: np.ndarray, sensor: np.ndarray | None = None,
             R: np.ndarray | None = None) -> _Fusion:
-        raise NotImplementedError
+        """Cluster plots ``z`` (n, 2) of radars ``sensor`` with covariances ``R``."""
 
     def fuse(self, scan: Scan) -> FusedScan:
         """Cluster ``scan``'s plots and return the fused scan (see :class:`FusedScan`)."""

@@ -274,7 +274,11 @@ def run_path(out_dir: Path, tracker: str, run: int, suffix: str = ".parquet") ->
     return Path(out_dir) / "runs" / tracker / f"run-{run}{suffix}"
 
 
-def _atomic_write_bytes(path: Path, data: bytes) -> None:
+def atomic_write(path: Path, data: bytes | str) -> None:
+    """Write ``data`` (text is UTF-8) to ``path`` atomically: a temporary file in the same
+    folder, then ``os.replace``, so a reader or an interruption never sees half a file."""
+    if isinstance(data, str):
+        data = data.encode("utf-8")
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
     try:
@@ -441,7 +445,7 @@ class MonteCarloResult:
         from mhtrack.plotting.metrics import plot_ospa_cardinality
         from mhtrack.plotting.scene import save_figure
 
-        _atomic_write_bytes(self.out_dir / SUMMARY_FILE, self.to_markdown().encode())
+        atomic_write(self.out_dir / SUMMARY_FILE, self.to_markdown().encode())
         curves = {t: v["per_scan"] for t, v in self.summary().items() if v["per_scan"]["scans"]}
         if curves:
             cutoff = self.spec.run_kwargs.get("cutoff", 500.0)
@@ -542,12 +546,7 @@ def run_montecarlo(
     holds a study with other parameters. Does not write ``summary.md`` or the figure
     (:meth:`MonteCarloResult.write_reports`).
     """
-    if executor not in ("local", "dask"):
-        raise ValueError(f"executor: expected 'local' or 'dask', got {executor!r}")
-    if executor == "dask" and scheduler is None:
-        raise ValueError("executor 'dask' needs a scheduler address")
-    if workers is not None and (isinstance(workers, bool) or workers < 1):
-        raise ValueError(f"workers: expected an integer >= 1, got {workers!r}")
+    check_executor(executor, workers, scheduler)
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     _check_study(spec, out_dir)
@@ -563,7 +562,7 @@ def run_montecarlo(
                     f"{p} holds a run of other parameters (job hash {h[:12]}…, expected "
                     f"{job['job_hash'][:12]}…); use another --out directory or delete it")
         pending.append(job)
-    _atomic_write_bytes(out_dir / SPEC_FILE,
+    atomic_write(out_dir / SPEC_FILE,
                         (json.dumps(spec.to_dict(), indent=1) + "\n").encode())
     n_total = spec.runs * len(spec.trackers)
     fn = job_function or run_job
@@ -581,7 +580,7 @@ def run_montecarlo(
         if error is None and record is not None and "error" in record:
             error = str(record["error"])
         if error is not None:
-            _atomic_write_bytes(err_path, error.encode())
+            atomic_write(err_path, error.encode())
             n_failed += 1
             bar.set_postfix_str(f"{n_failed} failed")
         else:
@@ -592,19 +591,43 @@ def run_montecarlo(
         bar.update(1)
 
     try:
-        if executor == "dask":
-            _run_dask(pending, fn, scheduler, finish)
-        elif (workers or os.cpu_count() or 1) == 1 or len(pending) <= 1:
-            for job in pending:
-                _run_inline(job, fn, finish)
-        else:
-            _run_pool(pending, fn, workers or os.cpu_count() or 1, finish)
+        execute(pending, fn, finish, executor=executor, workers=workers, scheduler=scheduler)
     finally:
         bar.close()
     result = load_results(out_dir)
     result.computed = len(pending)
     result.skipped = n_total - len(pending)
     return result
+
+
+def check_executor(executor: str, workers: int | None, scheduler: Any) -> None:
+    """Validate the executor arguments of :func:`execute` (``ValueError`` naming the bad one)."""
+    if executor not in ("local", "dask"):
+        raise ValueError(f"executor: expected 'local' or 'dask', got {executor!r}")
+    if executor == "dask" and scheduler is None:
+        raise ValueError("executor 'dask' needs a scheduler address")
+    if workers is not None and (isinstance(workers, bool) or workers < 1):
+        raise ValueError(f"workers: expected an integer >= 1, got {workers!r}")
+
+
+def execute(pending: Sequence[Mapping[str, Any]], fn: Callable[..., Any],
+            finish: Callable[..., Any], *, executor: str = "local", workers: int | None = None,
+            scheduler: Any = None) -> None:
+    """Run ``fn(job)`` for every job of ``pending`` and call ``finish(job, record, error)``
+    in this process as each one ends: on a Dask cluster (``executor="dask"``, ``scheduler``
+    an address or a ``distributed.Client``), in this process (one worker, or one job), or
+    in a pool of ``workers`` local processes (default: the CPU count)."""
+    check_executor(executor, workers, scheduler)
+    if not pending:
+        return
+    n_workers = workers or os.cpu_count() or 1
+    if executor == "dask":
+        _run_dask(pending, fn, scheduler, finish)
+    elif n_workers == 1 or len(pending) <= 1:
+        for job in pending:
+            _run_inline(job, fn, finish)
+    else:
+        _run_pool(pending, fn, n_workers, finish)
 
 
 def _run_inline(job: Mapping[str, Any], fn: Callable[..., Any], finish: Callable[..., Any]

@@ -28,6 +28,7 @@ import numpy as np
 from mhtrack.experiments.montecarlo import (
     MonteCarloResult,
     MonteCarloSpec,
+    atomic_write,
     run_montecarlo,
     run_seed,
 )
@@ -137,16 +138,6 @@ class P1Reproduction:
 
 
 # ---------------------------------------------------------------------------- numbers
-def _write_text(path: Path, text: str) -> None:
-    """Write ``text`` to ``path`` atomically (temporary name, then ``os.replace``)."""
-    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-    try:
-        tmp.write_text(text, encoding="utf-8")
-        os.replace(tmp, path)
-    finally:
-        tmp.unlink(missing_ok=True)
-
-
 def _num(v: Any) -> float:
     try:
         f = float(v)
@@ -580,16 +571,16 @@ def reproduce_p1(
     n_ok = {t: summary[t]["n_runs"] for t in spec.trackers}
     table_md = _table3_file(table, spec.runs, n_ok)
     table_path = out_dir / TABLE_FILE
-    _write_text(table_path, table_md)
+    atomic_write(table_path, table_md)
     js = {"source": PAPER_SOURCE, "runs": spec.runs, "seed": spec.seed,
           "n_runs_ok": n_ok,
           "table": {t: {k: {kk: (None if not math.isfinite(vv) else vv)
                             for kk, vv in v.items()} for k, v in row.items()}
                     for t, row in table.items()}}
-    _write_text(out_dir / TABLE_JSON, json.dumps(js, indent=1) + "\n")
+    atomic_write(out_dir / TABLE_JSON, json.dumps(js, indent=1) + "\n")
 
     figures = _figures(out_dir, result, run0, sim, seed0)
     repro = P1Reproduction(out_dir, result, table, table_md, out_dir / REPORT_FILE,
                            table_path, figures, run0, seed0)
-    _write_text(repro.report_path, report_markdown(repro))
+    atomic_write(repro.report_path, report_markdown(repro))
     return repro

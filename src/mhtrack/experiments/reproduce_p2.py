@@ -43,6 +43,7 @@ from typing import Any
 import numpy as np
 from scipy.spatial import cKDTree
 
+from mhtrack.experiments.montecarlo import atomic_write, execute
 from mhtrack.initiation import INITIATORS, Window, make_initiator, remove_dominated
 from mhtrack.initiation.logic import _ball, leg_angle
 from mhtrack.initiation.runs import fuse, fused_scans, n_targets_seen, run_seeds
@@ -333,16 +334,6 @@ def make_jobs(runs: int, seed: int, thetas: Sequence[float], sigmas: Sequence[fl
     return jobs
 
 
-def _atomic_write(path: Path, text: str) -> None:
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-    try:
-        tmp.write_text(text, encoding="utf-8")
-        os.replace(tmp, path)
-    finally:
-        tmp.unlink(missing_ok=True)
-
-
 def _done(path: Path, job: Mapping[str, Any]) -> dict[str, Any] | None:
     """The stored result of ``job`` if ``path`` holds it (same parameters)."""
     try:
@@ -359,7 +350,6 @@ def run_jobs(jobs: Sequence[Mapping[str, Any]], jobs_dir: Path, *, executor: str
     name, number computed)."""
     from tqdm.auto import tqdm
 
-    from mhtrack.experiments.montecarlo import _run_dask, _run_inline, _run_pool
 
     results: dict[str, dict[str, Any]] = {}
     errors: dict[str, str] = {}
@@ -377,28 +367,17 @@ def run_jobs(jobs: Sequence[Mapping[str, Any]], jobs_dir: Path, *, executor: str
         bar.update(1)
         if error is not None:
             errors[job["name"]] = error
-            _atomic_write(jobs_dir / f"{job['name']}.error.txt", error)
+            atomic_write(jobs_dir / f"{job['name']}.error.txt", error)
             return
         results[job["name"]] = dict(record)  # type: ignore[arg-type]
-        _atomic_write(jobs_dir / f"{job['name']}.json",
+        atomic_write(jobs_dir / f"{job['name']}.json",
                       json.dumps({"job": dict(job), "result": record}) + "\n")
         (jobs_dir / f"{job['name']}.error.txt").unlink(missing_ok=True)
 
     jobs_dir.mkdir(parents=True, exist_ok=True)
     try:
-        if not pending:
-            pass
-        elif executor == "dask":
-            if scheduler is None:
-                raise ValueError("executor 'dask' needs a scheduler address")
-            _run_dask(pending, run_job, scheduler, finish)
-        elif executor != "local":
-            raise ValueError(f"unknown executor {executor!r} (expected local, dask)")
-        elif (workers or os.cpu_count() or 1) == 1 or len(pending) == 1:
-            for j in pending:
-                _run_inline(j, run_job, finish)
-        else:
-            _run_pool(pending, run_job, workers or os.cpu_count() or 1, finish)
+        execute(pending, run_job, finish, executor=executor, workers=workers,
+                scheduler=scheduler)
     finally:
         bar.close()
     return results, errors, len(pending)
@@ -836,7 +815,7 @@ def reproduce_p2(out_dir: str | os.PathLike[str], runs: int = 10, seed: int = 0,
                                             "complexity": PAPER_COMPLEXITY},
                jobs={"total": len(jobs), "computed": computed, "failed": sorted(errors)})
     res = _jsonable(res)
-    _atomic_write(out / RESULTS_FILE, json.dumps(res, indent=1) + "\n")
+    atomic_write(out / RESULTS_FILE, json.dumps(res, indent=1) + "\n")
     sig = sorted({c["sigma_range"] for c in res["curves"] if c["clutter_rate"] == RATE0})
     rat = sorted({c["clutter_rate"] for c in res["curves"] if c["sigma_range"] == SIGMA0})
     _curve_figure(res, "p_true", [(s, RATE0) for s in sig], lambda s, r: f"σr = {s:g} m",
@@ -849,8 +828,8 @@ def reproduce_p2(out_dir: str | os.PathLike[str], runs: int = 10, seed: int = 0,
         try:
             fn(seed, out / FIGURES[name])
         except Exception:  # a figure must not lose the study
-            _atomic_write(out / f"{FIGURES[name]}.error.txt", traceback.format_exc())
-    _atomic_write(out / TABLES_FILE, tables_markdown(res))
-    _atomic_write(out / REPORT_FILE, report_markdown(res, runs, seed,
+            atomic_write(out / f"{FIGURES[name]}.error.txt", traceback.format_exc())
+    atomic_write(out / TABLES_FILE, tables_markdown(res))
+    atomic_write(out / REPORT_FILE, report_markdown(res, runs, seed,
                                                      wall if computed else None))
     return P2Reproduction(out, res, computed, len(jobs) - computed, errors, wall)

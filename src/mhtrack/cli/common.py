@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import math
+import sys
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -83,3 +84,49 @@ def table_path(directory: Path, stem: str) -> Path | None:
         if p.is_file():
             return p
     return None
+
+
+def executor_options(f: Callable[..., Any]) -> Callable[..., Any]:
+    """``--workers`` / ``--dask-scheduler`` / ``--progress`` of the Monte-Carlo commands."""
+    for opt in reversed(
+        [
+            click.option("--workers", type=click.IntRange(min=1), default=None,
+                         help="Local worker processes [number of CPUs]; 1 runs in this "
+                         "process."),
+            click.option("--dask-scheduler", default=None, metavar="ADDRESS",
+                         help="Run the jobs on this Dask scheduler (e.g. tcp://host:8786) "
+                         "instead."),
+            click.option("--progress/--no-progress", default=None,
+                         help="Progress bar over jobs on stderr [when stderr is a "
+                         "terminal]."),
+        ]
+    ):
+        f = opt(f)
+    return f
+
+
+def executor_kwargs(workers: int | None, dask_scheduler: str | None,
+                    progress: bool | None) -> dict[str, Any]:
+    """The ``executor``, ``workers``, ``scheduler`` and ``progress`` keywords of the
+    experiment runners, from :func:`executor_options`' values."""
+    if workers is not None and dask_scheduler is not None:
+        raise click.UsageError("give --workers or --dask-scheduler, not both")
+    return {
+        "executor": "dask" if dask_scheduler else "local",
+        "workers": workers,
+        "scheduler": dask_scheduler,
+        "progress": sys.stderr.isatty() if progress is None else progress,
+    }
+
+
+def exit_if_runs_failed(command: str, result: Any) -> None:
+    """After a Monte-Carlo study (:class:`~mhtrack.experiments.MonteCarloResult`): name the
+    failed runs on stderr and exit with status 1, if any failed or are missing."""
+    failed = [(t, i) for t, f in result.failures.items() for i in sorted(f)]
+    if failed or result.missing:
+        shown = ", ".join(f"{t} run {i}" for t, i in failed[:10])
+        more = f" and {len(failed) - 10} more" if len(failed) > 10 else ""
+        click.echo(f"mhtrack {command}: {len(failed)} run(s) failed ({shown}{more}); "
+                   f"tracebacks in {result.out_dir}/runs/<tracker>/run-<i>.error.txt",
+                   err=True)
+        click.get_current_context().exit(1)

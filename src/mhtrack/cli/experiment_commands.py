@@ -3,14 +3,20 @@
 from __future__ import annotations
 
 import json
-import sys
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
 import click
 
-from mhtrack.cli.common import echo_json, load_scenario_arg, scenario_options
+from mhtrack.cli.common import (
+    echo_json,
+    executor_kwargs,
+    executor_options,
+    exit_if_runs_failed,
+    load_scenario_arg,
+    scenario_options,
+)
 from mhtrack.cli.track_commands import tracker_options
 
 
@@ -69,10 +75,7 @@ def _run_kwargs(ctx: click.Context, param: click.Parameter, value: tuple[str, ..
 @click.option("--out", type=click.Path(file_okay=False, path_type=Path), required=True,
               help="Study directory (runs/, montecarlo.json, summary.md, "
               "ospa_cardinality.png); an existing one with the same parameters is resumed.")
-@click.option("--workers", type=click.IntRange(min=1), default=None,
-              help="Local worker processes [number of CPUs]; 1 runs in this process.")
-@click.option("--dask-scheduler", default=None, metavar="ADDRESS",
-              help="Run the jobs on this Dask scheduler (e.g. tcp://host:8786) instead.")
+@executor_options
 @_params_of(tracker_options("--tracker-pd"), drop={"tracker"})
 @click.option("--cutoff", type=click.FloatRange(min=0, min_open=True), default=500.0,
               show_default=True, help="OSPA/GOSPA cut-off c (m).")
@@ -83,8 +86,6 @@ def _run_kwargs(ctx: click.Context, param: click.Parameter, value: tuple[str, ..
               "else as text); repeatable.")
 @click.option("--json", "as_json", is_flag=True,
               help="Print one JSON object keyed by tracker (means, std, per-scan curves).")
-@click.option("--progress/--no-progress", default=None,
-              help="Progress bar over jobs on stderr [when stderr is a terminal].")
 def montecarlo(scenario: str, clutter: str | None, clutter_rate: float | None,
                pd: float | None, scans: int | None, trackers: tuple[str, ...], runs: int,
                seed: int, out: Path, workers: int | None, dask_scheduler: str | None,
@@ -105,8 +106,7 @@ def montecarlo(scenario: str, clutter: str | None, clutter_rate: float | None,
         run_montecarlo,
     )
 
-    if workers is not None and dask_scheduler is not None:
-        raise click.UsageError("give --workers or --dask-scheduler, not both")
+    run_on = executor_kwargs(workers, dask_scheduler, progress)
     sc = load_scenario_arg(scenario, clutter, clutter_rate, pd, scans)
     tracker_pd = tracker_pd if tracker_pd is not None else pd
     config = {k: v for k, v in {
@@ -118,10 +118,7 @@ def montecarlo(scenario: str, clutter: str | None, clutter_rate: float | None,
     kwargs.update(run_kwarg)
     try:
         spec = MonteCarloSpec(sc, trackers, runs, seed, config=config, run_kwargs=kwargs)
-        result = run_montecarlo(
-            spec, out, executor="dask" if dask_scheduler else "local", workers=workers,
-            scheduler=dask_scheduler,
-            progress=sys.stderr.isatty() if progress is None else progress)
+        result = run_montecarlo(spec, out, **run_on)
     except (SpecMismatchError, ValueError) as e:
         raise click.ClickException(str(e)) from None
     result.write_reports()
@@ -136,13 +133,7 @@ def montecarlo(scenario: str, clutter: str | None, clutter_rate: float | None,
         listed = ", ".join(f"{t}: {n} of {len(result.records[t])} runs" for t, n in capped.items())
         click.echo(f"mhtrack montecarlo: hard caps of the MHT acted ({listed}); per-run "
                    f"counts in the 'caps' column of {out}/runs/", err=True)
-    failed = [(t, i) for t, f in result.failures.items() for i in sorted(f)]
-    if failed or result.missing:
-        shown = ", ".join(f"{t} run {i}" for t, i in failed[:10])
-        more = f" and {len(failed) - 10} more" if len(failed) > 10 else ""
-        click.echo(f"mhtrack montecarlo: {len(failed)} run(s) failed ({shown}{more}); "
-                   f"tracebacks in {out}/runs/<tracker>/run-<i>.error.txt", err=True)
-        click.get_current_context().exit(1)
+    exit_if_runs_failed("montecarlo", result)
 
 
 COMMANDS = [montecarlo]

@@ -2,10 +2,11 @@
 
 from __future__ import annotations
 
-import sys
 from pathlib import Path
 
 import click
+
+from mhtrack.cli.common import executor_kwargs, executor_options, exit_if_runs_failed
 
 
 @click.group()
@@ -21,12 +22,7 @@ def reproduce() -> None:
               "fig2–fig6 PNG); an existing study with the same parameters is resumed.")
 @click.option("--seed", type=click.IntRange(min=0), default=0, show_default=True,
               help="Base seed; run i simulates with a seed derived from (SEED, i) only.")
-@click.option("--workers", type=click.IntRange(min=1), default=None,
-              help="Local worker processes [number of CPUs]; 1 runs in this process.")
-@click.option("--dask-scheduler", default=None, metavar="ADDRESS",
-              help="Run the jobs on this Dask scheduler (e.g. tcp://host:8786) instead.")
-@click.option("--progress/--no-progress", default=None,
-              help="Progress bar over jobs on stderr [when stderr is a terminal].")
+@executor_options
 def p1(runs: int, out: Path, seed: int, workers: int | None, dask_scheduler: str | None,
        progress: bool | None) -> None:
     """P1 §3: Monte-Carlo study of `crossing` with mht, mht-gmm and mht-agmm.
@@ -39,13 +35,9 @@ def p1(runs: int, out: Path, seed: int, workers: int | None, dask_scheduler: str
     from mhtrack.experiments.montecarlo import SpecMismatchError
     from mhtrack.experiments.reproduce_p1 import reproduce_p1
 
-    if workers is not None and dask_scheduler is not None:
-        raise click.UsageError("give --workers or --dask-scheduler, not both")
+    run_on = executor_kwargs(workers, dask_scheduler, progress)
     try:
-        repro = reproduce_p1(
-            out, runs, seed, executor="dask" if dask_scheduler else "local",
-            workers=workers, scheduler=dask_scheduler,
-            progress=sys.stderr.isatty() if progress is None else progress)
+        repro = reproduce_p1(out, runs, seed, **run_on)
     except (SpecMismatchError, ValueError) as e:
         raise click.ClickException(str(e)) from None
     res = repro.result
@@ -54,13 +46,7 @@ def p1(runs: int, out: Path, seed: int, workers: int | None, dask_scheduler: str
     click.echo("wrote:")
     for p in repro.paths:
         click.echo(f"  {p}{'/' if p.is_dir() else ''}")
-    failed = [(t, i) for t, f in res.failures.items() for i in sorted(f)]
-    if failed or res.missing:
-        shown = ", ".join(f"{t} run {i}" for t, i in failed[:10])
-        more = f" and {len(failed) - 10} more" if len(failed) > 10 else ""
-        click.echo(f"mhtrack reproduce p1: {len(failed)} run(s) failed ({shown}{more}); "
-                   f"tracebacks in {res.out_dir}/runs/<tracker>/run-<i>.error.txt", err=True)
-        click.get_current_context().exit(1)
+    exit_if_runs_failed("reproduce p1", res)
 
 
 @reproduce.command("p2")
@@ -71,12 +57,7 @@ def p1(runs: int, out: Path, seed: int, workers: int | None, dask_scheduler: str
               "fig2/fig3/fig4/fig12_15 PNG); finished jobs in OUT/jobs are skipped.")
 @click.option("--seed", type=click.IntRange(min=0), default=0, show_default=True,
               help="Base seed; run i simulates with a seed derived from (SEED, i) only.")
-@click.option("--workers", type=click.IntRange(min=1), default=None,
-              help="Local worker processes [number of CPUs]; 1 runs in this process.")
-@click.option("--dask-scheduler", default=None, metavar="ADDRESS",
-              help="Run the jobs on this Dask scheduler (e.g. tcp://host:8786) instead.")
-@click.option("--progress/--no-progress", default=None,
-              help="Progress bar over jobs on stderr [when stderr is a terminal].")
+@executor_options
 def p2(runs: int, out: Path, seed: int, workers: int | None, dask_scheduler: str | None,
        progress: bool | None) -> None:
     """P2 (Gong, Dai & Ma 2013) on `multiradar`: Figs. 2, 3, 4, 12–15 and Tables 1–2.
@@ -90,13 +71,9 @@ def p2(runs: int, out: Path, seed: int, workers: int | None, dask_scheduler: str
     """
     from mhtrack.experiments.reproduce_p2 import reproduce_p2
 
-    if workers is not None and dask_scheduler is not None:
-        raise click.UsageError("give --workers or --dask-scheduler, not both")
+    run_on = executor_kwargs(workers, dask_scheduler, progress)
     try:
-        repro = reproduce_p2(
-            out, runs, seed, executor="dask" if dask_scheduler else "local",
-            workers=workers, scheduler=dask_scheduler,
-            progress=sys.stderr.isatty() if progress is None else progress)
+        repro = reproduce_p2(out, runs, seed, **run_on)
     except ValueError as e:
         raise click.ClickException(str(e)) from None
     click.echo((repro.out_dir / "tables.md").read_text(encoding="utf-8"))

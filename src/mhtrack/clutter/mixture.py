@@ -21,6 +21,7 @@ See ``docs/clutter.md`` for the reasoning behind every default.
 
 from __future__ import annotations
 
+import dataclasses
 from collections import deque
 from typing import Any, Literal
 
@@ -227,18 +228,15 @@ class MixtureClutter:
         if self.mixture_ is None or self.count_ == 0.0:
             return np.zeros(len(z))
         m = self.mixture_
-        if m.background_box is None or not self._gated:
-            return self.count_ * m.pdf(z)
-        # The uniform background also absorbs the targets' own plots; take out of its count
-        # those that confirmed tracks explain (plots in their gates), keeping at least the
-        # background floor's share: κ̂ = M̂·Σπⱼ𝒩ⱼ + max(M̂π₀ − ḡ, M̂·floor)/A.
-        g = float(np.mean(self._gated))
-        background = max(self.count_ * m.background_weight - g,
-                         self.count_ * self.background_floor)
-        inside = np.exp(m.log_background(z)) * m.background_area  # 1 inside the box, else 0
-        gauss = self.count_ * m.pdf(z) - self.count_ * m.background_weight * inside / \
-            m.background_area
-        return np.maximum(gauss, 0.0) + background * inside / m.background_area
+        if m.background_box is not None and self._gated:
+            # The uniform background also absorbs the targets' own plots; take out of its
+            # count those that confirmed tracks explain (plots in their gates), keeping at
+            # least the floor's share: κ̂ = M̂·Σπⱼ𝒩ⱼ + max(M̂π₀ − ḡ, M̂·floor)/A, i.e. the
+            # same mixture with π₀ replaced by max(π₀ − ḡ/M̂, floor) (c(z) is linear in π).
+            g = float(np.mean(self._gated))
+            pi0 = max(m.background_weight - g / self.count_, self.background_floor)
+            m = dataclasses.replace(m, background_weight=pi0)
+        return self.count_ * m.pdf(z)
 
     def density(self, z: np.ndarray) -> np.ndarray:
         """``ĉ_k(z)`` (P1 eq. 13), per m²; 0 before any plot was seen."""

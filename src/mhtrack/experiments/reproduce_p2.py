@@ -41,13 +41,12 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from scipy.spatial import cKDTree
 
 from mhtrack.experiments.montecarlo import atomic_write, execute
-from mhtrack.initiation import INITIATORS, Window, make_initiator, remove_dominated
-from mhtrack.initiation.logic import _ball, leg_angle
+from mhtrack.initiation import INITIATORS, Window, make_initiator
+from mhtrack.initiation.logic import sweep_modified_logic
 from mhtrack.initiation.runs import fuse, fused_scans, n_targets_seen, run_seeds
-from mhtrack.initiation.window import NO_PLOT, last_slot, previous_plot, sliding_windows
+from mhtrack.initiation.window import sliding_windows
 from mhtrack.metrics.initiation import initiable_targets, track_targets
 from mhtrack.scenario import Scenario, preset, simulate
 
@@ -80,97 +79,6 @@ TABLES_FILE, REPORT_FILE, RESULTS_FILE, JOBS_DIR = ("tables.md", "report.md",
                                                     "results.json", "jobs")
 
 
-# ---------------------------------------------------------------------- the θ sweep
-def sweep_modified_logic(window: Window, thetas_deg: Sequence[float], *,
-                         gate_radius: float = 300.0, v_min: float = 50.0,
-                         v_max: float = 400.0, n_scans: int = 4, min_plots: int = 3,
-                         ) -> list[np.ndarray]:
-    """The tracks (flat plot indices, as ``InitiatedTracks.flat``) that
-    ``make_initiator("modified-logic", theta_deg=θ)`` initiates in ``window``, for every
-    ``θ`` of ``thetas_deg``, in one pass.
-
-    The branching of :class:`~mhtrack.initiation.logic.LogicInitiator` is replayed with
-    every angle test postponed: each partial track carries the set of ``θ`` for which it
-    exists, an interval ``lo ≤ θ < hi`` — taking a plot at leg angle ``α`` needs
-    ``θ ≥ α`` (``lo = max(lo, α)``); a miss happens only when the gate holds no plot with
-    ``α ≤ θ`` (``hi = min(hi, min α)``). Partial tracks valid for no ``θ`` of the grid are
-    dropped. At the end each ``θ`` keeps its tracks (same order as the initiator) and
-    applies :func:`~mhtrack.initiation.window.remove_dominated`. Not simply "the angle
-    filters the plain logic's tracks": a miss branch exists only while the gate is empty,
-    and a longer track removes its sub-tracks, so the track count need not be monotone
-    in ``θ``."""
-    th = np.radians(np.asarray(thetas_deg, float))
-    order = np.argsort(th)
-    ths = th[order]
-    N, M = n_scans, min_plots
-    max_miss = N - M
-    z, t = window.z, window.times
-
-    def on_grid(lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
-        i = np.searchsorted(ths, lo, side="left")
-        return (i < len(ths)) & (ths[np.minimum(i, len(ths) - 1)] < hi)
-
-    path = np.full((0, N), NO_PLOT, np.int64)
-    lo = np.zeros(0)
-    hi = np.zeros(0)
-    for c in range(N):
-        rows = window.rows(c)
-        if len(path):
-            last = path[np.arange(len(path)), last_slot(path)]
-            prev = previous_plot(path)
-            hits = (path >= 0).sum(axis=1)
-            miss = c - hits
-            tree = cKDTree(z[rows]) if len(rows) else None
-            q_all, j_all, a_all = [], [], []
-            one = np.flatnonzero(hits == 1)
-            if len(one) and tree is not None:
-                dt = t[c] - t[window.slot[last[one]]]
-                q, j = _ball(tree, z[last[one]], v_max * dt)
-                d = np.hypot(*(z[rows[j]] - z[last[one[q]]]).T)
-                ok = d >= v_min * dt[q]
-                q_all.append(one[q[ok]])
-                j_all.append(rows[j[ok]])
-                a_all.append(np.full(int(ok.sum()), -np.inf))  # no angle test
-            more = np.flatnonzero(hits >= 2)
-            if len(more) and tree is not None:
-                a, b = prev[more], last[more]
-                step = (t[c] - t[window.slot[b]]) / (t[window.slot[b]] - t[window.slot[a]])
-                leg = z[b] - z[a]
-                pred = z[b] + leg * step[:, None]
-                q, j = _ball(tree, pred, gate_radius)
-                ang = (leg_angle(z[rows[j]] - z[b[q]], leg[q]) if len(q)
-                       else np.zeros(0))
-                q_all.append(more[q])
-                j_all.append(rows[j])
-                a_all.append(ang)
-            q = np.concatenate(q_all) if q_all else np.zeros(0, np.int64)
-            j = np.concatenate(j_all) if j_all else np.zeros(0, np.int64)
-            ang = np.concatenate(a_all) if a_all else np.zeros(0)
-            gate_min = np.full(len(path), np.inf)
-            np.minimum.at(gate_min, q, ang)
-            ext_lo = np.maximum(lo[q], ang)
-            ext_hi = hi[q]
-            ok = on_grid(ext_lo, ext_hi)
-            extended = path[q[ok]].copy()
-            extended[:, c] = j[ok]
-            mis_hi = np.minimum(hi, gate_min)
-            mis = (miss + 1 <= max_miss) & on_grid(lo, mis_hi)
-            path = np.concatenate((extended, path[mis]))
-            lo = np.concatenate((ext_lo[ok], lo[mis]))
-            hi = np.concatenate((ext_hi[ok], mis_hi[mis]))
-        if c <= max_miss and len(rows):
-            born = np.full((len(rows), N), NO_PLOT, np.int64)
-            born[:, c] = rows
-            path = np.concatenate((path, born))
-            lo = np.concatenate((lo, np.full(len(rows), -np.inf)))
-            hi = np.concatenate((hi, np.full(len(rows), np.inf)))
-    full = (path >= 0).sum(axis=1) >= M
-    path, lo, hi = path[full], lo[full], hi[full]
-    out = []
-    for x in th:
-        f = path[(lo <= x) & (x < hi)]
-        out.append(f[remove_dominated(f)] if len(f) else f)
-    return out
 
 
 # ---------------------------------------------------------------------- jobs

@@ -123,50 +123,115 @@ class LogicInitiator:
         return InitiatedTracks(w.scans, float(w.times[-1]), plots, flat, x, P)
 
     def _tracks(self, w: Window) -> np.ndarray:
-        N, M = self.n_scans, self.min_plots
-        max_miss = N - M
-        z, t = w.z, w.times
-        # partial tracks: path (P, N) of flat indices; last, prev hit; hits; misses
-        path = np.full((0, N), NO_PLOT, np.int64)
-        for c in range(N):
-            rows = w.rows(c)
-            if len(path):
-                last = path[np.arange(len(path)), last_slot(path)]
-                prev = previous_plot(path)
-                hits = (path >= 0).sum(axis=1)
-                miss = c - hits  # slots 0..c−1 are decided: each a plot or a miss
-                tree = cKDTree(z[rows]) if len(rows) else None
-                q_all, j_all = [], []
-                one = np.flatnonzero(hits == 1)
-                if len(one) and tree is not None:
-                    dt = t[c] - t[w.slot[last[one]]]
-                    q, j = _ball(tree, z[last[one]], self.v_max * dt)
-                    d = np.hypot(*(z[rows[j]] - z[last[one[q]]]).T)
-                    ok = d >= self.v_min * dt[q]
-                    q_all.append(one[q[ok]])
-                    j_all.append(rows[j[ok]])
-                more = np.flatnonzero(hits >= 2)
-                if len(more) and tree is not None:
-                    a, b = prev[more], last[more]
-                    step = (t[c] - t[w.slot[b]]) / (t[w.slot[b]] - t[w.slot[a]])
-                    leg = z[b] - z[a]
-                    pred = z[b] + leg * step[:, None]
-                    q, j = _ball(tree, pred, self.gate_radius)
-                    if self.angle_limit_deg is not None and len(q):
-                        new = z[rows[j]] - z[b[q]]
-                        ok = leg_angle(new, leg[q]) <= np.radians(self.angle_limit_deg)
-                        q, j = q[ok], j[ok]
-                    q_all.append(more[q])
-                    j_all.append(rows[j])
-                q = np.concatenate(q_all) if q_all else np.zeros(0, np.int64)
-                j = np.concatenate(j_all) if j_all else np.zeros(0, np.int64)
-                extended = path[q].copy()
-                extended[:, c] = j
-                empty = np.bincount(q, minlength=len(path)) == 0
-                missed = path[empty & (miss + 1 <= max_miss)]
-                path = np.concatenate((extended, missed))
-            if c <= max_miss and len(rows):
-                born = np.full((len(rows), N), NO_PLOT, np.int64)
-                born[:, c] = rows
-                path = np.concatenate((path, born))
-        return path[(path >= 0).sum(axis=1) >= M]
+        """The window's tracks at this initiator's angle limit (θ = π, no limit, for the
+        plain logic: a leg angle is never above π)."""
+        theta = np.pi if self.angle_limit_deg is None else np.radians(self.angle_limit_deg)
+        path, lo, hi = branch_tracks(w, np.array([theta]), gate_radius=self.gate_radius,
+                                     v_min=self.v_min, v_max=self.v_max,
+                                     n_scans=self.n_scans, min_plots=self.min_plots)
+        return path[(lo <= theta) & (theta < hi)]
+
+
+def branch_tracks(window: Window, thetas: np.ndarray, *, gate_radius: float = 300.0,
+                  v_min: float = 50.0, v_max: float = 400.0, n_scans: int = 4,
+                  min_plots: int = 3) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The M-of-N branching of the (modified) logic over a window, for a grid of angle
+    limits ``thetas`` (radians) at once.
+
+    Scan by scan every partial track branches on each plot in its gate — the velocity gate
+    ``v_min·Δt ≤ |Δz| ≤ v_max·Δt`` for the second plot, the radius ``gate_radius`` around
+    the straight-line prediction after that — and takes a miss only when its gate is empty
+    (at most ``n_scans − min_plots`` misses). Each partial track carries the interval
+    ``lo ≤ θ < hi`` of angle limits for which it exists: taking a plot at leg angle ``α``
+    needs ``θ ≥ α`` (``lo = max(lo, α)``); a miss happens only when the gate holds no plot
+    with ``α ≤ θ`` (``hi = min(hi, min α)``). Partial tracks valid for no ``θ`` of the grid
+    are dropped. Returns the tracks with at least ``min_plots`` plots as ``path`` (n,
+    n_scans) flat plot indices (``-1`` a miss) and their intervals ``lo``, ``hi``; the
+    tracks of limit ``θ`` are ``path[(lo <= θ) & (θ < hi)]``, in the initiator's order.
+    """
+    ths = np.sort(np.asarray(thetas, float))
+    N, M = n_scans, min_plots
+    max_miss = N - M
+    z, t = window.z, window.times
+
+    def on_grid(lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+        i = np.searchsorted(ths, lo, side="left")
+        return (i < len(ths)) & (ths[np.minimum(i, len(ths) - 1)] < hi)
+
+    path = np.full((0, N), NO_PLOT, np.int64)
+    lo = np.zeros(0)
+    hi = np.zeros(0)
+    for c in range(N):
+        rows = window.rows(c)
+        if len(path):
+            last = path[np.arange(len(path)), last_slot(path)]
+            prev = previous_plot(path)
+            hits = (path >= 0).sum(axis=1)
+            miss = c - hits  # slots 0..c−1 are decided: each a plot or a miss
+            tree = cKDTree(z[rows]) if len(rows) else None
+            q_all, j_all, a_all = [], [], []
+            one = np.flatnonzero(hits == 1)
+            if len(one) and tree is not None:
+                dt = t[c] - t[window.slot[last[one]]]
+                q, j = _ball(tree, z[last[one]], v_max * dt)
+                d = np.hypot(*(z[rows[j]] - z[last[one[q]]]).T)
+                ok = d >= v_min * dt[q]
+                q_all.append(one[q[ok]])
+                j_all.append(rows[j[ok]])
+                a_all.append(np.full(int(ok.sum()), -np.inf))  # no angle test
+            more = np.flatnonzero(hits >= 2)
+            if len(more) and tree is not None:
+                a, b = prev[more], last[more]
+                step = (t[c] - t[window.slot[b]]) / (t[window.slot[b]] - t[window.slot[a]])
+                leg = z[b] - z[a]
+                pred = z[b] + leg * step[:, None]
+                q, j = _ball(tree, pred, gate_radius)
+                ang = (leg_angle(z[rows[j]] - z[b[q]], leg[q]) if len(q)
+                       else np.zeros(0))
+                q_all.append(more[q])
+                j_all.append(rows[j])
+                a_all.append(ang)
+            q = np.concatenate(q_all) if q_all else np.zeros(0, np.int64)
+            j = np.concatenate(j_all) if j_all else np.zeros(0, np.int64)
+            ang = np.concatenate(a_all) if a_all else np.zeros(0)
+            gate_min = np.full(len(path), np.inf)
+            np.minimum.at(gate_min, q, ang)
+            ext_lo = np.maximum(lo[q], ang)
+            ext_hi = hi[q]
+            ok = on_grid(ext_lo, ext_hi)
+            extended = path[q[ok]].copy()
+            extended[:, c] = j[ok]
+            mis_hi = np.minimum(hi, gate_min)
+            mis = (miss + 1 <= max_miss) & on_grid(lo, mis_hi)
+            path = np.concatenate((extended, path[mis]))
+            lo = np.concatenate((ext_lo[ok], lo[mis]))
+            hi = np.concatenate((ext_hi[ok], mis_hi[mis]))
+        if c <= max_miss and len(rows):
+            born = np.full((len(rows), N), NO_PLOT, np.int64)
+            born[:, c] = rows
+            path = np.concatenate((path, born))
+            lo = np.concatenate((lo, np.full(len(rows), -np.inf)))
+            hi = np.concatenate((hi, np.full(len(rows), np.inf)))
+    full = (path >= 0).sum(axis=1) >= M
+    return path[full], lo[full], hi[full]
+
+
+def sweep_modified_logic(window: Window, thetas_deg: Sequence[float], *,
+                         gate_radius: float = 300.0, v_min: float = 50.0,
+                         v_max: float = 400.0, n_scans: int = 4, min_plots: int = 3,
+                         ) -> list[np.ndarray]:
+    """The tracks (flat plot indices, as ``InitiatedTracks.flat``) that
+    ``make_initiator("modified-logic", theta_deg=θ)`` initiates in ``window``, for every
+    ``θ`` of ``thetas_deg``, from one :func:`branch_tracks` pass, each with
+    :func:`~mhtrack.initiation.window.remove_dominated` applied. Not simply "the angle
+    filters the plain logic's tracks": a miss branch exists only while the gate is empty,
+    and a longer track removes its sub-tracks, so the track count need not be monotone
+    in ``θ``."""
+    th = np.radians(np.asarray(thetas_deg, float))
+    path, lo, hi = branch_tracks(window, th, gate_radius=gate_radius, v_min=v_min,
+                                 v_max=v_max, n_scans=n_scans, min_plots=min_plots)
+    out = []
+    for x in th:
+        f = path[(lo <= x) & (x < hi)]
+        out.append(f[remove_dominated(f)] if len(f) else f)
+    return out

@@ -17,7 +17,7 @@ from mhtrack.cli.common import (
     load_scenario_arg,
     scenario_options,
 )
-from mhtrack.cli.track_commands import tracker_options
+from mhtrack.cli.track_commands import config_changes, tracker_options
 
 
 def _params_of(decorator: Callable[[Callable[..., Any]], Callable[..., Any]],
@@ -109,9 +109,7 @@ def montecarlo(scenario: str, clutter: str | None, clutter_rate: float | None,
     run_on = executor_kwargs(workers, dask_scheduler, progress)
     sc = load_scenario_arg(scenario, clutter, clutter_rate, pd, scans)
     tracker_pd = tracker_pd if tracker_pd is not None else pd
-    config = {k: v for k, v in {
-        "p_detection": tracker_pd, "sigma_w": meas_sigma, "sigma_v": accel_sigma,
-        "new_target_density": birth_density, "n_scan": nscan}.items() if v is not None}
+    config = config_changes(tracker_pd, meas_sigma, accel_sigma, birth_density, nscan)
     kwargs: dict[str, Any] = {"cutoff": cutoff, "order": order}
     if clutter_density is not None:
         kwargs["clutter_density"] = clutter_density

@@ -75,12 +75,22 @@ def _check_clutter_density(tracker: str, clutter_density: float | None) -> None:
         )
 
 
+def config_changes(tracker_pd: float | None, meas_sigma: float | None,
+                   accel_sigma: float | None, birth_density: float | None,
+                   nscan: int | None) -> dict[str, Any]:
+    """The :class:`~mhtrack.mht.MHTConfig` fields that :func:`tracker_options` set (options
+    left out are not changed)."""
+    fields = {"p_detection": tracker_pd, "sigma_w": meas_sigma, "sigma_v": accel_sigma,
+              "new_target_density": birth_density, "n_scan": nscan}
+    return {k: v for k, v in fields.items() if v is not None}
+
+
 def _config(base: Any, tracker_pd: float | None, meas_sigma: float | None,
             accel_sigma: float | None, birth_density: float | None, nscan: int | None) -> Any:
     from mhtrack.experiments import config_with
 
-    return config_with(base, p_detection=tracker_pd, sigma_w=meas_sigma, sigma_v=accel_sigma,
-                       new_target_density=birth_density, n_scan=nscan)
+    return config_with(base, **config_changes(tracker_pd, meas_sigma, accel_sigma,
+                                              birth_density, nscan))
 
 
 @click.command()

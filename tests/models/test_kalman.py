@@ -110,3 +110,8 @@ def test_two_point_init_covariance_by_monte_carlo():
     err = x - truth
     assert np.allclose(err.mean(0), 0, atol=0.5)
     assert np.allclose(np.cov(err.T), P[0], rtol=0.03, atol=1.0)
+
+
+@pytest.mark.parametrize("p", [0.5, 0.9, 0.99, 0.999, 0.999999])
+def test_gate_threshold_matches_scipy_chi2(p):
+    assert kalman.gate_threshold(p) == pytest.approx(chi2.ppf(p, df=2), rel=1e-12)

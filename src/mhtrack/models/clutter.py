@@ -13,7 +13,6 @@ from dataclasses import dataclass, field
 from typing import Protocol
 
 import numpy as np
-from scipy.stats import multivariate_normal
 
 
 @dataclass(frozen=True)
@@ -101,6 +100,8 @@ class UniformClutter:
 
 def _box_mass(mean: np.ndarray, cov: np.ndarray, region: Region) -> float:
     """Probability mass of ``N(mean, cov)`` inside ``region``."""
+    from scipy.stats import multivariate_normal  # heavy (~0.6 s): only when a mixture is built
+
     lo = np.array([region.xmin, region.ymin])
     hi = np.array([region.xmax, region.ymax])
     return float(
@@ -152,6 +153,8 @@ class GaussianMixtureClutter:
     def density(self, z: np.ndarray, scan: int) -> np.ndarray:
         z = np.asarray(z, float).reshape(-1, 2)
         inside = self.region.contains(z)
+        from scipy.stats import multivariate_normal
+
         mix = np.zeros(len(z))
         for w, m, c in zip(self.weights, self.means, self.covariances, strict=True):
             mix += w * multivariate_normal(m, c).pdf(z).reshape(-1)

@@ -17,11 +17,11 @@ Equations (standard Kalman filter, e.g. Bar-Shalom et al. 2001 §5.2.3; P1 eqs. 
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
 from scipy.spatial import cKDTree
-from scipy.stats import chi2
 
 from mhtrack.models.motion import POS
 
@@ -36,7 +36,9 @@ def gate_threshold(probability: float) -> float:
     """χ² gate ``γ`` with 2 degrees of freedom holding ``probability`` of true plots."""
     if not 0.0 < probability < 1.0:
         raise ValueError(f"gate probability must be in (0, 1), got {probability}")
-    return float(chi2.ppf(probability, df=2))
+    # χ² with 2 d.o.f. is exponential with mean 2: P(d² ≤ γ) = 1 − exp(−γ/2), so the
+    # quantile is exact in closed form (and needs no scipy.stats at import time).
+    return -2.0 * math.log1p(-probability)
 
 
 def predict(

@@ -4,12 +4,14 @@ scenarios (``experiments.pipeline``)."""
 from __future__ import annotations
 
 import hashlib
+from dataclasses import replace
 
 import numpy as np
 import pytest
 
 from mhtrack.clutter import KnownClutter
 from mhtrack.experiments.pipeline import (
+    default_config,
     default_fusion,
     fuse_scan,
     make_tracker,
@@ -23,7 +25,8 @@ from mhtrack.scenario import preset, simulate
 
 #: sha256 of the tracks of ``crossing`` (uniform clutter, 10 plots/scan, 30 scans, seed 3,
 #: tracker ``mht`` with κ = 1.5625e−7), computed with the code *before* the birth process
-#: was added: the default birth process must reproduce it bit for bit.
+#: was added: the default birth process must reproduce it bit for bit. The defaults of
+#: that time were P1's single constant-velocity model and α = 0.01 (:data:`P1_MODEL`).
 CROSSING_DIGEST = "360763912e0e9765a13cd2bbb888a385e0071f07e2c3714ebc1b143c87c682e2"
 
 
@@ -47,10 +50,14 @@ def crossing_uniform() -> object:
 
 
 # ---------------------------------------------------------------------- every-plot
+P1_MODEL = {"imm_sigma_v": 0.0, "alpha": 0.01}
+
+
 def test_default_birth_is_unchanged_bit_for_bit():
     sc = crossing_uniform()
-    default = run_scenario(sc, 3, "mht", clutter_density=1.5625e-7)
-    explicit = run_scenario(sc, 3, "mht", MHTConfig(birth="every-plot"),
+    cfg = replace(default_config(sc), **P1_MODEL)
+    default = run_scenario(sc, 3, "mht", cfg, clutter_density=1.5625e-7)
+    explicit = run_scenario(sc, 3, "mht", replace(cfg, birth="every-plot"),
                             clutter_density=1.5625e-7, birth="every-plot", fusion="none")
     assert digest(default.run.tracks) == CROSSING_DIGEST
     assert same(default.run.tracks, explicit.run.tracks)
@@ -69,11 +76,13 @@ def one_target_scans(n: int, *, first: int = 1, start=(0.0, 0.0), v=(150.0, 50.0
     return out
 
 
-def test_sequence_score_equals_the_every_plot_branch_score():
-    """The initiator birth score is the score an every-plot tree gives the same branch."""
+@pytest.mark.parametrize("imm_sigma_v", [0.0, 1.0])
+def test_sequence_score_equals_the_every_plot_branch_score(imm_sigma_v):
+    """The initiator birth score is the score an every-plot tree gives the same branch
+    (single CV model and IMM)."""
     scans = one_target_scans(4)
     kappa = 1e-8
-    cfg = MHTConfig()
+    cfg = MHTConfig(imm_sigma_v=imm_sigma_v)
     trk = MHTTracker(cfg, KnownClutter(kappa))
     for s in scans:
         trk.step(s)
@@ -86,7 +95,8 @@ def test_sequence_score_equals_the_every_plot_branch_score():
         score, peak = sequence_score(
             np.arange(1.0, 5.0), z, R, has, np.full((1, 4), kappa),
             p_detection=cfg.p_detection, new_target_density=cfg.new_target_density,
-            miss_dl=miss_increment(cfg.p_detection), v_max=cfg.v_max, sigma_v=cfg.sigma_v)
+            miss_dl=miss_increment(cfg.p_detection), v_max=cfg.v_max, sigma_v=cfg.sigma_v,
+            models=cfg.models)
         if has.all():
             assert score[0] == pytest.approx(L.score[full[0]], abs=1e-9)
             assert peak[0] == pytest.approx(L.peak[full[0]], abs=1e-9)

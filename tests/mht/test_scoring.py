@@ -29,7 +29,7 @@ def test_one_track_two_scans_by_hand():
     #   L(2) = 2.197225 + 3.304123 = 5.501347.
     # Miss branch: L0 + ln(1 − 0.9) = 2.197225 − 2.302585 = −0.105361.
     # The scan-2 plot also starts its own tree at L0 = 2.197225.
-    trk = MHTTracker(MHTConfig(), KnownClutter(1e-8))
+    trk = MHTTracker(MHTConfig(imm_sigma_v=0.0), KnownClutter(1e-8))
     trk.step(Scan.from_positions(1, 0.0, [[0.0, 0.0]]))
     assert trk.leaves.score.tolist() == pytest.approx([2.197225], abs=1e-6)
     trk.step(Scan.from_positions(2, 1.0, [[100.0, 0.0]]))
@@ -42,6 +42,31 @@ def test_one_track_two_scans_by_hand():
     upd = first & (L.window[:, -1] == 0)
     assert L.score[upd].item() == pytest.approx(5.501347, abs=1e-6)
     assert L.n_updates[upd].item() == 2
+
+
+def test_imm_two_scans_by_hand():
+    # The same two plots with the default IMM: quiet model σ = 1, manoeuvre σ = 10, equal
+    # initial probabilities, both models at the one-point state. Mixing leaves the common
+    # state unchanged; per axis the predicted position variances are
+    #   R + T²(v_max/2)² + σ²T⁴/4 = 32 500.25 (quiet) and 32 525 (manoeuvre),
+    # and the score uses ln(½ N(ν; 0, S_q) + ½ N(ν; 0, S_m)) (Blom & Bar-Shalom 1988).
+    def lnN(S: float) -> float:  # ν = (100, 0), S = s·I
+        return -0.5 * (100.0**2 / S + 2 * math.log(S)) - math.log(2 * math.pi)
+
+    lq, lm = lnN(32_500.25 + 1e4), lnN(32_525.0 + 1e4)
+    mix = math.log(0.5 * math.exp(lq) + 0.5 * math.exp(lm))
+    expected = math.log(9) + mix + math.log(0.9) - math.log(1e-8 + 1e-7)
+    cfg = MHTConfig(imm_sigma_v=1.0)
+    trk = MHTTracker(cfg, KnownClutter(1e-8))
+    trk.step(Scan.from_positions(1, 0.0, [[0.0, 0.0]]))
+    trk.step(Scan.from_positions(2, 1.0, [[100.0, 0.0]]))
+    L = trk.leaves
+    upd = (L.tree == L.tree.min()) & (L.window[:, -1] == 0)
+    assert L.score[upd].item() == pytest.approx(expected, abs=1e-9)
+    # posterior model probabilities ∝ ½ exp(l_j), state = their mixture
+    wq = 1.0 / (1.0 + math.exp(lm - lq))
+    assert L.mu[upd][0].tolist() == pytest.approx([wq, 1.0 - wq], abs=1e-12)
+    assert L.x[upd][0] == pytest.approx(L.mu[upd][0] @ L.xm[upd][0], abs=1e-9)
 
 
 def test_increment_functions():

@@ -100,6 +100,28 @@ def test_per_plot_covariance_path_gives_the_same_tracks(crossing10):
     assert _same(a, c)
 
 
+def test_imm_of_identical_models_is_the_single_model_tracker(crossing10):
+    """An IMM whose models are the same CV model reduces to it: same tracks, same plots,
+    states and scores equal to rounding."""
+    single, _ = _run(crossing10, MHTConfig(imm_sigma_v=0.0))
+    twin, trk = _run(crossing10, MHTConfig(imm_sigma_v=10.0, sigma_v=10.0))
+    assert trk.leaves.n_models == 2 and len(single) > 250
+    for f in ("scan", "track_id", "plot"):
+        assert np.array_equal(getattr(single, f), getattr(twin, f))
+    for f in ("x", "y", "vx", "vy", "score", "P"):
+        np.testing.assert_allclose(getattr(twin, f), getattr(single, f), rtol=1e-9, atol=1e-6)
+
+
+def test_imm_tracks_straight_targets_more_accurately(crossing10):
+    """On straight-line targets the IMM's quiet model lowers the error of P1's σv = 10
+    model (measured: 90 → 70 m RMS on this fixture)."""
+    errs = {}
+    for sv in (0.0, 1.0):
+        out, _ = _run(crossing10, MHTConfig(imm_sigma_v=sv))
+        errs[sv] = float(np.sqrt(np.mean(assess(crossing10, out).errors ** 2)))
+    assert errs[1.0] < 0.85 * errs[0.0], errs
+
+
 def test_save_restore_continues_bit_for_bit(crossing40, tmp_path):
     full, _ = _run(crossing40)
     trk = MHTTracker(MHTConfig(), KnownClutter(crossing40.clutter_density))

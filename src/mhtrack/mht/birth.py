@@ -47,7 +47,8 @@ from mhtrack.initiation import Initiator, make_initiator
 from mhtrack.initiation.window import Window
 from mhtrack.mht.config import BIRTHS
 from mhtrack.mht.scoring import birth_score, update_increment
-from mhtrack.models import kalman
+from mhtrack.models import imm, kalman
+from mhtrack.models.imm import CVModelSet
 from mhtrack.models.motion import POS, VEL, ConstantVelocity
 from mhtrack.records import Scan
 
@@ -107,14 +108,19 @@ def sequence_score(
     miss_dl: float,
     v_max: float,
     sigma_v: float,
+    models: CVModelSet | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Score ``L`` and running peak of plot sequences, as an every-plot tree would score
-    the branch (module docstring).
+    the branch (module docstring); with ``models``, by the IMM's mixture likelihood.
 
     ``times`` (N,) scan times; per sequence and scan ``z`` (n, N, 2), ``R`` (n, N, 2, 2),
     ``has`` (n, N) plot present, ``kappa`` (n, N) clutter intensity at the plot. Every
     sequence needs at least one plot.
     """
+    if models is not None:
+        return _sequence_score_imm(times, z, R, has, kappa, p_detection=p_detection,
+                                   new_target_density=new_target_density, miss_dl=miss_dl,
+                                   v_max=v_max, models=models)
     n, N = has.shape
     motion = ConstantVelocity(sigma_v)
     x, P = np.zeros((n, 4)), np.zeros((n, 4, 4))
@@ -148,6 +154,51 @@ def sequence_score(
     return L, peak
 
 
+def _sequence_score_imm(
+    times: np.ndarray,
+    z: np.ndarray,
+    R: np.ndarray,
+    has: np.ndarray,
+    kappa: np.ndarray,
+    *,
+    p_detection: float,
+    new_target_density: float,
+    miss_dl: float,
+    v_max: float,
+    models: CVModelSet,
+) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`sequence_score` with an IMM (``mhtrack.models.imm``), as the tree scores it."""
+    n, N = has.shape
+    r = models.r
+    xm, Pm = np.zeros((n, r, 4)), np.zeros((n, r, 4, 4))
+    mu = models.initial_mu(n)
+    L, peak = np.zeros(n), np.full(n, -np.inf)
+    started = np.zeros(n, bool)
+    for s in range(N):
+        if s and started.any():
+            dt = float(times[s] - times[s - 1])
+            xm[started], Pm[started], mu[started] = models.predict(
+                xm[started], Pm[started], mu[started], dt)
+        h = has[:, s]
+        new = h & ~started
+        if new.any():
+            x0, P0 = one_point_state(z[new, s], R[new, s], v_max)
+            xm[new], Pm[new] = x0[:, None], P0[:, None]
+            mu[new] = models.initial_mu(int(new.sum()))
+            L[new] = birth_score(kappa[new, s], p_detection, new_target_density)
+        upd = h & started
+        if upd.any():
+            ll = imm.model_logliks(xm[upd], Pm[upd], z[upd, s], R[upd, s])
+            L[upd] += update_increment(imm.mixture_loglik(mu[upd], ll), kappa[upd, s],
+                                       p_detection, new_target_density)
+            xm[upd], Pm[upd], mu[upd] = imm.update(xm[upd], Pm[upd], mu[upd], z[upd, s],
+                                                   R[upd, s])
+        L[started & ~h] += miss_dl
+        started |= new
+        peak = np.where(started, np.maximum(peak, L), peak)
+    return L, peak
+
+
 def score_upper_bound(
     has: np.ndarray,
     R: np.ndarray,
@@ -158,7 +209,8 @@ def score_upper_bound(
     miss_dl: float,
 ) -> np.ndarray:
     """An upper bound of :func:`sequence_score` without any Kalman step: the innovation
-    covariance ``S = HPHᵀ + R`` has ``det S ≥ det R`` and ``d² ≥ 0``, so an update adds at
+    covariance ``S = HPHᵀ + R`` has ``det S ≥ det R`` and ``d² ≥ 0`` (for each IMM model,
+    hence for their mixture), so an update adds at
     most ``ln P_D − ln(κ̂ + λ_v) − ln 2π − ½ ln det R``. Sequences whose bound is below the
     birth floor cannot pass it and are dropped before they are scored."""
     n, N = has.shape
@@ -203,8 +255,8 @@ class InitiatorBirth:
     method : ``"logic"``, ``"modified-logic"``, ``"hough"`` or ``"modified-hough"``.
     theta_deg : angle limit of the modified methods (P2: 20°).
     width : columns of the leaf window (``n_scan + 1``).
-    p_detection, new_target_density, miss_dl, v_max, sigma_v : the tracker's scoring and
-        initialisation parameters (:func:`sequence_score`).
+    p_detection, new_target_density, miss_dl, v_max, sigma_v, models : the tracker's
+        scoring and initialisation parameters (:func:`sequence_score`).
     floor : initiated tracks scoring ``L ≤ floor`` are not born (the tracker passes its
         SPRT deletion threshold ``ln(β/(1−α))``: Wald's lower test on the sequence).
     n_scans, min_plots : window ``N`` and plots ``M`` (P2: 4, 3).
@@ -212,7 +264,8 @@ class InitiatorBirth:
 
     def __init__(self, method: str, *, theta_deg: float, width: int, p_detection: float,
                  new_target_density: float, miss_dl: float, v_max: float, sigma_v: float,
-                 floor: float, n_scans: int = 4, min_plots: int = 3) -> None:
+                 floor: float, n_scans: int = 4, min_plots: int = 3,
+                 models: CVModelSet | None = None) -> None:
         if method not in BIRTHS or method == EVERY_PLOT:
             raise ValueError(f"unknown initiator birth {method!r}")
         self.method = method
@@ -223,7 +276,7 @@ class InitiatorBirth:
         self.floor = float(floor)
         self._score_params = dict(p_detection=p_detection,
                                   new_target_density=new_target_density, miss_dl=miss_dl,
-                                  v_max=v_max, sigma_v=sigma_v)
+                                  v_max=v_max, sigma_v=sigma_v, models=models)
         # the window: per scan index, time, plot count; per plot z, R, row id, κ̂
         self.scan_index = np.zeros(0, np.int64)
         self.scan_time = np.zeros(0)

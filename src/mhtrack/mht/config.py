@@ -11,6 +11,8 @@ import math
 from dataclasses import asdict, dataclass, fields
 from typing import Any
 
+from mhtrack.models.imm import CVModelSet
+
 #: Birth processes by name (:attr:`MHTConfig.birth`; ``mhtrack.mht.birth``).
 BIRTHS: tuple[str, ...] = ("every-plot", "logic", "modified-logic", "hough", "modified-hough")
 
@@ -28,7 +30,13 @@ class MHTConfig:
     sigma_w : Cartesian measurement noise std (m), ``R = σw² I`` for plots without their
         own covariance. Default 100 (P1 §3, ``σw² = 10⁴``).
     sigma_v : process (acceleration) noise std of the constant-velocity model (m/s²).
-        Default 10 (P1 §3, ``σv² = 100``).
+        Default 10 (P1 §3, ``σv² = 100``). With an IMM, the manoeuvre model's.
+    imm_sigma_v : acceleration noise std (m/s²) of a second, *quiet* constant-velocity
+        model; when > 0 each track is an IMM of the quiet and the ``sigma_v`` models
+        (:mod:`mhtrack.models.imm`), when 0 a single CV model with ``sigma_v`` (P1).
+        Default 0 (P1).
+    imm_mode_time : mean time (s) a target stays in one IMM model, ``π_ii = exp(−dt/τ)``.
+        Default 100 (our choice).
     gate_probability : ``P_G``, probability a target's plot falls in the χ² (2 d.o.f.)
         gate. Default 0.999 (our choice: γ ≈ 13.8, a true plot is almost never lost).
     miss_uses_gate_probability : score a miss as ``ln(1 − P_D·P_G)`` (exact when a plot
@@ -45,6 +53,10 @@ class MHTConfig:
     beta : SPRT true-deletion probability. Default 1e−4 (our choice). Confirm at
         ``L ≥ ln((1−β)/α)`` ≈ 4.6, delete at ``L − L_peak ≤ ln(β/(1−α))`` ≈ −9.2, i.e. four
         consecutive misses at ``P_D = 0.9`` (Wald 1947; Blackman & Popoli 1999 §6.2).
+    confirm_min_plots : a tree is confirmed only once the chosen branch holds at least this
+        many plots. Default 2 (our choice: a single plot says nothing of a velocity; with
+        P1's plain-MHT κ = 1e−9 a lone plot's birth score ``ln(λ_v P_D/κ) = 4.5`` is
+        otherwise above the confirmation threshold by itself).
     confirm_hits : logic confirmation, ``M`` of an M-of-N rule over the ``N + 1`` scans of
         the leaf's window: a tentative tree is also confirmed when its chosen leaf used
         plots in at least ``confirm_hits`` of its last ``n_scan + 1`` scans **and** its
@@ -91,12 +103,15 @@ class MHTConfig:
     new_target_density: float = 1e-7
     sigma_w: float = 100.0
     sigma_v: float = 10.0
+    imm_sigma_v: float = 1.0
+    imm_mode_time: float = 100.0
     gate_probability: float = 0.999
     miss_uses_gate_probability: bool = False
     v_max: float = 300.0
     n_scan: int = 3
-    alpha: float = 1e-2
+    alpha: float = 0.03
     beta: float = 1e-4
+    confirm_min_plots: int = 2
     confirm_hits: int = 0
     confirm_min_score: float = 0.0
     prune_drop: float = 12.0
@@ -121,7 +136,7 @@ class MHTConfig:
             check(name, isinstance(v, int | float) and 0.0 < v < 1.0, "in (0, 1)")
         check("alpha", self.alpha + self.beta < 1.0, "such that alpha + beta < 1")
         for name in ("new_target_density", "sigma_w", "v_max", "prune_drop",
-                     "milp_time_limit", "min_clutter_density"):
+                     "milp_time_limit", "min_clutter_density", "imm_mode_time"):
             v = getattr(self, name)
             check(name, isinstance(v, int | float) and math.isfinite(v) and v > 0, "finite > 0")
         check(
@@ -130,9 +145,17 @@ class MHTConfig:
             and self.sigma_v >= 0,
             "finite >= 0",
         )
+        check(
+            "imm_sigma_v",
+            isinstance(self.imm_sigma_v, int | float) and math.isfinite(self.imm_sigma_v)
+            and self.imm_sigma_v >= 0,
+            "finite >= 0",
+        )
         check("miss_uses_gate_probability", isinstance(self.miss_uses_gate_probability, bool),
               "a bool")
         check("n_scan", _is_int(self.n_scan) and self.n_scan >= 1, "an integer >= 1")
+        check("confirm_min_plots", _is_int(self.confirm_min_plots)
+              and self.confirm_min_plots >= 1, "an integer >= 1")
         check("confirm_hits", _is_int(self.confirm_hits)
               and 0 <= self.confirm_hits <= self.n_scan + 1, "an integer in [0, n_scan + 1]")
         check("confirm_min_score", isinstance(self.confirm_min_score, int | float)
@@ -146,6 +169,13 @@ class MHTConfig:
               and 0 <= self.birth_theta_deg <= 180, "in [0, 180]")
         check("max_leaves", self.max_leaves > self.max_births_per_scan,
               "larger than max_births_per_scan")
+
+    @property
+    def models(self) -> CVModelSet | None:
+        """The IMM's model set (quiet, manoeuvre), or ``None`` for a single CV model."""
+        if self.imm_sigma_v <= 0:
+            return None
+        return CVModelSet((float(self.imm_sigma_v), float(self.sigma_v)), self.imm_mode_time)
 
     def to_json(self) -> str:
         """The configuration as a JSON string (exact round trip with :meth:`from_json`)."""

@@ -44,14 +44,21 @@ from mhtrack.mht.pruning import (
     tentative_keep,
 )
 from mhtrack.mht.scoring import birth_score, miss_increment, sprt_thresholds, update_increment
-from mhtrack.mht.tree import Children, Leaves, birth_leaves, grow_children, propose_children
-from mhtrack.models import kalman
+from mhtrack.mht.tree import (
+    Children,
+    Leaves,
+    birth_leaves,
+    grow_children,
+    model_arrays,
+    propose_children,
+)
+from mhtrack.models import imm, kalman
 from mhtrack.models.motion import ConstantVelocity
 from mhtrack.records import PlotTable, Scan, TrackTable
 
 logger = logging.getLogger(__name__)
 
-FORMAT = "mhtrack.mht.MHTTracker/1"
+FORMAT = "mhtrack.mht.MHTTracker/2"
 
 
 @dataclass(frozen=True)
@@ -105,7 +112,8 @@ class MHTTracker:
             cfg.p_detection, cfg.gate_probability if cfg.miss_uses_gate_probability else None
         )
         self.confirm_threshold, self.delete_threshold = sprt_thresholds(cfg.alpha, cfg.beta)
-        self._leaves = Leaves.empty(cfg.n_scan + 1)
+        self._models = cfg.models
+        self._leaves = Leaves.empty(cfg.n_scan + 1, 0 if self._models is None else self._models.r)
         self._last_time: float | None = None
         self._last_index: int | None = None
         self._next_tree = 0
@@ -118,7 +126,7 @@ class MHTTracker:
                 cfg.birth, theta_deg=cfg.birth_theta_deg, width=cfg.n_scan + 1,
                 p_detection=cfg.p_detection, new_target_density=cfg.new_target_density,
                 miss_dl=self._miss_dl, v_max=cfg.v_max, sigma_v=cfg.sigma_v,
-                floor=self.delete_threshold)
+                floor=self.delete_threshold, models=self._models)
 
     # ------------------------------------------------------------------ public API
     @property
@@ -144,8 +152,14 @@ class MHTTracker:
         leaves = self._leaves
         previous = _Reported.of(leaves)
 
-        xp, Pp = self._predict(leaves, scan)
+        xp, Pp, model_pred = self._predict(leaves, scan)
         gated = self._gate(leaves, xp, Pp, z, R, caps)
+        if model_pred is not None and len(gated):
+            # IMM: the score uses the mixture likelihood Σ_j μ̄_j N(z; H x⁻_j, S_j)
+            g, pj = gated.track, gated.plot
+            ll = imm.model_logliks(model_pred[0][g], model_pred[1][g], z[pj],
+                                   R if R.ndim == 2 else R[pj])
+            gated = kalman.Gated(g, pj, gated.d2, imm.mixture_loglik(model_pred[2][g], ll))
         in_gates = _plots_in_confirmed_gates(leaves, gated, len(z))
         kappa = self._clutter_intensity(scan, z, in_gates)
 
@@ -160,7 +174,7 @@ class MHTTracker:
             cand = self._initiated(scan, z, R, rows, kappa, caps)
             n_births = len(cand)
         children = self._prune_children(leaves, children, n_births, caps)
-        grown = grow_children(leaves, xp, Pp, children, z, R, rows)
+        grown = grow_children(leaves, xp, Pp, children, z, R, rows, model_pred)
         if self._birth is not None:
             births = self._seed(scan, *self._birth.select(cand, grown.window), caps)
         leaves = Leaves.concat(grown, births)
@@ -260,12 +274,22 @@ class MHTTracker:
             )
         return z, R, rows
 
-    def _predict(self, leaves: Leaves, scan: Scan) -> tuple[np.ndarray, np.ndarray]:
-        """All leaves to the scan time with the CV model, ``dt`` = time since last scan."""
+    def _predict(
+        self, leaves: Leaves, scan: Scan
+    ) -> tuple[np.ndarray, np.ndarray, tuple[np.ndarray, np.ndarray, np.ndarray] | None]:
+        """All leaves to the scan time, ``dt`` = time since last scan: ``(x⁻, P⁻, models)``
+        with the CV model (``models`` None), or with the IMM (``models = (x⁻_j, P⁻_j, μ̄)``
+        per model and ``x⁻, P⁻`` their mixture, used for gating)."""
         if len(leaves) == 0 or self._last_time is None:
-            return leaves.x, leaves.P
+            models = None if self._models is None else (leaves.xm, leaves.Pm, leaves.mu)
+            return leaves.x, leaves.P, models
         dt = float(scan.time) - self._last_time
-        return kalman.predict_cv(leaves.x, leaves.P, dt, self._motion.Q(dt))
+        if self._models is None:
+            xp, Pp = kalman.predict_cv(leaves.x, leaves.P, dt, self._motion.Q(dt))
+            return xp, Pp, None
+        xm, Pm, mubar = self._models.predict(leaves.xm, leaves.Pm, leaves.mu, dt)
+        xp, Pp = imm.combine(xm, Pm, mubar)
+        return xp, Pp, (xm, Pm, mubar)
 
     def _gate(
         self,
@@ -332,7 +356,7 @@ class MHTTracker:
             sel = np.sort(order[: cfg.max_births_per_scan])
         Rb = R if R.ndim == 2 else R[sel]
         out = birth_leaves(z[sel], Rb, rows[sel], score[sel], self._next_tree, int(scan.index),
-                           cfg.v_max, cfg.n_scan + 1)
+                           cfg.v_max, cfg.n_scan + 1, self._models)
         self._next_tree += sel.size
         return out
 
@@ -382,6 +406,7 @@ class MHTTracker:
             n_updates=cand.n_updates,
             window=cand.window,
             chosen=np.zeros(n, bool),
+            **model_arrays(cand.x, cand.P, self._models),
         )
 
     def _prune_children(
@@ -436,8 +461,9 @@ class MHTTracker:
         2. *Confirmation*: a tentative tree whose chosen leaf has ``L ≥ ln((1−β)/α)``
            (SPRT; Wald 1947; Blackman & Popoli 1999 §6.2), or has used plots in at least
            ``confirm_hits`` of the ``N + 1`` scans of its window with
-           ``L > confirm_min_score`` (M-of-N logic), gets the next track id, in tree-id
-           order; ids are never reused.
+           ``L > confirm_min_score`` (M-of-N logic), and whose branch holds at least
+           ``confirm_min_plots`` plots, gets the next track id, in tree-id order; ids are
+           never reused.
         """
         track = leaves.track
         chosen = np.flatnonzero(leaves.chosen)
@@ -464,6 +490,7 @@ class MHTTracker:
         if cfg.confirm_hits > 0:
             hits = (leaves.window >= 0).sum(axis=1)
             confirm |= (hits >= cfg.confirm_hits) & (leaves.score > cfg.confirm_min_score)
+        confirm &= leaves.n_updates >= cfg.confirm_min_plots
         new = leaves.chosen & (track < 0) & confirm
         if new.any():
             track = track.copy()

@@ -15,7 +15,7 @@ from dataclasses import dataclass, fields
 
 import numpy as np
 
-from mhtrack.models import kalman
+from mhtrack.models import imm, kalman
 from mhtrack.models.motion import POS, VEL
 
 NO_PLOT = -1
@@ -37,6 +37,10 @@ class Leaves:
     window : (L, N+1) plot row ids used at scans ``k−N … k`` (``-1`` for a miss or before
         the tree existed); column 0 is the scan N-scan pruning decides.
     chosen : (L,) leaf is in the current best global hypothesis.
+    mu, xm, Pm : (L, r), (L, r, 4), (L, r, 4, 4) model probabilities, states and
+        covariances of an IMM with ``r`` models (:mod:`mhtrack.models.imm`); ``x, P`` are
+        then their moment-matched mixture. ``r = 0`` (empty trailing axes) for the single
+        constant-velocity model.
     """
 
     x: np.ndarray
@@ -49,16 +53,21 @@ class Leaves:
     n_updates: np.ndarray
     window: np.ndarray
     chosen: np.ndarray
+    mu: np.ndarray
+    xm: np.ndarray
+    Pm: np.ndarray
 
     def __len__(self) -> int:
         return int(self.score.shape[0])
 
     @classmethod
-    def empty(cls, width: int) -> Leaves:
+    def empty(cls, width: int, r: int = 0) -> Leaves:
+        """No leaves; ``r`` IMM models (0: single model)."""
         i = np.zeros(0, np.int64)
         f = np.zeros(0)
         return cls(np.zeros((0, 4)), np.zeros((0, 4, 4)), f, f, i, i, i, i,
-                   np.zeros((0, width), np.int64), np.zeros(0, bool))
+                   np.zeros((0, width), np.int64), np.zeros(0, bool), np.zeros((0, r)),
+                   np.zeros((0, r, 4)), np.zeros((0, r, 4, 4)))
 
     def take(self, idx: np.ndarray) -> Leaves:
         """Rows ``idx`` (an index array or boolean mask), in that order."""
@@ -76,6 +85,11 @@ class Leaves:
     @classmethod
     def from_arrays(cls, arrays: dict[str, np.ndarray]) -> Leaves:
         return cls(**{f.name: np.asarray(arrays[f.name]) for f in fields(cls)})
+
+    @property
+    def n_models(self) -> int:
+        """IMM models per leaf (0: single constant-velocity model)."""
+        return int(self.mu.shape[1])
 
     @property
     def n_trees(self) -> int:
@@ -150,17 +164,30 @@ def grow_children(
     z: np.ndarray,
     R: np.ndarray,
     rows: np.ndarray,
+    models: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None,
 ) -> Leaves:
     """Materialise ``children`` as leaves: misses keep the prediction ``(xp, Pp)``, updates
-    get the Kalman update with their plot (``R`` shared (2, 2) or per plot (n, 2, 2))."""
+    get the Kalman update with their plot (``R`` shared (2, 2) or per plot (n, 2, 2)).
+    With an IMM, ``models = (x⁻, P⁻, μ̄)`` per leaf and model (:func:`imm.update`; a miss
+    keeps the predicted model states and probabilities) and ``x, P`` are their mixture."""
     par, plot = children.parent, children.plot
     x = xp[par]
     P = Pp[par]
     upd = np.flatnonzero(plot >= 0)
+    if models is None:
+        r = leaves.n_models
+        mu, xm, Pm = np.zeros((len(par), r)), np.zeros((len(par), r, 4)), np.zeros(
+            (len(par), r, 4, 4))
+    else:
+        xm, Pm, mu = models[0][par], models[1][par], models[2][par]
     if upd.size:
         pj = plot[upd]
         Ru = R if R.ndim == 2 else R[pj]
-        x[upd], P[upd] = kalman.update_position(x[upd], P[upd], z[pj], Ru)
+        if models is None:
+            x[upd], P[upd] = kalman.update_position(x[upd], P[upd], z[pj], Ru)
+        else:
+            xm[upd], Pm[upd], mu[upd] = imm.update(xm[upd], Pm[upd], mu[upd], z[pj], Ru)
+            x[upd], P[upd] = imm.combine(xm[upd], Pm[upd], mu[upd])
     new_col = np.where(plot >= 0, rows[np.maximum(plot, 0)] if rows.size else NO_PLOT, NO_PLOT)
     window = np.concatenate((leaves.window[par, 1:], new_col[:, None]), axis=1)
     return Leaves(
@@ -174,6 +201,9 @@ def grow_children(
         n_updates=leaves.n_updates[par] + (plot >= 0),
         window=window,
         chosen=np.zeros(len(par), bool),
+        mu=mu,
+        xm=xm,
+        Pm=Pm,
     )
 
 
@@ -186,11 +216,13 @@ def birth_leaves(
     scan_index: int,
     v_max: float,
     width: int,
+    models: imm.CVModelSet | None = None,
 ) -> Leaves:
     """One new tree per plot: one-point initialisation ``x = [zx, 0, zy, 0]`` with position
     covariance the plot's ``R`` and velocity variance ``(v_max/2)²`` per axis (the
     velocity is unknown but bounded by ``v_max`` at 2σ); initial score ``score``
     (the birth score, Blackman & Popoli 1999 §6.2). Tree ids ``first_tree, first_tree+1, …``.
+    With an IMM every model starts from that state, with equal probabilities.
     """
     n = len(z)
     x = np.zeros((n, 4))
@@ -211,4 +243,18 @@ def birth_leaves(
         n_updates=np.ones(n, np.int64),
         window=window,
         chosen=np.zeros(n, bool),
+        **model_arrays(x, P, models),
     )
+
+
+def model_arrays(
+    x: np.ndarray, P: np.ndarray, models: imm.CVModelSet | None
+) -> dict[str, np.ndarray]:
+    """``mu, xm, Pm`` of new leaves with state ``x``, ``P``: every model at that state
+    with equal probabilities; empty trailing axes without an IMM."""
+    n = len(x)
+    if models is None:
+        return {"mu": np.zeros((n, 0)), "xm": np.zeros((n, 0, 4)), "Pm": np.zeros((n, 0, 4, 4))}
+    r = models.r
+    return {"mu": models.initial_mu(n), "xm": np.repeat(x[:, None], r, axis=1),
+            "Pm": np.repeat(P[:, None], r, axis=1)}

@@ -1,0 +1,130 @@
+"""Interacting multiple model (IMM) filter of constant-velocity models, batched.
+
+Each track carries ``r`` constant-velocity models that differ only in their acceleration
+noise (a *quiet* model for straight flight and a *manoeuvre* model, typically), with
+model probabilities ``μ``. Equations (Blom & Bar-Shalom 1988; Bar-Shalom et al. 2001
+§11.6.6), for stacked tracks ``xm`` (M, r, 4), ``Pm`` (M, r, 4, 4), ``μ`` (M, r)::
+
+    mode switching   π_ij = P(model j at k | model i at k−1),  π_ii = exp(−dt/τ)
+    mixing           μ̄_j = Σ_i π_ij μ_i,   μ_i|j = π_ij μ_i / μ̄_j
+                     x0_j = Σ_i μ_i|j x_i,  P0_j = Σ_i μ_i|j [P_i + (x_i − x0_j)(x_i − x0_j)ᵀ]
+    predict          x⁻_j = F x0_j,  P⁻_j = F P0_j Fᵀ + Q_j
+    likelihood       p(z|T) = Σ_j μ̄_j N(z; H x⁻_j, H P⁻_j Hᵀ + R)
+    update           each model's Kalman update; μ_j ∝ μ̄_j N(z; H x⁻_j, S_j)
+    on a miss        x_j = x⁻_j, μ_j = μ̄_j
+    output           x = Σ_j μ_j x_j,  P = Σ_j μ_j [P_j + (x_j − x)(x_j − x)ᵀ]
+
+The mixture likelihood is what enters the MHT track score (P1 eq. 5) in place of the
+single-model innovation likelihood; with one model every formula reduces to the Kalman
+filter of :mod:`mhtrack.models.kalman`.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from mhtrack.models import kalman
+from mhtrack.models.motion import ConstantVelocity
+
+
+@dataclass(frozen=True)
+class CVModelSet:
+    """``r`` constant-velocity models with acceleration noise stds ``sigmas`` (m/s²) and
+    mean sojourn time ``mode_time`` (s) in a model: ``π_ii = exp(−dt/τ)``, the rest of
+    the row shared equally by the other models. Initial probabilities are equal."""
+
+    sigmas: tuple[float, ...]
+    mode_time: float = 100.0
+
+    def __post_init__(self) -> None:
+        if len(self.sigmas) < 2:
+            raise ValueError("an IMM needs at least two models")
+        if not all(math.isfinite(s) and s >= 0 for s in self.sigmas):
+            raise ValueError(f"IMM model sigmas must be finite and >= 0, got {self.sigmas}")
+        if not (math.isfinite(self.mode_time) and self.mode_time > 0):
+            raise ValueError(f"IMM mode_time must be finite and > 0, got {self.mode_time}")
+
+    @property
+    def r(self) -> int:
+        return len(self.sigmas)
+
+    def initial_mu(self, n: int) -> np.ndarray:
+        """Equal model probabilities for ``n`` new tracks, (n, r)."""
+        return np.full((n, self.r), 1.0 / self.r)
+
+    def transition(self, dt: float) -> np.ndarray:
+        """Mode transition matrix ``π`` (r, r) for a scan interval ``dt``."""
+        stay = math.exp(-dt / self.mode_time)
+        pi = np.full((self.r, self.r), (1.0 - stay) / (self.r - 1))
+        np.fill_diagonal(pi, stay)
+        return pi
+
+    def predict(
+        self, xm: np.ndarray, Pm: np.ndarray, mu: np.ndarray, dt: float
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Mixing and per-model prediction: ``(x⁻, P⁻, μ̄)`` (module docstring)."""
+        pi = self.transition(dt)
+        mubar = mu @ pi  # (M, r)
+        w = pi[None, :, :] * mu[:, :, None] / np.maximum(mubar, 1e-300)[:, None, :]  # (M,i,j)
+        x0 = np.einsum("mij,mia->mja", w, xm)
+        d = xm[:, :, None, :] - x0[:, None, :, :]  # (M, i, j, 4)
+        P0 = np.einsum("mij,miab->mjab", w, Pm) + np.einsum("mij,mija,mijb->mjab", w, d, d)
+        xp = np.empty_like(x0)
+        Pp = np.empty_like(P0)
+        for j, s in enumerate(self.sigmas):
+            xp[:, j], Pp[:, j] = kalman.predict_cv(x0[:, j], P0[:, j], dt,
+                                                   ConstantVelocity(s).Q(dt))
+        return xp, Pp, mubar
+
+
+def combine(xm: np.ndarray, Pm: np.ndarray, mu: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Moment-matched single Gaussian of the model mixture: ``(x, P)``, (M, 4), (M, 4, 4)."""
+    x = np.einsum("mj,mja->ma", mu, xm)
+    d = xm - x[:, None, :]
+    P = np.einsum("mj,mjab->mab", mu, Pm) + np.einsum("mj,mja,mjb->mab", mu, d, d)
+    return x, 0.5 * (P + np.swapaxes(P, -1, -2))
+
+
+def model_logliks(xm: np.ndarray, Pm: np.ndarray, z: np.ndarray, R: np.ndarray) -> np.ndarray:
+    """Per row and model, ``ln N(z; H x_j, H P_j Hᵀ + R)``: ``xm`` (K, r, 4), ``Pm``
+    (K, r, 4, 4), ``z`` (K, 2), ``R`` (2, 2) or (K, 2, 2). Returns (K, r)."""
+    R = np.asarray(R, float)
+    Rb = R if R.ndim == 2 else R[:, None]
+    s00 = Pm[..., 0, 0] + Rb[..., 0, 0]
+    s01 = Pm[..., 0, 2] + Rb[..., 0, 1]
+    s11 = Pm[..., 2, 2] + Rb[..., 1, 1]
+    n0 = z[:, None, 0] - xm[..., 0]
+    n1 = z[:, None, 1] - xm[..., 2]
+    det = s00 * s11 - s01 * s01
+    d2 = (s11 * n0 * n0 - 2 * s01 * n0 * n1 + s00 * n1 * n1) / det
+    return -0.5 * (d2 + np.log(det)) - kalman.LOG_2PI
+
+
+def mixture_loglik(mubar: np.ndarray, ll: np.ndarray) -> np.ndarray:
+    """``ln Σ_j μ̄_j exp(ll_j)`` per row (log-sum-exp), ``mubar`` and ``ll`` (K, r)."""
+    with np.errstate(divide="ignore"):
+        a = np.log(mubar) + ll
+    m = a.max(axis=1)
+    return m + np.log(np.exp(a - m[:, None]).sum(axis=1))
+
+
+def update(
+    xm: np.ndarray, Pm: np.ndarray, mubar: np.ndarray, z: np.ndarray, R: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Each model's Kalman update with plot ``z`` (one plot per row) and the posterior
+    model probabilities ``μ_j ∝ μ̄_j N(z; H x⁻_j, S_j)``: ``(x, P, μ)``."""
+    K, r = mubar.shape
+    ll = model_logliks(xm, Pm, z, R)
+    with np.errstate(divide="ignore"):
+        a = np.log(mubar) + ll
+    a -= a.max(axis=1, keepdims=True)
+    mu = np.exp(a)
+    mu /= mu.sum(axis=1, keepdims=True)
+    R = np.asarray(R, float)
+    Rr = R if R.ndim == 2 else np.repeat(R, r, axis=0)
+    xn, Pn = kalman.update_position(xm.reshape(K * r, 4), Pm.reshape(K * r, 4, 4),
+                                    np.repeat(z, r, axis=0), Rr)
+    return xn.reshape(K, r, 4), Pn.reshape(K, r, 4, 4), mu

@@ -90,7 +90,8 @@ def montecarlo(scenario: str, clutter: str | None, clutter_rate: float | None,
                pd: float | None, scans: int | None, trackers: tuple[str, ...], runs: int,
                seed: int, out: Path, workers: int | None, dask_scheduler: str | None,
                tracker_pd: float | None, meas_sigma: float | None,
-               accel_sigma: float | None, clutter_density: float | None,
+               accel_sigma: float | None, imm_accel_sigma: float | None,
+               clutter_density: float | None,
                birth_density: float | None, nscan: int | None, cutoff: float, order: float,
                run_kwarg: dict[str, Any], as_json: bool, progress: bool | None) -> None:
     """Monte-Carlo study: RUNS simulations of SCENARIO, each tracked by every tracker.
@@ -109,7 +110,8 @@ def montecarlo(scenario: str, clutter: str | None, clutter_rate: float | None,
     run_on = executor_kwargs(workers, dask_scheduler, progress)
     sc = load_scenario_arg(scenario, clutter, clutter_rate, pd, scans)
     tracker_pd = tracker_pd if tracker_pd is not None else pd
-    config = config_changes(tracker_pd, meas_sigma, accel_sigma, birth_density, nscan)
+    config = config_changes(tracker_pd, meas_sigma, accel_sigma, birth_density, nscan,
+                            imm_accel_sigma)
     kwargs: dict[str, Any] = {"cutoff": cutoff, "order": order}
     if clutter_density is not None:
         kwargs["clutter_density"] = clutter_density

@@ -31,7 +31,10 @@ def _tracker_options(f: Callable[..., Any], pd_flag: str) -> Callable[..., Any]:
         click.option("--meas-sigma", type=click.FloatRange(min=0, min_open=True), default=None,
                      help="Measurement noise σw (m) of Cartesian plots [100]."),
         click.option("--accel-sigma", type=click.FloatRange(min=0), default=None,
-                     help="Process noise σv (m/s²) [10]."),
+                     help="Process noise σv (m/s²) of the manoeuvre model [10]."),
+        click.option("--imm-accel-sigma", type=click.FloatRange(min=0), default=None,
+                     help="Process noise (m/s²) of the IMM's quiet model; 0 for P1's single "
+                     "constant-velocity model [1]."),
         click.option("--clutter-density", type=click.FloatRange(min=0, min_open=True),
                      default=None, help="Known clutter intensity κ (per m² per scan) for "
                      "--tracker mht [1e-9]."),
@@ -77,20 +80,22 @@ def _check_clutter_density(tracker: str, clutter_density: float | None) -> None:
 
 def config_changes(tracker_pd: float | None, meas_sigma: float | None,
                    accel_sigma: float | None, birth_density: float | None,
-                   nscan: int | None) -> dict[str, Any]:
+                   nscan: int | None, imm_accel_sigma: float | None = None) -> dict[str, Any]:
     """The :class:`~mhtrack.mht.MHTConfig` fields that :func:`tracker_options` set (options
     left out are not changed)."""
     fields = {"p_detection": tracker_pd, "sigma_w": meas_sigma, "sigma_v": accel_sigma,
-              "new_target_density": birth_density, "n_scan": nscan}
+              "new_target_density": birth_density, "n_scan": nscan,
+              "imm_sigma_v": imm_accel_sigma}
     return {k: v for k, v in fields.items() if v is not None}
 
 
 def _config(base: Any, tracker_pd: float | None, meas_sigma: float | None,
-            accel_sigma: float | None, birth_density: float | None, nscan: int | None) -> Any:
+            accel_sigma: float | None, birth_density: float | None, nscan: int | None,
+            imm_accel_sigma: float | None) -> Any:
     from mhtrack.experiments import config_with
 
     return config_with(base, **config_changes(tracker_pd, meas_sigma, accel_sigma,
-                                              birth_density, nscan))
+                                              birth_density, nscan, imm_accel_sigma))
 
 
 @click.command()
@@ -105,7 +110,8 @@ def _config(base: Any, tracker_pd: float | None, meas_sigma: float | None,
 @birth_options
 @click.option("--progress/--no-progress", default=True, help="Progress bar on stderr.")
 def track(plots: Path, tracker: str, tracker_pd: float | None, meas_sigma: float | None,
-          accel_sigma: float | None, clutter_density: float | None,
+          accel_sigma: float | None, imm_accel_sigma: float | None,
+          clutter_density: float | None,
           birth_density: float | None, nscan: int | None, out: Path,
           scenario_file: Path | None, birth: str, birth_theta: float, fusion: str | None,
           progress: bool) -> None:
@@ -138,7 +144,8 @@ def track(plots: Path, tracker: str, tracker_pd: float | None, meas_sigma: float
     else:  # no scenario: the plots' bounding box is the surveillance area
         span = max(float(np.ptp(table.x)), 1.0) * max(float(np.ptp(table.y)), 1.0)
         base = default_config(area=span) if len(table) > 1 else default_config()
-    cfg = _config(base, tracker_pd, meas_sigma, accel_sigma, birth_density, nscan)
+    cfg = _config(base, tracker_pd, meas_sigma, accel_sigma, birth_density, nscan,
+                  imm_accel_sigma)
     _check_clutter_density(tracker, clutter_density)
     trk = make_tracker(tracker, cfg, clutter_density=clutter_density, birth=birth,
                        theta_deg=birth_theta)
@@ -166,7 +173,8 @@ def track(plots: Path, tracker: str, tracker_pd: float | None, meas_sigma: float
 @click.option("--progress/--no-progress", default=True, help="Progress bar on stderr.")
 def run(scenario: str, seed: int, clutter: str | None, clutter_rate: float | None,
         pd: float | None, scans: int | None, tracker: str, tracker_pd: float | None,
-        meas_sigma: float | None, accel_sigma: float | None, clutter_density: float | None,
+        meas_sigma: float | None, accel_sigma: float | None, imm_accel_sigma: float | None,
+        clutter_density: float | None,
         birth_density: float | None, nscan: int | None, out: Path | None, cutoff: float,
         order: float, as_json: bool, birth: str, birth_theta: float, fusion: str | None,
         progress: bool) -> None:
@@ -183,7 +191,7 @@ def run(scenario: str, seed: int, clutter: str | None, clutter_rate: float | Non
     sc = load_scenario_arg(scenario, clutter, clutter_rate, pd, scans)
     tracker_pd = tracker_pd if tracker_pd is not None else pd
     cfg = _config(default_config(sc), tracker_pd, meas_sigma, accel_sigma, birth_density,
-                  nscan)
+                  nscan, imm_accel_sigma)
     _check_clutter_density(tracker, clutter_density)
     result = run_scenario(sc, seed, tracker, cfg, clutter_density=clutter_density,
                           cutoff=cutoff, order=order, progress=progress, birth=birth,

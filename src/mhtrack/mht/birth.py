@@ -117,82 +117,41 @@ def sequence_score(
     ``has`` (n, N) plot present, ``kappa`` (n, N) clutter intensity at the plot. Every
     sequence needs at least one plot.
     """
-    if models is not None:
-        return _sequence_score_imm(times, z, R, has, kappa, p_detection=p_detection,
-                                   new_target_density=new_target_density, miss_dl=miss_dl,
-                                   v_max=v_max, models=models)
     n, N = has.shape
+    # one filter loop for both motion models: the single CV model is kept as r = 1 model
+    # arrays, whose one-term mixture likelihood is its own likelihood
+    r = 1 if models is None else models.r
     motion = ConstantVelocity(sigma_v)
-    x, P = np.zeros((n, 4)), np.zeros((n, 4, 4))
+    xm, Pm, mu = np.zeros((n, r, 4)), np.zeros((n, r, 4, 4)), np.ones((n, r))
     L, peak = np.zeros(n), np.full(n, -np.inf)
     started = np.zeros(n, bool)
     for s in range(N):
         if s and started.any():
             dt = float(times[s] - times[s - 1])
-            x[started], P[started] = kalman.predict_cv(x[started], P[started], dt,
-                                                       motion.Q(dt))
-        h = has[:, s]
-        new = h & ~started
-        if new.any():
-            x[new], P[new] = one_point_state(z[new, s], R[new, s], v_max)
-            L[new] = birth_score(kappa[new, s], p_detection, new_target_density)
-        upd = h & started
-        if upd.any():
-            xu, Pu, zu, Ru = x[upd], P[upd], z[upd, s], R[upd, s]
-            S = Pu[:, POS[:, None], POS[None, :]] + Ru
-            nu = zu - xu[:, POS]
-            a, b, d = S[:, 0, 0], S[:, 0, 1], S[:, 1, 1]
-            det = a * d - b * b
-            d2 = (d * nu[:, 0] ** 2 - 2 * b * nu[:, 0] * nu[:, 1] + a * nu[:, 1] ** 2) / det
-            loglik = -0.5 * (d2 + np.log(det)) - kalman.LOG_2PI
-            L[upd] += update_increment(loglik, kappa[upd, s], p_detection,
-                                       new_target_density)
-            x[upd], P[upd] = kalman.update_position(xu, Pu, zu, Ru)
-        L[started & ~h] += miss_dl
-        started |= new
-        peak = np.where(started, np.maximum(peak, L), peak)
-    return L, peak
-
-
-def _sequence_score_imm(
-    times: np.ndarray,
-    z: np.ndarray,
-    R: np.ndarray,
-    has: np.ndarray,
-    kappa: np.ndarray,
-    *,
-    p_detection: float,
-    new_target_density: float,
-    miss_dl: float,
-    v_max: float,
-    models: CVModelSet,
-) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`sequence_score` with an IMM (``mhtrack.models.imm``), as the tree scores it."""
-    n, N = has.shape
-    r = models.r
-    xm, Pm = np.zeros((n, r, 4)), np.zeros((n, r, 4, 4))
-    mu = models.initial_mu(n)
-    L, peak = np.zeros(n), np.full(n, -np.inf)
-    started = np.zeros(n, bool)
-    for s in range(N):
-        if s and started.any():
-            dt = float(times[s] - times[s - 1])
-            xm[started], Pm[started], mu[started] = models.predict(
-                xm[started], Pm[started], mu[started], dt)
+            if models is None:
+                xm[started, 0], Pm[started, 0] = kalman.predict_cv(
+                    xm[started, 0], Pm[started, 0], dt, motion.Q(dt))
+            else:
+                xm[started], Pm[started], mu[started] = models.predict(
+                    xm[started], Pm[started], mu[started], dt)
         h = has[:, s]
         new = h & ~started
         if new.any():
             x0, P0 = one_point_state(z[new, s], R[new, s], v_max)
             xm[new], Pm[new] = x0[:, None], P0[:, None]
-            mu[new] = models.initial_mu(int(new.sum()))
+            if models is not None:
+                mu[new] = models.initial_mu(int(new.sum()))
             L[new] = birth_score(kappa[new, s], p_detection, new_target_density)
         upd = h & started
         if upd.any():
-            ll = imm.model_logliks(xm[upd], Pm[upd], z[upd, s], R[upd, s])
+            zu, Ru = z[upd, s], R[upd, s]
+            ll = imm.model_logliks(xm[upd], Pm[upd], zu, Ru)
             L[upd] += update_increment(imm.mixture_loglik(mu[upd], ll), kappa[upd, s],
                                        p_detection, new_target_density)
-            xm[upd], Pm[upd], mu[upd] = imm.update(xm[upd], Pm[upd], mu[upd], z[upd, s],
-                                                   R[upd, s])
+            if models is None:
+                xm[upd, 0], Pm[upd, 0] = kalman.update_position(xm[upd, 0], Pm[upd, 0], zu, Ru)
+            else:
+                xm[upd], Pm[upd], mu[upd] = imm.update(xm[upd], Pm[upd], mu[upd], zu, Ru)
         L[started & ~h] += miss_dl
         started |= new
         peak = np.where(started, np.maximum(peak, L), peak)

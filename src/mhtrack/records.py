@@ -206,7 +206,9 @@ class TruthTable:
 class TrackTable:
     """Tracker output, one row per (scan, reported track): ``scan, time, track_id, x, y, vx,
     vy, plot`` (``plot`` = plot-table row used at that scan, ``-1`` on a miss), optionally
-    the track ``score`` (log-likelihood ratio) and state covariance ``P`` (n, 4, 4)."""
+    the track ``score`` (log-likelihood ratio), state covariance ``P`` (n, 4, 4) and
+    ``tentative`` (bool: the row was reported after the scan, when the track was confirmed
+    later, see :mod:`mhtrack.mht.history`)."""
 
     scan: np.ndarray
     time: np.ndarray
@@ -218,6 +220,7 @@ class TrackTable:
     plot: np.ndarray
     score: np.ndarray | None = None
     P: np.ndarray | None = None
+    tentative: np.ndarray | None = None
 
     def __len__(self) -> int:
         return len(self.scan)
@@ -225,6 +228,19 @@ class TrackTable:
     @property
     def positions(self) -> np.ndarray:
         return np.column_stack((self.x, self.y))
+
+    def take(self, idx: np.ndarray) -> TrackTable:
+        """Rows ``idx`` (an index array or boolean mask), in that order."""
+        return TrackTable(**{f: None if (v := getattr(self, f)) is None else v[idx]
+                             for f in self.__dataclass_fields__})
+
+    def sorted(self) -> TrackTable:
+        """Rows ordered by scan, then track id (stable)."""
+        return self.take(np.lexsort((self.track_id, self.scan)))
+
+    def online(self) -> TrackTable:
+        """The rows reported at their own scan (``tentative`` false or absent)."""
+        return self if self.tentative is None else self.take(~self.tentative.astype(bool))
 
     @classmethod
     def empty(cls) -> TrackTable:

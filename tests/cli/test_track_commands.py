@@ -67,6 +67,24 @@ def test_track_on_plots_file_matches_run(run_dir, tmp_path):
     assert len(t) > 0 and (t.plot >= -1).all()
 
 
+def test_output_modes(run_dir, tmp_path):
+    """The default history output holds the online output plus each track's tentative
+    rows; the confirmation delay is the same in both, the association rate is higher."""
+    out, hist = run_dir
+    code, stdout, stderr = invoke(*RUN, "--out", str(tmp_path), "--json", "--output", "online")
+    assert code == 0, stderr
+    online = json.loads(stdout)
+    assert hist["output"] == "history" and online["output"] == "online"
+    h, o = read_tracks(out / "tracks.csv"), read_tracks(tmp_path / "tracks.csv")
+    assert h.tentative.sum() > 0 and o.tentative.sum() == 0
+    ho = h.online()
+    for f in ("scan", "track_id", "plot"):
+        assert (getattr(ho, f) == getattr(o, f)).all()
+    assert len(h) > len(o)
+    assert hist["delay"] == online["delay"] and hist["delay_max"] >= 1
+    assert hist["rcc"] > online["rcc"]
+
+
 def test_track_polar_plots_uses_scenario_sensors(tmp_path):
     code, _, stderr = invoke("simulate", "multiradar", "--seed", "2", "--scans", "6",
                              "--clutter-rate", "5", "--out", str(tmp_path))

@@ -47,7 +47,7 @@ def test_json_output_keys(study):
     assert sorted(p.name for p in (out / "runs" / "mht").iterdir()) == [
         "run-0.parquet", "run-1.parquet"]
     spec = json.loads((out / "montecarlo.json").read_text())
-    assert spec["run_kwargs"] == {"cutoff": 500.0, "order": 2.0}
+    assert spec["run_kwargs"] == {"cutoff": 500.0, "order": 2.0, "output": "history"}
 
 
 def test_rerun_resumes_and_prints_the_table(study):

@@ -156,6 +156,8 @@ def track_tables(draw: st.DrawFn) -> TrackTable:
         track_id=np.array(cols["track_id"], np.int64),
         plot=np.array(draw(st.lists(plot, min_size=n, max_size=n)), np.int64),
         score=score if draw(st.booleans()) else None,
+        tentative=(np.array(draw(st.lists(st.booleans(), min_size=n, max_size=n)), bool)
+                   if draw(st.booleans()) else None),
         **floats,
     )
 
@@ -172,6 +174,9 @@ def test_tracks_round_trip(tmp_path, fmt: str, table: TrackTable) -> None:
     assert (back.score is None) == (table.score is None)
     if table.score is not None:
         assert same_bits(table.score, back.score)
+    assert (back.tentative is None) == (table.tentative is None)
+    if table.tentative is not None:
+        assert np.array_equal(back.tentative, table.tentative)
     assert back.P is None
 
 

@@ -284,3 +284,31 @@ def test_keys_in_to_dict_and_table():
     assert set(KEYS) <= ev.to_dict().keys()
     text = ev.to_table()
     assert "Rcc correct association rate" in text and "3 / 3.5 / 4 s" in text
+
+
+def test_confirmation_delay_counts_live_scans_before_the_first_online_match():
+    """Target 1 alive at scans 1–6, target 2 at 3–6. Track 10 follows target 1 from scan 2,
+    its rows at 2–3 backfilled (tentative); track 20 follows target 2 from scan 3 online.
+    Target 1's first match reported at its scan is at scan 4: 3 live scans (1, 2, 3) before
+    it; target 2's is at its first scan: 0."""
+    truth = _truth([(k, 1, 0.0, 0.0) for k in range(1, 7)]
+                   + [(k, 2, 1000.0, 0.0) for k in range(3, 7)])
+    rows = [(k, 10, 10.0, 0.0, -1) for k in range(2, 7)] + [
+        (k, 20, 1010.0, 0.0, -1) for k in range(3, 7)]
+    rows.sort()
+    tracks = _tracks(rows)
+    tentative = np.array([(r[1] == 10 and r[0] <= 3) for r in rows])
+    hist = replace(tracks, tentative=tentative)
+    a = association_metrics(hist, truth)
+    assert a.delay.tolist() == [3.0, 0.0]
+    assert a.delay_mean == 1.5 and a.delay_max == 3.0
+    # without the flag every row counts as reported at its scan
+    assert association_metrics(tracks, truth).delay.tolist() == [1.0, 0.0]
+    # the online view of the history output gives the same delays
+    assert association_metrics(hist.online(), truth).delay.tolist() == [3.0, 0.0]
+    # a target never matched has no delay; it is left out of the mean
+    only_b = tracks.take(tracks.track_id == 20)
+    a = association_metrics(only_b, truth)
+    assert math.isnan(a.delay[0]) and a.delay[1] == 0.0 and a.delay_mean == 0.0
+    d = evaluate(hist, truth).to_dict()
+    assert d["delay_mean"] == 1.5 and d["delay_max"] == 3.0 and d["delay"] == [3.0, 0.0]

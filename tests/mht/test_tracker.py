@@ -18,8 +18,10 @@ BIRTHS = [first for _, first, _ in CROSSING_TARGETS]
 
 
 def _run(sim, config=None, stats=None):
+    """The online output: what each step reported at its scan (tests of the history
+    output, with the tentative past of each track, are in test_history.py)."""
     trk = MHTTracker(config or MHTConfig(), KnownClutter(sim.clutter_density))
-    return trk.run(sim.scans, stats), trk
+    return trk.run(sim.scans, stats, history=False), trk
 
 
 def _same(a: TrackTable, b: TrackTable) -> bool:
@@ -81,7 +83,7 @@ def test_deterministic_and_plot_table_input(crossing10):
     b, _ = _run(crossing10)
     assert _same(a, b)
     table = PlotTable.from_scans(crossing10.scans)
-    c = MHTTracker(MHTConfig(), KnownClutter(crossing10.clutter_density)).run(table)
+    c = MHTTracker(MHTConfig(), KnownClutter(crossing10.clutter_density)).run(table, history=False)
     assert _same(a, c)
 
 
@@ -91,12 +93,12 @@ def test_per_plot_covariance_path_gives_the_same_tracks(crossing10):
         dataclasses.replace(s, R=np.broadcast_to(np.eye(2) * 1e4, (len(s), 2, 2)).copy())
         for s in crossing10.scans
     ]
-    b = MHTTracker(MHTConfig(), KnownClutter(crossing10.clutter_density)).run(scans)
+    b = MHTTracker(MHTConfig(), KnownClutter(crossing10.clutter_density)).run(scans, history=False)
     assert _same(a, b)
     # rows with an all-NaN R (PlotTable.from_scans for scans without R) use the config's R
     mixed = [dataclasses.replace(s, R=np.full((len(s), 2, 2), np.nan)) if s.index % 2 else s
              for s in scans]
-    c = MHTTracker(MHTConfig(), KnownClutter(crossing10.clutter_density)).run(mixed)
+    c = MHTTracker(MHTConfig(), KnownClutter(crossing10.clutter_density)).run(mixed, history=False)
     assert _same(a, c)
 
 
@@ -125,17 +127,17 @@ def test_imm_tracks_straight_targets_more_accurately(crossing10):
 def test_save_restore_continues_bit_for_bit(crossing40, tmp_path):
     full, _ = _run(crossing40)
     trk = MHTTracker(MHTConfig(), KnownClutter(crossing40.clutter_density))
-    first = trk.run(crossing40.scans[:40])
+    first = trk.run(crossing40.scans[:40], history=False)
     path = tmp_path / "state.npz"
     trk.save(path)
     with np.load(path, allow_pickle=False) as data:  # no pickled object inside
         assert "meta" in data.files and data["leaves__x"].dtype == np.float64
     restored = MHTTracker.load(path)
     assert restored.config == trk.config
-    rest = restored.run(crossing40.scans[40:])
+    rest = restored.run(crossing40.scans[40:], history=False)
     assert _same(TrackTable.concat([first, rest]), full)
     # the saved tracker itself continues identically too
-    assert _same(trk.run(crossing40.scans[40:]), rest)
+    assert _same(trk.run(crossing40.scans[40:], history=False), rest)
 
 
 def test_load_checks_the_clutter_estimator(crossing10, tmp_path):

@@ -17,7 +17,7 @@ from mhtrack.cli.common import (
     load_scenario_arg,
     scenario_options,
 )
-from mhtrack.cli.track_commands import config_changes, tracker_options
+from mhtrack.cli.track_commands import config_changes, output_option, tracker_options
 
 
 def _params_of(decorator: Callable[[Callable[..., Any]], Callable[..., Any]],
@@ -81,6 +81,7 @@ def _run_kwargs(ctx: click.Context, param: click.Parameter, value: tuple[str, ..
               show_default=True, help="OSPA/GOSPA cut-off c (m).")
 @click.option("--order", type=click.FloatRange(min=1), default=2.0, show_default=True,
               help="OSPA/GOSPA order p.")
+@output_option
 @click.option("--run-kwarg", "run_kwarg", multiple=True, callback=_run_kwargs,
               metavar="KEY=VALUE", help="Extra keyword of run_scenario (VALUE read as JSON, "
               "else as text); repeatable.")
@@ -93,7 +94,8 @@ def montecarlo(scenario: str, clutter: str | None, clutter_rate: float | None,
                accel_sigma: float | None, imm_accel_sigma: float | None,
                clutter_density: float | None,
                birth_density: float | None, nscan: int | None, cutoff: float, order: float,
-               run_kwarg: dict[str, Any], as_json: bool, progress: bool | None) -> None:
+               output: str, run_kwarg: dict[str, Any], as_json: bool,
+               progress: bool | None) -> None:
     """Monte-Carlo study: RUNS simulations of SCENARIO, each tracked by every tracker.
 
     Every finished run is written at once to OUT/runs/<tracker>/run-<i>.parquet; rerunning
@@ -112,7 +114,7 @@ def montecarlo(scenario: str, clutter: str | None, clutter_rate: float | None,
     tracker_pd = tracker_pd if tracker_pd is not None else pd
     config = config_changes(tracker_pd, meas_sigma, accel_sigma, birth_density, nscan,
                             imm_accel_sigma)
-    kwargs: dict[str, Any] = {"cutoff": cutoff, "order": order}
+    kwargs: dict[str, Any] = {"cutoff": cutoff, "order": order, "output": output}
     if clutter_density is not None:
         kwargs["clutter_density"] = clutter_density
     kwargs.update(run_kwarg)

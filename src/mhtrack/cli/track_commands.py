@@ -70,6 +70,18 @@ def birth_options(f: Callable[..., Any]) -> Callable[..., Any]:
     return f
 
 
+def output_option(f: Callable[..., Any]) -> Callable[..., Any]:
+    """``--output history|online``: which rows a batch run reports (``docs/mht.md``)."""
+    from mhtrack.experiments.pipeline import OUTPUTS
+
+    return click.option(
+        "--output", "output", type=click.Choice(OUTPUTS), default="history",
+        show_default=True,
+        help="history: each confirmed track from its first plot, the rows before its "
+        "confirmation marked tentative; online: only what the tracker reported at each "
+        "scan.")(f)
+
+
 def _check_clutter_density(tracker: str, clutter_density: float | None) -> None:
     if clutter_density is not None and tracker != "mht":
         raise click.UsageError(
@@ -108,13 +120,14 @@ def _config(base: Any, tracker_pd: float | None, meas_sigma: float | None,
               help="Scenario TOML giving the sensors (needed for polar plots) and all scan "
               "times [default: scenario.toml beside PLOTS, if any].")
 @birth_options
+@output_option
 @click.option("--progress/--no-progress", default=True, help="Progress bar on stderr.")
 def track(plots: Path, tracker: str, tracker_pd: float | None, meas_sigma: float | None,
           accel_sigma: float | None, imm_accel_sigma: float | None,
           clutter_density: float | None,
           birth_density: float | None, nscan: int | None, out: Path,
           scenario_file: Path | None, birth: str, birth_theta: float, fusion: str | None,
-          progress: bool) -> None:
+          output: str, progress: bool) -> None:
     """Run a tracker on a PLOTS file and write its tracks."""
     import numpy as np
 
@@ -149,7 +162,8 @@ def track(plots: Path, tracker: str, tracker_pd: float | None, meas_sigma: float
     _check_clutter_density(tracker, clutter_density)
     trk = make_tracker(tracker, cfg, clutter_density=clutter_density, birth=birth,
                        theta_deg=birth_theta)
-    result = run_tracker(trk, table, name=tracker, progress=progress, fusion=fusion)
+    result = run_tracker(trk, table, name=tracker, progress=progress, fusion=fusion,
+                         output=output)
     write_tracks(result.tracks, out)
     n_ids = len(set(result.tracks.track_id.tolist()))
     caps = f", caps acted: {result.caps}" if result.caps else ""
@@ -170,6 +184,7 @@ def track(plots: Path, tracker: str, tracker_pd: float | None, meas_sigma: float
               help="OSPA/GOSPA order p.")
 @click.option("--json", "as_json", is_flag=True, help="Print one JSON object.")
 @birth_options
+@output_option
 @click.option("--progress/--no-progress", default=True, help="Progress bar on stderr.")
 def run(scenario: str, seed: int, clutter: str | None, clutter_rate: float | None,
         pd: float | None, scans: int | None, tracker: str, tracker_pd: float | None,
@@ -177,7 +192,7 @@ def run(scenario: str, seed: int, clutter: str | None, clutter_rate: float | Non
         clutter_density: float | None,
         birth_density: float | None, nscan: int | None, out: Path | None, cutoff: float,
         order: float, as_json: bool, birth: str, birth_theta: float, fusion: str | None,
-        progress: bool) -> None:
+        output: str, progress: bool) -> None:
     """Simulate SCENARIO, track, evaluate and plot, in one go.
 
     Writes plots, truth, tracks, scenario.toml, metrics.json, scene.png (truth, plots,
@@ -195,7 +210,7 @@ def run(scenario: str, seed: int, clutter: str | None, clutter_rate: float | Non
     _check_clutter_density(tracker, clutter_density)
     result = run_scenario(sc, seed, tracker, cfg, clutter_density=clutter_density,
                           cutoff=cutoff, order=order, progress=progress, birth=birth,
-                          theta_deg=birth_theta, fusion=fusion)
+                          theta_deg=birth_theta, fusion=fusion, output=output)
     suffix = "" if birth == "every-plot" else f"-{birth}"
     out = out if out is not None else Path("out") / f"{sc.name}-{tracker}{suffix}-{seed}"
     out.mkdir(parents=True, exist_ok=True)

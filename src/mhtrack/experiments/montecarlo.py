@@ -53,7 +53,7 @@ import pyarrow.parquet as pq
 from tqdm.auto import tqdm
 
 #: Bumped when the meaning of a job (and so its hash) changes.
-JOB_FORMAT = 1
+JOB_FORMAT = 2  # 2: run_scenario's history output (mhtrack.mht.history)
 SPEC_FILE = "montecarlo.json"
 SUMMARY_FILE = "summary.md"
 FIGURE_FILE = "ospa_cardinality.png"

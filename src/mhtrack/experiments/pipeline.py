@@ -103,6 +103,7 @@ class TrackingRun:
     tracker: str
     tracks: TrackTable
     stats: tuple[StepStats, ...]
+    output: str = "history"
 
     @property
     def seconds_per_scan(self) -> np.ndarray:
@@ -124,12 +125,21 @@ class TrackingRun:
         return total
 
 
+#: Output modes of a batch run: ``"history"`` — every confirmed track from its first
+#: plot (its tentative past backfilled when it is confirmed, rows marked ``tentative``,
+#: :mod:`mhtrack.mht.history`); ``"online"`` — only what each step reported at its scan.
+OUTPUTS = ("history", "online")
+
+
 def track(
     tracker: MHTTracker, scans: PlotTable | Iterable[Scan], *, name: str = "mht",
-    progress: bool = False, fusion: str = "none",
+    progress: bool = False, fusion: str = "none", output: str = "history",
 ) -> TrackingRun:
     """Run ``tracker`` over ``scans`` (a :class:`PlotTable` or scans), one step per scan;
-    with ``fusion="adaptive-kmeans"`` each scan is fused first (module docstring)."""
+    with ``fusion="adaptive-kmeans"`` each scan is fused first (module docstring).
+    ``output``: one of :data:`OUTPUTS`."""
+    if output not in OUTPUTS:
+        raise ValueError(f"unknown output {output!r} (expected one of {', '.join(OUTPUTS)})")
     total = None
     if isinstance(scans, PlotTable):
         total = scans.n_scans
@@ -140,9 +150,13 @@ def track(
     for scan in tqdm(scans, total=total, desc=name, unit="scan", disable=not progress,
                      leave=False):
         parts.append(tracker.step(scan))
+        if output == "history":
+            parts.append(tracker.last_backfill)
         assert tracker.last_stats is not None
         stats.append(tracker.last_stats)
-    return TrackingRun(name, TrackTable.concat(parts), tuple(stats))
+    tracks = TrackTable.concat(parts)
+    return TrackingRun(name, tracks.sorted() if output == "history" else tracks, tuple(stats),
+                       output)
 
 
 @dataclass(frozen=True)
@@ -154,12 +168,14 @@ class ScenarioRun:
     evaluation: Evaluation
 
     def summary(self) -> dict[str, Any]:
-        """The ``evaluate`` JSON object plus ``t_avg`` (s/scan), ``tracker`` and ``caps``."""
+        """The ``evaluate`` JSON object plus ``t_avg`` (s/scan), ``tracker``, ``caps`` and
+        ``output`` (the output mode, :data:`OUTPUTS`)."""
         return {
             **self.evaluation.to_dict(),
             "t_avg": self.run.t_avg,
             "tracker": self.run.tracker,
             "caps": self.run.caps,
+            "output": self.run.output,
         }
 
 
@@ -176,18 +192,20 @@ def run_scenario(
     birth: str | None = None,
     theta_deg: float | None = None,
     fusion: str | None = None,
+    output: str = "history",
 ) -> ScenarioRun:
     """Simulate ``scenario`` with ``seed``, run tracker ``tracker`` on it and evaluate.
 
     ``birth`` / ``theta_deg``: see :func:`make_tracker`; ``fusion``: ``"none"`` or
-    ``"adaptive-kmeans"``, default :func:`default_fusion` of the scenario's sensors."""
+    ``"adaptive-kmeans"``, default :func:`default_fusion` of the scenario's sensors;
+    ``output``: see :func:`track`."""
     sim = simulate(scenario, seed=seed)
     config = default_config(scenario) if config is None else config
     trk = make_tracker(tracker, config, clutter_density=clutter_density, birth=birth,
                        theta_deg=theta_deg)
     if fusion is None:
         fusion = default_fusion(len(scenario.sensors))
-    run = track(trk, sim.plots, name=tracker, progress=progress, fusion=fusion)
+    run = track(trk, sim.plots, name=tracker, progress=progress, fusion=fusion, output=output)
     ev = evaluate(run.tracks, sim.truth, plots=sim.plots, cutoff=cutoff, order=order)
     return ScenarioRun(sim, run, ev)
 

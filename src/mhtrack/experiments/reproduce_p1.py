@@ -80,7 +80,7 @@ _METRIC = {m.key: m for m in TABLE3_METRICS}
 
 #: run_scenario keywords of the study (those of ``mhtrack montecarlo``'s defaults, so the
 #: job hashes agree with ``mhtrack montecarlo crossing``).
-RUN_KWARGS: dict[str, Any] = {"cutoff": 500.0, "order": 2.0}
+RUN_KWARGS: dict[str, Any] = {"cutoff": 500.0, "order": 2.0, "output": "history"}
 
 MC_DIR = "montecarlo"
 TABLE_FILE = "table3.md"

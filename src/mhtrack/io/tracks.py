@@ -1,7 +1,8 @@
-"""Tracks files: ``scan, time, track_id, x, y, vx, vy, plot`` [, ``score``] — tracker output,
-one row per reported track and scan, in non-decreasing scan order. ``plot`` is the 0-based
-row of the plots file that the track used at that scan, empty (CSV) or null (Parquet) on a
-miss. See ``docs/file-formats.md``."""
+"""Tracks files: ``scan, time, track_id, x, y, vx, vy, plot`` [, ``score``, ``tentative``] —
+tracker output, one row per reported track and scan, in non-decreasing scan order. ``plot``
+is the 0-based row of the plots file that the track used at that scan, empty (CSV) or null
+(Parquet) on a miss; ``tentative`` is 1 on rows reported after their scan, when the track
+was confirmed later (the history output), else 0. See ``docs/file-formats.md``."""
 
 from __future__ import annotations
 
@@ -24,7 +25,8 @@ from mhtrack.io.truth import read_truth
 from mhtrack.records import NO_PLOT, TrackTable, TruthTable
 
 REQUIRED = ("scan", "time", "track_id", "x", "y", "vx", "vy", "plot")
-COLUMNS = dict.fromkeys((*REQUIRED, "score"), FLOAT) | {"scan": INT, "track_id": INT, "plot": INT}
+COLUMNS = dict.fromkeys((*REQUIRED, "score"), FLOAT) | {
+    "scan": INT, "track_id": INT, "plot": INT, "tentative": INT}
 
 
 def tracks_from_truth(truth: TruthTable) -> TrackTable:
@@ -74,9 +76,16 @@ def read_tracks(path: PathArg, *, accept_truth: bool = True) -> TrackTable:
         lambda r: f"plot index {num(plot[r])} is negative ({miss} for a miss)",
     )
     score = f.floats("score") if f.has("score") else None
+    tentative = None
+    if f.has("tentative"):
+        flag = f.ints("tentative")
+        f.check((flag != 0) & (flag != 1), "tentative",
+                lambda r: f"tentative must be 0 or 1, got {num(flag[r])}")
+        tentative = flag == 1
     check_scan_order(f, scan, time)
     check_unique(f, scan, tid, "track_id")
-    return TrackTable(scan=scan, time=time, track_id=tid, plot=plot, score=score, **cols)
+    return TrackTable(scan=scan, time=time, track_id=tid, plot=plot, score=score,
+                      tentative=tentative, **cols)
 
 
 def write_tracks(table: TrackTable, path: PathArg) -> None:
@@ -94,4 +103,6 @@ def write_tracks(table: TrackTable, path: PathArg) -> None:
     }
     if table.score is not None:
         cols["score"] = float_array(table.score)
+    if table.tentative is not None:
+        cols["tentative"] = int_array(table.tentative.astype(np.int64))
     write_frame(path, cols)

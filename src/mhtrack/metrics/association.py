@@ -45,6 +45,10 @@ class AssociationResult:
         ``T`` (s) used for the track life.
     target_id, life, breaks : (n_targets,) arrays
         Per target (ascending id): longest time followed by one track (s), and its breaks.
+    delay : (n_targets,) array
+        Per target, its confirmation delay in scans (NaN if never confirmed).
+    delay_mean, delay_max : float
+        Mean and max of ``delay`` over the targets that were confirmed (NaN if none).
     has_origin : bool
         Whether plot origins were available (``rcc``/``rmc`` computed).
     """
@@ -65,6 +69,17 @@ class AssociationResult:
     life: np.ndarray
     breaks: np.ndarray
     has_origin: bool
+    delay: np.ndarray | None = None
+
+    @property
+    def delay_mean(self) -> float:
+        d = self.delay
+        return float(np.nanmean(d)) if d is not None and np.isfinite(d).any() else float("nan")
+
+    @property
+    def delay_max(self) -> float:
+        d = self.delay
+        return float(np.nanmax(d)) if d is not None and np.isfinite(d).any() else float("nan")
 
 
 def association_metrics(
@@ -110,6 +125,13 @@ def association_metrics(
     ``life(o)`` is the longest run's duration, 0 if ``o`` is never matched;
     ``L_min, L_avg, L_max`` are the min, mean and max of ``life`` over the targets.
 
+    **Confirmation delay** (ours). ``delay(o)`` is the number of live scans of ``o``
+    before the first one at which it is matched to a track row reported *at its scan*
+    (``tracks.tentative`` false or absent): 0 when a track was reported on it at its first
+    scan. Rows backfilled later (``tentative``, :mod:`mhtrack.mht.history`) count for the
+    other metrics but not here, so the delay measures when the tracker decided, whatever
+    the output mode.
+
     Parameters
     ----------
     tracks : TrackTable
@@ -150,6 +172,7 @@ def association_metrics(
         n_det, n_cor, n_wrong = _association_counts(tracks, plots, matching)
 
     targets, breaks, life = _continuity(truth, matching, T)
+    delay = _confirm_delay(tracks, truth, matching)
     n_targets = len(targets)
     n_breaks = int(breaks.sum())
     nan = float("nan")
@@ -170,6 +193,7 @@ def association_metrics(
         life=life,
         breaks=breaks,
         has_origin=has_origin,
+        delay=delay,
     )
 
 
@@ -257,6 +281,32 @@ def _check_plot_column(tracks: TrackTable, p_scan: np.ndarray) -> np.ndarray:
             f"{int(p_scan[plot[r]])}: the tracks were not made from these plots"
         )
     return plot
+
+
+def _confirm_delay(tracks: TrackTable, truth: TruthTable, matching: MOTMatching) -> np.ndarray:
+    """Per target (ascending id), live scans before its first match to a row reported at
+    its own scan; NaN if there is none."""
+    targets, dense = np.unique(np.asarray(truth.target_id, np.int64), return_inverse=True)
+    delay = np.full(len(targets), np.nan)
+    if len(truth) == 0:
+        return delay
+    online = np.ones(len(matching), bool)
+    if tracks.tentative is not None and len(matching):
+        row = _find(matching.scan, matching.track_id, tracks.scan, tracks.track_id)
+        online = ~np.asarray(tracks.tentative, bool)[row]
+    scan = np.asarray(truth.scan, np.int64)
+    idx = _find(scan, truth.target_id, matching.scan, matching.target_id)
+    order = np.lexsort((scan, dense))
+    g = dense[order]
+    starts = np.flatnonzero(np.r_[True, g[1:] != g[:-1]])
+    pos = np.arange(len(g)) - np.repeat(starts, np.diff(np.r_[starts, len(g)]))
+    hit = idx[order] >= 0
+    hit[hit] = online[idx[order][hit]]
+    if hit.any():
+        first = np.full(len(targets), np.inf)
+        np.minimum.at(first, g[hit], pos[hit].astype(float))
+        delay = np.where(np.isfinite(first), first, np.nan)
+    return delay
 
 
 def _continuity(

@@ -85,7 +85,9 @@ class Evaluation:
         cardinality_error_mean, mota, motp, id_switches, fragmentations, n_matches,
         n_misses, n_false, n_truth`` and P1 Table 3's ``rcc, rmc, rfg, l_min, l_avg,
         l_max`` (always present; ``rcc``/``rmc`` are ``None`` without plot origins, all six
-        ``None`` when undefined — see :func:`association_metrics`). Per-scan lists (aligned
+        ``None`` when undefined — see :func:`association_metrics`), and the confirmation
+        delay ``delay_mean, delay_max`` (scans) with ``delay`` per target (by ascending
+        target id, ``None`` for a target never confirmed). Per-scan lists (aligned
         with ``scans``): ``scans, ospa, gospa, cardinality`` (number of tracks),
         ``cardinality_true``.
         """
@@ -118,12 +120,13 @@ class Evaluation:
             "cardinality_true": [int(v) for v in self.cardinality.n_true],
         }
 
-    def _association_dict(self) -> dict[str, float | None]:
+    def _association_dict(self) -> dict[str, Any]:
         a = self.association
-        keys = ("rcc", "rmc", "rfg", "l_min", "l_avg", "l_max")
+        keys = ("rcc", "rmc", "rfg", "l_min", "l_avg", "l_max", "delay_mean", "delay_max")
         if a is None:
-            return dict.fromkeys(keys)
-        return {k: _num(getattr(a, k)) for k in keys}
+            return {**dict.fromkeys(keys), "delay": []}
+        delay = [] if a.delay is None else [_num(float(v)) for v in a.delay]
+        return {**{k: _num(getattr(a, k)) for k in keys}, "delay": delay}
 
     def to_table(self, *, per_scan: bool = False) -> str:
         """Plain-text (ASCII) table of the summary metrics, for a terminal.
@@ -161,6 +164,8 @@ class Evaluation:
                     "track life Lmin / Lavg / Lmax",
                     f"{_fmt(a.l_min)} / {_fmt(a.l_avg)} / {_fmt(a.l_max)} s",
                 ),
+                ("confirmation delay mean / max",
+                 f"{_fmt(a.delay_mean)} / {_fmt(a.delay_max)} scans"),
             ]
         out = _render(("metric", "value"), rows)
         if per_scan:

@@ -94,6 +94,10 @@ class MHTConfig:
         4 scans; a tree starts only from each newly initiated track, seeded with its
         least-squares state, scored by the log-likelihood ratio of its plots.
     birth_theta_deg : angle limit ``θ`` of the modified initiators. Default 20 (P2 §2.2).
+    history_scans : how many scans of tentative leaves the tracker keeps so that a track,
+        once confirmed, can also be reported at the scans before (from its first plot,
+        :mod:`mhtrack.mht.history`; ``MHTTracker.last_backfill``). Default 30 (our choice:
+        longer than any tentative life we measured; 0 keeps nothing).
     min_clutter_density : floor on the estimator's ``κ̂(z)`` (per m²), so that a density
         estimate that underflows to 0 far from its components cannot give an infinite
         score. Default 1e−12 (our choice: 1000× below P1's plain-MHT κ = 1e−9).
@@ -125,6 +129,7 @@ class MHTConfig:
     min_clutter_density: float = 1e-12
     birth: str = "every-plot"
     birth_theta_deg: float = 20.0
+    history_scans: int = 30
 
     def __post_init__(self) -> None:
         def check(name: str, ok: bool, what: str) -> None:
@@ -164,6 +169,8 @@ class MHTConfig:
                      "max_births_per_scan", "max_cluster_size"):
             v = getattr(self, name)
             check(name, _is_int(v) and v >= 1, "an integer >= 1")
+        check("history_scans", _is_int(self.history_scans) and self.history_scans >= 0,
+              "an integer >= 0")
         check("birth", self.birth in BIRTHS, f"one of {', '.join(BIRTHS)}")
         check("birth_theta_deg", isinstance(self.birth_theta_deg, int | float)
               and 0 <= self.birth_theta_deg <= 180, "in [0, 180]")

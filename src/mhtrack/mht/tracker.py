@@ -15,6 +15,8 @@ The tracking cycle, each step one function::
     caps             pruning.cap_trees
     confirm          SPRT on the chosen leaves      stable track ids
     report           TrackTable of confirmed tracks in the best hypothesis
+    backfill         history.TentativeHistory       the tentative past of tracks
+                                                    confirmed at this scan
 """
 
 from __future__ import annotations
@@ -33,6 +35,7 @@ from mhtrack.clutter.base import ClutterEstimator
 from mhtrack.clutter.known import KnownClutter
 from mhtrack.mht.birth import EVERY_PLOT, BirthCandidates, InitiatorBirth
 from mhtrack.mht.config import MHTConfig
+from mhtrack.mht.history import TentativeHistory
 from mhtrack.mht.hypothesis import best_hypothesis
 from mhtrack.mht.pruning import (
     cap_leaves,
@@ -51,6 +54,7 @@ from mhtrack.mht.tree import (
     grow_children,
     model_arrays,
     propose_children,
+    root_links,
 )
 from mhtrack.models import imm, kalman
 from mhtrack.models.motion import ConstantVelocity
@@ -58,7 +62,7 @@ from mhtrack.records import PlotTable, Scan, TrackTable
 
 logger = logging.getLogger(__name__)
 
-FORMAT = "mhtrack.mht.MHTTracker/2"
+FORMAT = "mhtrack.mht.MHTTracker/3"
 
 
 @dataclass(frozen=True)
@@ -118,7 +122,12 @@ class MHTTracker:
         self._last_index: int | None = None
         self._next_tree = 0
         self._next_track = 0
+        self._next_node = 0
+        self._history = TentativeHistory(cfg.history_scans)
         self.last_stats: StepStats | None = None
+        #: Rows, at earlier scans, of the tracks confirmed by the last :meth:`step`: their
+        #: tentative past (``tentative`` true; :mod:`mhtrack.mht.history`).
+        self.last_backfill: TrackTable = TrackTable.empty()
         self._caps_warned: set[str] = set()
         self._birth: InitiatorBirth | None = None
         if cfg.birth != EVERY_PLOT:
@@ -142,8 +151,9 @@ class MHTTracker:
     def step(self, scan: Scan) -> TrackTable:
         """Process one scan; return the confirmed tracks of the best global hypothesis.
 
-        Statistics of the step are left in :attr:`last_stats`; a warning is logged (once)
-        when a hard cap acted.
+        Statistics of the step are left in :attr:`last_stats`, the earlier rows of tracks
+        confirmed at this scan in :attr:`last_backfill`; a warning is logged (once) when a
+        hard cap acted.
         """
         t0 = time.perf_counter()
         cfg = self.config
@@ -178,6 +188,9 @@ class MHTTracker:
         if self._birth is not None:
             births = self._seed(scan, *self._birth.select(cand, grown.window), caps)
         leaves = Leaves.concat(grown, births)
+        leaves = replace(leaves, node=np.arange(self._next_node, self._next_node + len(leaves),
+                                                dtype=np.int64))
+        self._next_node += len(leaves)
 
         hyp = best_hypothesis(
             leaves.score, leaves.tree, leaves.window, cfg.max_cluster_size, cfg.milp_time_limit
@@ -187,7 +200,11 @@ class MHTTracker:
         if hyp.n_time_limited:
             caps["milp_time_limit"] = hyp.n_time_limited
         leaves = self._prune_after_solve(leaves, hyp.leaves, caps)
+        first_new = self._next_track
         leaves = self._manage_tracks(leaves, previous)
+        self.last_backfill = self._history.backfill(
+            leaves, np.flatnonzero(leaves.chosen & (leaves.track >= first_new)))
+        self._history.record(int(scan.index), float(scan.time), leaves)
         if self._birth is not None:
             self._birth.forget_used(leaves.window[leaves.chosen & (leaves.track >= 0)])
         self._leaves = leaves
@@ -218,18 +235,25 @@ class MHTTracker:
         return out
 
     def run(
-        self, scans: Iterable[Scan] | PlotTable, stats: list[StepStats] | None = None
+        self, scans: Iterable[Scan] | PlotTable, stats: list[StepStats] | None = None,
+        *, history: bool = True,
     ) -> TrackTable:
         """Step through ``scans`` (or all scans of a :class:`PlotTable`) and concatenate the
-        outputs; per-scan statistics are appended to ``stats`` when given."""
+        outputs, ordered by scan then track id; per-scan statistics are appended to
+        ``stats`` when given. With ``history`` (default) the output also holds each
+        track's tentative past (:attr:`last_backfill` of every step, ``tentative`` true);
+        without, only what each step reported at its own scan."""
         if isinstance(scans, PlotTable):
             scans = scans.scans()
         parts = []
         for scan in scans:
             parts.append(self.step(scan))
+            if history:
+                parts.append(self.last_backfill)
             if stats is not None and self.last_stats is not None:
                 stats.append(self.last_stats)
-        return TrackTable.concat(parts)
+        out = TrackTable.concat(parts)
+        return out.sorted() if history else out
 
     # ------------------------------------------------------------------ cycle steps
     def _validate(self, scan: Scan) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -407,6 +431,7 @@ class MHTTracker:
             window=cand.window,
             chosen=np.zeros(n, bool),
             **model_arrays(cand.x, cand.P, self._models),
+            **root_links(n),
         )
 
     def _prune_children(
@@ -519,6 +544,7 @@ class MHTTracker:
             plot=leaves.window[sel, -1].copy(),
             score=leaves.score[sel].copy(),
             P=leaves.P[sel].copy(),
+            tentative=np.zeros(n, bool),
         )
 
     # ------------------------------------------------------------------ persistence
@@ -531,6 +557,7 @@ class MHTTracker:
         }
         if self._birth is not None:
             arrays.update({f"birth__{k}": v for k, v in self._birth.arrays().items()})
+        arrays.update({f"history__{k}": v for k, v in self._history.arrays().items()})
         clutter_state = _encode(self.clutter.get_state(), arrays)
         meta = {
             "format": FORMAT,
@@ -541,6 +568,7 @@ class MHTTracker:
             "last_index": self._last_index,
             "next_tree": self._next_tree,
             "next_track": self._next_track,
+            "next_node": self._next_node,
         }
         arrays["meta"] = np.array(json.dumps(meta, sort_keys=True))
         with open(path, "wb") as f:
@@ -578,6 +606,10 @@ class MHTTracker:
         trk._last_index = meta["last_index"]
         trk._next_tree = int(meta["next_tree"])
         trk._next_track = int(meta["next_track"])
+        trk._next_node = int(meta["next_node"])
+        trk._history.set_arrays(
+            {k.removeprefix("history__"): v for k, v in arrays.items()
+             if k.startswith("history__")})
         if trk._birth is not None:
             trk._birth.set_arrays(
                 {k.removeprefix("birth__"): v for k, v in arrays.items() if k.startswith("birth__")}

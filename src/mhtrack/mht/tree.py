@@ -41,6 +41,10 @@ class Leaves:
         covariances of an IMM with ``r`` models (:mod:`mhtrack.models.imm`); ``x, P`` are
         then their moment-matched mixture. ``r = 0`` (empty trailing axes) for the single
         constant-velocity model.
+    node, parent : (L,) id of this leaf (unique over the run, ascending in row order) and of
+        the leaf it grew from (``-1`` for a tree's root). New leaves get ``-1`` here and
+        their ids from the tracker; they link a track back to its tentative past
+        (:mod:`mhtrack.mht.history`).
     """
 
     x: np.ndarray
@@ -56,6 +60,8 @@ class Leaves:
     mu: np.ndarray
     xm: np.ndarray
     Pm: np.ndarray
+    node: np.ndarray
+    parent: np.ndarray
 
     def __len__(self) -> int:
         return int(self.score.shape[0])
@@ -67,7 +73,7 @@ class Leaves:
         f = np.zeros(0)
         return cls(np.zeros((0, 4)), np.zeros((0, 4, 4)), f, f, i, i, i, i,
                    np.zeros((0, width), np.int64), np.zeros(0, bool), np.zeros((0, r)),
-                   np.zeros((0, r, 4)), np.zeros((0, r, 4, 4)))
+                   np.zeros((0, r, 4)), np.zeros((0, r, 4, 4)), i, i)
 
     def take(self, idx: np.ndarray) -> Leaves:
         """Rows ``idx`` (an index array or boolean mask), in that order."""
@@ -204,6 +210,8 @@ def grow_children(
         mu=mu,
         xm=xm,
         Pm=Pm,
+        node=np.full(len(par), -1, np.int64),
+        parent=leaves.node[par],
     )
 
 
@@ -244,7 +252,13 @@ def birth_leaves(
         window=window,
         chosen=np.zeros(n, bool),
         **model_arrays(x, P, models),
+        **root_links(n),
     )
+
+
+def root_links(n: int) -> dict[str, np.ndarray]:
+    """``node, parent`` of ``n`` new roots: ids not yet given, no parent."""
+    return {"node": np.full(n, -1, np.int64), "parent": np.full(n, -1, np.int64)}
 
 
 def model_arrays(

@@ -1,0 +1,142 @@
+"""The history output (``mhtrack.mht.history``): each confirmed track also reported at
+the scans before its confirmation, from its first plot."""
+
+import numpy as np
+import pytest
+
+from mhtrack.clutter import KnownClutter
+from mhtrack.mht import MHTConfig, MHTTracker
+from mhtrack.mht.history import TentativeHistory
+from mhtrack.records import Scan, TrackTable
+
+FIELDS = ("scan", "time", "track_id", "x", "y", "vx", "vy", "plot", "score", "P")
+
+
+def _same(a: TrackTable, b: TrackTable, fields=FIELDS) -> bool:
+    return len(a) == len(b) and all(np.array_equal(getattr(a, f), getattr(b, f))
+                                    for f in fields)
+
+
+def _tracker(sim, **changes) -> MHTTracker:
+    return MHTTracker(MHTConfig(**changes), KnownClutter(sim.clutter_density))
+
+
+def test_online_part_of_the_history_is_the_online_output(crossing10):
+    hist = _tracker(crossing10).run(crossing10.scans)
+    online = _tracker(crossing10).run(crossing10.scans, history=False)
+    assert hist.tentative is not None and hist.tentative.any()
+    assert _same(hist.online(), online)
+    assert not online.tentative.any()
+    # ordered by scan, then track id, one row per (scan, track)
+    key = hist.scan * 10**6 + hist.track_id
+    assert np.all(np.diff(key) > 0)
+
+
+def test_each_track_is_reported_from_its_first_plot(crossing10):
+    trk = _tracker(crossing10)
+    hist = trk.run(crossing10.scans)
+    online = hist.online()
+    plot_scan = {int(r): s.index for s in crossing10.scans for r in s.rows}
+    for tid in np.unique(hist.track_id):
+        rows = hist.take(hist.track_id == tid)
+        confirmed_at = online.scan[online.track_id == tid].min()
+        tent = rows.tentative
+        # the tentative rows are exactly the scans from the first plot to confirmation − 1
+        assert np.array_equal(rows.scan[tent], np.arange(rows.scan[0], confirmed_at))
+        assert tent[: tent.sum()].all()
+        # the first row holds the tree's root plot, made at that very scan
+        assert rows.plot[0] >= 0 and plot_scan[int(rows.plot[0])] == rows.scan[0]
+        used = rows.plot[rows.plot >= 0]
+        assert all(plot_scan[int(p)] == s for p, s in zip(used, rows.scan[rows.plot >= 0],
+                                                          strict=True))
+
+
+def _one_target(n: int, sigma: float = 50.0, seed: int = 4) -> list[Scan]:
+    """One target at 120, −80 m/s, detected every scan, no clutter."""
+    rng = np.random.default_rng(seed)
+    out = []
+    for k in range(1, n + 1):
+        z = np.array([1000.0 + 120.0 * (k - 1), -500.0 - 80.0 * (k - 1)]) + rng.normal(
+            0, sigma, 2)
+        out.append(Scan(k, float(k), z[None], np.zeros(1, np.int64), np.array([k - 1])))
+    return out
+
+
+def _textbook_kf(zs: np.ndarray, dt: float, sigma_w: float, sigma_v: float, v_max: float):
+    """Filtered states of P1's CV model written out: x = [x, vx, y, vy], one-point
+    initialisation with velocity variance (v_max/2)², discrete white-noise acceleration."""
+    F = np.array([[1, dt, 0, 0], [0, 1, 0, 0], [0, 0, 1, dt], [0, 0, 0, 1]], float)
+    q = np.array([[dt**4 / 4, dt**3 / 2], [dt**3 / 2, dt**2]]) * sigma_v**2
+    Q = np.zeros((4, 4))
+    Q[:2, :2] = Q[2:, 2:] = q
+    H = np.array([[1, 0, 0, 0], [0, 0, 1, 0]], float)
+    R = np.eye(2) * sigma_w**2
+    x = np.array([zs[0, 0], 0.0, zs[0, 1], 0.0])
+    P = np.diag([sigma_w**2, (v_max / 2) ** 2, sigma_w**2, (v_max / 2) ** 2])
+    out = [x]
+    for z in zs[1:]:
+        x, P = F @ x, F @ P @ F.T + Q
+        S = H @ P @ H.T + R
+        K = P @ H.T @ np.linalg.inv(S)
+        x, P = x + K @ (z - H @ x), (np.eye(4) - K @ H) @ P
+        out.append(x)
+    return np.array(out)
+
+
+def test_backfilled_states_are_the_filtered_states_of_the_branch():
+    """One target without clutter, single CV model: the rows before confirmation equal a
+    textbook Kalman filter over the target's plots."""
+    scans = _one_target(8)
+    cfg = MHTConfig(imm_sigma_v=0.0, sigma_w=50.0, alpha=1e-6)  # confirms late
+    trk = MHTTracker(cfg, KnownClutter(1e-8))
+    hist = trk.run(scans)
+    assert set(hist.track_id.tolist()) == {0}
+    confirmed_at = hist.scan[~hist.tentative].min()
+    assert confirmed_at >= 3, "the test needs a tentative past"
+    zs = np.array([s.z[0] for s in scans])
+    ref = _textbook_kf(zs, 1.0, cfg.sigma_w, cfg.sigma_v, cfg.v_max)
+    est = np.column_stack((hist.x, hist.vx, hist.y, hist.vy))
+    np.testing.assert_allclose(est, ref[hist.scan - 1], rtol=1e-9, atol=1e-6)
+    assert np.array_equal(hist.scan, np.arange(1, 9)) and np.array_equal(hist.plot,
+                                                                          np.arange(8))
+    assert np.array_equal(hist.tentative, hist.scan < confirmed_at)
+
+
+def test_history_depth_bounds_the_backfill():
+    scans = _one_target(8)
+    cfg = MHTConfig(imm_sigma_v=0.0, sigma_w=50.0, alpha=1e-6)
+    full = MHTTracker(cfg, KnownClutter(1e-8)).run(scans)
+    c = int(full.scan[~full.tentative].min())
+    short = MHTTracker(MHTConfig(imm_sigma_v=0.0, sigma_w=50.0, alpha=1e-6, history_scans=1),
+                       KnownClutter(1e-8)).run(scans)
+    assert np.array_equal(short.scan[short.tentative], [c - 1])
+    none = MHTTracker(MHTConfig(imm_sigma_v=0.0, sigma_w=50.0, alpha=1e-6, history_scans=0),
+                      KnownClutter(1e-8)).run(scans)
+    assert not none.tentative.any() and _same(none, full.online())
+    with pytest.raises(ValueError, match="history_scans"):
+        MHTConfig(history_scans=-1)
+    with pytest.raises(ValueError, match="depth"):
+        TentativeHistory(-2)
+
+
+@pytest.mark.parametrize("cut", [3, 25, 41])
+def test_save_restore_keeps_the_tentative_past(crossing40, tmp_path, cut):
+    full = _tracker(crossing40).run(crossing40.scans)
+    trk = _tracker(crossing40)
+    first = trk.run(crossing40.scans[:cut])
+    path = tmp_path / "state.npz"
+    trk.save(path)
+    rest = MHTTracker.load(path).run(crossing40.scans[cut:])
+    both = TrackTable.concat([first, rest]).sorted()
+    assert _same(both, full, (*FIELDS, "tentative"))
+
+
+def test_initiator_birth_backfills_from_the_seed_scan(crossing10):
+    trk = _tracker(crossing10, birth="logic")
+    hist = trk.run(crossing10.scans)
+    online = _tracker(crossing10, birth="logic").run(crossing10.scans, history=False)
+    assert _same(hist.online(), online)
+    for tid in np.unique(hist.track_id):
+        rows = hist.take(hist.track_id == tid)
+        t = rows.tentative
+        assert np.array_equal(t, np.arange(t.size) < t.sum())  # tentative rows first

@@ -110,6 +110,12 @@ Known reasons for differences (our choices and what P1 does not give):
   tracks on clutter, and its hypothesis trees grow until the hard caps act. This weighs
   on its OSPA and cardinality far more than P1's Figs. 5–6 suggest for their MHT, whose
   clutter level is unknown.
+* **Output mode.** The tracks are scored in the history output (`docs/mht.md`): each
+  confirmed track also at the scans between its first plot and its confirmation, rows
+  that a live display would only show later. P1 does not say which it scores. Our
+  online output (`mhtrack montecarlo crossing --output online`) scores lower on Rcc and
+  OSPA, since a target is then uncovered for its confirmation delay (`delay_mean` in
+  `montecarlo/summary.md`, in scans, is the same in both).
 * **Metric definitions.** P1 does not define Rcc, Rmc, Rfg or L*; ours are in
   `docs/metrics.md`. In particular Rfg is the number of track breaks per target, counted
   per run over the 4 targets and averaged over runs — P1's values (0.02–0.04) suggest

@@ -19,7 +19,7 @@ def tracker_options(pd_flag: str) -> Callable[[Callable[..., Any]], Callable[...
 
 
 def _tracker_options(f: Callable[..., Any], pd_flag: str) -> Callable[..., Any]:
-    from mhtrack.experiments import TRACKERS
+    from mhtrack.cli.choices import TRACKERS
 
     opts = [
         click.option("--tracker", type=click.Choice(sorted(TRACKERS)), default="mht-agmm",
@@ -51,8 +51,7 @@ def _tracker_options(f: Callable[..., Any], pd_flag: str) -> Callable[..., Any]:
 def birth_options(f: Callable[..., Any]) -> Callable[..., Any]:
     """``--birth``, ``--birth-theta`` and ``--fusion`` (birth process and plot fusion of
     the MHT; ``docs/mht.md``)."""
-    from mhtrack.experiments.pipeline import FUSIONS
-    from mhtrack.mht.config import BIRTHS
+    from mhtrack.cli.choices import BIRTHS, FUSIONS
 
     opts = [
         click.option("--birth", type=click.Choice(BIRTHS), default="every-plot",
@@ -72,7 +71,7 @@ def birth_options(f: Callable[..., Any]) -> Callable[..., Any]:
 
 def output_option(f: Callable[..., Any]) -> Callable[..., Any]:
     """``--output history|online``: which rows a batch run reports (``docs/mht.md``)."""
-    from mhtrack.experiments.pipeline import OUTPUTS
+    from mhtrack.cli.choices import OUTPUTS
 
     return click.option(
         "--output", "output", type=click.Choice(OUTPUTS), default="history",

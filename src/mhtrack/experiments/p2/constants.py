@@ -1,0 +1,33 @@
+"""P2 (Gong, Dai & Ma 2013, multi-radar track initiation) study constants: the θ, σr and λ
+grids, P2's nominal setting, the initiator settings, P2's printed numbers (Tables 1–2),
+the method labels and the output file names."""
+
+from __future__ import annotations
+
+#: P2 §2.2: θ ∈ {0, π/18, …, π} (degrees).
+THETAS_DEG: tuple[float, ...] = tuple(float(10 * i) for i in range(19))
+#: P2 Fig. 3: range errors (m) at λ = 50.
+SIGMAS: tuple[float, ...] = (20.0, 30.0, 40.0, 50.0, 60.0)
+#: P2 Fig. 4: clutter rates per scan at σr = 20 m.
+RATES: tuple[float, ...] = (50.0, 100.0, 150.0, 200.0, 250.0)
+#: P2's nominal setting (§2.2, §3).
+SIGMA0, RATE0, THETA0 = 20.0, 50.0, 20.0
+#: Runs per job (a job is one grid point × a chunk of runs).
+CHUNK = 50
+#: Initiator settings (those of ``mhtrack initiate``; P2's r = 300 m, Nθ = Nρ = 90, 4 votes).
+LOGIC_PARAMS: dict[str, float] = {"gate_radius": 300.0, "v_min": 50.0, "v_max": 400.0}
+
+#: P2's printed numbers (SPEC §7; P2 Tables 1–2), their machine, their code.
+PAPER_T_CLUSTER = {"random": 0.045, "adaptive": 0.034}
+PAPER_T_INIT = {"logic": 0.17, "modified-logic": 0.18, "hough": 114.5,
+                "modified-hough": 7.29}
+PAPER_COMPLEXITY = {"random": 890, "adaptive": 585}
+METHOD_LABELS = {"logic": "3/4 logic", "modified-logic": "modified 3/4 logic",
+                 "hough": "Hough", "modified-hough": "modified Hough"}
+CLUSTER_LABELS = {"random": "K-means, random start (oracle k)",
+                  "adaptive": "adaptive K-means (P2 §1.2)"}
+
+FIGURES = {"fig2": "fig2_clustering.png", "fig3": "fig3_ptrue_theta.png",
+           "fig4": "fig4_pfalse_theta.png", "fig12_15": "fig12_15_initiated.png"}
+TABLES_FILE, REPORT_FILE, RESULTS_FILE, JOBS_DIR = ("tables.md", "report.md",
+                                                    "results.json", "jobs")

@@ -1,8 +1,10 @@
 """Multi-radar plot fusion and track initiation (P2; ``docs/initiation.md``).
 
-* :mod:`~mhtrack.initiation.kmeans` — plot fusion by clustering:
-  :class:`AdaptiveKMeansFusion` (P2 §1.2) and :class:`KMeansFusion` (random initial
-  centres, P2 §1.1); each ``fuse(scan)`` returns a :class:`FusedScan`;
+* :mod:`~mhtrack.initiation.kmeans` — the clustering: standard K-means (P2 §1.1), the
+  adaptive initial centres (P2 §1.2), the one-plot-per-radar repair, the merge;
+* :mod:`~mhtrack.initiation.fusion` — plot fusion: :class:`AdaptiveKMeansFusion` (P2 §1.2)
+  and :class:`KMeansFusion` (random initial centres, P2 §1.1); each ``fuse(scan)`` returns
+  a :class:`FusedScan` (one fused plot per cluster);
 * :mod:`~mhtrack.initiation.window` — sliding windows of ``N`` scans, the
   :class:`InitiatedTracks` record, least-squares initial states;
 * :mod:`~mhtrack.initiation.logic` — :class:`LogicInitiator` (3/4 logic, and the modified
@@ -16,18 +18,20 @@ from __future__ import annotations
 
 from typing import Any
 
-from mhtrack.initiation.hough import HoughInitiator
-from mhtrack.initiation.kmeans import (
+from mhtrack.initiation.fusion import (
     FUSED,
     AdaptiveKMeansFusion,
     FusedScan,
     KMeansFusion,
+    fuse_clusters,
+    majority_origin,
+)
+from mhtrack.initiation.hough import HoughInitiator
+from mhtrack.initiation.kmeans import (
     adaptive_initial_centres,
     dissimilarity_threshold,
     enforce_one_plot_per_sensor,
-    fuse_clusters,
     kmeans_lloyd,
-    majority_origin,
     merge_compatible_clusters,
     sorted_distances,
 )

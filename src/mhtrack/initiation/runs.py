@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 from tqdm.auto import tqdm
 
-from mhtrack.initiation.kmeans import AdaptiveKMeansFusion, FusedScan, KMeansFusion
+from mhtrack.initiation.fusion import AdaptiveKMeansFusion, FusedScan, KMeansFusion
 from mhtrack.initiation.window import Window, sliding_windows
 from mhtrack.records import Scan
 from mhtrack.scenario import Scenario, simulate

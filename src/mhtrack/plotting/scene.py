@@ -59,13 +59,23 @@ def draw_truth(ax: Axes, truth: TruthTable) -> None:
 
 
 def draw_tracks(ax: Axes, tracks: TrackTable, *, label_ids: bool = True) -> None:
-    """Tracks as coloured lines, one colour per track id, labelled at their end."""
+    """Tracks as coloured lines, one colour per track id, labelled at their end; rows
+    reported only once the track was confirmed (``tentative``, the history output) are
+    dotted."""
     cmap = plt.get_cmap("tab10")
     first = True
+    tentative = (np.zeros(len(tracks), bool) if tracks.tentative is None
+                 else np.asarray(tracks.tentative, bool))
     for rows in _segments(tracks.track_id, tracks.scan):
         tid = int(tracks.track_id[rows[0]])
         color = cmap(tid % 10)
-        ax.plot(tracks.x[rows], tracks.y[rows], "-", color=color, lw=1.6,
+        tent = np.flatnonzero(tentative[rows])
+        if tent.size:  # dotted up to the first confirmed row after the tentative ones
+            dotted = rows[: tent[-1] + 2]
+            ax.plot(tracks.x[dotted], tracks.y[dotted], ":", color=color, lw=1.4,
+                    label="tracks before confirmation" if first else None)
+        solid = rows[~tentative[rows]]
+        ax.plot(tracks.x[solid], tracks.y[solid], "-", color=color, lw=1.6,
                 label="tracks" if first else None)
         if label_ids and len(rows) > 1:
             ax.annotate(str(tid), (tracks.x[rows[-1]], tracks.y[rows[-1]]), color=color,

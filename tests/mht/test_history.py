@@ -3,6 +3,8 @@ the scans before its confirmation, from its first plot."""
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from mhtrack.clutter import KnownClutter
 from mhtrack.mht import MHTConfig, MHTTracker
@@ -140,3 +142,51 @@ def test_initiator_birth_backfills_from_the_seed_scan(crossing10):
         rows = hist.take(hist.track_id == tid)
         t = rows.tentative
         assert np.array_equal(t, np.arange(t.size) < t.sum())  # tentative rows first
+
+
+@st.composite
+def small_scenes(draw):
+    """1–3 straight targets with random starts, speeds, detection and clutter, 12 scans
+    with random gaps in time."""
+    rng = np.random.default_rng(draw(st.integers(0, 2**32 - 1)))
+    n_targets = draw(st.integers(1, 3))
+    p_d = draw(st.floats(0.5, 1.0))
+    clutter = draw(st.floats(0.0, 8.0))
+    dts = draw(st.lists(st.floats(0.5, 3.0), min_size=12, max_size=12))
+    x0 = rng.uniform(-3000, 3000, (n_targets, 2))
+    v = rng.uniform(-150, 150, (n_targets, 2))
+    scans, t, row = [], 0.0, 0
+    for k, dt in enumerate(dts, start=1):
+        t += dt
+        z = [x0[i] + v[i] * t + rng.normal(0, 100, 2) for i in range(n_targets)
+             if rng.random() < p_d]
+        z += list(rng.uniform(-4000, 4000, (rng.poisson(clutter), 2)))
+        z = np.asarray(z, float).reshape(-1, 2)
+        n = len(z)
+        scans.append(Scan(k, t, z, np.zeros(n, np.int64), np.arange(row, row + n)))
+        row += n
+    return scans, clutter / 8000.0**2 + 1e-9
+
+
+@settings(max_examples=25, deadline=None)
+@given(scene=small_scenes(), depth=st.integers(0, 6))
+def test_history_invariants(scene, depth):
+    """Whatever the scene: the history's online part is the online output, each track's
+    tentative rows come before its first online row on consecutive scans, at most
+    ``history_scans`` of them, and no (scan, track) appears twice."""
+    scans, kappa = scene
+    cfg = MHTConfig(history_scans=depth)
+    hist = MHTTracker(cfg, KnownClutter(kappa)).run(scans)
+    online = MHTTracker(cfg, KnownClutter(kappa)).run(scans, history=False)
+    assert _same(hist.online(), online)
+    key = hist.scan * 10**6 + hist.track_id
+    assert np.all(np.diff(key) > 0)
+    index = {s.index: i for i, s in enumerate(scans)}
+    for tid in np.unique(hist.track_id):
+        rows = hist.take(hist.track_id == tid)
+        t = rows.tentative
+        n = int(t.sum())
+        assert n <= depth and t[:n].all() and not t[n:].any()
+        if n:
+            pos = np.array([index[int(s)] for s in rows.scan[: n + 1]])
+            assert np.array_equal(np.diff(pos), np.ones(n, int))

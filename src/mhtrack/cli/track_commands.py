@@ -229,6 +229,9 @@ def run(scenario: str, seed: int, clutter: str | None, clutter_rate: float | Non
         echo_json(summary)
         return
     click.echo(result.evaluation.to_table())
+    click.echo("output: " + ("history (each track from its first plot; rows before its "
+                             "confirmation are marked tentative)" if output == "history"
+                             else "online (what the tracker reported at each scan)"))
     click.echo(f"tracker time: {1e3 * result.run.t_avg:.2f} ms/scan (mean)")
     if result.run.caps:
         click.echo(f"hard caps acted: {result.run.caps}")

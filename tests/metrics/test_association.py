@@ -312,3 +312,15 @@ def test_confirmation_delay_counts_live_scans_before_the_first_online_match():
     assert math.isnan(a.delay[0]) and a.delay[1] == 0.0 and a.delay_mean == 0.0
     d = evaluate(hist, truth).to_dict()
     assert d["delay_mean"] == 1.5 and d["delay_max"] == 3.0 and d["delay"] == [3.0, 0.0]
+
+
+def test_confirmation_delay_is_that_of_the_online_view():
+    """A far track reported all along and a near one tentative at scans 0–2: matched on the
+    whole table CLEAR-MOT keeps the near (tentative) track, yet the online view has the far
+    track from scan 0, so the delay is 0 in both (reviewer's counter-example)."""
+    truth = _truth([(k, 1, 0.0, 0.0) for k in range(6)])
+    rows = sorted([(k, 0, 400.0, 0.0, -1) for k in range(6)]
+                  + [(k, 1, 10.0, 0.0, -1) for k in range(6)])
+    hist = replace(_tracks(rows), tentative=np.array([r[1] == 1 and r[0] <= 2 for r in rows]))
+    assert association_metrics(hist, truth).delay.tolist() == [0.0]
+    assert association_metrics(hist.online(), truth).delay.tolist() == [0.0]

@@ -76,9 +76,10 @@ def output_option(f: Callable[..., Any]) -> Callable[..., Any]:
     return click.option(
         "--output", "output", type=click.Choice(OUTPUTS), default="history",
         show_default=True,
-        help="history: each confirmed track from its first plot, the rows before its "
-        "confirmation marked tentative; online: only what the tracker reported at each "
-        "scan.")(f)
+        help="history: each confirmed track also at the scans before its confirmation, back "
+        "to its first plot (at most MHTConfig.history_scans back; from the seed scan with "
+        "an initiator --birth), those rows marked tentative; online: only what the tracker "
+        "reported at each scan.")(f)
 
 
 def _check_clutter_density(tracker: str, clutter_density: float | None) -> None:
@@ -229,8 +230,8 @@ def run(scenario: str, seed: int, clutter: str | None, clutter_rate: float | Non
         echo_json(summary)
         return
     click.echo(result.evaluation.to_table())
-    click.echo("output: " + ("history (each track from its first plot; rows before its "
-                             "confirmation are marked tentative)" if output == "history"
+    click.echo("output: " + ("history (each track also before its confirmation, rows "
+                             "marked tentative)" if output == "history"
                              else "online (what the tracker reported at each scan)"))
     click.echo(f"tracker time: {1e3 * result.run.t_avg:.2f} ms/scan (mean)")
     if result.run.caps:

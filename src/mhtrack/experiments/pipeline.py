@@ -125,9 +125,10 @@ class TrackingRun:
         return total
 
 
-#: Output modes of a batch run: ``"history"`` — every confirmed track from its first
-#: plot (its tentative past backfilled when it is confirmed, rows marked ``tentative``,
-#: :mod:`mhtrack.mht.history`); ``"online"`` — only what each step reported at its scan.
+#: Output modes of a batch run: ``"history"`` — every confirmed track also at the scans
+#: before its confirmation (its tentative past, back to its first plot within
+#: ``MHTConfig.history_scans``, rows marked ``tentative``; :mod:`mhtrack.mht.history`);
+#: ``"online"`` — only what each step reported at its scan.
 OUTPUTS = ("history", "online")
 
 

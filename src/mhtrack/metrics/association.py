@@ -126,11 +126,12 @@ def association_metrics(
     ``L_min, L_avg, L_max`` are the min, mean and max of ``life`` over the targets.
 
     **Confirmation delay** (ours). ``delay(o)`` is the number of live scans of ``o``
-    before the first one at which it is matched to a track row reported *at its scan*
-    (``tracks.tentative`` false or absent): 0 when a track was reported on it at its first
-    scan. Rows backfilled later (``tentative``, :mod:`mhtrack.mht.history`) count for the
-    other metrics but not here, so the delay measures when the tracker decided, whatever
-    the output mode.
+    before the first one at which it is matched to a track in the *online view* of the
+    tracks — the rows reported at their scan (``tracks.tentative`` false or absent), matched
+    on their own by CLEAR-MOT: 0 when a track was reported on it at its first scan. Rows
+    backfilled later (``tentative``, :mod:`mhtrack.mht.history`) count for the other
+    metrics but not here, so the delay is the same for a history output and its online
+    view: it measures when the tracker decided.
 
     Parameters
     ----------
@@ -139,7 +140,8 @@ def association_metrics(
     plots : PlotTable, optional
         The plots the tracker was run on; ``rcc``/``rmc`` need its ``origin`` column.
     match_distance : float, default 500.0
-        CLEAR-MOT ``d_match`` (m), used when ``matching`` is not given.
+        CLEAR-MOT ``d_match`` (m), used when ``matching`` is not given, and for the
+        online view's matching of the confirmation delay.
     matching : MOTMatching, optional
         A precomputed ``clear_mot(tracks, truth).matching`` (as :func:`evaluate` does).
     scan_period : float, optional
@@ -172,7 +174,13 @@ def association_metrics(
         n_det, n_cor, n_wrong = _association_counts(tracks, plots, matching)
 
     targets, breaks, life = _continuity(truth, matching, T)
-    delay = _confirm_delay(tracks, truth, matching)
+    if tracks.tentative is not None and np.any(tracks.tentative):
+        online = tracks.online()
+        d_online = check_match_distance(match_distance, "match_distance")
+        online_matching = clear_mot(online, truth, match_distance=d_online).matching
+        delay = _confirm_delay(truth, online_matching)
+    else:
+        delay = _confirm_delay(truth, matching)
     n_targets = len(targets)
     n_breaks = int(breaks.sum())
     nan = float("nan")
@@ -283,17 +291,13 @@ def _check_plot_column(tracks: TrackTable, p_scan: np.ndarray) -> np.ndarray:
     return plot
 
 
-def _confirm_delay(tracks: TrackTable, truth: TruthTable, matching: MOTMatching) -> np.ndarray:
-    """Per target (ascending id), live scans before its first match to a row reported at
-    its own scan; NaN if there is none."""
+def _confirm_delay(truth: TruthTable, matching: MOTMatching) -> np.ndarray:
+    """Per target (ascending id), its live scans before its first match in ``matching``
+    (of the online view); NaN if there is none."""
     targets, dense = np.unique(np.asarray(truth.target_id, np.int64), return_inverse=True)
     delay = np.full(len(targets), np.nan)
     if len(truth) == 0:
         return delay
-    online = np.ones(len(matching), bool)
-    if tracks.tentative is not None and len(matching):
-        row = _find(matching.scan, matching.track_id, tracks.scan, tracks.track_id)
-        online = ~np.asarray(tracks.tentative, bool)[row]
     scan = np.asarray(truth.scan, np.int64)
     idx = _find(scan, truth.target_id, matching.scan, matching.target_id)
     order = np.lexsort((scan, dense))
@@ -301,7 +305,6 @@ def _confirm_delay(tracks: TrackTable, truth: TruthTable, matching: MOTMatching)
     starts = np.flatnonzero(np.r_[True, g[1:] != g[:-1]])
     pos = np.arange(len(g)) - np.repeat(starts, np.diff(np.r_[starts, len(g)]))
     hit = idx[order] >= 0
-    hit[hit] = online[idx[order][hit]]
     if hit.any():
         first = np.full(len(targets), np.inf)
         np.minimum.at(first, g[hit], pos[hit].astype(float))

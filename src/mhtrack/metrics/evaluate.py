@@ -243,7 +243,8 @@ def evaluate(
         clear_mot=mot,
         n_tracks=len(np.unique(tracks.track_id)),
         n_targets=len(np.unique(truth.target_id)),
-        association=association_metrics(tracks, truth, plots, matching=mot.matching),
+        association=association_metrics(tracks, truth, plots, matching=mot.matching,
+                                        match_distance=d_match),
     )
 
 

@@ -95,8 +95,9 @@ class MHTConfig:
         least-squares state, scored by the log-likelihood ratio of its plots.
     birth_theta_deg : angle limit ``θ`` of the modified initiators. Default 20 (P2 §2.2).
     history_scans : how many scans of tentative leaves the tracker keeps so that a track,
-        once confirmed, can also be reported at the scans before (from its first plot,
-        :mod:`mhtrack.mht.history`; ``MHTTracker.last_backfill``). Default 30 (our choice:
+        once confirmed, can also be reported at the scans before — back to its first plot
+        (to the seed scan with an initiator birth), at most this many scans
+        (:mod:`mhtrack.mht.history`; ``MHTTracker.last_backfill``). Default 30 (our choice:
         longer than any tentative life we measured; 0 keeps nothing).
     min_clutter_density : floor on the estimator's ``κ̂(z)`` (per m²), so that a density
         estimate that underflows to 0 far from its components cannot give an infinite

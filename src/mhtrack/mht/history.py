@@ -9,6 +9,12 @@ releases a track with its states since the first plot). This module keeps, for t
 leaf's ancestors give the track's states at the scans before ``k`` — exactly the filtered
 states, plots and scores of the branch the confirmation decided on.
 
+A backfilled row never takes a plot that the output already gives another track at that
+scan (a track reported then, or an earlier backfill): the best hypothesis keeps plots apart
+only within its N-scan window, so an older tentative past may reuse the plots of a track
+that has since ended. The chain is cut at the first such scan; the track is then reported
+from the scan after it.
+
 Backfilled rows are *tentative*: at their scans the tracker had not yet decided that the
 track is a target. :attr:`mhtrack.records.TrackTable.tentative` marks them, so the online
 view (``tentative == 0``) is always recoverable from a history output.
@@ -62,35 +68,52 @@ class TentativeHistory:
             raise ValueError(f"history depth must be >= 0, got {depth}")
         self.depth = int(depth)
         self._log: deque[_Logged] = deque(maxlen=max(self.depth, 1))
+        #: per logged scan, the sorted plot rows the output gives a track at that scan
+        self._claimed: deque[np.ndarray] = deque(maxlen=max(self.depth, 1))
 
     def record(self, scan: int, time: float, leaves: Leaves) -> None:
-        """Keep the tentative leaves (``track < 0``) of this scan."""
+        """Keep the tentative leaves (``track < 0``) of this scan, and the plots of the
+        tracks reported at it (chosen, confirmed)."""
         if self.depth:
             self._log.append(_Logged.of(scan, time, leaves))
+            used = leaves.window[leaves.chosen & (leaves.track >= 0), -1]
+            self._claimed.append(np.unique(used[used >= 0]))
 
     def backfill(self, leaves: Leaves, rows: np.ndarray) -> TrackTable:
         """The ancestors of leaves ``rows`` (just confirmed, ``track >= 0``) at the logged
         scans, as track rows with their track ids, ordered by scan then track id, all
         marked tentative. Walks each parent link one logged scan back at a time; a chain
-        ends at its tree's root or at the oldest logged scan."""
+        ends at its tree's root, at the oldest logged scan, or before a scan where its plot
+        is already another track's in the output (several new tracks claiming one plot:
+        the lower track id keeps it)."""
         rows = np.asarray(rows, np.int64)
         if not self.depth or rows.size == 0 or not self._log:
             return TrackTable.empty()
         cur = leaves.parent[rows]
         tid = leaves.track[rows]
         parts: list[TrackTable] = []
-        for log in reversed(self._log):
+        for i in range(len(self._log) - 1, -1, -1):
+            log = self._log[i]
             if cur.size == 0 or log.node.size == 0:
                 break  # every chain has ended (an ancestor is logged at every scan)
             j = np.minimum(np.searchsorted(log.node, cur), log.node.size - 1)
             found = log.node[j] == cur
             j, tid = j[found], tid[found]
+            plot = log.plot[j]
+            ok = (plot < 0) | ~np.isin(plot, self._claimed[i])
+            order = np.lexsort((tid, plot))  # a plot two new chains share: lower id keeps it
+            ps = plot[order]
+            dup = np.zeros(plot.size, bool)
+            dup[order[1:]] = (ps[1:] == ps[:-1]) & (ps[1:] >= 0)
+            ok &= ~dup
+            j, tid, plot = j[ok], tid[ok], plot[ok]
+            self._claimed[i] = np.union1d(self._claimed[i], plot[plot >= 0])
             x = log.x[j]
             n = j.size
             parts.append(TrackTable(
                 scan=np.repeat(log.scan, n), time=np.repeat(log.time, n), track_id=tid,
                 x=x[:, 0].copy(), y=x[:, 2].copy(), vx=x[:, 1].copy(), vy=x[:, 3].copy(),
-                plot=log.plot[j], score=log.score[j], P=log.P[j],
+                plot=plot, score=log.score[j], P=log.P[j],
                 tentative=np.ones(n, bool)))
             cur = log.parent[j]
             live = cur >= 0
@@ -105,14 +128,17 @@ class TentativeHistory:
     def arrays(self) -> dict[str, np.ndarray]:
         """The log as flat arrays (for :meth:`MHTTracker.save`)."""
         out: dict[str, np.ndarray] = {"count": np.array([len(self._log)], np.int64)}
-        for i, log in enumerate(self._log):
+        for i, (log, claimed) in enumerate(zip(self._log, self._claimed, strict=True)):
             for f in fields(_Logged):
                 out[f"{i}__{f.name}"] = getattr(log, f.name)
+            out[f"{i}__claimed"] = claimed
         return out
 
     def set_arrays(self, arrays: dict[str, np.ndarray]) -> None:
         """Restore what :meth:`arrays` wrote."""
         self._log.clear()
+        self._claimed.clear()
         for i in range(int(arrays["count"][0]) if "count" in arrays else 0):
             self._log.append(_Logged(**{f.name: np.asarray(arrays[f"{i}__{f.name}"])
                                         for f in fields(_Logged)}))
+            self._claimed.append(np.asarray(arrays[f"{i}__claimed"], np.int64))

@@ -145,19 +145,11 @@ def track(
     if isinstance(scans, PlotTable):
         total = scans.n_scans
         scans = scans.scans()
-    scans = fused(scans, fusion)
-    parts: list[TrackTable] = []
     stats: list[StepStats] = []
-    for scan in tqdm(scans, total=total, desc=name, unit="scan", disable=not progress,
-                     leave=False):
-        parts.append(tracker.step(scan))
-        if output == "history":
-            parts.append(tracker.last_backfill)
-        assert tracker.last_stats is not None
-        stats.append(tracker.last_stats)
-    tracks = TrackTable.concat(parts)
-    return TrackingRun(name, tracks.sorted() if output == "history" else tracks, tuple(stats),
-                       output)
+    bar = tqdm(fused(scans, fusion), total=total, desc=name, unit="scan",
+               disable=not progress, leave=False)
+    tracks = tracker.run(bar, stats, history=output == "history")
+    return TrackingRun(name, tracks, tuple(stats), output)
 
 
 @dataclass(frozen=True)

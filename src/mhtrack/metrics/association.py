@@ -291,20 +291,28 @@ def _check_plot_column(tracks: TrackTable, p_scan: np.ndarray) -> np.ndarray:
     return plot
 
 
-def _confirm_delay(truth: TruthTable, matching: MOTMatching) -> np.ndarray:
-    """Per target (ascending id), its live scans before its first match in ``matching``
-    (of the online view); NaN if there is none."""
+def _target_walk(
+    truth: TruthTable, matching: MOTMatching
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """``(target ids, order, g, row)``: the truth rows ``order`` sorted by target then scan,
+    ``g`` the dense target index of each, ``row`` its pair in ``matching`` (−1: unmatched)."""
     targets, dense = np.unique(np.asarray(truth.target_id, np.int64), return_inverse=True)
-    delay = np.full(len(targets), np.nan)
-    if len(truth) == 0:
-        return delay
     scan = np.asarray(truth.scan, np.int64)
     idx = _find(scan, truth.target_id, matching.scan, matching.target_id)
     order = np.lexsort((scan, dense))
-    g = dense[order]
+    return targets, order, dense[order], idx[order]
+
+
+def _confirm_delay(truth: TruthTable, matching: MOTMatching) -> np.ndarray:
+    """Per target (ascending id), its live scans before its first match in ``matching``
+    (of the online view); NaN if there is none."""
+    targets, _, g, row = _target_walk(truth, matching)
+    delay = np.full(len(targets), np.nan)
+    if len(truth) == 0:
+        return delay
     starts = np.flatnonzero(np.r_[True, g[1:] != g[:-1]])
     pos = np.arange(len(g)) - np.repeat(starts, np.diff(np.r_[starts, len(g)]))
-    hit = idx[order] >= 0
+    hit = row >= 0
     if hit.any():
         first = np.full(len(targets), np.inf)
         np.minimum.at(first, g[hit], pos[hit].astype(float))
@@ -316,19 +324,15 @@ def _continuity(
     truth: TruthTable, matching: MOTMatching, T: float
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """``(target ids, breaks per target, life per target in s)`` — Rfg and track life."""
-    targets, dense = np.unique(np.asarray(truth.target_id, np.int64), return_inverse=True)
+    targets, order, g, row = _target_walk(truth, matching)
     n = len(targets)
     breaks = np.zeros(n, np.int64)
     life = np.zeros(n)
     if len(truth) == 0:
         return targets, breaks, life
-    scan = np.asarray(truth.scan, np.int64)
-    idx = _find(scan, truth.target_id, matching.scan, matching.target_id)
-    order = np.lexsort((scan, dense))
-    g = dense[order]
-    m = idx[order] >= 0
+    m = row >= 0
     track_id = np.append(np.asarray(matching.track_id, np.int64), -1)
-    h = track_id[idx[order]]  # -1 (the appended sentinel) where unmatched
+    h = track_id[row]  # -1 (the appended sentinel) where unmatched
     t = np.asarray(truth.time, np.float64)[order]
 
     same = g[1:] == g[:-1]

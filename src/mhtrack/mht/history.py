@@ -119,10 +119,7 @@ class TentativeHistory:
             live = cur >= 0
             cur, tid = cur[live], tid[live]
         parts.reverse()
-        out = TrackTable.concat(parts)
-        if len(out) == 0:
-            return TrackTable.empty()
-        return out.sorted()
+        return TrackTable.concat(parts).sorted()
 
     # ------------------------------------------------------------- persistence
     def arrays(self) -> dict[str, np.ndarray]:

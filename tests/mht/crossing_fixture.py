@@ -142,3 +142,9 @@ def assess(sim: Simulated, out, radius: float = 400.0) -> Assessment:
         if o >= 0:
             first.setdefault(o, int(out.scan[i]))
     return Assessment(first, owner, tracks_of, false_lengths, np.asarray(errs), switches)
+
+
+def same_tracks(a, b) -> bool:
+    """Two TrackTables equal column by column, bit for bit (absent columns equal absent)."""
+    return len(a) == len(b) and all(
+        np.array_equal(getattr(a, f), getattr(b, f)) for f in type(a).__dataclass_fields__)

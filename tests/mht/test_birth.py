@@ -8,6 +8,7 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
+from crossing_fixture import same_tracks
 
 from mhtrack.clutter import KnownClutter
 from mhtrack.experiments.pipeline import (
@@ -40,11 +41,6 @@ def digest(t: TrackTable) -> str:
     return h.hexdigest()
 
 
-def same(a: TrackTable, b: TrackTable) -> bool:
-    return all(np.array_equal(getattr(a, f), getattr(b, f))
-               for f in TrackTable.__dataclass_fields__)
-
-
 def crossing_uniform() -> object:
     return preset("crossing", clutter="uniform", clutter_rate=10.0, scans=30)
 
@@ -62,7 +58,7 @@ def test_default_birth_is_unchanged_bit_for_bit():
                             clutter_density=1.5625e-7, birth="every-plot", fusion="none",
                             output="online")
     assert digest(default.run.tracks) == CROSSING_DIGEST
-    assert same(default.run.tracks, explicit.run.tracks)
+    assert same_tracks(default.run.tracks, explicit.run.tracks)
     assert default.run.tracks.plot.size == 50
 
 
@@ -206,7 +202,7 @@ def test_save_restore_with_modified_logic_is_bit_identical(crossing10, tmp_path)
     for k, v in trk.birth_process.arrays().items():
         assert np.array_equal(v, back.birth_process.arrays()[k]), k
     rest = back.run(scans[17:])
-    assert same(TrackTable.concat([first, rest]), full)
+    assert same_tracks(TrackTable.concat([first, rest]), full)
     assert len(np.unique(full.track_id)) >= 2
 
 

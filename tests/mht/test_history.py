@@ -3,7 +3,7 @@ the scans before its confirmation, from its first plot."""
 
 import numpy as np
 import pytest
-from crossing_fixture import simulate
+from crossing_fixture import same_tracks, simulate
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -11,13 +11,6 @@ from mhtrack.clutter import KnownClutter
 from mhtrack.mht import MHTConfig, MHTTracker
 from mhtrack.mht.history import TentativeHistory
 from mhtrack.records import Scan, TrackTable
-
-FIELDS = ("scan", "time", "track_id", "x", "y", "vx", "vy", "plot", "score", "P")
-
-
-def _same(a: TrackTable, b: TrackTable, fields=FIELDS) -> bool:
-    return len(a) == len(b) and all(np.array_equal(getattr(a, f), getattr(b, f))
-                                    for f in fields)
 
 
 def _tracker(sim, **changes) -> MHTTracker:
@@ -28,7 +21,7 @@ def test_online_part_of_the_history_is_the_online_output(crossing10):
     hist = _tracker(crossing10).run(crossing10.scans)
     online = _tracker(crossing10).run(crossing10.scans, history=False)
     assert hist.tentative is not None and hist.tentative.any()
-    assert _same(hist.online(), online)
+    assert same_tracks(hist.online(), online)
     assert not online.tentative.any()
     # ordered by scan, then track id, one row per (scan, track)
     key = hist.scan * 10**6 + hist.track_id
@@ -115,7 +108,7 @@ def test_history_depth_bounds_the_backfill():
     assert np.array_equal(short.scan[short.tentative], [c - 1])
     none = MHTTracker(MHTConfig(imm_sigma_v=0.0, sigma_w=50.0, alpha=1e-6, history_scans=0),
                       KnownClutter(1e-8)).run(scans)
-    assert not none.tentative.any() and _same(none, full.online())
+    assert not none.tentative.any() and same_tracks(none, full.online())
     with pytest.raises(ValueError, match="history_scans"):
         MHTConfig(history_scans=-1)
     with pytest.raises(ValueError, match="depth"):
@@ -131,14 +124,14 @@ def test_save_restore_keeps_the_tentative_past(crossing40, tmp_path, cut):
     trk.save(path)
     rest = MHTTracker.load(path).run(crossing40.scans[cut:])
     both = TrackTable.concat([first, rest]).sorted()
-    assert _same(both, full, (*FIELDS, "tentative"))
+    assert same_tracks(both, full)
 
 
 def test_initiator_birth_backfills_from_the_seed_scan(crossing10):
     trk = _tracker(crossing10, birth="logic")
     hist = trk.run(crossing10.scans)
     online = _tracker(crossing10, birth="logic").run(crossing10.scans, history=False)
-    assert _same(hist.online(), online)
+    assert same_tracks(hist.online(), online)
     for tid in np.unique(hist.track_id):
         rows = hist.take(hist.track_id == tid)
         t = rows.tentative
@@ -179,7 +172,7 @@ def test_history_invariants(scene, depth):
     cfg = MHTConfig(history_scans=depth)
     hist = MHTTracker(cfg, KnownClutter(kappa)).run(scans)
     online = MHTTracker(cfg, KnownClutter(kappa)).run(scans, history=False)
-    assert _same(hist.online(), online)
+    assert same_tracks(hist.online(), online)
     key = hist.scan * 10**6 + hist.track_id
     assert np.all(np.diff(key) > 0)
     used = hist.plot >= 0  # no plot given to two tracks at one scan
@@ -210,4 +203,4 @@ def test_no_plot_is_given_to_two_tracks_at_a_scan(seed, clutter, birth):
     assert len(np.unique(pairs, axis=0)) == len(pairs)
     online = MHTTracker(MHTConfig(birth=birth), KnownClutter(sim.clutter_density)).run(
         sim.scans, history=False)
-    assert _same(hist.online(), online)
+    assert same_tracks(hist.online(), online)

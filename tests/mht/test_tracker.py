@@ -8,7 +8,7 @@ import tracemalloc
 
 import numpy as np
 import pytest
-from crossing_fixture import CROSSING_TARGETS, assess, simulate
+from crossing_fixture import CROSSING_TARGETS, assess, same_tracks, simulate
 
 from mhtrack.clutter import KnownClutter
 from mhtrack.mht import MHTConfig, MHTTracker, StepStats
@@ -22,12 +22,6 @@ def _run(sim, config=None, stats=None):
     output, with the tentative past of each track, are in test_history.py)."""
     trk = MHTTracker(config or MHTConfig(), KnownClutter(sim.clutter_density))
     return trk.run(sim.scans, stats, history=False), trk
-
-
-def _same(a: TrackTable, b: TrackTable) -> bool:
-    return all(
-        np.array_equal(getattr(a, f), getattr(b, f)) for f in TrackTable.__dataclass_fields__
-    )
 
 
 @pytest.mark.parametrize(
@@ -81,10 +75,10 @@ def test_output_rows_and_stats(crossing10):
 def test_deterministic_and_plot_table_input(crossing10):
     a, _ = _run(crossing10)
     b, _ = _run(crossing10)
-    assert _same(a, b)
+    assert same_tracks(a, b)
     table = PlotTable.from_scans(crossing10.scans)
     c = MHTTracker(MHTConfig(), KnownClutter(crossing10.clutter_density)).run(table, history=False)
-    assert _same(a, c)
+    assert same_tracks(a, c)
 
 
 def test_per_plot_covariance_path_gives_the_same_tracks(crossing10):
@@ -94,12 +88,12 @@ def test_per_plot_covariance_path_gives_the_same_tracks(crossing10):
         for s in crossing10.scans
     ]
     b = MHTTracker(MHTConfig(), KnownClutter(crossing10.clutter_density)).run(scans, history=False)
-    assert _same(a, b)
+    assert same_tracks(a, b)
     # rows with an all-NaN R (PlotTable.from_scans for scans without R) use the config's R
     mixed = [dataclasses.replace(s, R=np.full((len(s), 2, 2), np.nan)) if s.index % 2 else s
              for s in scans]
     c = MHTTracker(MHTConfig(), KnownClutter(crossing10.clutter_density)).run(mixed, history=False)
-    assert _same(a, c)
+    assert same_tracks(a, c)
 
 
 def test_imm_of_identical_models_is_the_single_model_tracker(crossing10):
@@ -135,9 +129,9 @@ def test_save_restore_continues_bit_for_bit(crossing40, tmp_path):
     restored = MHTTracker.load(path)
     assert restored.config == trk.config
     rest = restored.run(crossing40.scans[40:], history=False)
-    assert _same(TrackTable.concat([first, rest]), full)
+    assert same_tracks(TrackTable.concat([first, rest]), full)
     # the saved tracker itself continues identically too
-    assert _same(trk.run(crossing40.scans[40:], history=False), rest)
+    assert same_tracks(trk.run(crossing40.scans[40:], history=False), rest)
 
 
 def test_load_checks_the_clutter_estimator(crossing10, tmp_path):

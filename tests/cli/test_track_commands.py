@@ -159,3 +159,34 @@ def test_clutter_density_needs_the_known_clutter_tracker():
     code, _, stderr = invoke("run", "crossing", "--clutter-density", "1e-7", "--scans", "3")
     assert code == 2
     assert "--clutter-density" in stderr and "mht-agmm" in stderr
+
+
+def test_run_warns_when_mht_keeps_p1_kappa_on_denser_clutter(tmp_path, caplog):
+    # 10 uniform clutter plots per scan over 6.4e7 m²: 1.5625e-7 per m², 156× P1's κ
+    args = ("run", "crossing", "--clutter", "uniform", "--clutter-rate", "10", "--scans", "5",
+            "--seed", "1", "--tracker", "mht", "--no-progress")
+    with caplog.at_level("WARNING", logger="mhtrack"):
+        code, _, stderr = invoke(*args, "--out", str(tmp_path / "a"))
+    assert code == 0, stderr
+    assert "--clutter-density 1.56e-07" in caplog.text
+    caplog.clear()
+    with caplog.at_level("WARNING", logger="mhtrack"):
+        code, _, stderr = invoke(*args, "--out", str(tmp_path / "b"),
+                                 "--clutter-density", "1.5625e-7")
+    assert code == 0, stderr
+    assert "clutter density" not in caplog.text
+
+
+def test_run_takes_pd_and_sigma_of_a_single_cartesian_sensor():
+    from mhtrack.experiments.pipeline import MAX_TRACKER_PD, default_config
+    from mhtrack.scenario import preset
+    from mhtrack.scenario.spec import from_dict
+
+    d = preset("crossing").to_dict()
+    d["sensors"][0].update(pd=0.7, sigma=20.0)
+    cfg = default_config(from_dict(d))
+    assert (cfg.p_detection, cfg.sigma_w) == (0.7, 20.0)
+    d["sensors"][0]["pd"] = 1.0
+    assert default_config(from_dict(d)).p_detection == MAX_TRACKER_PD
+    # several (polar) sensors: fused scans, P1's 0.9 kept
+    assert default_config(preset("multiradar")).p_detection == 0.9

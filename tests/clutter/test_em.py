@@ -15,6 +15,7 @@ from mhtrack.clutter.em import (
     logsumexp_rows,
     m_step,
     mixture_from_centres,
+    removal_gain,
 )
 
 
@@ -127,3 +128,48 @@ def test_pdf_fast_path_equals_log_path() -> None:
                                 background_weight=0.1)
     g = np.random.default_rng(0).uniform(-3500, 3500, (40_000, 2))  # n*K above the cut
     np.testing.assert_allclose(init.pdf(g), np.exp(init.log_pdf(g)), rtol=1e-12, atol=1e-300)
+
+
+def test_removal_gain_is_the_log_likelihood_lost() -> None:
+    """``removal_gain`` equals the difference of two log-likelihood sums computed with the
+    mixture as is and with component ``j``'s weight given to the background."""
+    rng = np.random.default_rng(4)
+    z = np.concatenate((rng.normal([0.0, 0.0], 30.0, (40, 2)),
+                        rng.uniform(-4000, 4000, (60, 2))))
+    box = (-4000.0, 4000.0, -4000.0, 4000.0)
+    mix = Mixture(np.array([0.3, 0.2]), np.array([[0.0, 0.0], [2000.0, -1000.0]]),
+                  np.array([np.eye(2) * 900.0, np.eye(2) * 1e6]), 0.5, box)
+    w = rng.uniform(0.5, 2.0, len(z))
+    gain = removal_gain(z, mix, w)
+    for j in range(2):
+        keep = np.arange(2) != j
+        without = Mixture(mix.weights[keep], mix.means[keep], mix.covariances[keep],
+                          mix.background_weight + mix.weights[j], box)
+        direct = w @ (mix.log_pdf(z) - without.log_pdf(z))
+        assert gain[j] == pytest.approx(direct, rel=1e-10)
+    assert gain[0] > 100 > gain[1]  # the clump pays for itself, the broad bump barely
+
+
+def test_bic_drops_bumps_on_uniform_clutter_and_keeps_clumps() -> None:
+    """On uniform plots, EM from 8 k-means++ seeds with the BIC test ends with no
+    Gaussian; a tight clump of 15 plots and a broad (σ = 900 m) one of 80 survive it."""
+    rng = np.random.default_rng(7)
+    box = (-5000.0, 5000.0, -5000.0, 5000.0)
+    kw = dict(reg_covar=100.0, tol=1e-4, max_iter=100, min_points=3.0,
+              background_floor=0.01, min_contrast=5.0)
+
+    def fit(z, bic):
+        centres = kmeanspp_centres(z, 8, np.random.default_rng(0))
+        init = mixture_from_centres(z, centres, reg_covar=100.0, background_box=box,
+                                    background_weight=0.05)
+        return fit_em(z, init, bic=bic, **kw).mixture
+
+    for _ in range(10):
+        assert fit(rng.uniform(-5000, 5000, (100, 2)), True).n_components == 0
+    uniform = rng.uniform(-5000, 5000, (100, 2))
+    clumps = np.concatenate((uniform, rng.normal([1000.0, 1000.0], 40.0, (15, 2)),
+                             rng.normal([-2500.0, 2500.0], 900.0, (80, 2))))
+    m = fit(clumps, True)
+    assert m.n_components >= 2
+    near = lambda c: np.min(np.hypot(*(m.means - c).T))  # noqa: E731
+    assert near([1000.0, 1000.0]) < 100 and near([-2500.0, 2500.0]) < 500

@@ -250,26 +250,46 @@ def test_intensity_always_finite(scans: list[np.ndarray], cls: type, background:
 
 
 @pytest.mark.parametrize("cls", [GMMClutter, AGMMClutter])
-def test_plots_in_confirmed_gates_leave_the_background(cls: type) -> None:
-    """Same plots, but two per scan flagged as inside confirmed tracks' gates: the
-    background's count drops by exactly two plots per scan (κ̂ far from every clump falls
-    by 2/A), the clumps' intensity is unchanged, and the integral falls by 2."""
-    scans = _scans(6)
+def test_forgotten_plots_leave_the_window(cls: type) -> None:
+    """Same plots, but after each scan the tracker says its first two were confirmed
+    tracks' plots: the window then holds every scan without them, ``M̂`` counts the last
+    scan whole and the others without them, and save/restore keeps the result."""
+    scans = _scans(8)
     plain = _feed(cls(region=REGION), scans)
-    gated = cls(region=REGION)
+    est = cls(region=REGION)
     for s in scans:
-        mask = np.zeros(len(s), bool)
-        mask[:2] = True
-        gated.update(s, mask)
-    far = np.array([[3500.0, 3500.0]])
-    clump = np.array([[-2000.0, 1000.0]])
-    assert plain.intensity(far)[0] - gated.intensity(far)[0] == pytest.approx(
-        2.0 / REGION.area, rel=1e-9)
-    assert gated.intensity(clump)[0] == pytest.approx(
-        plain.intensity(clump)[0] - 2.0 / REGION.area, rel=1e-9)
-    g, cell = REGION.grid(400)
-    assert gated.intensity(g).sum() * cell == pytest.approx(gated.count_ - 2.0, rel=3e-3)
-    state = json.loads(json.dumps(gated.get_state(), default=lambda a: a.tolist()))
+        est.update(s, None)
+        used = np.zeros(len(s), bool)
+        used[:2] = True
+        est.forget(used)
+    W = est.window
+    window = est.get_state()["window"]
+    assert len(window) == W
+    for w, s in zip(window, scans[-W:], strict=True):
+        np.testing.assert_array_equal(w, np.asarray(s.z)[2:])
+    assert est.count_ == pytest.approx(plain.count_ - 2.0 * (W - 1) / W, rel=1e-12)
+    state = json.loads(json.dumps(est.get_state(), default=lambda a: a.tolist()))
     restored = cls(region=REGION)
     restored.set_state(state)
-    assert np.array_equal(restored.intensity(g), gated.intensity(g))
+    g, _ = REGION.grid(100)
+    assert np.array_equal(restored.intensity(g), est.intensity(g))
+
+
+def test_forget_maps_to_the_plots_the_window_kept() -> None:
+    """With ``source="outside-gates"`` the window holds only the plots outside the gates;
+    ``forget`` is over the scan's plots, so a forgotten plot that was in a gate (not in the
+    window) changes nothing and one outside leaves."""
+    s = _scans(1)[0]
+    z = np.asarray(s.z)
+    est = AGMMClutter(region=REGION, source="outside-gates")
+    gates = np.zeros(len(s), bool)
+    gates[:3] = True
+    est.update(s, gates)
+    used = np.zeros(len(s), bool)
+    used[[1, 5]] = True  # row 1 is in a gate, row 5 is not
+    est.forget(used)
+    keep = np.ones(len(s), bool)
+    keep[[0, 1, 2, 5]] = False
+    np.testing.assert_array_equal(est.get_state()["window"][-1], z[keep])
+    est.forget(used)  # already gone: nothing more leaves
+    np.testing.assert_array_equal(est.get_state()["window"][-1], z[keep])

@@ -12,6 +12,7 @@ from mhtrack.initiation import (
     KMeansFusion,
     fuse_clusters,
     majority_origin,
+    split_inconsistent,
 )
 from mhtrack.records import Scan
 from mhtrack.scenario import preset, simulate
@@ -147,5 +148,60 @@ def test_bad_parameters_are_rejected():
         KMeansFusion(0).fit(z)
     with pytest.raises(ValueError, match="shape"):
         AdaptiveKMeansFusion().fit(np.zeros((3, 3)))
-    with pytest.raises(ValueError, match="information weighting needs"):
-        fuse_clusters(z, np.zeros(3, np.int64), None, weighting="information")
+
+
+def test_information_weighting_without_covariances_is_the_plain_centre():
+    z = np.array([[0.0, 0.0], [2.0, 4.0], [10.0, 10.0]])
+    labels = np.array([0, 0, 1])
+    zi, Ri = fuse_clusters(z, labels, None, weighting="information")
+    assert Ri is None
+    np.testing.assert_array_equal(zi, [[1.0, 2.0], [10.0, 10.0]])
+
+
+def test_split_inconsistent_hand_cases():
+    from scipy.stats import chi2
+
+    R = np.tile(np.eye(2) * 50.0**2, (5, 1, 1))
+    # two plots 500 m apart with σ = 50 m: T = 500²/(2·50²) = 50 > χ²₂(0.9999) ≈ 18.4
+    z = np.array([[0.0, 0.0], [500.0, 0.0], [1000.0, 0.0], [1050.0, 0.0], [2000.0, 0.0]])
+    labels = np.array([0, 0, 1, 1, 2])
+    out = split_inconsistent(z, R, labels, 0.9999)
+    assert out[0] != out[1]  # 500 m apart: split
+    assert out[2] == out[3]  # 50 m apart: T = 0.5, kept
+    assert len(np.unique(out)) == 4
+    # the threshold is the χ²_{2(n-1)} quantile: a pair at T just below it stays together
+    d = np.sqrt(2 * 50.0**2 * chi2.ppf(0.9999, 2)) * 0.999
+    keep = split_inconsistent(np.array([[0.0, 0.0], [d, 0.0]]), R[:2], np.zeros(2, np.int64),
+                              0.9999)
+    assert keep[0] == keep[1]
+
+
+def test_split_inconsistent_drops_the_outlier_of_three():
+    R = np.array([np.diag([20.0**2, 80.0**2])] * 3)
+    z = np.array([[0.0, 0.0], [10.0, 60.0], [400.0, 0.0]])  # the third is 20 σ off in x
+    out = split_inconsistent(z, R, np.zeros(3, np.int64), 0.9999)
+    assert out[0] == out[1] and out[2] != out[0]
+
+
+@given(st.integers(0, 2**31 - 1))
+@settings(max_examples=40, deadline=None)
+def test_split_inconsistent_leaves_only_consistent_clusters(seed):
+    from scipy.stats import chi2
+
+    rng = np.random.default_rng(seed)
+    n = int(rng.integers(1, 12))
+    z = rng.uniform(-300, 300, (n, 2))
+    A = rng.normal(0, 40, (n, 2, 2))
+    R = A @ np.swapaxes(A, 1, 2) + np.eye(2) * 100.0
+    labels = rng.integers(0, 3, n)
+    out = split_inconsistent(z, R, labels, 0.999)
+    # a split only ever separates plots that were together
+    assert all(len(np.unique(labels[out == c])) == 1 for c in np.unique(out))
+    for c in np.unique(out):
+        i = np.flatnonzero(out == c)
+        if len(i) < 2:
+            continue
+        W = np.linalg.inv(R[i])
+        zh = np.linalg.solve(W.sum(0), np.einsum("nij,nj->i", W, z[i]))
+        d = z[i] - zh
+        assert np.einsum("ni,nij,nj->", d, W, d) <= chi2.ppf(0.999, 2 * (len(i) - 1)) + 1e-9

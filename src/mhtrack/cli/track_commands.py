@@ -208,6 +208,7 @@ def run(scenario: str, seed: int, clutter: str | None, clutter_rate: float | Non
     cfg = _config(default_config(sc), tracker_pd, meas_sigma, accel_sigma, birth_density,
                   nscan, imm_accel_sigma)
     _check_clutter_density(tracker, clutter_density)
+    _warn_known_kappa(sc, tracker, clutter_density)
     result = run_scenario(sc, seed, tracker, cfg, clutter_density=clutter_density,
                           cutoff=cutoff, order=order, progress=progress, birth=birth,
                           theta_deg=birth_theta, fusion=fusion, output=output)
@@ -237,6 +238,26 @@ def run(scenario: str, seed: int, clutter: str | None, clutter_rate: float | Non
     if result.run.caps:
         click.echo(f"hard caps acted: {result.run.caps}")
     click.echo(f"wrote {out}/ (plots, truth, tracks, metrics.json, scene.png, metrics.png)")
+
+
+def _warn_known_kappa(sc: Any, tracker: str, clutter_density: float | None) -> None:
+    """Warn when ``mht`` keeps P1's κ on a scenario whose clutter is 10× denser or sparser
+    (its plots are then mostly scored as targets, or targets as clutter)."""
+    if tracker != "mht" or clutter_density is not None:
+        return
+    import logging
+
+    import numpy as np
+
+    from mhtrack.experiments.pipeline import DEFAULT_CLUTTER_DENSITY
+
+    rates = [sc.clutter_rate(int(k)) for k in sc.scan_indices()]
+    mean = len(sc.sensors) * float(np.mean(rates)) / sc.region.area if rates else 0.0
+    if mean > 10 * DEFAULT_CLUTTER_DENSITY or 0 < mean < 0.1 * DEFAULT_CLUTTER_DENSITY:
+        logging.getLogger("mhtrack").warning(
+            "tracker mht assumes P1's clutter density %.3g per m²; this scenario's clutter "
+            "averages %.3g per m² over its region: pass --clutter-density %.3g, or use "
+            "mht-agmm, which estimates it", DEFAULT_CLUTTER_DENSITY, mean, mean)
 
 
 def _json_text(obj: Any) -> str:

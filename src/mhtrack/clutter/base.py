@@ -3,7 +3,10 @@
 Every scan the tracker calls :meth:`ClutterEstimator.update` with the scan's plots and a
 mask of the plots that fall inside confirmed tracks' gates (estimators may leave those out
 as likely target plots), then :meth:`ClutterEstimator.intensity` on the plots it scores.
-The intensity is in plots per m² per scan, the ``κ`` of P1 eqs. 3, 5, 14–15.
+The intensity is in plots per m² per scan, the ``κ`` of P1 eqs. 3, 5, 14–15. An estimator
+that learns from past scans may also have ``forget(used)``: after the scan's best global
+hypothesis, the tracker passes the mask of the plots confirmed tracks used (optional: the
+tracker calls it only when it exists).
 """
 
 from __future__ import annotations

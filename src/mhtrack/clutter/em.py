@@ -20,7 +20,9 @@ _gaussian_mixture.py``), with optional sample weights ``s_i``:
 * optionally a *pruning* rule after the M-step (P1 step c: eq. 12 for the AGMM, a fixed
   weight threshold for the GMM), deletion of components with fewer than ``min_points``
   effective plots (``n_j``), which could only collapse onto a plot or two, and of
-  components whose peak density is under ``min_contrast`` times the background's;
+  components whose peak density is under ``min_contrast`` times the background's, and
+  (``bic``) of components that do not pay for their parameters in likelihood
+  (:func:`removal_gain`);
 * stop when ``|L_i − L_{i−1}| < tol·|L_{i−1}|`` (P1 step 3) with no component deleted in the
   iteration, or after ``max_iter`` iterations.
 
@@ -267,6 +269,7 @@ def fit_em(
     min_points: float = 0.0,
     background_floor: float = 0.0,
     min_contrast: float = 0.0,
+    bic: bool = False,
 ) -> EMResult:
     """Run EM (P1 eqs. 9–11, plus optional pruning, P1 step c) from ``init``.
 
@@ -283,6 +286,9 @@ def fit_em(
     background_floor : lower bound on ``π₀`` (with a background box).
     min_contrast : with a background, delete Gaussians whose peak density
         ``π_j / (2π√|Σ_j|)`` is below ``min_contrast · π₀ / A`` after each M-step.
+    bic : with a background, delete Gaussians whose :func:`removal_gain` is below the BIC
+        price of their six parameters (2 mean, 3 covariance, 1 weight),
+        ``½·6·ln n = 3 ln n`` nats for ``n`` (weighted) plots (Schwarz 1978).
 
     With ``prune=None``, ``min_points=0``, no background and no sample weights, this is
     scikit-learn's ``GaussianMixture(covariance_type="full")`` EM from the same
@@ -303,6 +309,9 @@ def fit_em(
             det = c[:, 0, 0] * c[:, 1, 1] - c[:, 0, 1] * c[:, 1, 0]
             peak = mix.weights / (2.0 * np.pi * np.sqrt(det))
             keep &= peak >= min_contrast * mix.background_weight / mix.background_area
+        if bic and mix.background_box is not None and mix.n_components:
+            n_eff = float(len(z) if sample_weight is None else sample_weight.sum())
+            keep &= removal_gain(z, mix, sample_weight) >= 3.0 * np.log(max(n_eff, 1.0))
         if prune is not None and keep.any():
             w = np.where(keep, mix.weights, 0.0)
             keep &= prune(w / w.sum())
@@ -320,6 +329,27 @@ def fit_em(
         prev = ll
     final = float(np.average(mix.log_pdf(z), weights=sample_weight))
     return EMResult(mix, final, n_iter, converged, n_pruned)
+
+
+def removal_gain(
+    z: np.ndarray, mix: Mixture, sample_weight: np.ndarray | None = None
+) -> np.ndarray:
+    """Per Gaussian ``j``, the log-likelihood (nats) the mixture loses when ``j`` is removed
+    and its weight given to the uniform background:
+    ``ΔL_j = Σ_i s_i [ln c(z_i) − ln(c(z_i) − π_j 𝒩_j(z_i) + π_j/A)]``
+    ``= −Σ_i s_i ln(1 − r_ij + π_j/(A c(z_i)))`` with ``r_ij`` the responsibility.
+    A Gaussian fitted to the fluctuations of uniform clutter gains little over the
+    background it takes weight from; a clump, or a broad Gaussian under which the plots are
+    denser than elsewhere, gains many nats. Needs a background box."""
+    wlp = mix.weighted_log_prob(z)
+    norm = logsumexp_rows(wlp)
+    resp = np.exp(wlp[:, 1:] - norm[:, None])
+    with np.errstate(divide="ignore"):
+        to_bg = np.exp(np.log(mix.weights)[None, :] + mix.log_background(z)[:, None]
+                       - norm[:, None])
+    ratio = np.maximum(1.0 - resp + to_bg, 1e-300)
+    per = -np.log(ratio)
+    return per.sum(axis=0) if sample_weight is None else sample_weight @ per
 
 
 # ------------------------------------------------------------------ initialisation

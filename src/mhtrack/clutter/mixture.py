@@ -21,7 +21,6 @@ See ``docs/clutter.md`` for the reasoning behind every default.
 
 from __future__ import annotations
 
-import dataclasses
 from collections import deque
 from typing import Any, Literal
 
@@ -81,6 +80,9 @@ class MixtureClutter:
         fits the fluctuations of uniform clutter, not a clump. Default 5 (ours, empirical:
         half to a quarter of the weakest true clump of our scenarios, ~20 for the swollen
         patch of ``docs/examples/drifting-clutter.toml``; 0 turns it off).
+    bic : with a background, also delete a Gaussian whose removal costs the fit less than
+        the BIC price of its six parameters, ``3 ln n`` nats
+        (:func:`~mhtrack.clutter.em.removal_gain`). Default True (ours, ``docs/clutter.md``).
 
     Warm start: the previous Gaussians are kept and, when at least ``min_points`` of the
     pooled plots are farther than χ²₂(0.99) from all of them, up to ``K − K_prev`` new
@@ -115,6 +117,7 @@ class MixtureClutter:
         max_points: int = 2000,
         seed: int = 0,
         min_contrast: float = 5.0,
+        bic: bool = True,
     ) -> None:
         if not (isinstance(n_components, int | np.integer) and n_components >= 1):
             raise ValueError(f"n_components must be an integer >= 1, got {n_components!r}")
@@ -154,11 +157,12 @@ class MixtureClutter:
         self.max_points = int(max_points)
         self.seed = int(seed)
         self.min_contrast = float(min_contrast)
+        self.bic = bool(bic)
         self._reset()
 
     def _reset(self) -> None:
         self._window: deque[np.ndarray] = deque(maxlen=self.window)
-        self._gated: deque[int] = deque(maxlen=self.window)  # plots in confirmed gates
+        self._kept: np.ndarray = np.zeros(0, np.int64)  # last scan's plots in the window
         self.mixture_: Mixture | None = None
         self.count_ = 0.0
         self.n_iter_ = 0
@@ -189,12 +193,14 @@ class MixtureClutter:
                     f"scan {scan.index}: in_track_gates has {mask.size} entries, "
                     f"expected {len(z)}"
                 )
-            if self.source == "outside-gates":
-                z = z[~mask]
+        kept = np.arange(len(z))
+        if in_track_gates is not None and self.source == "outside-gates":
+            kept = kept[~mask]
+            z = z[kept]
         rng = np.random.default_rng(np.random.SeedSequence(self.seed, spawn_key=(self.n_updates_,)))
         self.n_updates_ += 1
         self._window.append(z.copy())
-        self._gated.append(0 if in_track_gates is None else int(np.count_nonzero(in_track_gates)))
+        self._kept = kept
         self.count_ = float(np.mean([len(w) for w in self._window]))  # Poisson ML
         pooled = np.concatenate(self._window) if len(self._window) > 1 else self._window[0]
         if len(pooled) == 0:
@@ -214,6 +220,7 @@ class MixtureClutter:
             pooled, init, reg_covar=self.reg_covar, tol=self.tol, max_iter=self.max_iter,
             prune=self._prune_rule(), min_points=self.min_points,
             background_floor=self.background_floor, min_contrast=self.min_contrast,
+            bic=self.bic,
         )
         self.mixture_ = res.mixture
         self.n_iter_, self.converged_ = res.n_iter, res.converged
@@ -228,15 +235,27 @@ class MixtureClutter:
         if self.mixture_ is None or self.count_ == 0.0:
             return np.zeros(len(z))
         m = self.mixture_
-        if m.background_box is not None and self._gated:
-            # The uniform background also absorbs the targets' own plots; take out of its
-            # count those that confirmed tracks explain (plots in their gates), keeping at
-            # least the floor's share: κ̂ = M̂·Σπⱼ𝒩ⱼ + max(M̂π₀ − ḡ, M̂·floor)/A, i.e. the
-            # same mixture with π₀ replaced by max(π₀ − ḡ/M̂, floor) (c(z) is linear in π).
-            g = float(np.mean(self._gated))
-            pi0 = max(m.background_weight - g / self.count_, self.background_floor)
-            m = dataclasses.replace(m, background_weight=pi0)
         return self.count_ * m.pdf(z)
+
+    def forget(self, used: np.ndarray) -> None:
+        """Take out of the window the plots of the last scan that the tracker's best
+        hypothesis gives to confirmed tracks (``used``, a mask over that scan's plots).
+
+        Those plots are the targets', not clutter: left in, the plots of targets that fly
+        together (a formation, two aircraft in trail) pile up in the window into a
+        Gaussian that the next fits take for a clutter clump, and the tracks there lose
+        their scores. A track uses at most one plot per scan, so a clutter clump that a
+        track crosses keeps its other plots. The fit of the scan itself already happened
+        (it needs ``κ̂`` before the tracker can decide); the next scans' fits and counts
+        ``M̂`` go without them.
+        """
+        used = np.asarray(used, dtype=bool).reshape(-1)
+        if not self._window or not used.any():
+            return
+        drop = used[self._kept] if self._kept.size else np.zeros(0, bool)
+        if drop.any():
+            self._window[-1] = self._window[-1][~drop]
+            self._kept = self._kept[~drop]
 
     def density(self, z: np.ndarray) -> np.ndarray:
         """``ĉ_k(z)`` (P1 eq. 13), per m²; 0 before any plot was seen."""
@@ -247,7 +266,7 @@ class MixtureClutter:
         """The learned state (window, fit, counters) as JSON-able values and arrays."""
         return {
             "window": [w.copy() for w in self._window],
-            "gated": list(self._gated),
+            "kept": self._kept.copy(),
             "mixture": None if self.mixture_ is None else self.mixture_.to_state(),
             "count": self.count_,
             "n_iter": self.n_iter_,
@@ -263,8 +282,7 @@ class MixtureClutter:
         self._reset()
         for w in state["window"]:
             self._window.append(np.asarray(w, dtype=float).reshape(-1, 2))
-        for n in state.get("gated", []):
-            self._gated.append(int(n))
+        self._kept = np.asarray(state.get("kept", np.zeros(0)), np.int64).reshape(-1)
         m = state["mixture"]
         self.mixture_ = None if m is None else Mixture.from_state(m)
         self.count_ = float(state["count"])

@@ -7,7 +7,8 @@ Birth process (``birth``, ``theta_deg``): which plots start new track trees
 (``MHTConfig.birth``, ``docs/mht.md``). Fusion (``fusion``): the MHT assumes at most one
 plot per target per scan, so with several sensors each scan is first fused by
 :class:`~mhtrack.initiation.AdaptiveKMeansFusion` (P2 §1.2) — the default when the scenario
-has more than one sensor (:func:`default_fusion`). A fused plot's row id (the ``plot``
+has more than one sensor (:func:`default_fusion`) — with a χ² consistency split and
+information weighting (:func:`tracker_fuser`). A fused plot's row id (the ``plot``
 column of the tracks) is the plot-table row of the first plot of its cluster (in scan
 order), so it stays a valid plot-table row.
 """
@@ -27,6 +28,7 @@ from mhtrack.clutter.registry import agmm_for_tracker, gmm_for_tracker
 from mhtrack.initiation import AdaptiveKMeansFusion
 from mhtrack.metrics import Evaluation, evaluate
 from mhtrack.mht import MHTConfig, MHTTracker, StepStats
+from mhtrack.models.sensors import CartesianSensor
 from mhtrack.records import PlotTable, Scan, TrackTable
 from mhtrack.scenario import Scenario, Simulation, simulate
 
@@ -74,12 +76,31 @@ def default_fusion(n_sensors: int) -> str:
     return "adaptive-kmeans" if n_sensors > 1 else "none"
 
 
+#: How the tracker's fusion combines a cluster's plots: ``"information"``, the maximum-
+#: likelihood position of independent Gaussian plots of one point,
+#: ``P = (Σ R_i⁻¹)⁻¹``, ``z = P Σ R_i⁻¹ z_i`` (e.g. Bar-Shalom, Willett & Tian 2011), not
+#: P2's plain centre, whose error keeps half of the worse radar's cross-range error.
+TRACKER_FUSION_WEIGHTING = "information"
+#: χ² test probability with which the tracker's fusion splits clusters whose plots cannot
+#: be of one point (:func:`~mhtrack.initiation.fusion.split_inconsistent`); the same
+#: 0.9999 as the clustering's merge gate. Measured in ``docs/mht.md``, *Fusion*.
+TRACKER_FUSION_CONSISTENCY = 0.9999
+
+
+def tracker_fuser() -> AdaptiveKMeansFusion:
+    """The fusion the tracker's pipeline uses: P2's adaptive K-means clustering, then
+    :data:`TRACKER_FUSION_CONSISTENCY` and :data:`TRACKER_FUSION_WEIGHTING`."""
+    return AdaptiveKMeansFusion(weighting=TRACKER_FUSION_WEIGHTING,
+                                consistency=TRACKER_FUSION_CONSISTENCY)
+
+
 def fuse_scan(scan: Scan, fuser: AdaptiveKMeansFusion | None = None) -> Scan:
     """``scan`` fused by adaptive K-means (P2 §1.2): one plot per cluster, with its fused
-    ``R`` and, as row id, the row of the cluster's first plot (module docstring)."""
+    ``R`` and, as row id, the row of the cluster's first plot (module docstring). Default
+    ``fuser``: :func:`tracker_fuser`."""
     if len(scan) == 0:
         return scan
-    f = (AdaptiveKMeansFusion() if fuser is None else fuser).fuse(scan)
+    f = (tracker_fuser() if fuser is None else fuser).fuse(scan)
     k = len(f.scan)
     first = np.full(k, -1, np.int64)
     first[f.labels[::-1]] = np.arange(len(f.labels))[::-1]
@@ -92,7 +113,7 @@ def fused(scans: Iterable[Scan], fusion: str) -> Iterable[Scan]:
         raise ValueError(f"unknown fusion {fusion!r} (expected {', '.join(FUSIONS)})")
     if fusion == "none":
         return scans
-    fuser = AdaptiveKMeansFusion()
+    fuser = tracker_fuser()
     return (fuse_scan(s, fuser) for s in scans)
 
 
@@ -210,6 +231,12 @@ def run_scenario(
 P1_BIRTHS_PER_SCAN = 1e-7 * 8000.0**2
 
 
+#: Largest ``P_D`` :func:`default_config` takes from a scenario: a sensor with ``P_D = 1``
+#: would make one missed plot (gating, a plot lost in fusion) cost ``ln 0``; at 0.999 a
+#: miss costs ``ln 0.001 ≈ −6.9``, two delete the track (``β = 1e−4``).
+MAX_TRACKER_PD = 0.999
+
+
 def birth_density_for_area(area: float) -> float:
     """``λv = 6.4 / A`` per m² per scan: P1's new-target rate over an area of ``A`` m²."""
     if not (np.isfinite(area) and area > 0):
@@ -218,14 +245,28 @@ def birth_density_for_area(area: float) -> float:
 
 
 def default_config(scenario: Scenario | None = None, *, area: float | None = None) -> MHTConfig:
-    """The tracker defaults (:class:`MHTConfig`, P1 §3) with the new-target density scaled to
-    the surveillance area: the scenario's region, or ``area`` (e.g. the bounding box of a
-    plots file), by :func:`birth_density_for_area`. P1's crossing region gives P1's 1e−7."""
-    if scenario is not None:
-        area = scenario.region.area
-    if area is None:
-        return MHTConfig()
-    return MHTConfig(new_target_density=birth_density_for_area(area))
+    """The tracker defaults (:class:`MHTConfig`, P1 §3) fitted to what is known of the data.
+
+    * The new-target density is scaled to the surveillance area — the scenario's region,
+      or ``area`` (e.g. the bounding box of a plots file) — by
+      :func:`birth_density_for_area`; P1's crossing region gives P1's 1e−7.
+    * With a scenario of **one** sensor, the tracker's ``P_D`` is that sensor's (at most
+      :data:`MAX_TRACKER_PD`), and with a Cartesian sensor ``σw`` is its ``sigma`` (its
+      plots carry no covariance of their own; polar plots do). With several sensors the
+      scans are fused first and a fused plot's detection probability is not one sensor's,
+      so ``P_D`` stays P1's 0.9. On P1's crossing (``P_D`` 0.9, σ 100 m) nothing changes.
+    """
+    if scenario is None:
+        return MHTConfig() if area is None else MHTConfig(
+            new_target_density=birth_density_for_area(area))
+    changes: dict[str, Any] = {"new_target_density": birth_density_for_area(
+        scenario.region.area)}
+    if len(scenario.sensors) == 1:
+        changes["p_detection"] = min(float(scenario.pd[0]), MAX_TRACKER_PD)
+        sensor = scenario.sensors[0]
+        if isinstance(sensor, CartesianSensor):
+            changes["sigma_w"] = float(sensor.sigma)
+    return MHTConfig(**changes)
 
 
 def config_with(config: MHTConfig | None = None, **changes: Any) -> MHTConfig:

@@ -25,6 +25,7 @@ from mhtrack.initiation.fusion import (
     KMeansFusion,
     fuse_clusters,
     majority_origin,
+    split_inconsistent,
 )
 from mhtrack.initiation.hough import HoughInitiator
 from mhtrack.initiation.kmeans import (
@@ -92,4 +93,5 @@ __all__ = [
     "remove_dominated",
     "sliding_windows",
     "sorted_distances",
+    "split_inconsistent",
 ]

@@ -58,8 +58,9 @@ def fuse_clusters(
     """One fused plot per cluster ``0..k−1`` and its covariance.
 
     ``"mean"`` (P2): ``z̄ = (1/n) Σ z_i``, ``R̄ = (1/n²) Σ R_i``. ``"information"``:
-    ``P = (Σ R_i⁻¹)⁻¹``, ``z = P Σ R_i⁻¹ z_i`` (needs ``R``). A one-plot cluster gives that
-    plot and its ``R`` exactly in both cases.
+    ``P = (Σ R_i⁻¹)⁻¹``, ``z = P Σ R_i⁻¹ z_i``. A one-plot cluster gives that plot and its
+    ``R`` exactly in both cases. Without ``R`` the plots count as equally accurate, where
+    both weightings give the plain centre (and no covariance).
     """
     if weighting not in WEIGHTINGS:
         raise ValueError(f"weighting must be one of {WEIGHTINGS}, got {weighting!r}")
@@ -68,8 +69,6 @@ def fuse_clusters(
     k = int(labels.max()) + 1 if len(labels) else 0
     zc, n = _means(z, labels, k)
     if R is None:
-        if weighting == "information":
-            raise ValueError("information weighting needs the plots' covariances R")
         return zc, None
     R = np.asarray(R, float).reshape(-1, 2, 2)
     if weighting == "mean":
@@ -114,6 +113,50 @@ def majority_origin(origin: np.ndarray, labels: np.ndarray, k: int) -> np.ndarra
         win = cnt >= n_clutter[lab]
         out[lab[win]] = oid[win]
     return out
+
+
+def split_inconsistent(
+    z: np.ndarray, R: np.ndarray, labels: np.ndarray, probability: float
+) -> np.ndarray:
+    """Labels with every cluster made statistically consistent (ours).
+
+    The plots of one point, independent with covariances ``R_i``, scatter round its
+    information-weighted estimate ``ẑ`` (:func:`fuse_clusters`) so that
+    ``T = Σ (z_i − ẑ)ᵀ R_i⁻¹ (z_i − ẑ)`` is χ² with ``2(n − 1)`` degrees of freedom
+    (the residual sum of a weighted least-squares fit; Bar-Shalom, Willett & Tian 2011,
+    multisensor measurement association). While ``T`` exceeds its ``probability``
+    quantile, the plot with the largest term leaves the cluster as a cluster of its own.
+    The clustering's Euclidean threshold ``ε`` can put two radars' plots of *different*
+    points (e.g. two clutter plots 500 m apart with 50 m errors) into one cluster; fused,
+    they would give a plot that is neither. Returns compact labels ``0..k'−1`` (the old
+    clusters keep their order, split-off plots come after).
+    """
+    from scipy.stats import chi2
+
+    z = np.asarray(z, float).reshape(-1, 2)
+    R = np.asarray(R, float).reshape(-1, 2, 2)
+    labels = np.asarray(labels, np.int64).copy()
+    if len(labels) == 0:
+        return labels
+    k = int(labels.max()) + 1
+    n = np.bincount(labels, minlength=k)
+    W = np.linalg.inv(R)
+    limit = chi2.ppf(probability, 2 * np.arange(int(n.max())))  # by n − 1
+    nxt = k
+    for c in np.flatnonzero(n >= 2):
+        idx = np.flatnonzero(labels == c)
+        while len(idx) >= 2:
+            Wsum = W[idx].sum(0)
+            zh = np.linalg.solve(Wsum, np.einsum("nij,nj->i", W[idx], z[idx]))
+            d = z[idx] - zh
+            term = np.einsum("ni,nij,nj->n", d, W[idx], d)
+            if term.sum() <= limit[len(idx) - 1]:
+                break
+            worst = int(np.argmax(term))
+            labels[idx[worst]] = nxt
+            nxt += 1
+            idx = np.delete(idx, worst)
+    return labels
 
 
 # ---------------------------------------------------------------------- estimators
@@ -215,6 +258,9 @@ class AdaptiveKMeansFusion(_Fusion):
     max_threshold : cap (m) on ``ε``; ``"auto"`` (ours): ``√(γ · 2 · max λmax(R))`` when
         the plots carry ``R``; ``None``: P2's ``ε`` uncapped.
     max_iter : K-means iterations at most.
+    consistency : probability ``p`` of a final χ² test of each cluster
+        (:func:`split_inconsistent`, ours), which splits off the plots that cannot be of one
+        point; needs ``R``. Default ``None`` (off: P2's clusters).
 
     Attributes (after :meth:`fit`)
     ----------
@@ -224,11 +270,13 @@ class AdaptiveKMeansFusion(_Fusion):
     """
 
     def __init__(self, *, weighting: str = "mean", merge_probability: float | None = 0.9999,
-                 max_threshold: float | str | None = "auto", max_iter: int = 300) -> None:
+                 max_threshold: float | str | None = "auto", max_iter: int = 300,
+                 consistency: float | None = None) -> None:
         self.weighting = weighting
         self.merge_probability = merge_probability
         self.max_threshold = max_threshold
         self.max_iter = max_iter
+        self.consistency = consistency
 
     def fit(self, z: np.ndarray, sensor: np.ndarray | None = None,
             R: np.ndarray | None = None) -> AdaptiveKMeansFusion:
@@ -251,8 +299,14 @@ class AdaptiveKMeansFusion(_Fusion):
         self.threshold_cap_ = cap
         c0, _, eps = adaptive_initial_centres(za, s, R=Ra, gamma=gamma, max_threshold=cap)
         self.initial_centers_ = c0
+        q = self.consistency
+        if q is not None and not (isinstance(q, float) and 0.0 < q < 1.0):
+            raise ValueError(f"consistency must be in (0, 1) or None, got {q!r}")
         _, labels, it = kmeans_lloyd(za, c0, max_iter=self.max_iter)
         self._finish(za, s, labels, eps, it, adaptive=True, R=Ra, gamma=gamma)
+        if q is not None and Ra is not None and len(za):
+            self.labels_ = split_inconsistent(za, Ra, self.labels_, q)
+            self.cluster_centers_, _ = _means(za, self.labels_, int(self.labels_.max()) + 1)
         return self
 
 

@@ -33,8 +33,8 @@ class MHTConfig:
         Default 10 (P1 §3, ``σv² = 100``). With an IMM, the manoeuvre model's.
     imm_sigma_v : acceleration noise std (m/s²) of a second, *quiet* constant-velocity
         model; when > 0 each track is an IMM of the quiet and the ``sigma_v`` models
-        (:mod:`mhtrack.models.imm`), when 0 a single CV model with ``sigma_v`` (P1).
-        Default 0 (P1).
+        (:mod:`mhtrack.models.imm`), when 0 a single CV model with ``sigma_v`` (P1's).
+        Default 1 (ours, measured in ``docs/mht.md``, *Motion model*).
     imm_mode_time : mean time (s) a target stays in one IMM model, ``π_ii = exp(−dt/τ)``.
         Default 100 (our choice).
     gate_probability : ``P_G``, probability a target's plot falls in the χ² (2 d.o.f.)

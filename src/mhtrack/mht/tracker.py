@@ -15,6 +15,8 @@ The tracking cycle, each step one function::
     caps             pruning.cap_trees
     confirm          SPRT on the chosen leaves      stable track ids
     report           TrackTable of confirmed tracks in the best hypothesis
+    clutter          clutter.forget (if it has one)   the confirmed tracks' plots leave
+                                                    the estimator's window
     backfill         history.TentativeHistory       the tentative past of tracks
                                                     confirmed at this scan
 """
@@ -205,8 +207,12 @@ class MHTTracker:
         self.last_backfill = self._history.backfill(
             leaves, np.flatnonzero(leaves.chosen & (leaves.track >= first_new)))
         self._history.record(int(scan.index), float(scan.time), leaves)
+        confirmed = leaves.chosen & (leaves.track >= 0)
         if self._birth is not None:
-            self._birth.forget_used(leaves.window[leaves.chosen & (leaves.track >= 0)])
+            self._birth.forget_used(leaves.window[confirmed])
+        forget = getattr(self.clutter, "forget", None)
+        if forget is not None and len(z):
+            forget(np.isin(rows, leaves.window[confirmed, -1]))
         self._leaves = leaves
         self._last_time, self._last_index = float(scan.time), int(scan.index)
 

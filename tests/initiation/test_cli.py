@@ -57,6 +57,11 @@ def test_initiate_same_seed_same_output_and_text(tmp_path):
     assert "p_true" in text and (tmp_path / "f.png").stat().st_size > 0
 
 
+def test_initiate_needs_a_four_scan_window():
+    r = CliRunner().invoke(initiate, ["multiradar", "--scans", "3"])
+    assert r.exit_code == 2 and "4-scan windows" in r.output
+
+
 def test_initiate_rejects_bad_velocity_gate():
     r = CliRunner().invoke(initiate, ["multiradar", "--v-min", "500", "--v-max", "400"])
     assert r.exit_code != 0

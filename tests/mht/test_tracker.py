@@ -228,6 +228,9 @@ def test_bad_input_names_the_scan_and_plot():
         trk.step(Scan(11, 3.0, np.zeros((2, 2)), np.zeros(2, np.int64), np.arange(2), R))
     with pytest.raises(ValueError, match="not unique"):
         trk.step(Scan(12, 3.0, np.ones((2, 2)), np.zeros(2, np.int64), np.array([5, 5])))
+    with pytest.raises(ValueError, match=r"scan 13: plot row 1 lies at .*beyond ±1e\+09 m"):
+        trk.step(Scan.from_positions(13, 3.0, [[0.0, 0.0], [1e30, 0.0]]))
+    assert len(trk.step(Scan.from_positions(14, 3.0, [[1e9, -1e9]]))) == 0  # at the bound
 
 
 def test_config_is_validated_and_round_trips():
@@ -235,6 +238,10 @@ def test_config_is_validated_and_round_trips():
         MHTConfig(p_detection=1.0)
     with pytest.raises(ValueError, match="n_scan"):
         MHTConfig(n_scan=0)
+    with pytest.raises(ValueError, match=r"n_scan must be an integer in \[1, 20\]"):
+        MHTConfig(n_scan=1_000_000)
+    with pytest.raises(ValueError, match="history_scans"):
+        MHTConfig(history_scans=10**6)
     with pytest.raises(ValueError, match="alpha"):
         MHTConfig(alpha=0.7, beta=0.5)
     with pytest.raises(ValueError, match="max_leaves"):

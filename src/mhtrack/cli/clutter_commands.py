@@ -24,7 +24,8 @@ from mhtrack.cli.common import echo_json, jsonable, load_scenario_arg, scenario_
 @click.option("--oracle-gates", is_flag=True,
               help="Leave the true target plots out of the fit (source=outside-gates fed the "
               "true target mask) [default: the estimator sees every plot].")
-@click.option("--resolution", type=click.IntRange(min=2), default=400, show_default=True,
+@click.option("--resolution", type=click.IntRange(min=2, max=4000), default=400,
+              show_default=True,
               help="Cells per side of the IAE quadrature grid.")
 @click.option("--map-scan", type=int, default=None,
               help="Scan of the intensity maps figure [default: the middle scan].")

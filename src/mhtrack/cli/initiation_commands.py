@@ -117,6 +117,11 @@ def initiate(scenario: str, seed: int, clutter: str | None, clutter_rate: float 
     if v_min >= v_max:
         raise click.BadParameter(f"--v-min ({v_min}) must be below --v-max ({v_max})")
     sc = load_scenario_arg(scenario, clutter, clutter_rate, pd, scans)
+    n_scans = len(sc.scan_indices())
+    if n_scans < 4:
+        raise click.BadParameter(
+            f"the initiators work on 4-scan windows; {sc.name} has {n_scans} scan(s)",
+            param_hint="'--scans' or the scenario's scans")
     params: dict[str, Any] = {"v_min": v_min, "v_max": v_max}
     if method.endswith("logic"):
         params["gate_radius"] = gate_radius

@@ -154,6 +154,15 @@ class MonteCarloSpec:
         bad = sorted(set(self.run_kwargs) & _RESERVED_KWARGS)
         if bad:
             raise ValueError(f"run_kwargs: {', '.join(bad)} are set by the runner")
+        import inspect
+
+        from mhtrack.experiments.pipeline import run_scenario
+
+        known = set(inspect.signature(run_scenario).parameters) - _RESERVED_KWARGS
+        bad = sorted(set(self.run_kwargs) - known)
+        if bad:
+            raise ValueError(f"run_kwargs: unknown keyword(s) {', '.join(bad)} "
+                             f"(expected some of {', '.join(sorted(known))})")
         try:
             plain = {k: _plain(v) for k, v in
                      (("scenario", sc), ("config", self.config), ("run_kwargs", self.run_kwargs))}

@@ -13,6 +13,12 @@ from typing import Any
 
 from mhtrack.models.imm import CVModelSet
 
+#: Largest N-scan depth: every leaf keeps ``N + 1`` plot ids and the trees grow with ``N``;
+#: deeper than this only costs memory (P1 uses 3).
+MAX_N_SCAN = 20
+#: Largest tentative history kept (scans).
+MAX_HISTORY_SCANS = 1000
+
 #: Birth processes by name (:attr:`MHTConfig.birth`; ``mhtrack.mht.birth``).
 BIRTHS: tuple[str, ...] = ("every-plot", "logic", "modified-logic", "hough", "modified-hough")
 
@@ -159,7 +165,8 @@ class MHTConfig:
         )
         check("miss_uses_gate_probability", isinstance(self.miss_uses_gate_probability, bool),
               "a bool")
-        check("n_scan", _is_int(self.n_scan) and self.n_scan >= 1, "an integer >= 1")
+        check("n_scan", _is_int(self.n_scan) and 1 <= self.n_scan <= MAX_N_SCAN,
+              f"an integer in [1, {MAX_N_SCAN}]")
         check("confirm_min_plots", _is_int(self.confirm_min_plots)
               and self.confirm_min_plots >= 1, "an integer >= 1")
         check("confirm_hits", _is_int(self.confirm_hits)
@@ -170,8 +177,9 @@ class MHTConfig:
                      "max_births_per_scan", "max_cluster_size"):
             v = getattr(self, name)
             check(name, _is_int(v) and v >= 1, "an integer >= 1")
-        check("history_scans", _is_int(self.history_scans) and self.history_scans >= 0,
-              "an integer >= 0")
+        check("history_scans", _is_int(self.history_scans)
+              and 0 <= self.history_scans <= MAX_HISTORY_SCANS,
+              f"an integer in [0, {MAX_HISTORY_SCANS}]")
         check("birth", self.birth in BIRTHS, f"one of {', '.join(BIRTHS)}")
         check("birth_theta_deg", isinstance(self.birth_theta_deg, int | float)
               and 0 <= self.birth_theta_deg <= 180, "in [0, 180]")

@@ -62,6 +62,10 @@ from mhtrack.models import imm, kalman
 from mhtrack.models.motion import ConstantVelocity
 from mhtrack.records import PlotTable, Scan, TrackTable
 
+#: Largest plot coordinate the tracker accepts (m): 10⁹ m is 2.6× the Moon's distance;
+#: beyond it squared distances in gating and the clutter fit lose all precision.
+MAX_COORDINATE = 1e9
+
 logger = logging.getLogger(__name__)
 
 FORMAT = "mhtrack.mht.MHTTracker/3"
@@ -282,6 +286,14 @@ class MHTTracker:
             raise ValueError(
                 f"scan {scan.index}: plot row {int(rows[i])} has a non-finite position "
                 f"{z[i].tolist()}"
+            )
+        far = np.abs(z).max(axis=1) > MAX_COORDINATE if n else np.zeros(0, bool)
+        if far.any():
+            i = int(np.flatnonzero(far)[0])
+            raise ValueError(
+                f"scan {scan.index}: plot row {int(rows[i])} lies at {z[i].tolist()} m, "
+                f"beyond ±{MAX_COORDINATE:g} m of the frame's origin (a unit or parsing "
+                "error?)"
             )
         if n > 1 and np.unique(rows).size != n:
             raise ValueError(f"scan {scan.index}: plot row ids are not unique")

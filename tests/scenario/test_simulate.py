@@ -236,3 +236,22 @@ def _timed(f) -> float:
     t = time.perf_counter()
     f()
     return time.perf_counter() - t
+
+
+def test_oversized_overrides_are_refused_before_simulating():
+    """Too many scans or plots: a clear error naming the key, not an out-of-memory kill."""
+    from mhtrack.scenario import apply_overrides, from_dict
+    from mhtrack.scenario.spec import MAX_PLOTS, MAX_SCANS
+
+    assert (MAX_SCANS, MAX_PLOTS) == (100_000, 50_000_000)
+    with pytest.raises(ValueError, match=r"^scans: .*more than the maximum 100000 \(MAX_SCANS\)"):
+        preset("crossing", scans=10**9)
+    with pytest.raises(ValueError, match=r"^clutter\.rate: .* more than the maximum 5e7"):
+        preset("crossing", clutter_rate=1e9)
+    s = from_dict(preset("multiradar").to_dict())
+    with pytest.raises(ValueError, match=r"^clutter\.rate: .*3 sensor\(s\) × mean clutter rate"):
+        apply_overrides(s, clutter_rate=1e9)
+    with pytest.raises(ValueError, match=r"^scans: .*more than the maximum 100000"):
+        apply_overrides(s, scans=100_001)
+    # just under the limits is accepted (nothing is simulated here)
+    assert apply_overrides(s, clutter_rate=MAX_PLOTS / 3 / 10 - 100).n_scans == 10

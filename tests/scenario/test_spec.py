@@ -253,6 +253,40 @@ BAD = [
         },
         r"^clutter: clutter mixture has no mass inside the region",
     ),
+    # limits (MAX_SCANS, MAX_PLOTS, MAX_T, MAX_SIGMA, MAX_SIGMA_BEARING_DEG, MAX_COORDINATE,
+    # MAX_SPEED): refused up front instead of running out of memory or overflowing
+    (
+        ("scans",),
+        [1, 10**9],
+        r"^scans: \[1, 1000000000\] is 1000000000 scans, more than "
+        r"the maximum 100000 \(MAX_SCANS\)",
+    ),
+    (("scans",), [1, 2**63 - 1], r"^scans: .* more than the maximum 100000 \(MAX_SCANS\)"),
+    (
+        ("clutter", "keyframes", 1, "rate"),
+        1e12,
+        r"^clutter\.keyframes\[1\]\.rate: a simulation would give about .* plots .* more "
+        r"than the maximum 5e7 \(MAX_PLOTS\)",
+    ),
+    (("T",), 1e300, r"^T: must be <= 1e6 s, got 1e\+300"),
+    (("truth_sigma_v",), 1e300, r"^truth_sigma_v: must be <= 1e4 m/s², got"),
+    (("sensors", 0, "sigma"), 1e200, r"^sensors\[0\]\.sigma: must be <= 1e6 m, got 1e\+200"),
+    (("sensors", 1, "sigma_range"), 1e7, r"^sensors\[1\]\.sigma_range: must be <= 1e6 m"),
+    (
+        ("sensors", 1, "sigma_bearing_deg"),
+        1000.0,
+        r"^sensors\[1\]\.sigma_bearing_deg: must be <= 30 degrees, got 1000\.0",
+    ),
+    (("sensors", 1, "position", 0), 1e10, r"^sensors\[1\]\.position\[0\]: must be within ±1e9 m"),
+    (("region", "xmin"), -1e300, r"^region\.xmin: must be within ±1e9 m, got -1e\+300"),
+    (("region", "ymax"), 1e300, r"^region\.ymax: must be within ±1e9 m"),
+    (("targets", 0, "state", 2), 2e9, r"^targets\[0\]\.state\[2\]: must be within ±1e9 m"),
+    (("targets", 0, "state", 1), -7e5, r"^targets\[0\]\.state\[1\]: must be within ±1e5 m/s"),
+    (
+        ("targets", 0),
+        {"id": 4, "scans": [3], "states": [[0, 0, 0, 1e300]]},
+        r"^targets\[0\]\.states\[0\]\[3\]: must be within ±1e5 m/s",
+    ),
     (("targets",), {"id": 1}, r"^targets: expected a list"),
     (
         ("targets", 0),
@@ -286,6 +320,47 @@ def test_load_scenario_errors_name_the_file(tmp_path):
     f.write_text("T = = 1\n")
     with pytest.raises(ValueError, match=r"bad\.toml: not valid TOML"):
         load_scenario(f)
+
+
+def test_load_scenario_bad_utf8_names_the_file_and_bom_is_accepted(tmp_path):
+    text = EXAMPLE.read_bytes()
+    f = tmp_path / "latin1.toml"
+    f.write_bytes(text.replace(b'name = "drifting-clutter"', b'name = "caf\xe9"'))
+    msg = r"latin1\.toml: not valid UTF-8 text \(byte 0xe9 on line 6\)"
+    with pytest.raises(ValueError, match=msg):
+        load_scenario(f)
+    f.write_bytes(bytes(range(256)))
+    with pytest.raises(ValueError, match=r"latin1\.toml: not valid UTF-8 text"):
+        load_scenario(f)
+    bom = tmp_path / "bom.toml"
+    bom.write_bytes(b"\xef\xbb\xbf" + text)
+    assert load_scenario(bom) == load_scenario(EXAMPLE)
+    from mhtrack.io import read_toml
+
+    assert read_toml(bom) == read_toml(EXAMPLE)
+
+
+def test_sensor_and_scenario_constructors_enforce_the_limits():
+    import dataclasses
+
+    with pytest.raises(ValueError, match=r"sensor 0: sigma must be > 0 and <= 1e6 m, got 1e\+200"):
+        CartesianSensor(0, 1e200)
+    with pytest.raises(ValueError, match=r"sensor 1: sigma_range must be > 0 and <= 1e6 m"):
+        PolarRadar(1, (0.0, 0.0), 1e7, 0.3)
+    with pytest.raises(ValueError, match=r"sensor 1: sigma_bearing_deg must be > 0 and <= 30"):
+        PolarRadar(1, (0.0, 0.0), 20.0, 1000.0)
+    with pytest.raises(ValueError, match=r"sensor 1: position must be two finite coordinates"):
+        PolarRadar(1, (1e300, 0.0))
+    s = preset("crossing", scans=3)
+    with pytest.raises(ValueError, match=r"^T: must be <= 1e6 s"):
+        dataclasses.replace(s, T=1e300)
+    with pytest.raises(ValueError, match=r"^region\.xmin: must be within ±1e9 m"):
+        big = Region(-1e300, 1e300, -1.0, 1.0)
+        dataclasses.replace(s, region=big, clutter=UniformClutter(big, 1.0))
+    with pytest.raises(ValueError, match=r"^targets\[0\]\.state\[0\]: must be within ±1e9 m"):
+        dataclasses.replace(s, targets=(Target(1, (1e12, 0.0, 0.0, 0.0), 1, 3),))
+    with pytest.raises(ValueError, match=r"^scans: \[1, 100001\] is 100001 scans"):
+        dataclasses.replace(s, scans=(1, 100_001))
 
 
 def test_scenario_constructor_validates():

@@ -1,6 +1,7 @@
 """TOML files for the CLI: scenario and configuration dictionaries.
 
-Read with :mod:`tomllib`; written with ``tomli-w``. Floats are written in shortest
+Read with :mod:`tomllib` (UTF-8, with or without a byte-order mark); written with
+``tomli-w``. Floats are written in shortest
 round-trip form, so a written scenario reads back exactly.
 """
 
@@ -40,7 +41,7 @@ def read_toml(path: PathArg) -> dict[str, Any]:
     except OSError as e:
         raise InputError(f"{name}: cannot read ({e.strerror or e})", file=name) from None
     try:
-        text = data.decode("utf-8")
+        text = data.decode("utf-8-sig")  # a UTF-8 byte-order mark is accepted and dropped
     except UnicodeDecodeError as e:
         line = text_line(data, e.start)
         raise InputError(

@@ -22,6 +22,30 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+#: Largest Cartesian ``sigma`` and polar ``sigma_range`` accepted (m): 1000 km, far beyond
+#: any real sensor, and small enough that ``σ²`` and the plots stay finite.
+MAX_SIGMA = 1e6
+#: Largest polar ``sigma_bearing_deg`` accepted (degrees). The converted measurement divides
+#: by ``λ = exp(−σθ²/2)``, which explodes for wide bearing errors (σθ = 1000° gives plots
+#: at 1e68 m); beyond 30° a "radar" no longer gives a usable bearing.
+MAX_SIGMA_BEARING_DEG = 30.0
+#: Largest ``|coordinate|`` of a radar position (m), as for plots (``MHTTracker``).
+MAX_SENSOR_COORDINATE = 1e9
+
+
+def _g(x: float) -> str:
+    """Short form of a limit in messages: ``1e6``, ``30``."""
+    return f"{x:g}".replace("e+0", "e").replace("e+", "e")
+
+
+def _in_range(value: object, hi: float) -> bool:
+    """``value`` is a finite real number in ``(0, hi]``."""
+    try:
+        x = float(value)  # type: ignore[arg-type]
+    except (TypeError, ValueError):
+        return False
+    return bool(np.isfinite(x)) and 0 < x <= hi
+
 
 @dataclass(frozen=True)
 class Observation:
@@ -43,8 +67,10 @@ class CartesianSensor:
     kind: str = field(default="cartesian", init=False)
 
     def __post_init__(self) -> None:
-        if not (np.isfinite(self.sigma) and self.sigma > 0):
-            raise ValueError(f"sensor {self.id}: sigma must be > 0, got {self.sigma}")
+        if not _in_range(self.sigma, MAX_SIGMA):
+            raise ValueError(
+                f"sensor {self.id}: sigma must be > 0 and <= {_g(MAX_SIGMA)} m, got {self.sigma}"
+            )
 
     @property
     def R(self) -> np.ndarray:
@@ -74,11 +100,25 @@ class PolarRadar:
     kind: str = field(default="polar", init=False)
 
     def __post_init__(self) -> None:
-        if not (np.isfinite(self.sigma_range) and self.sigma_range > 0):
-            raise ValueError(f"sensor {self.id}: sigma_range must be > 0")
-        if not (np.isfinite(self.sigma_bearing_deg) and self.sigma_bearing_deg > 0):
-            raise ValueError(f"sensor {self.id}: sigma_bearing_deg must be > 0")
-        object.__setattr__(self, "position", tuple(float(v) for v in self.position))
+        if not _in_range(self.sigma_range, MAX_SIGMA):
+            raise ValueError(
+                f"sensor {self.id}: sigma_range must be > 0 and <= {_g(MAX_SIGMA)} m, "
+                f"got {self.sigma_range}"
+            )
+        if not _in_range(self.sigma_bearing_deg, MAX_SIGMA_BEARING_DEG):
+            raise ValueError(
+                f"sensor {self.id}: sigma_bearing_deg must be > 0 and <= "
+                f"{_g(MAX_SIGMA_BEARING_DEG)} degrees, got {self.sigma_bearing_deg}"
+            )
+        pos = tuple(float(v) for v in self.position)
+        if len(pos) != 2 or not all(
+            np.isfinite(v) and abs(v) <= MAX_SENSOR_COORDINATE for v in pos
+        ):
+            raise ValueError(
+                f"sensor {self.id}: position must be two finite coordinates within "
+                f"±{_g(MAX_SENSOR_COORDINATE)} m, got {self.position!r}"
+            )
+        object.__setattr__(self, "position", pos)
 
     def to_polar(self, positions: np.ndarray) -> np.ndarray:
         """Exact ``(range m, bearing deg)`` of Cartesian ``positions`` (n, 2)."""

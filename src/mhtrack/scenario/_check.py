@@ -65,15 +65,45 @@ def _tname(v: object) -> str:
     return type(v).__name__
 
 
-def number(v: object, path: str, *, lo: float | None = None, lo_open: bool = False) -> float:
-    """A finite real number (bools rejected), optionally ``>= lo`` (or ``> lo``)."""
+def fmt(x: float) -> str:
+    """Short form of a limit or a count in messages: ``1e6``, ``30``, ``5e7``, ``2.5e4``."""
+    if abs(x) >= 1e4:
+        m, e = f"{x:.6e}".split("e")
+        return f"{m.rstrip('0').rstrip('.')}e{int(e)}"
+    return f"{x:g}"
+
+
+def number(
+    v: object,
+    path: str,
+    *,
+    lo: float | None = None,
+    lo_open: bool = False,
+    hi: float | None = None,
+    unit: str = "",
+) -> float:
+    """A finite real number (bools rejected), optionally ``>= lo`` (or ``> lo``) and
+    ``<= hi`` (``unit`` is appended to ``hi`` in the message)."""
     if isinstance(v, bool) or not isinstance(v, int | float | np.integer | np.floating):
         raise ValueError(f"{path}: expected a number, got {_tname(v)} {v!r}")
-    x = float(v)
+    try:
+        x = float(v)
+    except OverflowError:  # a Python int beyond the float range
+        x = math.inf if v > 0 else -math.inf  # type: ignore[operator]
     if not math.isfinite(x):
         raise ValueError(f"{path}: must be finite, got {x}")
     if lo is not None and (x <= lo if lo_open else x < lo):
         raise ValueError(f"{path}: must be {'>' if lo_open else '>='} {lo}, got {x}")
+    if hi is not None and x > hi:
+        raise ValueError(f"{path}: must be <= {fmt(hi)}{' ' + unit if unit else ''}, got {x}")
+    return x
+
+
+def bounded(v: object, path: str, limit: float, unit: str = "m") -> float:
+    """A finite number with ``|v| <= limit`` (coordinates, velocities)."""
+    x = number(v, path)
+    if abs(x) > limit:
+        raise ValueError(f"{path}: must be within ±{fmt(limit)} {unit}, got {x}")
     return x
 
 
@@ -99,17 +129,20 @@ def string(v: object, path: str) -> str:
     return v
 
 
-def array(v: object, path: str, shape: tuple[int | None, ...]) -> np.ndarray:
-    """A nested list of finite numbers of the given ``shape`` (``None`` = any length); the
-    error names the first offending element, e.g. ``means[1][0]``."""
+def array(
+    v: object, path: str, shape: tuple[int | None, ...], limit: float | None = None
+) -> np.ndarray:
+    """A nested list of finite numbers of the given ``shape`` (``None`` = any length), each
+    within ``±limit`` if given (in m); the error names the first offending element, e.g.
+    ``means[1][0]``."""
     if len(shape) == 0:
-        return np.asarray(number(v, path))
+        return np.asarray(number(v, path) if limit is None else bounded(v, path, limit))
     if not isinstance(v, list | tuple | np.ndarray):
         raise ValueError(f"{path}: expected a list, got {_tname(v)} {v!r}")
     n = shape[0]
     if n is not None and len(v) != n:
         raise ValueError(f"{path}: expected {n} elements, got {len(v)}")
-    rows = [array(e, join(path, i), shape[1:]) for i, e in enumerate(v)]
+    rows = [array(e, join(path, i), shape[1:], limit) for i, e in enumerate(v)]
     if not rows:
         return np.zeros((0, *[s or 0 for s in shape[1:]]))
     return np.stack(rows)

@@ -7,9 +7,12 @@ ignored, so a CLI can pass unset options through. Overrides:
   scan; ``"gmm"``: keep a mixture (or time-varying mixture) as it is, and replace uniform
   clutter by :func:`default_mixture` with the same rate;
 * ``clutter_rate`` — mean clutter count per scan **per sensor** (``>= 0``; for time-varying
-  clutter every keyframe gets this rate);
+  clutter every keyframe gets this rate); a rate that would make the simulation exceed
+  :data:`~mhtrack.scenario.spec.MAX_PLOTS` plots is refused with the message naming
+  ``clutter.rate`` that a TOML file gets (the check is in :class:`Scenario`);
 * ``pd`` — detection probability of every sensor;
-* ``scans`` — number of scans from the first one (the targets are not changed: those
+* ``scans`` — number of scans from the first one, at most
+  :data:`~mhtrack.scenario.spec.MAX_SCANS` (the targets are not changed: those
   outside the new range are simply not simulated);
 * ``truth_sigma_v`` — truth acceleration noise σv (m/s²);
 * ``sigma_range`` — range σ (m) of every polar sensor (error if there is none).
@@ -29,9 +32,9 @@ from mhtrack.models.clutter import (
     TimeVaryingClutter,
     UniformClutter,
 )
-from mhtrack.models.sensors import PolarRadar
+from mhtrack.models.sensors import MAX_SIGMA, PolarRadar
 from mhtrack.scenario import _check as ck
-from mhtrack.scenario.spec import ClutterSpec, Scenario
+from mhtrack.scenario.spec import MAX_SCANS, MAX_SIGMA_V, ClutterSpec, Scenario
 
 #: Overrides accepted by :func:`apply_overrides`.
 OVERRIDES: tuple[str, ...] = (
@@ -100,11 +103,17 @@ def apply_overrides(scenario: Scenario, **overrides: Any) -> Scenario:
         changes["pd"] = ck.probability(ov["pd"], "pd")
     if "scans" in ov:
         n = ck.integer(ov["scans"], "scans", lo=1)
+        if n > MAX_SCANS:
+            raise ValueError(f"scans: {n} scans, more than the maximum {MAX_SCANS} (MAX_SCANS)")
         changes["scans"] = (s.first, s.first + n - 1)
     if "truth_sigma_v" in ov:
-        changes["truth_sigma_v"] = ck.number(ov["truth_sigma_v"], "truth_sigma_v", lo=0.0)
+        changes["truth_sigma_v"] = ck.number(
+            ov["truth_sigma_v"], "truth_sigma_v", lo=0.0, hi=MAX_SIGMA_V, unit="m/s²"
+        )
     if "sigma_range" in ov:
-        sr = ck.number(ov["sigma_range"], "sigma_range", lo=0.0, lo_open=True)
+        sr = ck.number(
+            ov["sigma_range"], "sigma_range", lo=0.0, lo_open=True, hi=MAX_SIGMA, unit="m"
+        )
         if not any(isinstance(x, PolarRadar) for x in s.sensors):
             raise ValueError(f"sigma_range: scenario {s.name!r} has no polar sensor")
         changes["sensors"] = tuple(

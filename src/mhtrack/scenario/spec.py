@@ -27,13 +27,21 @@ from typing import Any
 
 import numpy as np
 
+from mhtrack.errors import InputError
 from mhtrack.models.clutter import (
     GaussianMixtureClutter,
     Region,
     TimeVaryingClutter,
     UniformClutter,
 )
-from mhtrack.models.sensors import CartesianSensor, PolarRadar, Sensor
+from mhtrack.models.sensors import (
+    MAX_SENSOR_COORDINATE,
+    MAX_SIGMA,
+    MAX_SIGMA_BEARING_DEG,
+    CartesianSensor,
+    PolarRadar,
+    Sensor,
+)
 from mhtrack.scenario import _check as ck
 from mhtrack.scenario.targets import AnyTarget, RecordedTarget, Target
 
@@ -43,6 +51,25 @@ ClutterSpec = UniformClutter | GaussianMixtureClutter | TimeVaryingClutter
 CLUTTER_KINDS = ("uniform", "gmm", "time-varying")
 #: Sensor kinds of the dict form.
 SENSOR_KINDS = ("cartesian", "polar")
+
+# ---------------------------------------------------------------------- limits
+# Bounds beyond which a scenario is refused up front, before any memory is allocated or a
+# number overflows (see docs/scenarios.md, "Limits"). Sensor limits: ``MAX_SIGMA`` (m),
+# ``MAX_SIGMA_BEARING_DEG`` and ``MAX_SENSOR_COORDINATE`` in :mod:`mhtrack.models.sensors`.
+
+#: Largest number of scans of a scenario (``last − first + 1``).
+MAX_SCANS = 100_000
+#: Largest expected number of plots of one simulation: sensors × mean clutter rate × scans
+#: plus the target plots (each plot costs about 100 bytes in the tables).
+MAX_PLOTS = 50_000_000
+#: Largest scan period ``T`` (s): about 11.6 days.
+MAX_T = 1e6
+#: Largest ``|coordinate|`` of the region and of target positions (m), as for plots.
+MAX_COORDINATE = 1e9
+#: Largest ``|velocity component|`` of a target (m/s): 100 km/s.
+MAX_SPEED = 1e5
+#: Largest truth acceleration noise ``truth_sigma_v`` (m/s²): about 1000 g.
+MAX_SIGMA_V = 1e4
 
 
 @dataclass(frozen=True, eq=False, kw_only=True)
@@ -84,18 +111,13 @@ class Scenario:
         ck.string(self.description, "description")
         if not isinstance(self.region, Region):
             raise ValueError(f"region: expected a Region, got {type(self.region).__name__}")
-        object.__setattr__(self, "T", ck.number(self.T, "T", lo=0.0, lo_open=True))
-        object.__setattr__(
-            self, "truth_sigma_v", ck.number(self.truth_sigma_v, "truth_sigma_v", lo=0.0)
-        )
+        _check_region(self.region, "region")
+        object.__setattr__(self, "T", _period(self.T))
+        object.__setattr__(self, "truth_sigma_v", _sigma_v(self.truth_sigma_v))
         sc = tuple(self.scans)
         if len(sc) != 2:
             raise ValueError(f"scans: expected [first, last], got {self.scans!r}")
-        first = ck.integer(sc[0], "scans[0]", lo=0)
-        last = ck.integer(sc[1], "scans[1]", lo=0)
-        if first > last:
-            raise ValueError(f"scans: first must be <= last, got [{first}, {last}]")
-        object.__setattr__(self, "scans", (first, last))
+        object.__setattr__(self, "scans", _scan_range(sc[0], sc[1]))
 
         sensors = tuple(self.sensors)
         if not sensors:
@@ -139,7 +161,51 @@ class Scenario:
             if t.id in tids:
                 raise ValueError(f"targets[{i}].id: duplicate id {t.id}")
             tids.add(t.id)
+            if isinstance(t, Target):
+                _check_state(t.state, f"targets[{i}].state")
+            else:
+                for j, row in enumerate(t.states):
+                    _check_state(row, f"targets[{i}].states[{j}]")
         object.__setattr__(self, "targets", targets)
+        self._check_size()
+
+    def _check_size(self) -> None:
+        """Refuse a scenario whose simulation would not fit in memory (:data:`MAX_PLOTS`)
+        or whose truth noise would be drawn over more than :data:`MAX_SCANS` steps."""
+        first, last = self.scans
+        n_sensors = len(self.sensors)
+        target_scans = 0
+        for i, t in enumerate(self.targets):
+            if isinstance(t, Target):
+                target_scans += max(0, min(t.death, last) - max(t.birth, first) + 1)
+                steps = min(t.death, last) - t.birth
+                if self.truth_sigma_v > 0 and steps > MAX_SCANS and t.death >= first:
+                    raise ValueError(
+                        f"targets[{i}].birth: with truth_sigma_v > 0 the truth noise is drawn "
+                        f"from the birth scan {t.birth} on, {steps} steps, more than "
+                        f"{MAX_SCANS} (MAX_SCANS)"
+                    )
+            else:
+                target_scans += sum(first <= k <= last for k in t.scans)
+        clutter = n_sensors * self.mean_clutter_rate() * self.n_scans
+        total = clutter + n_sensors * target_scans
+        if total <= MAX_PLOTS:
+            return
+        c = self.clutter
+        if clutter < n_sensors * target_scans:
+            key = "targets"
+        elif isinstance(c, TimeVaryingClutter):
+            i = int(np.argmax([m.rate_per_scan for _, m in c.keyframes]))
+            key = f"clutter.keyframes[{i}].rate"
+        else:
+            key = "clutter.rate"
+        raise ValueError(
+            f"{key}: a simulation would give about {ck.fmt(float(f'{total:.3g}'))} plots "
+            f"({n_sensors} sensor(s) × mean clutter rate {ck.fmt(self.mean_clutter_rate())} "
+            f"× {self.n_scans} scans + {n_sensors * target_scans} target plots), more than "
+            f"the maximum {ck.fmt(MAX_PLOTS)} (MAX_PLOTS); lower the clutter rate or the "
+            f"number of scans"
+        )
 
     # ------------------------------------------------------------------ derived values
     @property
@@ -165,6 +231,16 @@ class Scenario:
     def clutter_rate(self, scan: int) -> float:
         """Mean clutter count per sensor at ``scan`` (``λ_k``)."""
         return float(self.clutter.rate(scan))
+
+    def mean_clutter_rate(self) -> float:
+        """Mean of ``λ_k`` over the scans of the range (per sensor)."""
+        c = self.clutter
+        if isinstance(c, TimeVaryingClutter):
+            ks = np.array([k for k, _ in c.keyframes], float)
+            rates = np.array([m.rate_per_scan for _, m in c.keyframes], float)
+            # linear between keyframes, constant outside: exactly np.interp
+            return float(np.interp(self.scan_indices().astype(float), ks, rates).mean())
+        return float(c.rate_per_scan)
 
     # ------------------------------------------------------------------ dict form
     def to_dict(self) -> dict[str, Any]:
@@ -268,15 +344,12 @@ def from_dict(d: Mapping[str, Any]) -> Scenario:
         ck.integer(d["seed"], "seed", lo=0)
     name = ck.string(d.get("name", "custom"), "name")
     description = ck.string(d.get("description", ""), "description")
-    T = ck.number(d["T"], "T", lo=0.0, lo_open=True)
-    sigma_v = ck.number(d.get("truth_sigma_v", 0.0), "truth_sigma_v", lo=0.0)
+    T = _period(d["T"])
+    sigma_v = _sigma_v(d.get("truth_sigma_v", 0.0))
     scans = d["scans"]
     if not isinstance(scans, list | tuple) or len(scans) != 2:
         raise ValueError(f"scans: expected [first, last], got {scans!r}")
-    first = ck.integer(scans[0], "scans[0]", lo=0)
-    last = ck.integer(scans[1], "scans[1]", lo=0)
-    if first > last:
-        raise ValueError(f"scans: first must be <= last, got [{first}, {last}]")
+    first, last = _scan_range(scans[0], scans[1])
     region = _region_from(d["region"], "region")
 
     raw_sensors = _list(d["sensors"], "sensors")
@@ -305,19 +378,78 @@ def from_dict(d: Mapping[str, Any]) -> Scenario:
 
 
 def load_scenario(source: str | os.PathLike[str] | Mapping[str, Any]) -> Scenario:
-    """A scenario from a TOML file (path) or from its dict form (see :func:`from_dict`)."""
+    """A scenario from a TOML file (path) or from its dict form (see :func:`from_dict`).
+
+    The file is UTF-8, with or without a byte-order mark. Errors name the file:
+    ``<file>: not valid UTF-8 text (byte 0xe9 on line 6)``, ``<file>: not valid TOML: …``,
+    ``<file>: <key path>: …``.
+    """
     if isinstance(source, Mapping):
         return from_dict(source)
     path = Path(source)
     try:
-        with path.open("rb") as f:
-            data = tomllib.load(f)
+        raw = path.read_bytes()
+    except OSError as e:
+        raise InputError(f"{path}: cannot read ({e.strerror or e})", file=str(path)) from None
+    try:
+        text = raw.decode("utf-8-sig")  # a UTF-8 byte-order mark is accepted and dropped
+    except UnicodeDecodeError as e:
+        line = raw.count(b"\n", 0, e.start) + 1
+        raise InputError(
+            f"{path}: not valid UTF-8 text (byte 0x{raw[e.start]:02x} on line {line})",
+            file=str(path),
+            line=line,
+        ) from None
+    try:
+        data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as e:
         raise ValueError(f"{path}: not valid TOML: {e}") from None
     try:
         return from_dict(data)
     except ValueError as e:
         raise ValueError(f"{path}: {e}") from None
+
+
+def _period(v: object) -> float:
+    return ck.number(v, "T", lo=0.0, lo_open=True, hi=MAX_T, unit="s")
+
+
+def _sigma_v(v: object) -> float:
+    return ck.number(v, "truth_sigma_v", lo=0.0, hi=MAX_SIGMA_V, unit="m/s²")
+
+
+def _scan_range(first: object, last: object) -> tuple[int, int]:
+    """Validated ``(first, last)``; at most :data:`MAX_SCANS` scans."""
+    f = ck.integer(first, "scans[0]", lo=0)
+    la = ck.integer(last, "scans[1]", lo=0)
+    if f > la:
+        raise ValueError(f"scans: first must be <= last, got [{f}, {la}]")
+    if la - f + 1 > MAX_SCANS:
+        raise ValueError(
+            f"scans: [{f}, {la}] is {la - f + 1} scans, more than the maximum {MAX_SCANS} "
+            f"(MAX_SCANS)"
+        )
+    if la > _MAX_SCAN_INDEX:
+        raise ValueError(f"scans[1]: must be <= {_MAX_SCAN_INDEX} (2**53), got {la}")
+    return f, la
+
+
+#: Largest scan index: scan times ``k·T`` and int64 scan arrays stay exact.
+_MAX_SCAN_INDEX = 2**53
+
+
+def _check_region(r: Region, path: str) -> None:
+    for k in ("xmin", "xmax", "ymin", "ymax"):
+        ck.bounded(getattr(r, k), ck.join(path, k), MAX_COORDINATE)
+
+
+def _check_state(state: Any, path: str) -> None:
+    """``[x, vx, y, vy]`` within ±:data:`MAX_COORDINATE` m and ±:data:`MAX_SPEED` m/s."""
+    for j, v in enumerate(state):
+        if j % 2 == 0:
+            ck.bounded(v, f"{path}[{j}]", MAX_COORDINATE)
+        else:
+            ck.bounded(v, f"{path}[{j}]", MAX_SPEED, "m/s")
 
 
 def _list(v: object, path: str) -> list[Any]:
@@ -329,7 +461,9 @@ def _list(v: object, path: str) -> list[Any]:
 def _region_from(v: object, path: str) -> Region:
     d = ck.table(v, path)
     ck.keys(d, path, {"xmin", "xmax", "ymin", "ymax"})
-    x0, x1, y0, y1 = (ck.number(d[k], ck.join(path, k)) for k in ("xmin", "xmax", "ymin", "ymax"))
+    x0, x1, y0, y1 = (
+        ck.bounded(d[k], ck.join(path, k), MAX_COORDINATE) for k in ("xmin", "xmax", "ymin", "ymax")
+    )
     if x1 <= x0:
         raise ValueError(f"{path}.xmax: must be > xmin ({x1} <= {x0})")
     if y1 <= y0:
@@ -352,14 +486,23 @@ def _sensor_from(v: object, path: str) -> tuple[Sensor, float]:
     if kind == "cartesian":
         ck.keys(d, path, {"kind", "id", "sigma", "pd"})
         sid = ck.integer(d["id"], f"{path}.id", lo=0)
-        sigma = ck.number(d["sigma"], f"{path}.sigma", lo=0.0, lo_open=True)
+        sigma = ck.number(d["sigma"], f"{path}.sigma", lo=0.0, lo_open=True, hi=MAX_SIGMA, unit="m")
         sensor: Sensor = CartesianSensor(id=sid, sigma=sigma)
     else:
         ck.keys(d, path, {"kind", "id", "position", "sigma_range", "sigma_bearing_deg", "pd"})
         sid = ck.integer(d["id"], f"{path}.id", lo=0)
-        pos = ck.array(d["position"], f"{path}.position", (2,))
-        sr = ck.number(d["sigma_range"], f"{path}.sigma_range", lo=0.0, lo_open=True)
-        sb = ck.number(d["sigma_bearing_deg"], f"{path}.sigma_bearing_deg", lo=0.0, lo_open=True)
+        pos = ck.array(d["position"], f"{path}.position", (2,), MAX_SENSOR_COORDINATE)
+        sr = ck.number(
+            d["sigma_range"], f"{path}.sigma_range", lo=0.0, lo_open=True, hi=MAX_SIGMA, unit="m"
+        )
+        sb = ck.number(
+            d["sigma_bearing_deg"],
+            f"{path}.sigma_bearing_deg",
+            lo=0.0,
+            lo_open=True,
+            hi=MAX_SIGMA_BEARING_DEG,
+            unit="degrees",
+        )
         sensor = PolarRadar(sid, (float(pos[0]), float(pos[1])), sr, sb)
     return sensor, ck.probability(d["pd"], f"{path}.pd")
 
@@ -379,11 +522,14 @@ def _target_from(v: object, path: str, first: int, last: int) -> AnyTarget:
                     f"{path}.scans[{i}]: must be > the previous scan ({sc[i]} <= {sc[i - 1]})"
                 )
         st = ck.array(d["states"], f"{path}.states", (len(sc), 4))
+        for i, row in enumerate(st):
+            _check_state(row, f"{path}.states[{i}]")
         with ck.at(path):
             return RecordedTarget(tid, tuple(sc), tuple(map(tuple, st.tolist())))
     ck.keys(d, path, {"id", "state"}, {"birth", "death"})
     tid = ck.integer(d["id"], f"{path}.id", lo=0)
     state = ck.array(d["state"], f"{path}.state", (4,))
+    _check_state(state, f"{path}.state")
     birth = ck.integer(d.get("birth", first), f"{path}.birth", lo=0)
     death = ck.integer(d.get("death", last), f"{path}.death", lo=0)
     with ck.at(path):

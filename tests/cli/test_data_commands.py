@@ -135,3 +135,22 @@ def test_bad_scenario_toml_names_the_key(crossing, tmp_path):
     code, _, stderr = invoke("simulate", str(src), "--out", str(tmp_path / "o"))
     assert code != 0 and "Traceback" not in stderr
     assert "s.toml" in stderr and "T:" in stderr
+
+
+def test_evaluate_refuses_tracks_and_truth_of_different_times(crossing, tmp_path):
+    truth = crossing / "truth.csv"
+    lines = truth.read_text().splitlines()
+    rows = [lines[0]]
+    for line in lines[1:]:
+        f = line.split(",")
+        rows.append(",".join([f[0], repr(float(f[1]) * 10), *f[2:]]))
+    slow = tmp_path / "tracks.csv"
+    slow.write_text("\n".join(rows) + "\n")
+    code, _, stderr = invoke("evaluate", str(slow), str(truth))
+    assert code != 0 and "Traceback" not in stderr
+    first = lines[1].split(",")
+    assert (f"{slow} and {truth} give scan {first[0]} different times "
+            f"({float(first[1]) * 10!r} s and {float(first[1])!r} s)") in stderr
+    code, _, stderr = invoke("evaluate", str(truth), str(truth), "--plots",
+                             str(crossing / "plots.csv"))
+    assert code == 0, stderr

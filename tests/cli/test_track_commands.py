@@ -190,3 +190,101 @@ def test_run_takes_pd_and_sigma_of_a_single_cartesian_sensor():
     assert default_config(from_dict(d)).p_detection == MAX_TRACKER_PD
     # several (polar) sensors: fused scans, P1's 0.9 kept
     assert default_config(preset("multiradar")).p_detection == 0.9
+
+
+@pytest.fixture(scope="module")
+def small_crossing(tmp_path_factory) -> Path:
+    """Plots of 10 crossing scans, moved away from their scenario.toml (kept as s.toml)."""
+    out = tmp_path_factory.mktemp("small")
+    code, _, stderr = invoke("simulate", "crossing", "--seed", "1", "--scans", "10",
+                             "--out", str(out / "sim"))
+    assert code == 0, stderr
+    (out / "p").mkdir()
+    (out / "sim" / "plots.csv").rename(out / "p" / "plots.csv")
+    (out / "sim" / "scenario.toml").rename(out / "s.toml")
+    return out
+
+
+def _edit_plots(src: Path, dst: Path, edit) -> Path:
+    """Copy a plots CSV, applying ``edit(fields)`` to every data row's list of fields."""
+    lines = src.read_text().splitlines()
+    rows = [lines[0]] + [",".join(edit(line.split(","))) for line in lines[1:]]
+    dst.parent.mkdir(parents=True, exist_ok=True)
+    dst.write_text("\n".join(rows) + "\n")
+    return dst
+
+
+def test_track_refuses_a_huge_scan_gap_quickly(small_crossing, tmp_path):
+    def shift(f):
+        return [str(int(f[0]) + 10**9) if int(f[0]) > 5 else f[0], *f[1:]]
+
+    bad = _edit_plots(small_crossing / "p" / "plots.csv", tmp_path / "plots.csv", shift)
+    code, _, stderr = invoke("track", str(bad), "--out", str(tmp_path / "t.csv"),
+                             "--no-progress")
+    assert code != 0 and "Traceback" not in stderr
+    assert f"{bad}, line " in stderr and "follows scan 5" in stderr and "1000000006" in stderr
+    assert not (tmp_path / "t.csv").exists()
+
+
+def test_track_rejects_plots_outside_or_off_the_scenario_scans(small_crossing, tmp_path):
+    plots, scenario = small_crossing / "p" / "plots.csv", str(small_crossing / "s.toml")
+    extra = tmp_path / "extra" / "plots.csv"
+    extra.parent.mkdir()
+    extra.write_text(plots.read_text() + "11,11,0,1,2,-1\n")
+    code, _, stderr = invoke("track", str(extra), "--scenario", scenario,
+                             "--out", str(tmp_path / "t.csv"), "--no-progress")
+    assert code != 0 and "Traceback" not in stderr
+    assert "column 'scan': scan 11 is not a scan of scenario" in stderr
+    assert "(scans 1 to 10); 1 row(s) are outside it" in stderr
+
+    def slow(f):
+        return [f[0], repr(float(f[1]) * 1.5), *f[2:]]
+
+    off = _edit_plots(plots, tmp_path / "off" / "plots.csv", slow)
+    code, _, stderr = invoke("track", str(off), "--scenario", scenario,
+                             "--out", str(tmp_path / "t.csv"), "--no-progress")
+    assert code != 0 and "Traceback" not in stderr
+    assert f"{off}, line 2, column 'time': scan 1 has time 1.5 s, but scenario" in stderr
+    assert "gives 1.0 s" in stderr
+    code, _, stderr = invoke("track", str(plots), "--scenario", scenario,
+                             "--out", str(tmp_path / "t.csv"), "--no-progress")
+    assert code == 0, stderr
+
+
+def test_track_warns_about_polar_plots_without_scenario(tmp_path, caplog):
+    code, _, stderr = invoke("simulate", "multiradar", "--seed", "2", "--scans", "3",
+                             "--clutter-rate", "2", "--out", str(tmp_path / "sim"))
+    assert code == 0, stderr
+    (tmp_path / "p").mkdir()
+    plots = (tmp_path / "sim" / "plots.csv").rename(tmp_path / "p" / "plots.csv")
+    with caplog.at_level("WARNING", logger="mhtrack"):
+        code, _, stderr = invoke("track", str(plots), "--out", str(tmp_path / "t.csv"),
+                                 "--no-progress")
+    assert code == 0, stderr
+    assert "range/bearing columns (polar plots)" in caplog.text and "--scenario" in caplog.text
+
+
+def test_track_area_ignores_and_reports_wild_plots(small_crossing, tmp_path, caplog):
+    from mhtrack.cli.track_commands import _plots_area
+    from mhtrack.io import read_plots
+
+    plots = small_crossing / "p" / "plots.csv"
+    rows = iter(range(10**6))
+
+    def wild(f):
+        return [*f[:3], "1e8", *f[4:]] if next(rows) == 7 else f
+
+    bad = _edit_plots(plots, tmp_path / "plots.csv", wild)
+    with caplog.at_level("WARNING", logger="mhtrack"):
+        area = _plots_area(bad, read_plots(bad))
+    assert "1 of " in caplog.text and "far outside" in caplog.text
+    caplog.clear()
+    with caplog.at_level("WARNING", logger="mhtrack"):
+        assert _plots_area(plots, read_plots(plots)) == pytest.approx(area, rel=0.05)
+    assert "far outside" not in caplog.text
+    assert area < 1e8
+    with caplog.at_level("WARNING", logger="mhtrack"):
+        code, _, stderr = invoke("track", str(bad), "--out", str(tmp_path / "t.csv"),
+                                 "--no-progress")
+    assert code == 0, stderr
+    assert "far outside" in caplog.text

@@ -68,12 +68,12 @@ def test_other_parameters_are_refused(study):
 
 def test_failed_runs_exit_non_zero(tmp_path):
     code, stdout, stderr = invoke(*SMALL, "--trackers", "mht", "--runs", "1", "--workers",
-                                  "1", "--run-kwarg", "no_such_keyword=1", "--out",
+                                  "1", "--run-kwarg", "fusion=bogus", "--out",
                                   str(tmp_path), "--json")
     assert code == 1
     assert "1 run(s) failed" in stderr
     assert json.loads(stdout)["mht"]["failed"] == [0]
-    assert "no_such_keyword" in (tmp_path / "runs" / "mht" / "run-0.error.txt").read_text()
+    assert "unknown fusion 'bogus'" in (tmp_path / "runs" / "mht" / "run-0.error.txt").read_text()
 
 
 def test_bad_options(tmp_path):

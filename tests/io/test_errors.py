@@ -119,6 +119,30 @@ CSV_CASES = [
      "{f}, line 2, column 'range': range 1e+200 is too large (its covariance overflows)"),
     ("polar-needs-range", read_plots, REG, P + "1,0,0,1,2\n1,0,2,1,2\n",
      "{f}: missing column(s) 'range', 'bearing', needed by polar sensor(s) 2"),
+    ("equal-times", read_plots, None, P + "79,79,0,1,2\n80,79,0,1,2\n",
+     "{f}, line 3, column 'time': scan 80 has time 79.0 s, not after scan 79's (line 2); "
+     "times must strictly increase with scan number"),
+    ("equal-times-truth", read_truth, None, G + "1,0,3,1,2,3,4\n2,0,3,1,2,3,4\n",
+     "{f}, line 3, column 'time': scan 2 has time 0.0 s, not after scan 1's (line 2); "
+     "times must strictly increase with scan number"),
+    ("scan-gap", read_plots, None, P + "50,50,0,1,2\n50,50,0,1,2\n1000051,51,0,1,2\n",
+     "{f}, line 4, column 'scan': scan 1000051 follows scan 50 (line 3): the 1000000 scan "
+     "numbers between them would each be tracked as an empty scan, more than the 10000 "
+     "allowed in one gap; renumber the scans"),
+    ("scan-gap-int64-extremes", read_plots, None,
+     P + f"{-2**63},0,0,1,2\n{2**63 - 1},1,0,1,2\n",
+     "{f}, line 3, column 'scan': scan 9223372036854775807 follows scan "
+     "-9223372036854775808 (line 2): the 18446744073709551614 scan numbers between them "
+     "would each be tracked as an empty scan, more than the 10000 allowed in one gap; "
+     "renumber the scans"),
+    ("scan-gaps-total", read_plots, None,
+     P + "".join(f"{k * 5001},{k},0,1,2\n" for k in range(4)),
+     "{f}, line 3, column 'scan': the file has 4 scans with plots but 15000 scan numbers "
+     "without any, more than the 10000 allowed (max(10000, 10 × scans with plots)); the "
+     "largest gap: scan 5001 follows scan 0 (line 2): the 5000 scan numbers between them "
+     "would each be tracked as an empty scan; renumber the scans"),
+    ("cr-only-line-ends", read_plots, None, (P + "1,0,0,1,2\n\n1,0,0,x,2\n").replace("\n", "\r"),
+     "{f}, line 4, column 'x': value 'x' is not a number"),
 ]  # fmt: skip
 
 
@@ -135,6 +159,62 @@ def test_malformed_csv(tmp_path: Path, reader, sensors, text: str, message: str)
         reader(path, **kwargs)
     assert str(info.value) == message.format(f=path)
     assert info.value.file == str(path)
+
+
+def test_gap_of_max_gap_empty_scans_is_accepted(tmp_path: Path) -> None:
+    from mhtrack.io.plots import MAX_GAP
+
+    path = tmp_path / "plots.csv"
+    path.write_text(P + f"1,1,0,1,2\n{MAX_GAP + 2},2,0,1,2\n")
+    assert read_plots(path).n_scans == MAX_GAP + 2
+
+
+def test_cr_only_line_ends_read_like_lf(tmp_path: Path) -> None:
+    text = "\ufeff" + P + "1,0,0,1,2\n\n2,1,0,3,4\n"
+    (tmp_path / "lf.csv").write_text(text, newline="")
+    (tmp_path / "cr.csv").write_text(text.replace("\n", "\r"), newline="")
+    a, b = read_plots(tmp_path / "lf.csv"), read_plots(tmp_path / "cr.csv")
+    for name in ("scan", "time", "sensor", "x", "y"):
+        assert np.array_equal(getattr(a, name), getattr(b, name))
+
+
+@pytest.mark.parametrize(("line", "column"), [(3, "scan"), (4, "y")])
+def test_invalid_utf8_names_file_line_and_column(tmp_path: Path, line: int, column: str) -> None:
+    lines = [P.encode()[:-1], b"1,0,0,1,2", b"2,1,0,1,2", b"2,1,0,1,2"]
+    if column == "scan":
+        lines[line - 1] = b"2\xff,1,0,1,2"
+    else:
+        lines[line - 1] = b"2,1,0,1,2\xff"
+    path = tmp_path / "plots.csv"
+    path.write_bytes(b"\n".join(lines) + b"\n")
+    with pytest.raises(InputError) as info:
+        read_plots(path)
+    assert str(info.value) == (
+        f"{path}, line {line}, column {column!r}: not valid UTF-8 text (byte 0xff)"
+    )
+
+
+def test_plots_checked_against_scenario_scans(tmp_path: Path) -> None:
+    from mhtrack.io.plots import check_scan_times
+
+    path = tmp_path / "plots.csv"
+    path.write_text(P + "1,1,0,1,2\n2,2,0,1,2\n5,5,0,1,2\n")
+    table = read_plots(path)
+    scans, times = np.arange(1, 6), np.arange(1, 6) * 1.0
+    check_scan_times(path, table, scans, times, "scenario s.toml")
+    check_scan_times(path, table, scans, times * (1 + 1e-9), "scenario s.toml")
+    with pytest.raises(InputError) as info:
+        check_scan_times(path, table, scans[:4], times[:4], "scenario s.toml")
+    assert str(info.value) == (
+        f"{path}, line 4, column 'scan': scan 5 is not a scan of scenario s.toml (scans 1 "
+        "to 4); 1 row(s) are outside it"
+    )
+    with pytest.raises(InputError) as info:
+        check_scan_times(path, table, scans, times * 10, "scenario s.toml")
+    assert str(info.value) == (
+        f"{path}, line 2, column 'time': scan 1 has time 1.0 s, but scenario s.toml gives "
+        "10.0 s for it; the plots' times must match the scenario's k·T"
+    )
 
 
 def test_error_attributes_locate_the_cell(tmp_path: Path) -> None:
@@ -319,3 +399,10 @@ def test_toml_none_is_refused(tmp_path: Path) -> None:
     with pytest.raises(ValueError, match=r"scenario key 'clutter\.rate' is None"):
         write_scenario_toml({"clutter": {"rate": None}}, tmp_path / "s.toml")
     assert not (tmp_path / "s.toml").exists()
+
+
+def test_plot_coordinates_beyond_the_trackers_bound_are_located(tmp_path: Path) -> None:
+    p = tmp_path / "plots.csv"
+    p.write_text("scan,time,sensor,x,y\n1,1,0,0,0\n1,1,0,1e30,0\n2,2,0,0,0\n")
+    with pytest.raises(InputError, match=r"line 3.*'x'.*beyond ±1e\+09 m"):
+        read_plots(p)

@@ -16,6 +16,7 @@ from mhtrack.io import (
     write_tracks,
     write_truth,
 )
+from mhtrack.io.plots import MAX_GAP
 from mhtrack.models.sensors import CartesianSensor, PolarRadar
 from mhtrack.records import PlotTable, TrackTable, TruthTable
 
@@ -45,23 +46,34 @@ def same_bits(want: np.ndarray, got: np.ndarray) -> bool:
 
 
 @st.composite
-def scans_and_times(draw: st.DrawFn, min_scans: int = 0) -> list[tuple[int, float]]:
-    """Strictly increasing scan indices with non-decreasing times."""
-    scans = sorted(draw(st.sets(int64, min_size=min_scans, max_size=8)))
-    times = sorted(draw(st.lists(finite, min_size=len(scans), max_size=len(scans))))
+def scans_and_times(
+    draw: st.DrawFn, min_scans: int = 0, max_step: int | None = None
+) -> list[tuple[int, float]]:
+    """Strictly increasing scan indices with strictly increasing times; with ``max_step``,
+    consecutive scan indices at most that far apart (plots files bound the gaps)."""
+    if max_step is None:
+        scans = sorted(draw(st.sets(int64, min_size=min_scans, max_size=8)))
+    else:
+        steps = draw(st.lists(st.integers(1, max_step), min_size=max(min_scans - 1, 0),
+                              max_size=7))
+        first = draw(st.integers(-(2**63), 2**63 - 1 - sum(steps)))
+        scans = [first + sum(steps[:i]) for i in range(len(steps) + 1)]
+    times = sorted(draw(st.sets(finite, min_size=len(scans), max_size=len(scans))))
     return list(zip(scans, times, strict=True))
 
 
 @st.composite
 def plot_tables(draw: st.DrawFn) -> PlotTable:
     rows = []
-    for k, t in draw(scans_and_times(min_scans=1)):
+    for k, t in draw(scans_and_times(min_scans=1, max_step=MAX_GAP // 7 + 1)):
         rows += [(k, t)] * draw(st.integers(1, 4))
     n = len(rows)
     polar = draw(st.booleans())
     with_origin = draw(st.booleans())
     sensor = np.array(draw(st.lists(st.integers(0, 3), min_size=n, max_size=n)), np.int64)
     floats = st.lists(finite, min_size=n, max_size=n)
+    # plot positions within the readers' ±1e9 m (io.plots.MAX_COORDINATE)
+    coords = st.lists(st.floats(-1e9, 1e9), min_size=n, max_size=n)
     rng = bearing = None
     if polar:  # sensors 0, 1 are polar; 2, 3 Cartesian with empty range/bearing
         cart = sensor >= 2
@@ -72,8 +84,8 @@ def plot_tables(draw: st.DrawFn) -> PlotTable:
         scan=np.array([r[0] for r in rows], np.int64),
         time=np.array([r[1] for r in rows], np.float64),
         sensor=sensor,
-        x=np.array(draw(floats)),
-        y=np.array(draw(floats)),
+        x=np.array(draw(coords)),
+        y=np.array(draw(coords)),
         range=rng,
         bearing=bearing,
         origin=np.array(draw(st.lists(st.integers(-1, 2**62), min_size=n, max_size=n)))

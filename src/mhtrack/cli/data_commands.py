@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import click
 
@@ -57,12 +58,31 @@ def evaluate(tracks: Path, truth: Path, plots: Path | None, cutoff: float, order
     tr = read_tracks(tracks)
     gt = read_truth(truth)
     pl = read_plots(plots) if plots is not None else None
+    _check_same_times(tracks, tr, truth, gt)
+    if pl is not None and plots is not None:
+        _check_same_times(plots, pl, truth, gt)
     ev = run_evaluation(tr, gt, plots=pl, cutoff=cutoff, order=order,
                         match_distance=match_distance)
     if as_json:
         echo_json(ev.to_dict())
     else:
         click.echo(ev.to_table())
+
+
+def _check_same_times(path_a: Path, a: Any, path_b: Path, b: Any) -> None:
+    """Two tables of one run give every scan they share the same time; else an
+    :class:`~mhtrack.io.InputError` names both files and the first scan that differs."""
+    from mhtrack.io import InputError
+    from mhtrack.metrics._common import first_time_mismatch
+
+    bad = first_time_mismatch(a.scan, a.time, b.scan, b.time)
+    if bad is not None:
+        k, ta, tb = bad
+        raise InputError(
+            f"{path_a} and {path_b} give scan {k} different times ({ta!r} s and {tb!r} s); "
+            "they do not come from the same scans (same scan numbers must have the same time)",
+            file=str(path_a),
+        )
 
 
 @click.command()

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import logging
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -134,6 +135,7 @@ def track(plots: Path, tracker: str, tracker_pd: float | None, meas_sigma: float
     from mhtrack.experiments.pipeline import default_config, default_fusion, make_tracker
     from mhtrack.experiments.pipeline import track as run_tracker
     from mhtrack.io import read_plots, write_tracks
+    from mhtrack.io.plots import check_scan_times
     from mhtrack.scenario import load_scenario
 
     if scenario_file is None and (plots.parent / "scenario.toml").is_file():
@@ -145,18 +147,25 @@ def track(plots: Path, tracker: str, tracker_pd: float | None, meas_sigma: float
         sensors = {s.id: s for s in scenario.sensors}
     table = read_plots(plots, sensors=sensors)
     if scenario is not None:
+        check_scan_times(plots, table, scenario.scan_indices(), scenario.scan_times(),
+                         f"scenario {scenario_file}")
         table = dataclasses.replace(
             table, scan_times=(scenario.scan_indices(), scenario.scan_times())
         )
+    elif table.range is not None:
+        logging.getLogger("mhtrack").warning(
+            "%s has range/bearing columns (polar plots), but no scenario gives its sensors: "
+            "they are ignored and x, y tracked as Cartesian plots with the tracker's σw; "
+            "pass --scenario with the radar(s) to use the polar measurement model", plots)
     if fusion is None:
         n_sensors = (len(scenario.sensors) if scenario is not None
                      else len(np.unique(table.sensor)))
         fusion = default_fusion(n_sensors)
     if scenario is not None:
         base = default_config(scenario)
-    else:  # no scenario: the plots' bounding box is the surveillance area
-        span = max(float(np.ptp(table.x)), 1.0) * max(float(np.ptp(table.y)), 1.0)
-        base = default_config(area=span) if len(table) > 1 else default_config()
+    else:  # no scenario: a robust box around the plots is the surveillance area
+        base = default_config(area=_plots_area(plots, table)) if len(table) > 1 \
+            else default_config()
     cfg = _config(base, tracker_pd, meas_sigma, accel_sigma, birth_density, nscan,
                   imm_accel_sigma)
     _check_clutter_density(tracker, clutter_density)
@@ -204,7 +213,10 @@ def run(scenario: str, seed: int, clutter: str | None, clutter_rate: float | Non
     from mhtrack.plotting.scene import plot_scene, save_figure
 
     sc = load_scenario_arg(scenario, clutter, clutter_rate, pd, scans)
-    tracker_pd = tracker_pd if tracker_pd is not None else pd
+    if tracker_pd is None and pd is not None:  # the scenario's P_D, as default_config caps it
+        from mhtrack.experiments.pipeline import MAX_TRACKER_PD
+
+        tracker_pd = min(pd, MAX_TRACKER_PD)
     cfg = _config(default_config(sc), tracker_pd, meas_sigma, accel_sigma, birth_density,
                   nscan, imm_accel_sigma)
     _check_clutter_density(tracker, clutter_density)
@@ -238,6 +250,32 @@ def run(scenario: str, seed: int, clutter: str | None, clutter_rate: float | Non
     if result.run.caps:
         click.echo(f"hard caps acted: {result.run.caps}")
     click.echo(f"wrote {out}/ (plots, truth, tracks, metrics.json, scene.png, metrics.png)")
+
+
+#: Without a scenario, ``track`` takes the surveillance area from the box between these
+#: quantiles of the plots' x and y (so a few wild plots do not inflate it), and warns about
+#: plots lying farther outside that box than its own width (east-west) or height.
+AREA_QUANTILES = (0.005, 0.995)
+
+
+def _plots_area(plots: Path, table: Any) -> float:
+    """Surveillance area (m²) of a plots file with no scenario: the 0.5–99.5 % quantile
+    box of x and y (each side at least 1 m); warns about plots far outside it."""
+    import numpy as np
+
+    (x0, x1), (y0, y1) = (np.quantile(v, AREA_QUANTILES) for v in (table.x, table.y))
+    wx, wy = max(float(x1 - x0), 1.0), max(float(y1 - y0), 1.0)
+    with np.errstate(over="ignore", invalid="ignore"):
+        far = ((table.x < x0 - wx) | (table.x > x1 + wx)
+               | (table.y < y0 - wy) | (table.y > y1 + wy))
+    n_far = int(np.count_nonzero(far))
+    if n_far:
+        logging.getLogger("mhtrack").warning(
+            "%s: %d of %d plots lie far outside the box holding the middle 99%% of the plots "
+            "(x %.6g to %.6g m, y %.6g to %.6g m); the surveillance area (%.4g m²) is taken "
+            "from that box — check those plots, or pass --scenario with the true region",
+            plots, n_far, len(table), x0, x1, y0, y1, wx * wy)
+    return wx * wy
 
 
 def _warn_known_kappa(sc: Any, tracker: str, clutter_density: float | None) -> None:

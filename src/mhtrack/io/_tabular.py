@@ -104,15 +104,25 @@ class Source:
     # -- CSV line numbers (computed only when an error needs one) ------------------------
     def _scan_lines(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         buf = np.frombuffer(self.path.read_bytes(), np.uint8)
-        nl = np.flatnonzero(buf == ord("\n"))
+        lf = buf == ord("\n")
+        cr = buf == ord("\r")
+        bare_cr = cr & ~np.concatenate((lf[1:], [False]))  # old-Mac line end
+        nl = np.flatnonzero(lf | bare_cr)
         starts = np.concatenate(([0], nl + 1))
         ends = np.concatenate((nl, [buf.size]))
         length = ends - starts
         has = length > 0
-        cr = np.zeros(length.size, bool)
-        cr[has] = buf[ends[has] - 1] == ord("\r")
-        nonempty = np.flatnonzero(length - cr > 0)  # pyarrow skips empty lines
+        crlf = np.zeros(length.size, bool)
+        crlf[has] = cr[ends[has] - 1]
+        nonempty = np.flatnonzero(length - crlf > 0)  # pyarrow skips empty lines
         return buf, starts, ends, nonempty
+
+    def line_at_offset(self, offset: int) -> tuple[int, int]:
+        """(1-based line, 0-based field index) of byte ``offset`` of a CSV file."""
+        buf, starts, _ends, _nonempty = self._scan_lines()
+        i = int(np.searchsorted(starts, offset, side="right")) - 1
+        field = int(np.count_nonzero(buf[starts[i] : offset] == ord(",")))
+        return i + 1, field
 
     def line_of(self, row: int) -> int | None:
         """1-based line of data row ``row`` of a CSV file (the header is the first non-empty
@@ -136,14 +146,22 @@ class Source:
 
 
 def _csv_header(src: Source) -> list[str]:
+    """The first non-empty line (ended by ``\n``, ``\r\n`` or a lone ``\r``), parsed."""
+    data = stripped = b""
+    end = None
     with src.path.open("rb") as fh:
-        for raw in fh:
-            if raw.strip(b"\r\n"):
+        while end is None:
+            chunk = fh.read(1 << 16)
+            data += chunk
+            stripped = data.lstrip(b"\r\n")
+            end = re.search(rb"[\r\n]", stripped)
+            if not chunk:
                 break
-        else:
-            raise src.error("file is empty (no header line)")
+    if not stripped:
+        raise src.error("file is empty (no header line)")
+    raw = stripped[: end.start()] if end else stripped
     try:
-        text = raw.decode("utf-8-sig").rstrip("\r\n")
+        text = raw.decode("utf-8-sig")
     except UnicodeDecodeError:
         raise src.error("header line is not valid UTF-8 text") from None
     return next(csv.reader([text]))
@@ -280,6 +298,10 @@ def read_frame(
 
 def _csv_error(src: Source, names: list[str], message: str) -> InputError:
     """Turn a pyarrow CSV error (which has no line number) into a located InputError."""
+    if "invalid UTF8" in message or "\ufffd" in message:
+        utf8 = _utf8_error(src, names)
+        if utf8 is not None:
+            return utf8
     m = _CONVERSION.search(message)
     if m and int(m[1]) < len(names):
         name, value = names[int(m[1])], m[3]
@@ -297,6 +319,20 @@ def _csv_error(src: Source, names: list[str], message: str) -> InputError:
         line = src.line_with_field_count_not(int(m[1]))
         return src.error(f"expected {m[1]} comma-separated fields, found {m[2]}", line=line)
     return src.error(f"cannot parse CSV ({message})")
+
+
+def _utf8_error(src: Source, names: list[str]) -> InputError | None:
+    """Locate the first byte that is not UTF-8 (pyarrow's error names only a column);
+    ``None`` if the file is valid UTF-8 after all."""
+    data = src.path.read_bytes()
+    try:
+        data.decode("utf-8")
+    except UnicodeDecodeError as e:
+        line, field = src.line_at_offset(e.start)
+        column = names[field] if field < len(names) else None
+        byte = data[e.start]
+        return src.error(f"not valid UTF-8 text (byte 0x{byte:02x})", line=line, column=column)
+    return None
 
 
 def write_frame(path: PathArg, columns: Mapping[str, pa.Array]) -> None:
@@ -358,6 +394,15 @@ def check_scan_order(frame: Frame, scan: np.ndarray, time: np.ndarray) -> None:
         lambda r: (
             f"time goes backwards: {num(time[r])} at scan {num(scan[r])} after "
             f"{num(time[r - 1])} at scan {num(scan[r - 1])} ({src.where(r - 1)})"
+        ),
+    )
+    frame.check(
+        ~same & ~changed & (np.arange(scan.size) > 0),
+        "time",
+        lambda r: (
+            f"scan {num(scan[r])} has time {num(time[r])} s, not after scan "
+            f"{num(scan[r - 1])}'s ({src.where(r - 1)}); times must strictly increase "
+            "with scan number"
         ),
     )
 

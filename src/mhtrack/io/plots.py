@@ -16,6 +16,7 @@ from mhtrack.io._tabular import (
     INT,
     Frame,
     PathArg,
+    Source,
     check_scan_order,
     float_array,
     int_array,
@@ -39,6 +40,17 @@ COLUMNS = {
 }
 
 SensorRegistry = Mapping[int, CartesianSensor | PolarRadar]
+
+#: Empty scans (scan numbers with no plot) that a plots file may imply between two of its
+#: scans: at most MAX_GAP in one gap, and at most max(MAX_GAP, MAX_EMPTY_RATIO × the number
+#: of scans with plots) in all; ``PlotTable.scans()`` feeds every one of them to the tracker.
+MAX_GAP = 10_000
+MAX_EMPTY_RATIO = 10
+
+
+#: Largest plot coordinate a plots file may hold (m), the tracker's own bound
+#: (:data:`mhtrack.mht.tracker.MAX_COORDINATE`).
+MAX_COORDINATE = 1e9
 
 
 def read_plots(path: PathArg, sensors: SensorRegistry | None = None) -> PlotTable:
@@ -71,7 +83,12 @@ def read_plots(path: PathArg, sensors: SensorRegistry | None = None) -> PlotTabl
     sensor = f.ints("sensor")
     x = f.floats("x")
     y = f.floats("y")
+    for name, v in (("x", x), ("y", y)):
+        f.check(np.abs(v) > MAX_COORDINATE, name,
+                lambda r, v=v: f"{num(v[r])} m is beyond ±{MAX_COORDINATE:g} m of the "
+                "frame's origin (a unit or parsing error?)")
     check_scan_order(f, scan, time)
+    _check_gaps(f, scan)
     origin = None
     if f.has("origin"):
         origin = f.ints("origin")
@@ -96,6 +113,39 @@ def read_plots(path: PathArg, sensors: SensorRegistry | None = None) -> PlotTabl
         scan=scan, time=time, sensor=sensor, x=x, y=y,
         range=rng, bearing=bearing, origin=origin, R=R,
     )  # fmt: skip
+
+
+def _check_gaps(f: Frame, scan: np.ndarray) -> None:
+    """Refuse scan-number gaps that would make the tracker run through a huge number of
+    empty scans (see :data:`MAX_GAP`)."""
+    new = np.flatnonzero(scan[1:] != scan[:-1]) + 1  # first row of each scan but the first
+    if new.size == 0:
+        return
+    gap = scan[new].astype(np.float64) - scan[new - 1].astype(np.float64) - 1.0  # no overflow
+    where = f.src.where
+
+    def text(i: int) -> str:
+        r = int(new[i])
+        a, b = int(scan[r - 1]), int(scan[r])
+        return (
+            f"scan {b} follows scan {a} ({where(r - 1)}): the {b - a - 1} scan numbers "
+            f"between them would each be tracked as an empty scan"
+        )
+
+    big = np.flatnonzero(gap > MAX_GAP)
+    if big.size:
+        i = int(big[0])
+        f.fail(f"{text(i)}, more than the {MAX_GAP} allowed in one gap; renumber the scans",
+               row=int(new[i]), column="scan")
+    total = float(gap.sum())
+    limit = max(MAX_GAP, MAX_EMPTY_RATIO * (new.size + 1))
+    if total > limit:
+        i = int(np.argmax(gap))
+        f.fail(
+            f"the file has {new.size + 1} scans with plots but {int(total)} scan numbers "
+            f"without any, more than the {limit} allowed (max({MAX_GAP}, "
+            f"{MAX_EMPTY_RATIO} × scans with plots)); the largest gap: {text(i)}; renumber "
+            "the scans", row=int(new[i]), column="scan")
 
 
 def _check_sensors(f: Frame, sensor: np.ndarray, sensors: SensorRegistry) -> np.ndarray:
@@ -172,6 +222,42 @@ def _covariances(
         else:
             R[rows] = s.R
     return R
+
+
+def check_scan_times(
+    path: PathArg, table: PlotTable, scans: np.ndarray, times: np.ndarray, origin: str,
+    *, rtol: float = 1e-6,
+) -> None:
+    """Check the plots read from ``path`` against the scan list of ``origin`` (e.g. a
+    scenario file): every row's scan must be one of ``scans`` and its time the matching
+    entry of ``times`` (to ``rtol``, relative). Raises a located :class:`InputError` for the
+    first offending row."""
+    src = Source(path)
+    scans = np.asarray(scans, np.int64)
+    times = np.asarray(times, np.float64)
+    order = np.argsort(scans, kind="stable")
+    scans, times = scans[order], times[order]
+    if scans.size == 0:
+        raise src.error(f"{origin} has no scans")
+    pos = np.clip(np.searchsorted(scans, table.scan), 0, scans.size - 1)
+    outside = np.flatnonzero(scans[pos] != table.scan)
+    if outside.size:
+        r = int(outside[0])
+        raise src.error(
+            f"scan {num(table.scan[r])} is not a scan of {origin} (scans "
+            f"{num(scans[0])} to {num(scans[-1])}); {outside.size} row(s) are outside it",
+            row=r, column="scan",
+        )
+    expected = times[pos]
+    tol = rtol * np.maximum(np.abs(expected), np.abs(table.time)) + 1e-12
+    off = np.flatnonzero(np.abs(table.time - expected) > tol)
+    if off.size:
+        r = int(off[0])
+        raise src.error(
+            f"scan {num(table.scan[r])} has time {num(table.time[r])} s, but {origin} gives "
+            f"{num(expected[r])} s for it; the plots' times must match the scenario's k·T",
+            row=r, column="time",
+        )
 
 
 def write_plots(table: PlotTable, path: PathArg) -> None:

@@ -163,3 +163,22 @@ def per_scan_points(
 def all_scans(tracks: TrackTable, truth: TruthTable, scans: npt.ArrayLike | None) -> np.ndarray:
     """The union of the truth's scans, the tracks' scans and an explicit list."""
     return scan_union(truth.scan, tracks.scan, check_scans(scans))
+
+
+def first_time_mismatch(
+    scan_a: np.ndarray, time_a: np.ndarray, scan_b: np.ndarray, time_b: np.ndarray,
+    *, rtol: float = 1e-6, atol: float = 1e-9,
+) -> tuple[int, float, float] | None:
+    """The first scan (in scan order) present in both tables whose times differ (beyond
+    ``rtol`` relative, ``atol`` absolute), as ``(scan, time in a, time in b)``; ``None``
+    when they agree. Each table holds one time per scan (as the file readers check)."""
+    ka, ia = np.unique(np.asarray(scan_a, np.int64), return_index=True)
+    kb, ib = np.unique(np.asarray(scan_b, np.int64), return_index=True)
+    common, ja, jb = np.intersect1d(ka, kb, assume_unique=True, return_indices=True)
+    ta = np.asarray(time_a, np.float64)[ia[ja]]
+    tb = np.asarray(time_b, np.float64)[ib[jb]]
+    bad = np.flatnonzero(~np.isclose(ta, tb, rtol=rtol, atol=atol))
+    if bad.size == 0:
+        return None
+    i = int(bad[0])
+    return int(common[i]), float(ta[i]), float(tb[i])

@@ -19,6 +19,14 @@ This module imports nothing from mhtrack, so any layer may import it cheaply.
 from __future__ import annotations
 
 
+def short_number(x: float) -> str:
+    """Short form of a limit or a count in messages: ``1e6``, ``30``, ``5e7``, ``2.5e4``."""
+    if abs(x) >= 1e4:
+        m, e = f"{x:.6e}".split("e")
+        return f"{m.rstrip('0').rstrip('.')}e{int(e)}"
+    return f"{x:g}"
+
+
 class InputError(ValueError):
     """A user-supplied file (or path) is missing, unreadable or malformed.
 

@@ -23,6 +23,11 @@ import numpy as np
 
 CLUTTER = -1
 NO_PLOT = -1
+#: Largest ``|coordinate|`` (m) of the local frame that plots, sensors, regions and target
+#: states may have: 10⁹ m is 2.6× the Moon's distance; beyond it squared distances in
+#: gating and the clutter fit lose all precision. Checked by the plots reader, the
+#: scenario and sensor validation and the tracker.
+MAX_COORDINATE = 1e9
 
 
 def _f8(a: object) -> np.ndarray:

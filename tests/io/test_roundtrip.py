@@ -72,7 +72,7 @@ def plot_tables(draw: st.DrawFn) -> PlotTable:
     with_origin = draw(st.booleans())
     sensor = np.array(draw(st.lists(st.integers(0, 3), min_size=n, max_size=n)), np.int64)
     floats = st.lists(finite, min_size=n, max_size=n)
-    # plot positions within the readers' ±1e9 m (io.plots.MAX_COORDINATE)
+    # plot positions within the readers' ±1e9 m (records.MAX_COORDINATE)
     coords = st.lists(st.floats(-1e9, 1e9), min_size=n, max_size=n)
     rng = bearing = None
     if polar:  # sensors 0, 1 are polar; 2, 3 Cartesian with empty range/bearing

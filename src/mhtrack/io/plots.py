@@ -25,7 +25,7 @@ from mhtrack.io._tabular import (
     write_frame,
 )
 from mhtrack.models.sensors import CartesianSensor, PolarRadar
-from mhtrack.records import PlotTable
+from mhtrack.records import MAX_COORDINATE, PlotTable
 
 REQUIRED = ("scan", "time", "sensor", "x", "y")
 COLUMNS = {
@@ -46,11 +46,6 @@ SensorRegistry = Mapping[int, CartesianSensor | PolarRadar]
 #: of scans with plots) in all; ``PlotTable.scans()`` feeds every one of them to the tracker.
 MAX_GAP = 10_000
 MAX_EMPTY_RATIO = 10
-
-
-#: Largest plot coordinate a plots file may hold (m), the tracker's own bound
-#: (:data:`mhtrack.mht.tracker.MAX_COORDINATE`).
-MAX_COORDINATE = 1e9
 
 
 def read_plots(path: PathArg, sensors: SensorRegistry | None = None) -> PlotTable:

@@ -47,9 +47,10 @@ from mhtrack.initiation import Initiator, make_initiator
 from mhtrack.initiation.window import Window
 from mhtrack.mht.config import BIRTHS
 from mhtrack.mht.scoring import birth_score, update_increment
+from mhtrack.mht.tree import one_point_state
 from mhtrack.models import imm, kalman
 from mhtrack.models.imm import CVModelSet
-from mhtrack.models.motion import POS, VEL, ConstantVelocity
+from mhtrack.models.motion import ConstantVelocity
 from mhtrack.records import Scan
 
 NO_PLOT = -1
@@ -81,19 +82,6 @@ class BirthCandidates:
         f = np.zeros(0)
         return cls(np.zeros((0, 4)), np.zeros((0, 4, 4)), f, f.copy(),
                    np.zeros((0, width), np.int64), np.zeros(0, np.int64))
-
-
-def one_point_state(z: np.ndarray, R: np.ndarray, v_max: float) -> tuple[np.ndarray,
-                                                                          np.ndarray]:
-    """``x = [zx, 0, zy, 0]``, position covariance ``R``, velocity variance ``(v_max/2)²``
-    (the every-plot initialisation of :func:`~mhtrack.mht.tree.birth_leaves`)."""
-    n = len(z)
-    x = np.zeros((n, 4))
-    x[:, POS] = z
-    P = np.zeros((n, 4, 4))
-    P[:, POS[:, None], POS[None, :]] = R
-    P[:, VEL, VEL] = (0.5 * v_max) ** 2
-    return x, P
 
 
 def sequence_score(

@@ -60,11 +60,7 @@ from mhtrack.mht.tree import (
 )
 from mhtrack.models import imm, kalman
 from mhtrack.models.motion import ConstantVelocity
-from mhtrack.records import PlotTable, Scan, TrackTable
-
-#: Largest plot coordinate the tracker accepts (m): 10⁹ m is 2.6× the Moon's distance;
-#: beyond it squared distances in gating and the clutter fit lose all precision.
-MAX_COORDINATE = 1e9
+from mhtrack.records import MAX_COORDINATE, PlotTable, Scan, TrackTable
 
 logger = logging.getLogger(__name__)
 

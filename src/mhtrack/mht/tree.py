@@ -215,6 +215,20 @@ def grow_children(
     )
 
 
+def one_point_state(z: np.ndarray, R: np.ndarray, v_max: float) -> tuple[np.ndarray,
+                                                                          np.ndarray]:
+    """One-point initialisation of plots ``z`` (n, 2): ``x = [zx, 0, zy, 0]``, position
+    covariance ``R``, velocity variance ``(v_max/2)²`` per axis (the velocity is unknown
+    but bounded by ``v_max`` at 2σ)."""
+    n = len(z)
+    x = np.zeros((n, 4))
+    x[:, POS] = z
+    P = np.zeros((n, 4, 4))
+    P[:, POS[:, None], POS[None, :]] = R
+    P[:, VEL, VEL] = (0.5 * v_max) ** 2
+    return x, P
+
+
 def birth_leaves(
     z: np.ndarray,
     R: np.ndarray,
@@ -226,18 +240,12 @@ def birth_leaves(
     width: int,
     models: imm.CVModelSet | None = None,
 ) -> Leaves:
-    """One new tree per plot: one-point initialisation ``x = [zx, 0, zy, 0]`` with position
-    covariance the plot's ``R`` and velocity variance ``(v_max/2)²`` per axis (the
-    velocity is unknown but bounded by ``v_max`` at 2σ); initial score ``score``
+    """One new tree per plot, from :func:`one_point_state`; initial score ``score``
     (the birth score, Blackman & Popoli 1999 §6.2). Tree ids ``first_tree, first_tree+1, …``.
     With an IMM every model starts from that state, with equal probabilities.
     """
     n = len(z)
-    x = np.zeros((n, 4))
-    x[:, POS] = z
-    P = np.zeros((n, 4, 4))
-    P[:, POS[:, None], POS[None, :]] = R
-    P[:, VEL, VEL] = (0.5 * v_max) ** 2
+    x, P = one_point_state(z, R, v_max)
     window = np.full((n, width), NO_PLOT, np.int64)
     window[:, -1] = rows
     return Leaves(

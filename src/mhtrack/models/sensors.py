@@ -22,6 +22,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from mhtrack.errors import short_number
+from mhtrack.records import MAX_COORDINATE
+
 #: Largest Cartesian ``sigma`` and polar ``sigma_range`` accepted (m): 1000 km, far beyond
 #: any real sensor, and small enough that ``σ²`` and the plots stay finite.
 MAX_SIGMA = 1e6
@@ -29,13 +32,6 @@ MAX_SIGMA = 1e6
 #: by ``λ = exp(−σθ²/2)``, which explodes for wide bearing errors (σθ = 1000° gives plots
 #: at 1e68 m); beyond 30° a "radar" no longer gives a usable bearing.
 MAX_SIGMA_BEARING_DEG = 30.0
-#: Largest ``|coordinate|`` of a radar position (m), as for plots (``MHTTracker``).
-MAX_SENSOR_COORDINATE = 1e9
-
-
-def _g(x: float) -> str:
-    """Short form of a limit in messages: ``1e6``, ``30``."""
-    return f"{x:g}".replace("e+0", "e").replace("e+", "e")
 
 
 def _in_range(value: object, hi: float) -> bool:
@@ -69,7 +65,8 @@ class CartesianSensor:
     def __post_init__(self) -> None:
         if not _in_range(self.sigma, MAX_SIGMA):
             raise ValueError(
-                f"sensor {self.id}: sigma must be > 0 and <= {_g(MAX_SIGMA)} m, got {self.sigma}"
+                f"sensor {self.id}: sigma must be > 0 and <= {short_number(MAX_SIGMA)} m, "
+                f"got {self.sigma}"
             )
 
     @property
@@ -102,21 +99,21 @@ class PolarRadar:
     def __post_init__(self) -> None:
         if not _in_range(self.sigma_range, MAX_SIGMA):
             raise ValueError(
-                f"sensor {self.id}: sigma_range must be > 0 and <= {_g(MAX_SIGMA)} m, "
+                f"sensor {self.id}: sigma_range must be > 0 and <= {short_number(MAX_SIGMA)} m, "
                 f"got {self.sigma_range}"
             )
         if not _in_range(self.sigma_bearing_deg, MAX_SIGMA_BEARING_DEG):
             raise ValueError(
                 f"sensor {self.id}: sigma_bearing_deg must be > 0 and <= "
-                f"{_g(MAX_SIGMA_BEARING_DEG)} degrees, got {self.sigma_bearing_deg}"
+                f"{short_number(MAX_SIGMA_BEARING_DEG)} degrees, got {self.sigma_bearing_deg}"
             )
         pos = tuple(float(v) for v in self.position)
         if len(pos) != 2 or not all(
-            np.isfinite(v) and abs(v) <= MAX_SENSOR_COORDINATE for v in pos
+            np.isfinite(v) and abs(v) <= MAX_COORDINATE for v in pos
         ):
             raise ValueError(
                 f"sensor {self.id}: position must be two finite coordinates within "
-                f"±{_g(MAX_SENSOR_COORDINATE)} m, got {self.position!r}"
+                f"±{short_number(MAX_COORDINATE)} m, got {self.position!r}"
             )
         object.__setattr__(self, "position", pos)
 

@@ -13,6 +13,8 @@ from typing import Any
 
 import numpy as np
 
+from mhtrack.errors import short_number as fmt
+
 _KEYED = re.compile(r"^[A-Za-z_]\w*(\[\d+\])*(\.\w+(\[\d+\])*)*: ")
 
 
@@ -63,14 +65,6 @@ def keys(
 
 def _tname(v: object) -> str:
     return type(v).__name__
-
-
-def fmt(x: float) -> str:
-    """Short form of a limit or a count in messages: ``1e6``, ``30``, ``5e7``, ``2.5e4``."""
-    if abs(x) >= 1e4:
-        m, e = f"{x:.6e}".split("e")
-        return f"{m.rstrip('0').rstrip('.')}e{int(e)}"
-    return f"{x:g}"
 
 
 def number(

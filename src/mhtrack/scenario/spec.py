@@ -35,13 +35,13 @@ from mhtrack.models.clutter import (
     UniformClutter,
 )
 from mhtrack.models.sensors import (
-    MAX_SENSOR_COORDINATE,
     MAX_SIGMA,
     MAX_SIGMA_BEARING_DEG,
     CartesianSensor,
     PolarRadar,
     Sensor,
 )
+from mhtrack.records import MAX_COORDINATE
 from mhtrack.scenario import _check as ck
 from mhtrack.scenario.targets import AnyTarget, RecordedTarget, Target
 
@@ -55,7 +55,8 @@ SENSOR_KINDS = ("cartesian", "polar")
 # ---------------------------------------------------------------------- limits
 # Bounds beyond which a scenario is refused up front, before any memory is allocated or a
 # number overflows (see docs/scenarios.md, "Limits"). Sensor limits: ``MAX_SIGMA`` (m),
-# ``MAX_SIGMA_BEARING_DEG`` and ``MAX_SENSOR_COORDINATE`` in :mod:`mhtrack.models.sensors`.
+# ``MAX_SIGMA_BEARING_DEG`` in :mod:`mhtrack.models.sensors`; ``MAX_COORDINATE`` in
+# :mod:`mhtrack.records`.
 
 #: Largest number of scans of a scenario (``last − first + 1``).
 MAX_SCANS = 100_000
@@ -64,8 +65,6 @@ MAX_SCANS = 100_000
 MAX_PLOTS = 50_000_000
 #: Largest scan period ``T`` (s): about 11.6 days.
 MAX_T = 1e6
-#: Largest ``|coordinate|`` of the region and of target positions (m), as for plots.
-MAX_COORDINATE = 1e9
 #: Largest ``|velocity component|`` of a target (m/s): 100 km/s.
 MAX_SPEED = 1e5
 #: Largest truth acceleration noise ``truth_sigma_v`` (m/s²): about 1000 g.
@@ -491,7 +490,7 @@ def _sensor_from(v: object, path: str) -> tuple[Sensor, float]:
     else:
         ck.keys(d, path, {"kind", "id", "position", "sigma_range", "sigma_bearing_deg", "pd"})
         sid = ck.integer(d["id"], f"{path}.id", lo=0)
-        pos = ck.array(d["position"], f"{path}.position", (2,), MAX_SENSOR_COORDINATE)
+        pos = ck.array(d["position"], f"{path}.position", (2,), MAX_COORDINATE)
         sr = ck.number(
             d["sigma_range"], f"{path}.sigma_range", lo=0.0, lo_open=True, hi=MAX_SIGMA, unit="m"
         )

@@ -285,12 +285,9 @@ def _warn_known_kappa(sc: Any, tracker: str, clutter_density: float | None) -> N
         return
     import logging
 
-    import numpy as np
-
     from mhtrack.experiments.pipeline import DEFAULT_CLUTTER_DENSITY
 
-    rates = [sc.clutter_rate(int(k)) for k in sc.scan_indices()]
-    mean = len(sc.sensors) * float(np.mean(rates)) / sc.region.area if rates else 0.0
+    mean = sc.mean_clutter_density()
     if mean > 10 * DEFAULT_CLUTTER_DENSITY or 0 < mean < 0.1 * DEFAULT_CLUTTER_DENSITY:
         logging.getLogger("mhtrack").warning(
             "tracker mht assumes P1's clutter density %.3g per m²; this scenario's clutter "

@@ -138,9 +138,7 @@ def true_intensity_grid(
 def uniform_guess(simulation: Simulation) -> float:
     """``κ = S λ̄ / A``: the scenario's true mean clutter count per scan (all sensors,
     averaged over its scans) spread uniformly over its region — the ``known`` baseline."""
-    sc = simulation.scenario
-    rates = [sc.clutter_rate(int(k)) for k in sc.scan_indices()]
-    return len(sc.sensors) * float(np.mean(rates)) / sc.region.area
+    return simulation.scenario.mean_clutter_density()
 
 
 def clutter_accuracy(

@@ -241,6 +241,11 @@ class Scenario:
             return float(np.interp(self.scan_indices().astype(float), ks, rates).mean())
         return float(c.rate_per_scan)
 
+    def mean_clutter_density(self) -> float:
+        """``S λ̄ / A``: the mean clutter count per scan of all ``S`` sensors spread
+        uniformly over the region (plots per m² per scan)."""
+        return len(self.sensors) * self.mean_clutter_rate() / self.region.area
+
     # ------------------------------------------------------------------ dict form
     def to_dict(self) -> dict[str, Any]:
         """Plain nested dict (tables, lists, strings, numbers) — the TOML schema of

@@ -12,6 +12,13 @@ P1 cites Zivkovic (2004) for the adaptive choice of the number of components; Zi
 rule shrinks every weight by a Dirichlet-prior constant and drops those that reach 0.
 We implement P1's rule as printed (eq. 12), not Zivkovic's.
 
+P1 derives its component count from "a Lagrange inequality of the model parameters and the
+number of components" [10]: the price of a component grows with its parameters. Eq. 12
+alone has no such price, so the adaptive GMM here also deletes, after each M-step, a
+Gaussian whose removal costs the fit less than the BIC price of its six parameters
+(``bic=True``, :func:`mhtrack.clutter.em.removal_gain`). The fixed-threshold GMM
+(:mod:`mhtrack.clutter.gmm`) has no test of the number of components, as P1 describes it.
+
 P1 step 1 initialises means and covariances with "random numbers in 1–100", which makes no
 sense in metres on an 8 km region (every mean would start in one corner 100 m wide); we
 seed the means by k-means++ among the plots from a seeded generator instead
@@ -54,17 +61,20 @@ class AGMMClutter(MixtureClutter):
     ----------
     n_components : ``K`` to start from, more than the truth. Default 8 (P1 Table 2 has 4).
     mass : eq. 12's threshold. Default 0.92 (P1).
+    bic : the BIC test of the number of components (module docstring). Default True.
     **kwargs : the shared parameters of :class:`~mhtrack.clutter.mixture.MixtureClutter`
         (``source``, ``window`` 5, ``background``, ``tol`` ε = 1e−4, ...).
     """
 
     name = "agmm"
 
-    def __init__(self, n_components: int = 8, *, mass: float = P1_MASS, **kwargs: Any) -> None:
+    def __init__(
+        self, n_components: int = 8, *, mass: float = P1_MASS, bic: bool = True, **kwargs: Any
+    ) -> None:
         if not (np.isfinite(mass) and 0.0 < mass < 1.0):
             raise ValueError(f"mass must be in (0, 1), got {mass!r}")
         self.mass = float(mass)
-        super().__init__(n_components, **kwargs)
+        super().__init__(n_components, bic=bic, **kwargs)
 
     def _prune_rule(self) -> PruneRule:
         m = self.mass

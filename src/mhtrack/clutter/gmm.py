@@ -6,7 +6,9 @@ removed to keep the cost down; P1 gives no value. Ours: after every M-step, dele
 Gaussians whose weight, normalised over the Gaussians, is below ``threshold`` (default
 0.05), then renormalise. Everything else (window, warm start, background, count ``M̂_k``)
 is :class:`~mhtrack.clutter.mixture.MixtureClutter`'s, identical to the AGMM's, so that the
-two differ only in the deletion rule.
+two differ only in how they choose the number of components: a fixed weight threshold here
+(P1: "a fixed deletion threshold ... to lower the cost"), eq. 12 and a BIC test of each
+component there (:mod:`mhtrack.clutter.agmm`). ``bic=True`` gives the GMM that test too.
 """
 
 from __future__ import annotations
@@ -37,6 +39,8 @@ class GMMClutter(MixtureClutter):
     ----------
     threshold : deletion threshold on the Gaussians' normalised weights. Default 0.05
         (ours; P1 gives none).
+    bic : also the AGMM's BIC test of each component. Default False (P1's fixed-threshold
+        GMM).
     **kwargs : the shared parameters of :class:`~mhtrack.clutter.mixture.MixtureClutter`
         (``n_components`` 8, ``source``, ``window`` 5, ``background``, ...).
     """

@@ -82,7 +82,9 @@ class MixtureClutter:
         patch of ``docs/examples/drifting-clutter.toml``; 0 turns it off).
     bic : with a background, also delete a Gaussian whose removal costs the fit less than
         the BIC price of its six parameters, ``3 ln n`` nats
-        (:func:`~mhtrack.clutter.em.removal_gain`). Default True (ours, ``docs/clutter.md``).
+        (:func:`~mhtrack.clutter.em.removal_gain`) — a test of the number of components,
+        part of the adaptive GMM (``agmm``, default on there), not of the fixed-threshold
+        GMM (``gmm``, default off). Default False here (``docs/clutter.md``).
 
     Warm start: the previous Gaussians are kept and, when at least ``min_points`` of the
     pooled plots are farther than χ²₂(0.99) from all of them, up to ``K − K_prev`` new
@@ -117,7 +119,7 @@ class MixtureClutter:
         max_points: int = 2000,
         seed: int = 0,
         min_contrast: float = 5.0,
-        bic: bool = True,
+        bic: bool = False,
     ) -> None:
         if not (isinstance(n_components, int | np.integer) and n_components >= 1):
             raise ValueError(f"n_components must be an integer >= 1, got {n_components!r}")

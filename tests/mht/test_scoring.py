@@ -4,6 +4,8 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import assume, given, settings
+from hypothesis import strategies as st
 
 from mhtrack.clutter import KnownClutter
 from mhtrack.mht import (
@@ -19,28 +21,30 @@ from mhtrack.records import Scan
 
 def test_one_track_two_scans_by_hand():
     # P_D = 0.9, λ_v = 1e-7, κ = 1e-8, σw = 100 (R = 1e4 I), v_max = 300, σv = 10, T = 1.
-    # Scan 1: one plot at (0, 0) starts a tree with L0 = ln(λ_v P_D / κ) = ln(9) = 2.197225.
+    # Scan 1: one plot at (0, 0) starts a tree with
+    #   L0 = ln(λ_v P_D / (κ + λ_v)) = ln(0.9e-7 / 1.1e-7) = ln(9/11) = −0.200671.
     # Scan 2: plot at (100, 0). Predicted position variance per axis
     #   = R (1e4) + T²·(v_max/2)² (22 500) + σv²·T⁴/4 (25) = 32 525, cross terms 0,
     #   S = 32 525 + 1e4 = 42 525 I;  d² = 100² / 42 525 = 0.235156;
     #   ln p(z|T) = −½(d² + 2 ln 42 525) − ln 2π = −½(0.235156 + 21.315695) − 1.837877
     #             = −12.613302;
     #   ΔL = ln p + ln 0.9 − ln(1e-8 + 1e-7) = −12.613302 − 0.105361 + 16.022785 = 3.304123;
-    #   L(2) = 2.197225 + 3.304123 = 5.501347.
-    # Miss branch: L0 + ln(1 − 0.9) = 2.197225 − 2.302585 = −0.105361.
-    # The scan-2 plot also starts its own tree at L0 = 2.197225.
+    #   L(2) = −0.200671 + 3.304123 = 3.103452.
+    # Miss branch: L0 + ln(1 − 0.9) = −0.200671 − 2.302585 = −2.503256.
+    # The scan-2 plot also starts its own tree at L0 = −0.200671.
+    l0 = math.log(9 / 11)
     trk = MHTTracker(MHTConfig(imm_sigma_v=0.0), KnownClutter(1e-8))
     trk.step(Scan.from_positions(1, 0.0, [[0.0, 0.0]]))
-    assert trk.leaves.score.tolist() == pytest.approx([2.197225], abs=1e-6)
+    assert trk.leaves.score.tolist() == pytest.approx([l0], abs=1e-9)
     trk.step(Scan.from_positions(2, 1.0, [[100.0, 0.0]]))
     L = trk.leaves
     first = L.tree == L.tree.min()
     got = sorted(L.score[first].tolist())
-    assert got == pytest.approx([-0.105361, 5.501347], abs=1e-6)
-    assert L.score[~first].tolist() == pytest.approx([2.197225], abs=1e-6)
+    assert got == pytest.approx([-2.503256, 3.103452], abs=1e-6)
+    assert L.score[~first].tolist() == pytest.approx([l0], abs=1e-9)
     # the updated leaf is the one that used the plot (row 0 of scan 2)
     upd = first & (L.window[:, -1] == 0)
-    assert L.score[upd].item() == pytest.approx(5.501347, abs=1e-6)
+    assert L.score[upd].item() == pytest.approx(3.103452, abs=1e-6)
     assert L.n_updates[upd].item() == 2
 
 
@@ -55,7 +59,7 @@ def test_imm_two_scans_by_hand():
 
     lq, lm = lnN(32_500.25 + 1e4), lnN(32_525.0 + 1e4)
     mix = math.log(0.5 * math.exp(lq) + 0.5 * math.exp(lm))
-    expected = math.log(9) + mix + math.log(0.9) - math.log(1e-8 + 1e-7)
+    expected = math.log(9 / 11) + mix + math.log(0.9) - math.log(1e-8 + 1e-7)
     cfg = MHTConfig(imm_sigma_v=1.0)
     trk = MHTTracker(cfg, KnownClutter(1e-8))
     trk.step(Scan.from_positions(1, 0.0, [[0.0, 0.0]]))
@@ -76,7 +80,7 @@ def test_increment_functions():
     dl = update_increment(np.array([-12.0]), np.array([1e-9]), 0.9, 1e-7)
     assert dl.item() == pytest.approx(-12.0 + math.log(0.9) - math.log(1.01e-7))
     assert birth_score(np.array([6.25e-7]), 0.9, 1e-7).item() == pytest.approx(
-        math.log(0.9e-7 / 6.25e-7)
+        math.log(0.9e-7 / 7.25e-7)
     )
 
 
@@ -85,7 +89,7 @@ def test_miss_option_changes_the_miss_score():
     trk = MHTTracker(cfg, KnownClutter(1e-8))
     trk.step(Scan.from_positions(1, 0.0, [[0.0, 0.0]]))
     trk.step(Scan.from_positions(2, 1.0, np.zeros((0, 2))))
-    assert trk.leaves.score.item() == pytest.approx(math.log(9) + math.log(1 - 0.9 * 0.99))
+    assert trk.leaves.score.item() == pytest.approx(math.log(9 / 11) + math.log(1 - 0.9 * 0.99))
 
 
 def test_sprt_thresholds_are_walds():
@@ -112,10 +116,10 @@ def _clean_target_confirmation_scan(kappa: float, seed: int) -> tuple[int, MHTTr
 
 
 def test_clean_target_confirms_within_a_few_scans():
-    # sparse clutter (κ = 1e-8): L0 = ln 9 = 2.2, then ~+3.5 per plot > 4.6 after one update
+    # sparse clutter (κ = 1e-8): L0 = ln(9/11) = −0.2, then ~+3.5 per plot
     scans = [_clean_target_confirmation_scan(1e-8, seed)[0] for seed in range(10)]
     assert max(scans) <= 4
-    # the true density of 10 clutter plots/scan over 64 km²: L0 = −0.55, ~+2 per plot
+    # the true density of 10 clutter plots/scan over 64 km²: L0 = −1.05, ~+2 per plot
     scans = [_clean_target_confirmation_scan(1.5625e-7, seed)[0] for seed in range(10)]
     assert np.median(scans) <= 5 and max(scans) <= 7
 
@@ -130,3 +134,33 @@ def test_track_is_deleted_after_consecutive_misses():
     out = trk.step(Scan.from_positions(19, 19.0, np.zeros((0, 2))))
     assert len(out) == 0
     assert len(trk.leaves) == 0
+
+
+@settings(max_examples=300, deadline=None)
+@given(log_kappa=st.floats(-32.0, -5.0), log_g=st.floats(-30.0, -5.0))
+def test_continuation_against_miss_plus_birth_does_not_depend_on_clutter(log_kappa, log_g):
+    # A plot z with innovation likelihood g either updates track T, or starts a new tree
+    # while T misses. Both alternatives are scored against the same reference density
+    # κ + λv (P1 eq. 15), so the update wins iff g > λv (1 − P_D), whatever κ is. With a
+    # birth score against κ alone, ln(λv P_D/κ), a small κ made the new tree win and
+    # tracks coast beside their own plots.
+    pd, lv = 0.9, 1e-7
+    assume(abs(log_g - math.log(lv * (1 - pd))) > 1e-6)
+    kappa = np.array([math.exp(log_kappa)])
+    upd = update_increment(np.array([log_g]), kappa, pd, lv).item()
+    alt = miss_increment(pd) + birth_score(kappa, pd, lv).item()
+    assert (upd > alt) == (log_g > math.log(lv * (1 - pd)))
+
+
+def test_lone_target_in_near_empty_clutter_keeps_its_plots():
+    # κ = 1e-12 per m² (a clutter-free sky): once confirmed, the track takes the target's
+    # plot at every scan and no second track appears.
+    trk = MHTTracker(MHTConfig(), KnownClutter(1e-12))
+    rng = np.random.default_rng(0)
+    rows = []
+    for k in range(1, 21):
+        z = np.array([[100.0 * k, 0.0]]) + rng.normal(0, 100, (1, 2))
+        rows.append(trk.step(Scan.from_positions(k, float(k), z)))
+    late = [r for r in rows[5:]]
+    assert all(r.track_id.tolist() == [0] for r in late)
+    assert all(r.plot.tolist() == [0] for r in late)

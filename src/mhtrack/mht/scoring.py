@@ -7,7 +7,7 @@
 
 ``p(z|T)`` is the Kalman innovation likelihood ``N(ν; 0, S)``, ``κ̂(z)`` the clutter
 intensity from the clutter estimator and ``λ_v`` the new-target density. A tree born from
-plot ``z`` starts at ``L₀ = ln(λ_v · P_D / κ̂(z))`` (Blackman & Popoli 1999 §6.2).
+plot ``z`` starts at ``L₀ = ln(λ_v · P_D / (κ̂(z) + λ_v))`` (:func:`birth_score`).
 Track management is Wald's sequential probability ratio test on that score.
 """
 
@@ -39,10 +39,18 @@ def update_increment(
 
 def birth_score(kappa: np.ndarray, p_detection: float, new_target_density: float) -> np.ndarray:
     """Initial score of a tree started by plot ``z``: the likelihood ratio of a new target
-    against clutter, ``L₀ = ln(λ_v · P_D / κ̂(z))`` (Blackman & Popoli 1999 §6.2,
-    ``LR(1) = P_D β_NT / β_FT`` with new-target density ``β_NT = λ_v`` and false-target
-    density ``β_FT = κ̂``)."""
-    return math.log(new_target_density * p_detection) - np.log(kappa)
+    against the reference of P1 eq. 15, ``L₀ = ln(λ_v · P_D / (κ̂(z) + λ_v))``.
+
+    Blackman & Popoli (1999 §6.2) start a track at ``LR(1) = P_D β_NT / β_FT`` (new-target
+    density ``β_NT = λ_v``, false-target density ``β_FT = κ̂``) and *continue* it with
+    ``P_D g / β_FT``. P1 eq. 15 continues it with ``P_D g / (κ̂ + λ_v)``: a plot not on the
+    track is clutter *or* a new target. A birth score must use the same denominator, or a
+    plot's two explanations are not comparable in the global hypothesis: with ``β_FT``
+    alone, "track missed + new tree on the plot" beats "track updated" as soon as
+    ``λ_v (1 − P_D)/κ̂ > g/(κ̂ + λ_v)`` — for every plot when ``κ̂ ≪ λ_v`` (tracks then coast
+    beside their own plots). With the shared denominator the update wins iff
+    ``g > λ_v (1 − P_D)``, whatever ``κ̂``. ``L₀ ≤ ln P_D``: a lone plot never confirms."""
+    return math.log(new_target_density * p_detection) - np.log(kappa + new_target_density)
 
 
 def sprt_thresholds(alpha: float, beta: float) -> tuple[float, float]:

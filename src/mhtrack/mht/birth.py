@@ -1,8 +1,8 @@
 """Birth processes of the MHT: which plots start new track trees (``docs/mht.md``).
 
 * ``every-plot`` (default, P1 Fig. 1): every plot of the scan starts a tree with the
-  one-point birth score ``ln(λ_v P_D / κ̂)`` — implemented in
-  :meth:`~mhtrack.mht.tracker.MHTTracker._births`, unchanged.
+  one-point birth score ``ln(λ_v P_D / (κ̂ + λ_v))`` (:func:`~mhtrack.mht.scoring.birth_score`)
+  — implemented in :meth:`~mhtrack.mht.tracker.MHTTracker._births`.
 * ``logic`` / ``modified-logic`` / ``hough`` / ``modified-hough`` (P2 §2–3 as the MHT's
   birth process, :class:`InitiatorBirth`): the tracker keeps a sliding window of the last
   ``N = 4`` scans' plots, runs the P2 initiator on it every scan, and starts a tree only

@@ -60,9 +60,10 @@ class MHTConfig:
         ``L ≥ ln((1−β)/α)`` ≈ 3.9, delete at ``L − L_peak ≤ ln(β/(1−α))`` ≈ −9.2, i.e. four
         consecutive misses at ``P_D = 0.9`` (Wald 1947; Blackman & Popoli 1999 §6.2).
     confirm_min_plots : a tree is confirmed only once the chosen branch holds at least this
-        many plots. Default 2 (our choice: a single plot says nothing of a velocity; with
-        P1's plain-MHT κ = 1e−9 a lone plot's birth score ``ln(λ_v P_D/κ) = 4.5`` is
-        otherwise above the confirmation threshold by itself).
+        many plots. Default 2 (our choice: a single plot says nothing of a velocity; the
+        birth score ``ln(λ_v P_D/(κ̂ + λ_v)) ≤ ln P_D < 0`` is below every SPRT confirmation
+        threshold ``ln((1−β)/α) > 0``, so this now matters only for logic confirmation,
+        ``confirm_hits``).
     confirm_hits : logic confirmation, ``M`` of an M-of-N rule over the ``N + 1`` scans of
         the leaf's window: a tentative tree is also confirmed when its chosen leaf used
         plots in at least ``confirm_hits`` of its last ``n_scan + 1`` scans **and** its

@@ -24,7 +24,7 @@ def tentative_keep(score: np.ndarray, tentative: np.ndarray, delete_threshold: f
     """Wald's lower SPRT threshold on the score itself for tentative (unconfirmed) leaves:
     keep unless ``tentative`` and ``L ≤ ln(β/(1−α))`` (Blackman & Popoli 1999 §6.2 delete
     tentative tracks on the absolute threshold, confirmed ones on the drop from the peak).
-    In dense clutter a tree born with ``L₀ = ln(λ_v P_D/κ̂)`` far below the threshold is
+    In dense clutter a tree born with ``L₀ = ln(λ_v P_D/(κ̂ + λ_v))`` far below the threshold is
     then never grown, instead of branching for four scans until its drop reaches it."""
     return ~(tentative & (score <= delete_threshold))
 

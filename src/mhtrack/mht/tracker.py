@@ -379,7 +379,7 @@ class MHTTracker:
         in_gates: np.ndarray | None,
         caps: dict[str, int],
     ) -> Leaves:
-        """Every plot whose birth score ``ln(λ_v P_D / κ̂)`` is above the SPRT deletion
+        """Every plot whose birth score ``ln(λ_v P_D / (κ̂ + λ_v))`` is above the SPRT deletion
         threshold starts a tree (a tentative tree at or below it would be deleted at
         once, :func:`~mhtrack.mht.pruning.tentative_keep`). Over ``max_births_per_scan``
         plots, those outside confirmed tracks' gates go first, then those with the highest

@@ -1,0 +1,29 @@
+"""Every name a user chooses a part by, defined once.
+
+The tracker builder (:mod:`mhtrack.build`) maps these names to classes, the MHT
+configuration validates its ``birth`` against :data:`BIRTHS`, and the CLI offers them as
+choices. This module imports nothing, so ``mhtrack --help`` and every command can build
+their options without loading SciPy or the tracker.
+"""
+
+from __future__ import annotations
+
+#: Trackers of P1 §3: the plain MHT with a known clutter density, and the MHT whose
+#: clutter intensity is estimated online by a GMM or by the adaptive GMM.
+TRACKERS: tuple[str, ...] = ("mht", "mht-agmm", "mht-gmm")
+#: Clutter-intensity estimators (``mhtrack.clutter``).
+CLUTTER_ESTIMATORS: tuple[str, ...] = ("known", "gmm", "agmm")
+#: P2's track initiators and their modified variants (``mhtrack.initiation``).
+INITIATORS: tuple[str, ...] = ("logic", "modified-logic", "hough", "modified-hough")
+#: The MHT's default birth process: every plot may start a tree (P1).
+EVERY_PLOT = "every-plot"
+#: Birth processes of the MHT: every plot, or a P2 initiator over the last scans.
+BIRTHS: tuple[str, ...] = (EVERY_PLOT, *INITIATORS)
+#: Plot fusion of several radars before the tracker.
+TRACKER_FUSIONS: tuple[str, ...] = ("none", "adaptive-kmeans")
+#: Plot fusion before P2's initiators (P2 §1.2; random-start K-means as its baseline).
+INITIATION_FUSIONS: tuple[str, ...] = ("adaptive-kmeans", "kmeans", "none")
+#: K-means seedings compared in P2's clustering study.
+CLUSTER_METHODS: tuple[str, ...] = ("adaptive", "random")
+#: Tracker output modes: ``history`` adds each confirmed track's tentative past.
+OUTPUTS: tuple[str, ...] = ("history", "online")

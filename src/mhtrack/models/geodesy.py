@@ -48,6 +48,7 @@ import numpy as np
 import pyproj
 
 from mhtrack.models.linalg2 import inv2
+from mhtrack.models.sensors import check_latlon
 
 #: The WGS-84 ellipsoid's geodesics (GeographicLib inside PROJ).
 WGS84 = pyproj.Geod(ellps="WGS84")
@@ -63,13 +64,6 @@ def _flat(*arrays: ArrayLike) -> tuple[tuple[int, ...], list[np.ndarray]]:
     """Broadcast the arguments together; their common shape and 1-D float copies."""
     b = np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in arrays))
     return b[0].shape, [np.ascontiguousarray(a, dtype=float).ravel() for a in b]
-
-
-def _check_latlon(lat: float, lon: float, what: str) -> None:
-    if not (np.isfinite(lat) and -90.0 <= lat <= 90.0):
-        raise ValueError(f"{what}: latitude must be within [-90, 90] degrees, got {lat}")
-    if not (np.isfinite(lon) and -180.0 <= lon <= 180.0):
-        raise ValueError(f"{what}: longitude must be within [-180, 180] degrees, got {lon}")
 
 
 def direct(
@@ -102,7 +96,7 @@ class LocalFrame:
 
     def __post_init__(self) -> None:
         lat0, lon0 = float(self.lat0), float(self.lon0)
-        _check_latlon(lat0, lon0, "origin")
+        check_latlon("origin", lat0, lon0)
         object.__setattr__(self, "lat0", lat0)
         object.__setattr__(self, "lon0", lon0)
 

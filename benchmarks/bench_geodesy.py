@@ -5,7 +5,10 @@ from the origin (ranges up to 250 km, any bearing) into the local frame with the
 covariances, and prints µs per plot beside references measured in the same run:
 GeographicLib's pure-Python ``Geodesic.WGS84.Direct`` per plot (on a sample of 2 000),
 pyproj's vectorised ``Geod.fwd`` alone, and the flat-earth converted measurement of the
-simulation's ``PolarRadar`` (no ellipsoid).
+simulation's ``PolarRadar`` (no ellipsoid). On the GeographicLib sample it also prints the
+largest position error (distance and azimuth from the origin against GeographicLib's
+``Inverse`` of its ``Direct`` end point) and the largest ``to_geodetic``/``to_local`` round
+trip error.
 """
 
 from __future__ import annotations
@@ -51,6 +54,16 @@ def main() -> int:
     g = Geodesic.WGS84
     ref = per_plot(best_of(lambda: [g.Direct(slat, slon, b[i], r[i]) for i in range(SAMPLE)],
                            repeat=3), SAMPLE)
+    z, _ = polar_to_local(frame, slat, slon, r[:SAMPLE], b[:SAMPLE], 80.0, 0.15)
+    worst = 0.0
+    for i in range(SAMPLE):
+        d = g.Direct(slat, slon, b[i], r[i])
+        inv = g.Inverse(46.8, 8.2, d["lat2"], d["lon2"])
+        a = np.radians(inv["azi1"])
+        worst = max(worst, float(np.hypot(z[i, 0] - inv["s12"] * np.sin(a),
+                                          z[i, 1] - inv["s12"] * np.cos(a))))
+    x2, y2 = frame.to_local(lat, lon)
+    trip = float(np.hypot(x2 - x, y2 - y).max())
     fwd = per_plot(best_of(lambda: WGS84.fwd(np.full(N, slon), np.full(N, slat), b, r)))
     flat = PolarRadar(1, (0.0, 0.0), sigma_range=80.0, sigma_bearing_deg=0.15)
     rb = np.column_stack((r, b))
@@ -69,6 +82,8 @@ def main() -> int:
     print(f"  reference: pyproj Geod.fwd (vectorised), per plot:              {fwd:8.3f} µs")
     print(f"  reference: flat PolarRadar.convert (no ellipsoid), per plot:    "
           f"{per_plot(best_of(lambda: flat.convert(rb))):8.3f} µs")
+    print(f"  accuracy: largest plot position error against geographiclib: {worst:.1e} m "
+          f"({SAMPLE} plots); to_geodetic/to_local round trip: {trip:.1e} m ({N} points)")
     for label, t in rows:
         us = per_plot(t)
         print(f"  {label:36s} {us:8.3f} µs/plot  ({ref / us:6.1f}x faster than one "

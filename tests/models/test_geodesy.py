@@ -230,6 +230,8 @@ def test_shapes_sigmas_per_plot_and_scalars():
     x, y = frame.to_local(46.8, 8.2)
     assert x.shape == () and (float(x), float(y)) == pytest.approx((0.0, 0.0), abs=1e-9)
     assert frame.to_local([[46.8, 47.0]], [[8.2, 8.3]])[0].shape == (1, 2)
+    z, R = polar_to_local(frame, 46.4, 6.1, np.empty(0), np.empty(0), 50.0, 0.2)
+    assert z.shape == (0, 2) and R.shape == (0, 2, 2)
 
 
 def test_frame_validates_and_pickles():

@@ -8,7 +8,7 @@ import pytest
 from mhtrack.errors import InputError
 from mhtrack.io.sensors import read_sensors, write_sensors
 from mhtrack.models.geodesy import LocalFrame
-from mhtrack.models.sensors import RadarSensor, SensorFieldError, SensorSet
+from mhtrack.models.radars import RadarSensor, SensorFieldError, SensorSet
 
 VALID = """\
 [origin]                 # optional: tangent point of the local east-north frame

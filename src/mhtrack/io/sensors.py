@@ -24,7 +24,7 @@ from mhtrack.errors import InputError
 from mhtrack.io._tabular import PathArg
 from mhtrack.io.atomic import atomic_write
 from mhtrack.io.tomlfile import read_toml
-from mhtrack.models.sensors import RadarSensor, SensorFieldError, SensorSet
+from mhtrack.models.radars import RadarSensor, SensorFieldError, SensorSet
 
 #: Keys of the ``[origin]`` table (both required).
 ORIGIN_KEYS = ("lat", "lon")

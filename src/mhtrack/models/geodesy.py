@@ -48,7 +48,7 @@ import numpy as np
 import pyproj
 
 from mhtrack.models.linalg2 import inv2
-from mhtrack.models.sensors import check_latlon
+from mhtrack.models.radars import check_latlon
 
 #: The WGS-84 ellipsoid's geodesics (GeographicLib inside PROJ).
 WGS84 = pyproj.Geod(ellps="WGS84")

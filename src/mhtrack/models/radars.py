@@ -1,0 +1,234 @@
+"""Real radars as a sensors file describes them (docs/file-formats.md, "Sensors file").
+
+A :class:`RadarSensor` is one radar: its geodetic site (or a position in the local frame),
+its errors (``σr``, ``σθ`` for a polar radar, ``σ`` for a Cartesian sensor), ``P_D``,
+rotation period and instrumented range; a :class:`SensorSet` gathers them with the origin
+of the local east-north frame. Their polar plots are converted on the WGS-84 ellipsoid by
+:mod:`mhtrack.models.geodesy`. Each record checks its own fields and raises
+:class:`SensorFieldError` naming the field, so that a file reader can point at the line.
+"""
+
+from __future__ import annotations
+
+from dataclasses import KW_ONLY, dataclass
+from functools import cached_property
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from mhtrack.errors import short_number
+from mhtrack.models.sensors import MAX_SIGMA, MAX_SIGMA_BEARING_DEG
+from mhtrack.records import MAX_COORDINATE
+
+if TYPE_CHECKING:
+    from mhtrack.models.geodesy import LocalFrame
+
+
+#: The kinds of real sensor a sensors file may declare.
+RADAR_KINDS = ("polar", "cartesian")
+
+
+class SensorFieldError(ValueError):
+    """A :class:`RadarSensor` or :class:`SensorSet` field out of its domain: ``where``
+    (``"sensor 3"``, ``"sensors[1]"``, ``"origin"``), the field ``key``, and for a
+    :class:`SensorSet` the sensor's 0-based ``index`` — so that a file reader can point
+    at the line."""
+
+    def __init__(self, where: str, key: str, message: str, index: int | None = None) -> None:
+        super().__init__(f"{where}: {key}: {message}")
+        self.where = where
+        self.key = key
+        self.message = message
+        self.index = index
+
+
+def check_latlon(where: str, lat: float, lon: float) -> None:
+    """Raise :class:`SensorFieldError` unless ``lat ∈ [−90, 90]`` and ``lon ∈ [−180, 180]``."""
+    if not (np.isfinite(lat) and -90.0 <= lat <= 90.0):
+        raise SensorFieldError(where, "lat", f"latitude must be within [-90, 90] degrees, "
+                               f"got {lat:g}")
+    if not (np.isfinite(lon) and -180.0 <= lon <= 180.0):
+        raise SensorFieldError(where, "lon", f"longitude must be within [-180, 180] degrees, "
+                               f"got {lon:g}")
+
+
+@dataclass(frozen=True)
+class RadarSensor:
+    """A real sensor: a polar radar at a geodetic site (or a Cartesian position sensor).
+
+    ``lat``/``lon`` (WGS-84 degrees) or ``position`` (x, y metres in the local frame) give
+    the site; ``alt`` its height (m, kept for output, unused by the 2-D conversions). Polar
+    sensors measure geodesic ground range (σ ``sigma_range`` m) and azimuth (σ
+    ``sigma_bearing_deg``); Cartesian ones ``x, y`` with σ ``sigma`` m. ``pd`` is the
+    detection probability, ``period`` the rotation period (s), ``max_range`` the
+    instrumented range (m). Out-of-domain fields raise :class:`SensorFieldError`.
+    """
+
+    id: int
+    kind: str
+    _: KW_ONLY
+    pd: float
+    lat: float | None = None
+    lon: float | None = None
+    alt: float | None = None
+    position: tuple[float, float] | None = None
+    sigma_range: float | None = None
+    sigma_bearing_deg: float | None = None
+    sigma: float | None = None
+    period: float | None = None
+    max_range: float | None = None
+
+    def __post_init__(self) -> None:
+        w = f"sensor {self.id}"
+        if isinstance(self.id, bool) or not isinstance(self.id, int | np.integer):
+            raise SensorFieldError(w, "id", f"must be an integer, got {self.id!r}")
+        object.__setattr__(self, "id", int(self.id))
+        if self.kind not in RADAR_KINDS:
+            raise SensorFieldError(w, "kind", f"must be 'polar' or 'cartesian', got {self.kind!r}")
+        for key in ("pd", "lat", "lon", "alt", "sigma_range", "sigma_bearing_deg", "sigma",
+                    "period", "max_range"):
+            v = getattr(self, key)
+            if v is not None:
+                object.__setattr__(self, key, float(v))
+                if not np.isfinite(float(v)):
+                    raise SensorFieldError(w, key, f"must be finite, got {v}")
+        if (self.lat is None) != (self.lon is None):
+            missing = "lon" if self.lon is None else "lat"
+            raise SensorFieldError(w, missing, "missing: lat and lon give the site together")
+        if self.lat is not None:
+            check_latlon(w, self.lat, self.lon)  # type: ignore[arg-type]
+        if self.position is not None:
+            if self.lat is not None:
+                raise SensorFieldError(w, "position", "give the site once: lat/lon or position")
+            pos = tuple(float(v) for v in self.position)
+            if len(pos) != 2 or not all(np.isfinite(v) and abs(v) <= MAX_COORDINATE
+                                        for v in pos):
+                raise SensorFieldError(w, "position", "must be two finite coordinates within "
+                                       f"±{short_number(MAX_COORDINATE)} m, got {self.position!r}")
+            object.__setattr__(self, "position", pos)
+        self._check_errors()
+        if not 0.0 < self.pd <= 1.0:
+            raise SensorFieldError(w, "pd", f"must be in (0, 1], got {self.pd:g}")
+        for key in ("period", "max_range"):
+            v = getattr(self, key)
+            if v is not None and v <= 0:
+                raise SensorFieldError(w, key, f"must be > 0, got {v:g}")
+
+    def _check_errors(self) -> None:
+        """The error keys of the sensor's kind are present and in range; the other kind's
+        are absent."""
+        w = f"sensor {self.id}"
+        if self.kind == "polar":
+            limits = {"sigma_range": (MAX_SIGMA, "m"),
+                      "sigma_bearing_deg": (MAX_SIGMA_BEARING_DEG, "degrees")}
+            other = ("sigma",)
+            if not self.has_site:
+                raise SensorFieldError(w, "lat", "a polar sensor needs its site: lat and lon, "
+                                       "or position = [x, y]")
+        else:
+            limits = {"sigma": (MAX_SIGMA, "m")}
+            other = ("sigma_range", "sigma_bearing_deg")
+        for key in other:
+            if getattr(self, key) is not None:
+                raise SensorFieldError(w, key, f"not used by a {self.kind} sensor")
+        for key, (hi, unit) in limits.items():
+            v = getattr(self, key)
+            if v is None:
+                raise SensorFieldError(w, key, f"missing: required for a {self.kind} sensor")
+            if not 0 < v <= hi:
+                raise SensorFieldError(w, key, f"must be > 0 and <= {short_number(hi)} {unit}, "
+                                       f"got {v:g}")
+
+    @property
+    def has_site(self) -> bool:
+        """The sensor's site is given (lat/lon or position)."""
+        return self.lat is not None or self.position is not None
+
+
+@dataclass(frozen=True)
+class SensorSet:
+    """The sensors of a data set and the origin of the local east-north frame.
+
+    ``origin`` is ``(lat, lon)`` (WGS-84 degrees) or ``None``: then the frame is centred on
+    the first sensor that has ``lat``/``lon``. Ids are unique; a sensor placed by
+    ``position`` while it is polar needs a geodetic frame (origin or a lat/lon site) to
+    convert its plots on the ellipsoid.
+    """
+
+    origin: tuple[float, float] | None
+    sensors: tuple[RadarSensor, ...]
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "sensors", tuple(self.sensors))
+        if self.origin is not None:
+            lat, lon = (float(v) for v in self.origin)
+            check_latlon("origin", lat, lon)
+            object.__setattr__(self, "origin", (lat, lon))
+        seen: dict[int, int] = {}
+        for i, s in enumerate(self.sensors):
+            if s.id in seen:
+                raise SensorFieldError(f"sensors[{i}]", "id", f"duplicate id {s.id} (also "
+                                       f"sensors[{seen[s.id]}])", index=i)
+            seen[s.id] = i
+        if self.reference is None:
+            for i, s in enumerate(self.sensors):
+                if s.kind == "polar":
+                    raise SensorFieldError(
+                        f"sensors[{i}]", "position",
+                        "a polar sensor placed by position needs [origin] (or a sensor with "
+                        "lat/lon) to put its range and bearing on the ellipsoid", index=i)
+
+    @property
+    def reference(self) -> tuple[float, float] | None:
+        """The frame's tangent point: ``origin``, else the first lat/lon site, else None."""
+        if self.origin is not None:
+            return self.origin
+        for s in self.sensors:
+            if s.lat is not None:
+                return (s.lat, s.lon)  # type: ignore[return-value]
+        return None
+
+    @property
+    def ids(self) -> tuple[int, ...]:
+        return tuple(s.id for s in self.sensors)
+
+    def sensor(self, sensor_id: int) -> RadarSensor:
+        """The sensor with this id (``KeyError`` if none)."""
+        for s in self.sensors:
+            if s.id == sensor_id:
+                return s
+        raise KeyError(f"unknown sensor {sensor_id} (known sensors: "
+                       f"{', '.join(str(i) for i in self.ids)})")
+
+    @cached_property
+    def _frame(self) -> LocalFrame:
+        from mhtrack.models.geodesy import LocalFrame  # pyproj is imported only when used
+
+        ref = self.reference
+        if ref is None:
+            raise ValueError("no geodetic reference: give [origin] or a sensor's lat/lon")
+        return LocalFrame(*ref)
+
+    def frame(self) -> LocalFrame:
+        """The local east-north frame (:class:`~mhtrack.models.geodesy.LocalFrame`)."""
+        return self._frame
+
+    def site_xy(self, sensor_id: int) -> tuple[float, float]:
+        """The sensor's site in the local frame (m)."""
+        s = self.sensor(sensor_id)
+        if s.position is not None:
+            return s.position
+        if s.lat is None:
+            raise ValueError(f"sensor {sensor_id} has no site")
+        x, y = self.frame().to_local(s.lat, s.lon)
+        return float(x), float(y)
+
+    def site_latlon(self, sensor_id: int) -> tuple[float, float]:
+        """The sensor's site in WGS-84 degrees (a ``position`` is carried to the ellipsoid)."""
+        s = self.sensor(sensor_id)
+        if s.lat is not None:
+            return s.lat, s.lon  # type: ignore[return-value]
+        if s.position is None:
+            raise ValueError(f"sensor {sensor_id} has no site")
+        lat, lon = self.frame().to_geodetic(*s.position)
+        return float(lat), float(lon)

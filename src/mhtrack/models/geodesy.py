@@ -48,7 +48,6 @@ import numpy as np
 import pyproj
 
 from mhtrack.models.linalg2 import inv2
-from mhtrack.models.radars import check_latlon
 
 #: The WGS-84 ellipsoid's geodesics (GeographicLib inside PROJ).
 WGS84 = pyproj.Geod(ellps="WGS84")
@@ -96,7 +95,11 @@ class LocalFrame:
 
     def __post_init__(self) -> None:
         lat0, lon0 = float(self.lat0), float(self.lon0)
-        check_latlon("origin", lat0, lon0)
+        if not (np.isfinite(lat0) and -90.0 <= lat0 <= 90.0):
+            raise ValueError(f"origin: latitude must be within [-90, 90] degrees, got {lat0:g}")
+        if not (np.isfinite(lon0) and -180.0 <= lon0 <= 180.0):
+            raise ValueError(f"origin: longitude must be within [-180, 180] degrees, "
+                             f"got {lon0:g}")
         object.__setattr__(self, "lat0", lat0)
         object.__setattr__(self, "lon0", lon0)
 

@@ -8,6 +8,7 @@ from pathlib import Path
 
 from mhtrack.experiments.montecarlo import MonteCarloResult
 from mhtrack.io.atomic import atomic_write
+from mhtrack.reports.figures import save
 
 SUMMARY_FILE = "summary.md"
 FIGURE_FILE = "ospa_cardinality.png"
@@ -50,7 +51,6 @@ def write_montecarlo_report(result: MonteCarloResult) -> list[Path]:
     """Write ``summary.md`` and (when some run has per-scan curves)
     ``ospa_cardinality.png`` into the study directory; returns the paths written."""
     from mhtrack.plotting.metrics import plot_ospa_cardinality
-    from mhtrack.plotting.scene import save_figure
 
     out = [atomic_write(result.out_dir / SUMMARY_FILE, summary_markdown(result))]
     curves = {t: v["per_scan"] for t, v in result.summary().items() if v["per_scan"]["scans"]}
@@ -58,6 +58,6 @@ def write_montecarlo_report(result: MonteCarloResult) -> list[Path]:
         spec = result.spec
         cutoff = spec.run_kwargs.get("cutoff", 500.0)
         title = f"{spec.scenario_name}: mean ± std over {spec.runs} runs"
-        out.append(save_figure(plot_ospa_cardinality(curves, cutoff=cutoff, title=title),
-                               result.out_dir / FIGURE_FILE))
+        out.append(save(plot_ospa_cardinality(curves, cutoff=cutoff, title=title),
+                        result.out_dir / FIGURE_FILE, dpi=130))
     return out

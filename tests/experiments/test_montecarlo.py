@@ -15,10 +15,15 @@ from mhtrack.experiments import (
     load_results,
     run_job,
     run_montecarlo,
-    run_seed,
 )
-from mhtrack.experiments.montecarlo import run_path
+from mhtrack.experiments.montecarlo import MonteCarloResult
+from mhtrack.reports.montecarlo import summary_markdown, write_montecarlo_report
 from mhtrack.scenario import preset
+
+
+def run_path(out, tracker, run, suffix=".parquet"):
+    """Where a run's file lives (the documented layout, written out independently)."""
+    return Path(out) / "runs" / tracker / f"run-{run}{suffix}"
 
 TRACKERS = ("mht", "mht-gmm", "mht-agmm")
 
@@ -52,13 +57,19 @@ def fail_mht_gmm_run_1(job):
     return run_job(job)
 
 
-def test_run_seed_depends_on_seed_and_run_only():
-    children = np.random.SeedSequence(5).spawn(4)
-    for i, child in enumerate(children):
-        expected = int(child.generate_state(1, np.uint64)[0] >> np.uint64(1))
-        assert run_seed(5, i) == expected
-    assert run_seed(5, 1) != run_seed(6, 1)
-    assert run_seed(5, 1) != run_seed(5, 2)
+def test_job_hash_of_an_old_study_is_unchanged():
+    """Pinned hash of a job as the code before the job runner computed it: an old study
+    directory resumes without recomputing anything."""
+    job = MonteCarloSpec({"name": "tiny"}, ("mht",), runs=2, seed=3).job("mht", 1)
+    assert job.hash == "0c59fb0fb776a4066ed4fccb29a1b6f6f8d13d604ee3ddbe3ea002ae98316a2d"
+    assert job.key == "mht/run-1"
+
+
+def test_trackers_share_a_run_seed_and_runs_differ(inline):
+    seeds = {t: [r["seed"] for r in inline.records[t]] for t in TRACKERS}
+    assert seeds["mht"] == seeds["mht-gmm"] == seeds["mht-agmm"]
+    assert len(set(seeds["mht"])) == 2
+    assert all(r["base_seed"] == 7 for recs in inline.records.values() for r in recs)
 
 
 def test_inline_run_writes_one_file_per_job(spec, inline):
@@ -73,7 +84,7 @@ def test_inline_run_writes_one_file_per_job(spec, inline):
             assert len(row) == 1
             row = row[0]
             assert row["tracker"] == t and row["run"] == i and row["scenario"] == "crossing"
-            assert row["seed"] == run_seed(7, i)
+            assert row["seed"] == inline.records["mht"][i]["seed"]
             assert len(row["ospa"]) == len(row["scans"]) == len(row["cardinality"]) == 12
             assert {"ospa_mean", "mota", "t_avg", "cardinality_true"} <= set(row)
     # every tracker sees the same plots in run i: same truth count
@@ -159,8 +170,9 @@ def test_a_failing_job_is_recorded_and_the_others_complete(spec, inline, tmp_pat
     assert [len(r.records[t]) for t in TRACKERS] == [2, 1, 2]
     s = r.summary()
     assert s["mht-gmm"]["failed"] == [1] and s["mht-gmm"]["n_runs"] == 1
-    r.write_reports()
-    assert "mht-gmm run 1" in (tmp_path / "summary.md").read_text()
+    write_montecarlo_report(r)
+    assert "* mht-gmm run 1: see `runs/mht-gmm/run-1.error.txt`" in (
+        tmp_path / "summary.md").read_text()
     # a rerun retries the failed job only and clears its error file
     fixed = run_montecarlo(spec, tmp_path, workers=1)
     assert fixed.ok and fixed.computed == 1
@@ -168,27 +180,53 @@ def test_a_failing_job_is_recorded_and_the_others_complete(spec, inline, tmp_pat
     assert comparable(fixed) == comparable(inline)
 
 
-def test_summary_and_reports(spec, inline):
+def test_summary_equals_numpy_on_the_stored_files(spec, inline):
+    """Means and population stds of the summary equal numpy's over the Parquet files read
+    back with pyarrow (not through the runner's reader)."""
     s = inline.summary()
     assert list(s) == list(TRACKERS)
     for t in TRACKERS:
-        e = s[t]
+        rows = [pq.read_table(run_path(inline.out_dir, t, i)).to_pylist()[0] for i in range(2)]
         for k in ("ospa_mean", "mota", "gospa_mean", "t_avg"):
-            vals = [r[k] for r in inline.records[t]]
-            assert e[k] == pytest.approx(np.mean(vals))
-            assert e["std"][k] == pytest.approx(np.std(vals))
-        ps = e["per_scan"]
+            vals = np.array([r[k] for r in rows], float)
+            assert s[t][k] == np.mean(vals)
+            assert s[t]["std"][k] == np.std(vals)
+        ps = s[t]["per_scan"]
         assert ps["scans"] == list(range(1, 13))
-        ospa = np.array([r["ospa"] for r in inline.records[t]])
-        np.testing.assert_allclose(ps["ospa"], ospa.mean(axis=0))
-        np.testing.assert_allclose(ps["ospa_std"], ospa.std(axis=0))
+        ospa = np.array([r["ospa"] for r in rows])
+        np.testing.assert_array_equal(ps["ospa"], ospa.mean(axis=0))
+        np.testing.assert_array_equal(ps["ospa_std"], ospa.std(axis=0))
         assert len(ps["cardinality"]) == len(ps["cardinality_std"]) == 12
-    inline.write_reports()
+    write_montecarlo_report(inline)
     md = (inline.out_dir / "summary.md").read_text()
     assert "| ospa_mean |" in md and " ± " in md
-    assert (inline.out_dir / "ospa_cardinality.png").stat().st_size > 1000
+    assert (inline.out_dir / "ospa_cardinality.png").read_bytes()[:4] == b"\x89PNG"
     loaded = load_results(inline.out_dir)
     assert comparable(loaded) == comparable(inline)
+
+
+def test_hand_worked_summary(tmp_path):
+    """Three runs: a metric 1, 2, NaN → mean 1.5, std 0.5 (NaN ignored); per scan, a scan
+    seen in one run only counts that run."""
+    spec = MonteCarloSpec({"name": "tiny"}, ("mht",), runs=3, seed=0)
+    recs = [
+        {"run": 0, "seed": 1, "m": 1.0, "scans": [1, 2], "ospa": [10.0, 20.0],
+         "gospa": [0.0, 0.0], "cardinality": [1, 2], "cardinality_true": [1, 1]},
+        {"run": 1, "seed": 2, "m": 2.0, "scans": [1, 2, 3], "ospa": [30.0, 40.0, 50.0],
+         "gospa": [0.0, 0.0, 0.0], "cardinality": [3, 2, 1], "cardinality_true": [1, 1, 1]},
+        {"run": 2, "seed": 3, "m": math.nan, "scans": [], "ospa": [], "gospa": [],
+         "cardinality": [], "cardinality_true": []},
+    ]
+    res = MonteCarloResult(spec, tmp_path, {"mht": recs}, {"mht": {}})
+    s = res.summary()["mht"]
+    assert res.metric_keys() == ["m"]
+    assert (s["m"], s["std"]["m"], s["n_runs"]) == (1.5, 0.5, 3)
+    ps = s["per_scan"]
+    assert ps["scans"] == [1, 2, 3]
+    assert ps["ospa"] == [20.0, 30.0, 50.0] and ps["ospa_std"] == [10.0, 10.0, 0.0]
+    assert ps["cardinality"] == [2.0, 2.0, 1.0] and ps["cardinality_std"] == [1.0, 0.0, 0.0]
+    md = summary_markdown(res)
+    assert "| m | 1.5 ± 0.5 |" in md and "| runs ok | 3 |" in md
 
 
 def test_spec_validation(spec):
@@ -206,12 +244,12 @@ def test_spec_validation(spec):
 def test_run_kwargs_are_forwarded_verbatim(spec, tmp_path):
     job = MonteCarloSpec(spec.scenario, ("mht",), runs=1, run_kwargs={"cutoff": 100.0}).job(
         "mht", 0)
-    assert run_job(job)["cutoff"] == 100.0
+    assert run_job(job.as_dict())["cutoff"] == 100.0
 
 
 def test_no_stray_temporary_files(inline):
     names = [p.name for p in Path(inline.out_dir).rglob("*")]
-    assert not [n for n in names if n.endswith(".tmp")]
+    assert not [n for n in names if n.startswith(".")]
     assert os.path.isdir(inline.out_dir / "runs" / "mht")
 
 
@@ -227,15 +265,13 @@ def test_an_interruption_loses_no_finished_run(spec, inline, tmp_path):
     with pytest.raises(KeyboardInterrupt):
         run_montecarlo(spec, tmp_path, workers=1, job_function=interrupted)
     assert len(list(tmp_path.glob("runs/*/*.parquet"))) == 2
-    assert not list(tmp_path.rglob("*.tmp"))
+    assert not list(tmp_path.rglob(".*"))
     resumed = run_montecarlo(spec, tmp_path, workers=1)
     assert resumed.computed == 4 and resumed.skipped == 2
     assert comparable(resumed) == comparable(inline)
 
 
 def test_runs_with_caps_counts_runs_where_a_cap_acted(tmp_path):
-    from mhtrack.experiments.montecarlo import MonteCarloResult
-
     spec = MonteCarloSpec(preset("crossing", scans=5), ["mht"], 3, 0)
     recs = [{"caps": "{}"}, {"caps": '{"max_leaves": 4}'}, {"caps": '{"max_trees": 1}'}]
     res = MonteCarloResult(spec, tmp_path, {"mht": recs}, {"mht": {}})

@@ -9,19 +9,36 @@ import pytest
 from click.testing import CliRunner
 
 from mhtrack.cli.reproduce_commands import COMMANDS, reproduce
-from mhtrack.experiments import reproduce_p1 as rp
-from mhtrack.experiments.montecarlo import run_seed
+from mhtrack.experiments.p1 import constants as rp
+from mhtrack.experiments.p1 import reproduce_p1
+from mhtrack.experiments.p1 import study as p1_study
+from mhtrack.reports.p1 import write_p1_report
+from mhtrack.reports.p1_text import compare_text, fmt
 from mhtrack.scenario import preset
 
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 FILES = ("table3.md", "table3.json", "report.md", *rp.FIGURES.values())
 
 
+def run_p1(out):
+    study = reproduce_p1(out, runs=2, seed=3, scenario=preset("crossing", scans=15),
+                         workers=1)
+    return study, write_p1_report(study)
+
+
 @pytest.fixture(scope="module")
-def repro(tmp_path_factory):
-    out = tmp_path_factory.mktemp("p1")
-    return rp.reproduce_p1(out, runs=2, seed=3, scenario=preset("crossing", scans=15),
-                           workers=1)
+def both(tmp_path_factory):
+    return run_p1(tmp_path_factory.mktemp("p1"))
+
+
+@pytest.fixture(scope="module")
+def repro(both):
+    return both[0]
+
+
+@pytest.fixture(scope="module")
+def report(both):
+    return both[1]
 
 
 def png_size(path) -> tuple[int, int]:
@@ -43,11 +60,11 @@ def test_files_exist(repro):
     assert repro.result.ok
 
 
-def test_figures_are_png(repro):
+def test_figures_are_png(repro, report):
     for key, name in rp.FIGURES.items():
         w, h = png_size(repro.out_dir / name)
         assert w >= 400 and h >= 300, (name, w, h)
-        assert repro.figures[key] == repro.out_dir / name
+        assert report.figures[key] == repro.out_dir / name
     w, h = png_size(repro.out_dir / rp.FIGURES["fig4"])
     assert w > 2 * h  # three panels side by side
 
@@ -65,11 +82,11 @@ def test_table_holds_paper_and_ours(repro):
         assert len(paper_cells) == len(ours_cells) == len(rp.TABLE3_METRICS)
         for m, pc, oc in zip(rp.TABLE3_METRICS, paper_cells, ours_cells, strict=True):
             if m.key in rp.PAPER_TABLE3[t]:
-                assert pc == rp.fmt(m.key, rp.PAPER_TABLE3[t][m.key])
+                assert pc == fmt(m.key, rp.PAPER_TABLE3[t][m.key])
             else:
                 assert pc == "–"
             mean, std = s[t][m.key], s[t]["std"][m.key]
-            assert oc == f"{rp.fmt(m.key, mean)} ± {rp.fmt(m.key, std)}", (t, m.key)
+            assert oc == f"{fmt(m.key, mean)} ± {fmt(m.key, std)}", (t, m.key)
     assert "0.9703" in md and "64.44" in md  # P1's MHT-AGMM Rcc and Lavg
 
 
@@ -89,7 +106,6 @@ def test_numbers_equal_summary_means(repro):
 
 
 def test_run0_recomputed_with_runner_seed(repro):
-    assert repro.run0_seed == run_seed(3, 0)
     for t in rp.P1_TRACKERS:
         rec = next(r for r in repro.result.records[t] if r["run"] == 0)
         assert rec["seed"] == repro.run0_seed
@@ -98,8 +114,8 @@ def test_run0_recomputed_with_runner_seed(repro):
             assert got[k] == pytest.approx(rec[k], nan_ok=True), (t, k)
 
 
-def test_report(repro):
-    text = repro.report_path.read_text()
+def test_report(repro, report):
+    text = report.report_path.read_text()
     for name in rp.FIGURES.values():
         assert f"]({name})" in text
     assert "## Settings" in text and "λ = 40" in text and "κ = 1e-09" in text
@@ -112,20 +128,19 @@ def test_report(repro):
                           text, flags=re.M)
     assert len(verdicts) == 7 * 3
     rcc = repro.table["mht-agmm"]["rcc"]["mean"]
-    assert f"Rcc: ours {rp.fmt('rcc', rcc)}" in text
+    assert f"Rcc: ours {fmt('rcc', rcc)}" in text
 
 
-def test_resume_computes_nothing(repro):
-    again = rp.reproduce_p1(repro.out_dir, runs=2, seed=3,
-                            scenario=preset("crossing", scans=15), workers=1)
+def test_resume_computes_nothing(repro, report):
+    again, again_report = run_p1(repro.out_dir)
     assert again.result.computed == 0 and again.result.skipped == 6
-    assert again.table_md == repro.table_md  # Tavg too is read back from the run files
+    assert again_report.table_md == report.table_md  # Tavg too is read back from the files
 
 
 def test_compare_text_ranks_ties():
     row = {m.key: {"mean": 1.0, "std": 0.0, "paper": math.nan} for m in rp.TABLE3_METRICS}
     table = {"mht": row, "mht-gmm": dict(row), "mht-agmm": dict(row)}
-    text = rp.compare_text(table)
+    text = compare_text(table)
     assert "MHT = MHT-GMM = MHT-AGMM" in text
     assert "Identical accuracy" in text
 
@@ -139,7 +154,7 @@ def test_cli_help():
 
 
 def test_cli_runs(tmp_path, monkeypatch):
-    monkeypatch.setattr(rp, "p1_scenario", lambda: preset("crossing", scans=8))
+    monkeypatch.setattr(p1_study, "p1_scenario", lambda: preset("crossing", scans=8))
     r = CliRunner().invoke(reproduce, ["p1", "--runs", "1", "--workers", "1", "--out",
                                        str(tmp_path), "--no-progress"])
     assert r.exit_code == 0, r.output

@@ -108,6 +108,7 @@ def montecarlo(scenario: str, clutter: str | None, clutter_rate: float | None,
         SpecMismatchError,
         run_montecarlo,
     )
+    from mhtrack.reports.montecarlo import summary_markdown, write_montecarlo_report
 
     run_on = executor_kwargs(workers, dask_scheduler, progress)
     sc = load_scenario_arg(scenario, clutter, clutter_rate, pd, scans)
@@ -123,11 +124,11 @@ def montecarlo(scenario: str, clutter: str | None, clutter_rate: float | None,
         result = run_montecarlo(spec, out, **run_on)
     except (SpecMismatchError, ValueError) as e:
         raise click.ClickException(str(e)) from None
-    result.write_reports()
+    write_montecarlo_report(result)
     if as_json:
         echo_json(result.summary())
     else:
-        click.echo(result.to_markdown(), nl=False)
+        click.echo(summary_markdown(result), nl=False)
         click.echo(f"{result.computed} runs computed, {result.skipped} already done; "
                    f"wrote {out}/ (runs/, montecarlo.json, summary.md, ospa_cardinality.png)")
     capped = {t: n for t, n in result.runs_with_caps().items() if n}

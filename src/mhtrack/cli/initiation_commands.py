@@ -1,7 +1,8 @@
 """``cluster`` and ``initiate``: multi-radar plot fusion and track initiation (P2).
 
 Both simulate ``--runs`` independent runs (seeds derived from ``--seed``), call
-:mod:`mhtrack.initiation.runs`, score with :mod:`mhtrack.metrics.initiation` and print.
+:mod:`mhtrack.experiments.initiation_runs`, score with :mod:`mhtrack.metrics.initiation`
+and print; ``--figure`` is drawn by :mod:`mhtrack.reports.initiation`.
 """
 
 from __future__ import annotations
@@ -12,6 +13,7 @@ from typing import Any
 import click
 
 from mhtrack.cli.common import echo_json, load_scenario_arg, scenario_options
+from mhtrack.names import CLUSTER_METHODS, INITIATION_FUSIONS, INITIATORS
 
 
 def _common(f: Any) -> Any:
@@ -38,7 +40,7 @@ def _rate(sc: Any) -> float:
 
 @click.command()
 @scenario_options
-@click.option("--method", type=click.Choice(["adaptive", "random"]), default="adaptive",
+@click.option("--method", type=click.Choice(CLUSTER_METHODS), default="adaptive",
               show_default=True,
               help="Adaptive K-means (P2 §1.2) or K-means from random plots with k = the "
               "number of targets seen (P2 Fig. 2a).")
@@ -49,7 +51,7 @@ def cluster(scenario: str, seed: int, clutter: str | None, clutter_rate: float |
     """Fuse the plots of every scan of SCENARIO by clustering and score the clusters:
     k_correct_rate (share of scans with as many clusters as targets seen), mean distance
     of the fused plots to the truth, cluster purity, time per scan."""
-    from mhtrack.initiation.runs import run_clustering
+    from mhtrack.experiments.initiation_runs import run_clustering
     from mhtrack.metrics.initiation import (
         cluster_purity,
         clustering_metrics,
@@ -69,8 +71,7 @@ def cluster(scenario: str, seed: int, clutter: str | None, clutter_rate: float |
     d = {"scenario": sc.name, "method": method, "runs": runs, "seed": seed,
          "clutter_rate": _rate(sc), "weighting": weighting, **m.to_dict()}
     if figure is not None:
-        from mhtrack.plotting.initiation import clustering_figure_for
-        from mhtrack.plotting.scene import save_figure
+        from mhtrack.reports.initiation import clustering_figure_for, save_figure
 
         save_figure(clustering_figure_for(sc, seed), figure)
     if as_json:
@@ -89,10 +90,9 @@ def cluster(scenario: str, seed: int, clutter: str | None, clutter_rate: float |
 
 @click.command()
 @scenario_options
-@click.option("--method", type=click.Choice(["logic", "modified-logic", "hough",
-                                             "modified-hough"]),
+@click.option("--method", type=click.Choice(INITIATORS),
               default="modified-logic", show_default=True, help="Initiator (P2 §2, §3.2).")
-@click.option("--fusion", type=click.Choice(["adaptive-kmeans", "kmeans", "none"]),
+@click.option("--fusion", type=click.Choice(INITIATION_FUSIONS),
               default="adaptive-kmeans", show_default=True,
               help="Plot fusion before initiation.")
 @click.option("--theta", "theta_deg", type=click.FloatRange(0, 180), default=20.0,
@@ -110,8 +110,8 @@ def initiate(scenario: str, seed: int, clutter: str | None, clutter_rate: float 
              weighting: str, as_json: bool, progress: bool, figure: Path | None) -> None:
     """Start tracks on every 4-scan window of SCENARIO and score them (P2's metrics):
     p_true, p_false, false tracks per run, time per window."""
+    from mhtrack.experiments.initiation_runs import run_initiation
     from mhtrack.initiation import make_initiator
-    from mhtrack.initiation.runs import run_initiation
     from mhtrack.metrics.initiation import initiable_targets, initiation_metrics, track_targets
 
     if v_min >= v_max:
@@ -142,8 +142,7 @@ def initiate(scenario: str, seed: int, clutter: str | None, clutter_rate: float 
          "runs": runs, "seed": seed, "clutter_rate": _rate(sc), **m.to_dict(),
          "t_fusion_scan": sum(fs) / len(fs) if fs else float("nan")}
     if figure is not None:
-        from mhtrack.plotting.initiation import initiation_figure_for
-        from mhtrack.plotting.scene import save_figure
+        from mhtrack.reports.initiation import initiation_figure_for, save_figure
 
         save_figure(initiation_figure_for(sc, seed, fusion=fusion, theta_deg=theta_deg,
                                           gate_radius=gate_radius, v_min=v_min, v_max=v_max),

@@ -33,18 +33,20 @@ def p1(runs: int, out: Path, seed: int, workers: int | None, dask_scheduler: str
     the table. Exit status 1 if any run failed (after everything was written).
     """
     from mhtrack.experiments.montecarlo import SpecMismatchError
-    from mhtrack.experiments.reproduce_p1 import reproduce_p1
+    from mhtrack.experiments.p1 import reproduce_p1
+    from mhtrack.reports.p1 import write_p1_report
 
     run_on = executor_kwargs(workers, dask_scheduler, progress)
     try:
         repro = reproduce_p1(out, runs, seed, **run_on)
     except (SpecMismatchError, ValueError) as e:
         raise click.ClickException(str(e)) from None
+    report = write_p1_report(repro)
     res = repro.result
-    click.echo(repro.table_md)
+    click.echo(report.table_md)
     click.echo(f"{res.computed} runs computed, {res.skipped} already done.")
     click.echo("wrote:")
-    for p in repro.paths:
+    for p in report.paths:
         click.echo(f"  {p}{'/' if p.is_dir() else ''}")
     exit_if_runs_failed("reproduce p1", res)
 
@@ -69,18 +71,20 @@ def p2(runs: int, out: Path, seed: int, workers: int | None, dask_scheduler: str
     window; Tables 1–2: run times beside P2's. Writes OUT/results.json, OUT/tables.md,
     OUT/report.md and the figures. Exit status 1 if any job failed.
     """
-    from mhtrack.experiments.reproduce_p2 import reproduce_p2
+    from mhtrack.experiments.p2 import reproduce_p2
+    from mhtrack.reports.p2 import write_p2_report
 
     run_on = executor_kwargs(workers, dask_scheduler, progress)
     try:
         repro = reproduce_p2(out, runs, seed, **run_on)
     except ValueError as e:
         raise click.ClickException(str(e)) from None
+    paths = write_p2_report(repro)
     click.echo((repro.out_dir / "tables.md").read_text(encoding="utf-8"))
     click.echo(f"{repro.computed} jobs computed, {repro.skipped} already done "
                f"({repro.wall_seconds:.1f} s).")
     click.echo("wrote:")
-    for p in repro.paths:
+    for p in paths:
         click.echo(f"  {p}{'/' if p.is_dir() else ''}")
     if repro.errors:
         names = sorted(repro.errors)

@@ -1,4 +1,8 @@
-"""Experiments: single tracking runs and Monte-Carlo studies."""
+"""Experiments: single tracking runs (:mod:`.pipeline`), Monte-Carlo studies
+(:mod:`.montecarlo`), the P1 and P2 reproductions (:mod:`.p1`, :mod:`.p2`), the
+multi-radar initiation runs (:mod:`.initiation_runs`), all on one job runner
+(:mod:`.jobs`). They compute and store results; :mod:`mhtrack.reports` writes the text
+and figures."""
 
 from mhtrack.experiments.montecarlo import (
     MonteCarloResult,
@@ -7,7 +11,6 @@ from mhtrack.experiments.montecarlo import (
     load_results,
     run_job,
     run_montecarlo,
-    run_seed,
 )
 from mhtrack.experiments.pipeline import (
     TRACKERS,
@@ -32,6 +35,5 @@ __all__ = [
     "run_job",
     "run_montecarlo",
     "run_scenario",
-    "run_seed",
     "track",
 ]

@@ -5,43 +5,34 @@
   adaptive initial centres);
 * :func:`initiation_figure` — the raw plots of one 4-scan window (P2 Fig. 10), the fused
   plots (Fig. 11), and the tracks each method initiates (Figs. 12–15): true tracks green,
-  false ones red (``docs/initiation.md`` for "true").
+  false ones red (``docs/initiation.md`` for "true");
+* :func:`initiated_tracks_figure` — P2 Figs. 12–15 as a 2 × 2 grid.
 
-``clustering_figure_for`` / ``initiation_figure_for`` simulate the first run of a
-``--seed`` (as the CLI does) and draw it. Axes zoom on the targets (truth box + margin).
+Drawing only: the data of a run come from :mod:`mhtrack.experiments.initiation_runs`.
+Axes zoom on the targets (:func:`zoom_to_truth`: truth box + margin). Figures are
+:class:`matplotlib.figure.Figure` objects (no pyplot state, no backend switch); they save
+to PNG through the Agg canvas.
 """
 
 from __future__ import annotations
 
 from collections.abc import Mapping
-from typing import Any
 
 import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
-from mhtrack.initiation import (
-    INITIATORS,
-    FusedScan,
-    InitiatedTracks,
-    Window,
-    make_initiator,
-    sliding_windows,
-)
-from mhtrack.initiation.runs import fuse, fused_scans, run_seeds
+from mhtrack.initiation import FusedScan, InitiatedTracks, Window
 from mhtrack.metrics.initiation import track_targets
-from mhtrack.records import Scan, TruthTable
-from mhtrack.scenario import Scenario, simulate
+from mhtrack.records import Scan
 
 MARKERS = "o^sDvP*X"
 SCAN_COLOURS = ("tab:blue", "tab:orange", "tab:green", "tab:purple", "tab:brown", "tab:cyan")
 
 
-def _zoom(ax: Axes, truth_xy: np.ndarray | None, margin: float = 800.0) -> None:
+def zoom_to_truth(ax: Axes, truth_xy: np.ndarray | None, margin: float = 800.0) -> None:
+    """Limit ``ax`` to the box of the truth positions plus ``margin`` (m) on each side."""
     if truth_xy is None or len(truth_xy) == 0:
         return
     lo, hi = truth_xy.min(axis=0) - margin, truth_xy.max(axis=0) + margin
@@ -49,7 +40,8 @@ def _zoom(ax: Axes, truth_xy: np.ndarray | None, margin: float = 800.0) -> None:
     ax.set_ylim(lo[1], hi[1])
 
 
-def _finish(ax: Axes, title: str) -> None:
+def finish_axes(ax: Axes, title: str) -> None:
+    """Equal axes in metres (x east, y north), a light grid and ``title``."""
     ax.set_aspect("equal", adjustable="box")
     ax.set_xlabel("x east (m)")
     ax.set_ylabel("y north (m)")
@@ -57,9 +49,17 @@ def _finish(ax: Axes, title: str) -> None:
     ax.set_title(title, fontsize=9)
 
 
+def _tracks_legend(ax: Axes, fontsize: int) -> None:
+    """Legend with the true/false track entries only."""
+    handles, labels = ax.get_legend_handles_labels()
+    keep = [i for i, lab in enumerate(labels) if "tracks" in lab]
+    ax.legend([handles[i] for i in keep], [labels[i] for i in keep], fontsize=fontsize,
+              loc="upper right")
+
+
 def draw_clusters(ax: Axes, scan: Scan, fused: FusedScan) -> None:
     """Plots coloured by cluster, marker by radar; centres as open circles."""
-    cmap = plt.get_cmap("tab20")
+    cmap = matplotlib.colormaps["tab20"]
     radars = np.unique(scan.sensor)
     for r_i, r in enumerate(radars):
         m = scan.sensor == r
@@ -74,13 +74,14 @@ def clustering_figure(scan: Scan, fused: Mapping[str, FusedScan],
                       truth_xy: np.ndarray | None = None, *, title: str = "") -> Figure:
     """One panel per method of ``fused`` (name → :class:`FusedScan` of ``scan``)."""
     n = len(fused)
-    fig, axes = plt.subplots(1, n, figsize=(6 * n, 5.6), squeeze=False)
+    fig = Figure(figsize=(6 * n, 5.6))
+    axes = fig.subplots(1, n, squeeze=False)
     for ax, (name, f) in zip(axes[0], fused.items(), strict=True):
         draw_clusters(ax, scan, f)
         if truth_xy is not None:
             ax.plot(truth_xy[:, 0], truth_xy[:, 1], "k+", ms=9, label="truth")
-        _zoom(ax, truth_xy)
-        _finish(ax, f"{name}: k = {f.n_clusters}")
+        zoom_to_truth(ax, truth_xy)
+        finish_axes(ax, f"{name}: k = {f.n_clusters}")
         ax.legend(fontsize=7, loc="upper right")
     if title:
         fig.suptitle(title)
@@ -122,23 +123,21 @@ def initiation_figure(raw: Window, fused: Window, results: Mapping[str, Initiate
     n = 2 + len(results)
     cols = 3
     rows = -(-n // cols)
-    fig, axes = plt.subplots(rows, cols, figsize=(5.2 * cols, 5.0 * rows), squeeze=False)
+    fig = Figure(figsize=(5.2 * cols, 5.0 * rows))
+    axes = fig.subplots(rows, cols, squeeze=False)
     flat_axes = list(axes.ravel())
     draw_window(flat_axes[0], raw)
     draw_window(flat_axes[1], fused)
     for ax, name in ((flat_axes[0], "plots of the window"), (flat_axes[1], "fused plots")):
-        _zoom(ax, truth_xy)
-        _finish(ax, name)
+        zoom_to_truth(ax, truth_xy)
+        finish_axes(ax, name)
         ax.legend(fontsize=7, loc="upper right", markerscale=1.5)
     for ax, (name, tr) in zip(flat_axes[2:], results.items(), strict=False):
         draw_window(ax, fused)
         draw_tracks(ax, fused, tr)
-        _zoom(ax, truth_xy)
-        _finish(ax, name)
-        handles, labels = ax.get_legend_handles_labels()
-        keep = [i for i, lab in enumerate(labels) if "tracks" in lab]
-        ax.legend([handles[i] for i in keep], [labels[i] for i in keep], fontsize=7,
-                  loc="upper right")
+        zoom_to_truth(ax, truth_xy)
+        finish_axes(ax, name)
+        _tracks_legend(ax, 7)
     for ax in flat_axes[n:]:
         ax.axis("off")
     if title:
@@ -146,43 +145,19 @@ def initiation_figure(raw: Window, fused: Window, results: Mapping[str, Initiate
     return fig
 
 
-def _truth_at(truth: TruthTable, scans: np.ndarray) -> np.ndarray:
-    return truth.positions[np.isin(truth.scan, scans)]
-
-
-def clustering_figure_for(scenario: Scenario, seed: int, *, scan_number: int = 0) -> Figure:
-    """Adaptive vs random K-means on one scan of the first run of ``seed``."""
-    rs = run_seeds(seed, 1)[0]
-    sim = simulate(scenario, rs)
-    scan = list(sim.plots.scans())[scan_number]
-    fused = {m: fuse(scan, m, run_seed=rs) for m in ("random", "adaptive")}
-    names = {"random": "K-means, random initial centres",
-             "adaptive": "adaptive K-means (P2 §1.2)"}
-    return clustering_figure(scan, {names[k]: v for k, v in fused.items()},
-                             _truth_at(sim.truth, np.array([scan.index])),
-                             title=f"{scenario.name}, scan {scan.index}")
-
-
-def initiation_figure_for(scenario: Scenario, seed: int, *, fusion: str = "adaptive-kmeans",
-                          theta_deg: float = 20.0, window_number: int = 0,
-                          gate_radius: float = 300.0, v_min: float = 50.0,
-                          v_max: float = 400.0) -> Figure:
-    """Every method on one window of the first run of ``seed``, with the CLI's settings
-    (Hough accumulators over the scenario's region)."""
-    rs = run_seeds(seed, 1)[0]
-    sim = simulate(scenario, rs)
-    raw = list(sim.plots.scans())
-    fused, _ = fused_scans(raw, fusion, run_seed=rs)
-    raw_w = Window.from_scans(list(sliding_windows(raw))[window_number])
-    win = Window.from_scans(list(sliding_windows(fused))[window_number])
-    results = {}
-    for m in INITIATORS:
-        p: dict[str, Any] = {"v_min": v_min, "v_max": v_max}
-        if m.endswith("logic"):
-            p["gate_radius"] = gate_radius
-        else:
-            p["region"] = scenario.region.as_tuple()
-        results[m] = make_initiator(m, theta_deg=theta_deg, **p).initiate(win)
-    return initiation_figure(raw_w, win, results, _truth_at(sim.truth, win.scans),
-                             title=f"{scenario.name}, scans {win.scans[0]}–{win.scans[-1]}, "
-                             f"fusion {fusion}, θ = {theta_deg:g}°")
+def initiated_tracks_figure(window: Window, tracks: Mapping[str, InitiatedTracks],
+                            truth_xy: np.ndarray | None, titles: Mapping[str, str], *,
+                            title: str = "") -> Figure:
+    """P2 Figs. 12–15: the fused window and each method's tracks, one panel per entry of
+    ``tracks`` in a 2 × 2 grid, titled ``titles[method]``."""
+    fig = Figure(figsize=(11, 10))
+    axes = fig.subplots(2, 2)
+    for ax, (m, tr) in zip(axes.ravel(), tracks.items(), strict=True):
+        draw_window(ax, window)
+        draw_tracks(ax, window, tr)
+        zoom_to_truth(ax, truth_xy)
+        finish_axes(ax, titles[m])
+        _tracks_legend(ax, 8)
+    if title:
+        fig.suptitle(title)
+    return fig

@@ -1,13 +1,12 @@
-"""Metric curves over scans: OSPA per scan and cardinality (P1 Figs. 5–6)."""
+"""Metric curves over scans: OSPA per scan and cardinality (P1 Figs. 5–6).
+
+Figures are :class:`matplotlib.figure.Figure` objects (no pyplot state, no backend
+switch); they save to PNG through the Agg canvas."""
 
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.figure import Figure
 
@@ -23,7 +22,8 @@ def plot_ospa_cardinality(
     :meth:`mhtrack.metrics.Evaluation.to_dict`. Entries may also hold ``ospa_std`` and
     ``cardinality_std`` (Monte-Carlo spread), drawn as bands.
     """
-    fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(8, 6.5), sharex=True)
+    fig = Figure(figsize=(8, 6.5))
+    ax1, ax2 = fig.subplots(2, 1, sharex=True)
     true_drawn = False
     for label, r in runs.items():
         k = np.asarray(r["scans"])

@@ -104,6 +104,7 @@ def curve_for(res: Mapping[str, Any], sigma: float, rate: float) -> dict[str, An
     return None
 
 
-def _nan(v: Sequence[float | None]) -> np.ndarray:
+def nan_for_none(v: Sequence[float | None]) -> np.ndarray:
+    """``v`` as a float array, ``None`` as NaN."""
     return np.array([np.nan if x is None else x for x in v], float)
 

@@ -1,10 +1,10 @@
-"""The jobs of the P2 (Gong, Dai & Ma 2013, multi-radar track initiation) study and their
-runner.
+"""The jobs of the P2 (Gong, Dai & Ma 2013, multi-radar track initiation) study.
 
 :func:`~mhtrack.experiments.p2.study.reproduce_p2` runs (or resumes) three kinds of jobs,
-each a chunk of runs, through a local process pool or a Dask scheduler
-(:func:`run_jobs`), saving each job's counts to ``DIR/jobs/<name>.json`` (atomically) as it
-finishes; a rerun skips finished jobs whose stored parameters match:
+each a chunk of runs, with the job runner :func:`mhtrack.experiments.jobs.run_jobs`
+(this process, local processes or Dask), which stores each job's counts in
+``DIR/jobs/<name>.json`` (:data:`STORE_FORMAT`) as it finishes; a rerun skips finished
+jobs whose stored hash matches:
 
 * ``grid`` — one grid point ``(σr, λ)`` of P2 Fig. 3 (``σr ∈ {20 … 60}`` m at
   ``λ = 50``) or Fig. 4 (``λ ∈ {50 … 250}`` at ``σr = 20`` m; the shared point is run
@@ -18,33 +18,40 @@ finishes; a rerun skips finished jobs whose stored parameters match:
 * ``methods`` — P2 Figs. 12–15 / Table 2: the four initiators at ``σr = 20`` m,
   ``λ = 50``, ``θ = 20°`` (CLI settings): ``p_true``, ``p_false`` and time per window.
 
-Run ``r`` simulates with ``run_seeds(seed, r + 1)[r]`` (the seed ``mhtrack initiate
---seed S`` uses for its run ``r``): it depends on ``seed`` and ``r`` only, so every θ and
-every method sees the same plots. ``λ`` is the clutter rate per radar per scan (3 radars).
+Run ``r`` simulates with ``run_seed(seed, r, "words")`` (:mod:`mhtrack.experiments.jobs.seeds`;
+the seed ``mhtrack initiate --seed S`` uses for its run ``r``): it depends on ``seed`` and
+``r`` only, so every θ and every method sees the same plots. ``λ`` is the clutter rate per
+radar per scan (3 radars).
 
 Job functions are top-level functions of plain data (picklable for the pool and Dask).
-A job's ``job_hash`` and its file hold only the job's parameters, no module path.
+A job's key is its ``name``; its hash (JSON with ``json.dumps``' default separators, as
+the study directories written so far) and its file hold only the job's parameters.
 """
 
 from __future__ import annotations
 
-import hashlib
-import json
 import time
 from collections.abc import Callable, Mapping, Sequence
-from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from mhtrack.experiments.montecarlo import atomic_write, execute
+from mhtrack.experiments.initiation_runs import (
+    fuse,
+    initiators,
+    n_targets_seen,
+    simulate_and_fuse,
+    targets_seen,
+)
+from mhtrack.experiments.jobs import SPACED, Job, JsonRecords, run_seed
 from mhtrack.experiments.p2.constants import CHUNK, LOGIC_PARAMS, RATE0, SIGMA0, THETA0
-from mhtrack.initiation import INITIATORS, Window, make_initiator
+from mhtrack.initiation import INITIATORS, Window
 from mhtrack.initiation.logic import sweep_modified_logic
-from mhtrack.initiation.runs import fuse, fused_scans, n_targets_seen, run_seeds
-from mhtrack.initiation.window import sliding_windows
 from mhtrack.metrics.initiation import initiable_targets, track_targets
 from mhtrack.scenario import Scenario, preset, simulate
+
+#: How a job's counts are stored: ``DIR/jobs/<name>.json``.
+STORE_FORMAT = JsonRecords()
 
 
 def p2_scenario(sigma_range: float = SIGMA0, clutter_rate: float = RATE0) -> Scenario:
@@ -53,14 +60,8 @@ def p2_scenario(sigma_range: float = SIGMA0, clutter_rate: float = RATE0) -> Sce
     return preset("multiradar", clutter_rate=clutter_rate, sigma_range=sigma_range)
 
 
-def _seed_of(seed: int, run: int) -> int:
-    return run_seeds(seed, run + 1)[run]
-
-
 def _initiable(raw_win: Sequence[Any]) -> np.ndarray:
-    seen = np.concatenate([np.unique(s.origin[s.origin >= 0]) for s in raw_win])
-    ids, n_seen = np.unique(seen, return_counts=True)
-    return initiable_targets(ids, n_seen)
+    return initiable_targets(*targets_seen(raw_win))
 
 
 def _score(window: Window, flat: np.ndarray, targets: np.ndarray) -> tuple[int, int, int]:
@@ -82,11 +83,8 @@ def grid_job(job: Mapping[str, Any]) -> dict[str, Any]:
     n_targets = n_windows = non_monotone = 0
     t0 = time.perf_counter()
     for r in range(job["start"], job["stop"]):
-        rs = _seed_of(job["seed"], r)
-        raw = list(simulate(sc, rs).plots.scans())
-        fused, _ = fused_scans(raw, "adaptive-kmeans", run_seed=rs)
-        for raw_win, win in zip(sliding_windows(raw, 4), sliding_windows(fused, 4),
-                                strict=True):
+        for raw_win, win in simulate_and_fuse(sc, run_seed(job["seed"], r, "words")
+                                              ).windows(4):
             w = Window.from_scans(win)
             targets = _initiable(raw_win)
             n_targets += len(targets)
@@ -110,7 +108,7 @@ def clustering_job(job: Mapping[str, Any]) -> dict[str, Any]:
                            for m in ("adaptive", "random")}
     n_scans = 0
     for r in range(job["start"], job["stop"]):
-        rs = _seed_of(job["seed"], r)
+        rs = run_seed(job["seed"], r, "words")
         for scan in simulate(sc, rs).plots.scans():
             n_scans += 1
             k_true = n_targets_seen(scan)
@@ -125,15 +123,8 @@ def clustering_job(job: Mapping[str, Any]) -> dict[str, Any]:
 
 
 def _initiators(region: tuple[float, ...]) -> dict[str, Any]:
-    out = {}
-    for m in INITIATORS:
-        p: dict[str, Any] = {"v_min": LOGIC_PARAMS["v_min"], "v_max": LOGIC_PARAMS["v_max"]}
-        if m.endswith("logic"):
-            p["gate_radius"] = LOGIC_PARAMS["gate_radius"]
-        else:
-            p["region"] = region
-        out[m] = make_initiator(m, theta_deg=THETA0, **p)
-    return out
+    """The four initiators with the study's settings (those of ``mhtrack initiate``)."""
+    return initiators(region, theta_deg=THETA0, **LOGIC_PARAMS)
 
 
 def methods_job(job: Mapping[str, Any]) -> dict[str, Any]:
@@ -146,13 +137,10 @@ def methods_job(job: Mapping[str, Any]) -> dict[str, Any]:
     n_targets = n_windows = n_scans = 0
     fusion_seconds = 0.0
     for r in range(job["start"], job["stop"]):
-        rs = _seed_of(job["seed"], r)
-        raw = list(simulate(sc, rs).plots.scans())
-        fused, secs = fused_scans(raw, "adaptive-kmeans", run_seed=rs)
-        fusion_seconds += sum(secs)
-        n_scans += len(secs)
-        for raw_win, win in zip(sliding_windows(raw, 4), sliding_windows(fused, 4),
-                                strict=True):
+        run = simulate_and_fuse(sc, run_seed(job["seed"], r, "words"))
+        fusion_seconds += sum(run.fusion_seconds)
+        n_scans += len(run.fusion_seconds)
+        for raw_win, win in run.windows(4):
             targets = _initiable(raw_win)
             n_targets += len(targets)
             n_windows += 1
@@ -179,13 +167,9 @@ def run_job(job: Mapping[str, Any]) -> dict[str, Any]:
     return JOB_FUNCTIONS[job["kind"]](job)
 
 
-def _hash(d: Mapping[str, Any]) -> str:
-    return hashlib.sha256(json.dumps(d, sort_keys=True).encode()).hexdigest()
-
-
 def make_jobs(runs: int, seed: int, thetas: Sequence[float], sigmas: Sequence[float],
-              rates: Sequence[float], chunk: int = CHUNK) -> list[dict[str, Any]]:
-    """All jobs of a study (module docstring); each a plain dict with a unique ``name``."""
+              rates: Sequence[float], chunk: int = CHUNK) -> list[Job]:
+    """All jobs of a study (module docstring); each keyed by its unique ``name``."""
     points = [(float(s), RATE0) for s in sigmas] + [(SIGMA0, float(r)) for r in rates]
     points = list(dict.fromkeys(points))
     chunks = [(a, min(a + chunk, runs)) for a in range(0, runs, chunk)]
@@ -193,11 +177,10 @@ def make_jobs(runs: int, seed: int, thetas: Sequence[float], sigmas: Sequence[fl
 
     def add(kind: str, name: str, sigma: float, rate: float, a: int, b: int,
             **extra: Any) -> None:
-        j: dict[str, Any] = {"kind": kind, "name": f"{name}-r{a}-{b}", "sigma": sigma,
-                             "rate": rate, "start": a, "stop": b, "seed": int(seed), **extra}
-        j["job_hash"] = _hash(j)
-        j["tracker"], j["run"] = kind, a  # keys the Dask runner names its tasks with
-        jobs.append(j)
+        params: dict[str, Any] = {"kind": kind, "name": f"{name}-r{a}-{b}", "sigma": sigma,
+                                  "rate": rate, "start": a, "stop": b, "seed": int(seed),
+                                  **extra}
+        jobs.append(Job.of(params["name"], params, SPACED))
 
     for a, b in chunks:
         for s, r in points:
@@ -205,52 +188,3 @@ def make_jobs(runs: int, seed: int, thetas: Sequence[float], sigmas: Sequence[fl
         add("clustering", "clustering-s20-l0", SIGMA0, 0.0, a, b)
         add("methods", f"methods-s{SIGMA0:g}-l{RATE0:g}", SIGMA0, RATE0, a, b)
     return jobs
-
-
-def _done(path: Path, job: Mapping[str, Any]) -> dict[str, Any] | None:
-    """The stored result of ``job`` if ``path`` holds it (same parameters)."""
-    try:
-        d = json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, ValueError):
-        return None
-    return d["result"] if d.get("job", {}).get("job_hash") == job["job_hash"] else None
-
-
-def run_jobs(jobs: Sequence[Mapping[str, Any]], jobs_dir: Path, *, executor: str = "local",
-             workers: int | None = None, scheduler: Any = None, progress: bool = False,
-             ) -> tuple[dict[str, dict[str, Any]], dict[str, str], int]:
-    """Run the jobs not finished in ``jobs_dir``; returns (results by name, errors by
-    name, number computed)."""
-    from tqdm.auto import tqdm
-
-
-    results: dict[str, dict[str, Any]] = {}
-    errors: dict[str, str] = {}
-    pending = []
-    for j in jobs:
-        r = _done(jobs_dir / f"{j['name']}.json", j)
-        if r is None:
-            pending.append(j)
-        else:
-            results[j["name"]] = r
-    bar = tqdm(total=len(pending), desc="reproduce p2", unit="job", disable=not progress)
-
-    def finish(job: Mapping[str, Any], record: Mapping[str, Any] | None,
-               error: str | None) -> None:
-        bar.update(1)
-        if error is not None:
-            errors[job["name"]] = error
-            atomic_write(jobs_dir / f"{job['name']}.error.txt", error)
-            return
-        results[job["name"]] = dict(record)  # type: ignore[arg-type]
-        atomic_write(jobs_dir / f"{job['name']}.json",
-                      json.dumps({"job": dict(job), "result": record}) + "\n")
-        (jobs_dir / f"{job['name']}.error.txt").unlink(missing_ok=True)
-
-    jobs_dir.mkdir(parents=True, exist_ok=True)
-    try:
-        execute(pending, run_job, finish, executor=executor, workers=workers,
-                scheduler=scheduler)
-    finally:
-        bar.close()
-    return results, errors, len(pending)

@@ -1,17 +1,5 @@
-"""Reproduce P1 §3: the Monte-Carlo study of ``crossing`` and P1's Table 3 and Figs. 2–6.
-
-:func:`reproduce_p1` runs (or resumes) the study of the ``crossing`` preset with the three
-trackers ``mht``, ``mht-gmm`` and ``mht-agmm`` through
-:func:`~mhtrack.experiments.montecarlo.run_montecarlo` into ``DIR/montecarlo/``, then writes
-
-* ``DIR/table3.md`` — our Table 3 (mean ± std over runs) beside P1's printed numbers
-  (:data:`PAPER_TABLE3`), and ``DIR/table3.json`` with the same numbers unrounded;
-* ``DIR/report.md`` — the settings, the table, the figures, a metric-by-metric comparison
-  generated from the measured numbers, and the known reasons for the differences;
-* ``DIR/fig2_truth.png`` … ``DIR/fig6_cardinality.png`` (P1 Figs. 2–6). Figs. 3–4 show run
-  0: it is recomputed with :func:`~mhtrack.experiments.pipeline.run_scenario` with the
-  seed the runner used for run 0 (:func:`~mhtrack.experiments.montecarlo.run_seed`).
-"""
+"""Markdown text of the P1 §3 reproduction: Table 3 (P1's rows and ours), the comparison
+generated from the measured numbers, the settings and ``report.md``."""
 
 from __future__ import annotations
 
@@ -19,82 +7,24 @@ import json
 import math
 import os
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
-from mhtrack.experiments.montecarlo import (
-    MonteCarloResult,
-    MonteCarloSpec,
-    atomic_write,
-    run_montecarlo,
-    run_seed,
+from mhtrack.experiments.montecarlo import MonteCarloSpec
+from mhtrack.experiments.p1 import P1Reproduction
+from mhtrack.experiments.p1.constants import (
+    MC_DIR,
+    METRIC_BY_KEY,
+    PAPER_SOURCE,
+    RUN_KWARGS,
+    TABLE3_METRICS,
+    TABLE_FILE,
+    TABLE_JSON,
+    TRACKER_LABELS,
+    Metric,
 )
 from mhtrack.scenario import Scenario
 
-#: Trackers of P1 Table 3, in the paper's row order.
-P1_TRACKERS: tuple[str, ...] = ("mht", "mht-gmm", "mht-agmm")
-#: Row labels of the trackers.
-TRACKER_LABELS = {"mht": "MHT", "mht-gmm": "MHT-GMM", "mht-agmm": "MHT-AGMM"}
-
-#: Where :data:`PAPER_TABLE3` comes from.
-PAPER_SOURCE = (
-    "P1 (MHT-AGMM: MHT with adaptive-GMM clutter estimation), §3, Table 3 "
-    "(\"Performance metrics of three algorithms\"), as copied in SPEC.md §7; "
-    "their machine, their code"
-)
-#: P1 Table 3, as printed (Tavg, L* in s). P1 gives no OSPA mean (only Fig. 5).
-PAPER_TABLE3: dict[str, dict[str, float]] = {
-    "mht": {"rcc": 0.8902, "rmc": 0.0056, "rfg": 0.0350, "t_avg": 0.6090,
-            "l_min": 38.86, "l_avg": 59.34, "l_max": 76.36},
-    "mht-gmm": {"rcc": 0.9301, "rmc": 0.0040, "rfg": 0.0400, "t_avg": 1.0387,
-                "l_min": 36.76, "l_avg": 61.94, "l_max": 79.12},
-    "mht-agmm": {"rcc": 0.9703, "rmc": 0.0028, "rfg": 0.0200, "t_avg": 0.9365,
-                 "l_min": 47.90, "l_avg": 64.44, "l_max": 79.40},
-}
-
-
-@dataclass(frozen=True)
-class Metric:
-    key: str          #: summary key
-    label: str        #: column heading
-    higher_better: bool
-    digits: int       #: decimals in the tables
-    unit: str = ""
-
-
-#: Columns of our Table 3: P1's seven plus the OSPA mean.
-TABLE3_METRICS: tuple[Metric, ...] = (
-    Metric("rcc", "Rcc", True, 4),
-    Metric("rmc", "Rmc", False, 4),
-    Metric("rfg", "Rfg", False, 4),
-    Metric("t_avg", "Tavg (s)", False, 4, " s"),
-    Metric("l_min", "Lmin (s)", True, 2, " s"),
-    Metric("l_avg", "Lavg (s)", True, 2, " s"),
-    Metric("l_max", "Lmax (s)", True, 2, " s"),
-    Metric("ospa_mean", "OSPA mean (m)", False, 1, " m"),
-)
-_METRIC = {m.key: m for m in TABLE3_METRICS}
-
-#: run_scenario keywords of the study (those of ``mhtrack montecarlo``'s defaults, so the
-#: job hashes agree with ``mhtrack montecarlo crossing``).
-RUN_KWARGS: dict[str, Any] = {"cutoff": 500.0, "order": 2.0, "output": "history"}
-
-MC_DIR = "montecarlo"
-TABLE_FILE = "table3.md"
-TABLE_JSON = "table3.json"
-REPORT_FILE = "report.md"
-FIGURES = {
-    "fig2": "fig2_truth.png",
-    "fig3": "fig3_plots.png",
-    "fig4": "fig4_tracks.png",
-    "fig5": "fig5_ospa.png",
-    "fig6": "fig6_cardinality.png",
-}
-
-#: Fixed paragraph of the report: known reasons for the differences.
 KNOWN_REASONS = """\
 Known reasons for differences (our choices and what P1 does not give):
 
@@ -122,57 +52,12 @@ Known reasons for differences (our choices and what P1 does not give):
   another normalisation (e.g. per track point), so Rfg compares only in ranking.
 """
 
-
-@dataclass
-class P1Reproduction:
-    """What :func:`reproduce_p1` produced."""
-
-    out_dir: Path
-    result: MonteCarloResult
-    table: dict[str, dict[str, dict[str, float]]]  #: tracker → metric → mean/std/paper
-    table_md: str
-    report_path: Path
-    table_path: Path
-    figures: dict[str, Path] = field(default_factory=dict)
-    run0: dict[str, Any] = field(default_factory=dict)  #: tracker → ScenarioRun of run 0
-    run0_seed: int = 0
-
-    @property
-    def paths(self) -> list[Path]:
-        return [self.table_path, self.out_dir / TABLE_JSON, self.report_path,
-                *self.figures.values(), self.result.out_dir]
-
-
-# ---------------------------------------------------------------------------- numbers
-def _num(v: Any) -> float:
-    try:
-        f = float(v)
-    except (TypeError, ValueError):
-        return math.nan
-    return f
-
-
 def fmt(key: str, v: float) -> str:
     """``v`` as printed in the tables for metric ``key`` (``–`` for NaN)."""
     if not math.isfinite(v):
         return "–"
-    return f"{v:.{_METRIC[key].digits}f}"
+    return f"{v:.{METRIC_BY_KEY[key].digits}f}"
 
-
-def table3_numbers(summary: Mapping[str, Mapping[str, Any]],
-                   trackers: Sequence[str] = P1_TRACKERS) -> dict[str, dict[str, dict[str, float]]]:
-    """``{tracker: {metric: {"mean", "std", "paper"}}}`` from a Monte-Carlo summary; the
-    paper's value is NaN where P1 gives none (OSPA)."""
-    out: dict[str, dict[str, dict[str, float]]] = {}
-    for t in trackers:
-        s = summary.get(t, {})
-        std = s.get("std", {})
-        out[t] = {
-            m.key: {"mean": _num(s.get(m.key)), "std": _num(std.get(m.key)),
-                    "paper": _num(PAPER_TABLE3.get(t, {}).get(m.key))}
-            for m in TABLE3_METRICS
-        }
-    return out
 
 
 def _mean_pm_std(key: str, mean: float, std: float) -> str:
@@ -196,7 +81,7 @@ def table3_markdown(table: Mapping[str, Mapping[str, Mapping[str, float]]], runs
     return "\n".join(lines) + "\n"
 
 
-def _table3_file(table: Mapping[str, Any], runs: int, n_ok: Mapping[str, int]) -> str:
+def table3_file(table: Mapping[str, Any], runs: int, n_ok: Mapping[str, int]) -> str:
     ok = ", ".join(f"{TRACKER_LABELS.get(t, t)} {n}" for t, n in n_ok.items())
     return (
         "# Table 3: performance metrics of the three algorithms (`crossing`)\n\n"
@@ -324,7 +209,7 @@ def _is_best(table: Mapping[str, Mapping[str, Mapping[str, float]]], t: str, m: 
 
 
 # ---------------------------------------------------------------------------- report
-def _settings_text(spec: MonteCarloSpec) -> str:
+def settings_text(spec: MonteCarloSpec) -> str:
     from mhtrack.experiments.pipeline import DEFAULT_CLUTTER_DENSITY, config_with
 
     sc = Scenario.from_dict(spec.scenario)
@@ -368,12 +253,14 @@ def _short(d: Mapping[str, Any]) -> str:
     return "`" + json.dumps(r(dict(d)), separators=(", ", ": ")) + "`"
 
 
-def report_markdown(repro: P1Reproduction) -> str:
+def report_markdown(repro: P1Reproduction, figures: Mapping[str, Path]) -> str:
+    """``report.md``: settings, Table 3, the generated comparison, the known reasons for
+    the differences and the figures (``figures``: key of :data:`FIGURES` → path)."""
     res = repro.result
     spec = res.spec
     s = res.summary()
     failed = [(t, i) for t in spec.trackers for i in s[t]["failed"]]
-    fig = repro.figures
+    fig = figures
     rel = {k: os.path.relpath(p, repro.out_dir) for k, p in fig.items()}
     run0_check = []
     for t, sr in repro.run0.items():
@@ -391,7 +278,7 @@ def report_markdown(repro: P1Reproduction) -> str:
         "",
         "## Settings",
         "",
-        _settings_text(spec),
+        settings_text(spec),
         "",
         "## Table 3",
         "",
@@ -438,155 +325,8 @@ def _same(a: Any, b: Any) -> bool:
     return fa == fb
 
 
-# ---------------------------------------------------------------------------- figures
-#: Line styles per tracker, so that coinciding curves stay visible.
-_LINESTYLES = ("-", "--", ":")
-
-
-def _figures(out_dir: Path, result: MonteCarloResult, run0: Mapping[str, Any], sim: Any,
-             run0_seed: int) -> dict[str, Path]:
-    import matplotlib.pyplot as plt
-
-    from mhtrack.plotting.scene import plot_scene, save_figure
-
-    spec = result.spec
-    name = spec.scenario_name
-    paths = {k: out_dir / v for k, v in FIGURES.items()}
-    save_figure(plot_scene(truth=sim.truth, title=f"Fig. 2 — {name}: target trajectories"),
-                paths["fig2"])
-    save_figure(plot_scene(plots=sim.plots,
-                           title=f"Fig. 3 — {name}: plots with clutter (run 0, seed {run0_seed})"),
-                paths["fig3"])
-
-    n = len(spec.trackers)
-    fig, axes = plt.subplots(1, n, figsize=(5.5 * n, 5.5), squeeze=False)
-    for ax, t in zip(axes[0], spec.trackers, strict=True):
-        sr = run0.get(t)
-        if sr is None:
-            ax.text(0.5, 0.5, "run 0 failed", ha="center", va="center", transform=ax.transAxes)
-            ax.set_title(TRACKER_LABELS.get(t, t))
-            continue
-        plot_scene(truth=sim.truth, tracks=sr.run.tracks, ax=ax,
-                   title=f"{TRACKER_LABELS.get(t, t)} (run 0)")
-    fig.suptitle(f"Fig. 4 — {name}: tracks of the three algorithms")
-    save_figure(fig, paths["fig4"])
-
-    summ = result.summary()
-    curves = {t: summ[t]["per_scan"] for t in spec.trackers if summ[t]["per_scan"]["scans"]}
-    fig, ax = plt.subplots(figsize=(8, 4.5))
-    for j, (t, c) in enumerate(curves.items()):
-        k = np.asarray(c["scans"])
-        m, sd = np.asarray(c["ospa"], float), np.asarray(c["ospa_std"], float)
-        (line,) = ax.plot(k, m, lw=1.4, ls=_LINESTYLES[j % 3], label=TRACKER_LABELS.get(t, t))
-        ax.fill_between(k, m - sd, m + sd, color=line.get_color(), alpha=0.12, lw=0)
-    cutoff = spec.run_kwargs.get("cutoff", 500.0)
-    ax.set(xlabel="scan", ylabel=f"OSPA (m), c = {cutoff:g}, p = "
-           f"{spec.run_kwargs.get('order', 2.0):g}",
-           title=f"Fig. 5 — OSPA distance, mean over {spec.runs} runs (band ± std)")
-    ax.grid(True, lw=0.3, alpha=0.5)
-    if curves:
-        ax.legend(fontsize=8)
-    save_figure(fig, paths["fig5"])
-
-    fig, ax = plt.subplots(figsize=(8, 4.5))
-    true_drawn = False
-    for j, (t, c) in enumerate(curves.items()):
-        k = np.asarray(c["scans"])
-        m = np.asarray(c["cardinality"], float)
-        sd = np.asarray(c["cardinality_std"], float)
-        (line,) = ax.plot(k, m, lw=1.4, ls=_LINESTYLES[j % 3], label=TRACKER_LABELS.get(t, t))
-        ax.fill_between(k, m - sd, m + sd, color=line.get_color(), alpha=0.15, lw=0)
-        if not true_drawn:
-            ax.step(k, np.asarray(c["cardinality_true"], float), where="mid", color="black",
-                    lw=1.2, ls="--", label="truth")
-            true_drawn = True
-    ax.set(xlabel="scan", ylabel="number of targets / tracks",
-           title=f"Fig. 6 — cardinality estimate, mean (band ± std) over {spec.runs} runs")
-    ax.grid(True, lw=0.3, alpha=0.5)
-    if curves:
-        ax.legend(fontsize=8)
-    save_figure(fig, paths["fig6"])
-    return paths
-
-
-# ---------------------------------------------------------------------------- driver
-def p1_scenario() -> Scenario:
-    """The scenario of P1 §3: the ``crossing`` preset, unchanged."""
-    from mhtrack.scenario import preset
-
-    return preset("crossing")
-
-
-def p1_spec(runs: int, seed: int = 0, scenario: Scenario | None = None) -> MonteCarloSpec:
-    """The study: ``crossing`` (or ``scenario``), P1's three trackers, default configuration
-    (P1's parameters), :data:`RUN_KWARGS`."""
-    sc = p1_scenario() if scenario is None else scenario
-    return MonteCarloSpec(sc, P1_TRACKERS, runs=runs, seed=seed, config={},
-                          run_kwargs=dict(RUN_KWARGS))
-
-
-def reproduce_p1(
-    out_dir: str | os.PathLike[str],
-    runs: int = 10,
-    seed: int = 0,
-    *,
-    scenario: Scenario | None = None,
-    executor: str = "local",
-    workers: int | None = None,
-    scheduler: Any = None,
-    progress: bool = False,
-) -> P1Reproduction:
-    """Run (or resume) the P1 study into ``out_dir/montecarlo/`` and write Table 3, the
-    report and Figs. 2–6 into ``out_dir`` (module docstring). ``scenario`` replaces the
-    ``crossing`` preset (tests use a shortened one). Raises
-    :class:`~mhtrack.experiments.montecarlo.SpecMismatchError` if ``out_dir/montecarlo``
-    holds another study."""
-    from mhtrack.experiments.pipeline import config_with, run_scenario
-
-    out_dir = Path(out_dir)
-    out_dir.mkdir(parents=True, exist_ok=True)
-    spec = p1_spec(runs, seed, scenario)
-    result = run_montecarlo(spec, out_dir / MC_DIR, executor=executor, workers=workers,
-                            scheduler=scheduler, progress=progress)
-    result.write_reports()
-
-    # run 0, recomputed with the runner's seed (the one stored in its records when present)
-    seed0 = run_seed(spec.seed, 0)
-    for t in spec.trackers:
-        for r in result.records.get(t, []):
-            if r["run"] == 0:
-                seed0 = int(r["seed"])
-                break
-    sc = Scenario.from_dict(spec.scenario)
-    config = config_with(**spec.config) if spec.config else None
-    run0: dict[str, Any] = {}
-    sim = None
-    for t in spec.trackers:
-        try:
-            run0[t] = run_scenario(sc, seed0, t, config, **spec.run_kwargs)
-            sim = run0[t].simulation
-        except Exception:  # the runner recorded the failure; draw an empty panel
-            run0[t] = None
-    if sim is None:
-        from mhtrack.scenario import simulate
-
-        sim = simulate(sc, seed=seed0)
-
-    summary = result.summary()
-    table = table3_numbers(summary, spec.trackers)
-    n_ok = {t: summary[t]["n_runs"] for t in spec.trackers}
-    table_md = _table3_file(table, spec.runs, n_ok)
-    table_path = out_dir / TABLE_FILE
-    atomic_write(table_path, table_md)
-    js = {"source": PAPER_SOURCE, "runs": spec.runs, "seed": spec.seed,
-          "n_runs_ok": n_ok,
-          "table": {t: {k: {kk: (None if not math.isfinite(vv) else vv)
-                            for kk, vv in v.items()} for k, v in row.items()}
-                    for t, row in table.items()}}
-    atomic_write(out_dir / TABLE_JSON, json.dumps(js, indent=1) + "\n")
-
-    figures = _figures(out_dir, result, run0, sim, seed0)
-    repro = P1Reproduction(out_dir, result, table, table_md, out_dir / REPORT_FILE,
-                           table_path, figures, run0, seed0)
-    atomic_write(repro.report_path, report_markdown(repro))
-    return repro
+def _num(v: Any) -> float:
+    try:
+        return float(v)
+    except (TypeError, ValueError):
+        return math.nan

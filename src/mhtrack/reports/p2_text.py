@@ -1,6 +1,7 @@
 """Markdown text of the P2 (Gong, Dai & Ma 2013, multi-radar track initiation) study:
 Tables 1–2 beside the paper's (``tables.md``), the comparison with P2's claims and the
-report (``report.md``), all generated from the measured numbers."""
+report (``report.md``), all generated from the measured numbers (the aggregated results
+of :func:`mhtrack.experiments.p2.reproduce_p2`)."""
 
 from __future__ import annotations
 
@@ -10,7 +11,7 @@ from typing import Any
 
 import numpy as np
 
-from mhtrack.experiments.p2.aggregate import _nan, curve_for
+from mhtrack.experiments.p2.aggregate import curve_for, nan_for_none
 from mhtrack.experiments.p2.constants import (
     CLUSTER_LABELS,
     FIGURES,
@@ -84,7 +85,7 @@ def comparison_text(res: Mapping[str, Any]) -> list[str]:
     out = []
     c0 = curve_for(res, SIGMA0, RATE0)
     if c0 is not None:
-        p = _nan(c0["p_true"])[o]
+        p = nan_for_none(c0["p_true"])[o]
         if np.isfinite(p).any():
             best = float(np.nanmax(p))
             first = th[np.flatnonzero(p >= best - 0.005)[0]]
@@ -123,7 +124,7 @@ def comparison_text(res: Mapping[str, Any]) -> list[str]:
                        f"{drop:.4f}.")
     sig = sorted({c["sigma_range"] for c in res["curves"] if c["clutter_rate"] == RATE0})
     if len(sig) > 1 and (th == THETA0).any():
-        at = [_nan(curve_for(res, s, RATE0)["p_true"])[o][th == THETA0][0]  # type: ignore[index]
+        at = [nan_for_none(curve_for(res, s, RATE0)["p_true"])[o][th == THETA0][0]  # type: ignore[index]
               for s in sig]
         out.append("**p_true against σr at θ = 20°:** "
                    + ", ".join(f"σr = {s:g} m: {_f(v)}" for s, v in zip(sig, at, strict=True))
@@ -131,7 +132,7 @@ def comparison_text(res: Mapping[str, Any]) -> list[str]:
                    "legs more, so a fixed θ = 20° loses more true tracks as σr grows.")
     rates = sorted({c["clutter_rate"] for c in res["curves"] if c["sigma_range"] == SIGMA0})
     if rates:
-        pf = {r: _nan(curve_for(res, SIGMA0, r)["p_false"])[o] for r in rates}  # type: ignore[index]
+        pf = {r: nan_for_none(curve_for(res, SIGMA0, r)["p_false"])[o] for r in rates}  # type: ignore[index]
         steps = [np.diff(v[np.isfinite(v)]) for v in pf.values()]
         n_up = sum(int((s >= 0).sum()) for s in steps)
         n_all = sum(len(s) for s in steps)

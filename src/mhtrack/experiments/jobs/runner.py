@@ -1,0 +1,57 @@
+"""Run (or resume) a study's jobs into a :class:`~mhtrack.experiments.jobs.store.JobStore`."""
+
+from __future__ import annotations
+
+import sys
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+from mhtrack.experiments.jobs.executor import JobFunction, check_executor, execute
+from mhtrack.experiments.jobs.job import Job
+from mhtrack.experiments.jobs.store import JobStore
+
+
+@dataclass
+class JobsRun:
+    """What :func:`run_jobs` did: jobs ``computed`` now (failed ones included), jobs
+    ``skipped`` as already done, and the traceback of each job that failed now."""
+
+    computed: int
+    skipped: int
+    errors: dict[str, str] = field(default_factory=dict)
+
+
+def run_jobs(jobs: Sequence[Job], fn: JobFunction, store: JobStore, *,
+             executor: str = "local", workers: int | None = None, scheduler: Any = None,
+             progress: bool = False, desc: str = "jobs", unit: str = "job") -> JobsRun:
+    """Run every job of ``jobs`` not done in ``store`` (:meth:`JobStore.is_done`) with
+    :func:`~mhtrack.experiments.jobs.executor.execute`, storing each record — or its
+    traceback — as the job ends. ``progress``: a tqdm bar on stderr. A job that raises does
+    not stop the others; an interruption loses no finished job."""
+    from tqdm.auto import tqdm
+
+    check_executor(executor, workers, scheduler)
+    keys = [j.key for j in jobs]
+    if len(set(keys)) != len(keys):
+        raise ValueError("run_jobs: two jobs share a key")
+    pending = [j for j in jobs if not store.is_done(j)]
+    out = JobsRun(computed=len(pending), skipped=len(jobs) - len(pending))
+    bar = tqdm(total=len(jobs), initial=out.skipped, unit=unit, desc=desc,
+               disable=not progress, file=sys.stderr, dynamic_ncols=True)
+
+    def finish(job: Job, record: Mapping[str, Any] | None, error: str | None) -> None:
+        if error is not None:
+            store.save_error(job, error)
+            out.errors[job.key] = error
+            bar.set_postfix_str(f"{len(out.errors)} failed")
+        else:
+            assert record is not None
+            store.save(job, record)
+        bar.update(1)
+
+    try:
+        execute(pending, fn, finish, executor=executor, workers=workers, scheduler=scheduler)
+    finally:
+        bar.close()
+    return out

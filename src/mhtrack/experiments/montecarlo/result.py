@@ -1,0 +1,142 @@
+"""The records of a Monte-Carlo study and their summary: per tracker and scalar metric,
+mean and population standard deviation (``ddof=0``) over the successful runs, ignoring
+NaN; per scan, the mean ± std of OSPA, GOSPA and cardinality over runs."""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from mhtrack.experiments.jobs import JobStore
+from mhtrack.experiments.montecarlo.job import RECORDS
+from mhtrack.experiments.montecarlo.spec import RUNS_DIR, SPEC_FILE, MonteCarloSpec
+
+#: Scalar columns that are bookkeeping, not metrics.
+NOT_METRICS = frozenset({"run", "seed", "base_seed"})
+
+
+def run_store(out_dir: str | os.PathLike[str]) -> JobStore:
+    """The job store of a study directory: ``runs/<tracker>/run-<i>.parquet``."""
+    return JobStore(Path(out_dir) / RUNS_DIR, RECORDS)
+
+
+@dataclass
+class MonteCarloResult:
+    """Records of a study: ``records[tracker]`` the successful runs (sorted by run),
+    ``failures[tracker][run]`` the traceback of each failed run, ``missing`` jobs with
+    neither; ``computed`` / ``skipped`` count this call's jobs (0 from :func:`load_results`)."""
+
+    spec: MonteCarloSpec
+    out_dir: Path
+    records: dict[str, list[dict[str, Any]]]
+    failures: dict[str, dict[int, str]]
+    missing: list[tuple[str, int]] = field(default_factory=list)
+    computed: int = 0
+    skipped: int = 0
+
+    def runs_with_caps(self) -> dict[str, int]:
+        """Per tracker, the number of successful runs in which a hard cap of the MHT acted."""
+        return {t: sum(1 for r in recs if json.loads(r.get("caps") or "{}"))
+                for t, recs in self.records.items()}
+
+    @property
+    def ok(self) -> bool:
+        return not any(self.failures.values()) and not self.missing
+
+    def metric_keys(self) -> list[str]:
+        """Numeric scalar columns, in first-seen order."""
+        keys: dict[str, None] = {}
+        for recs in self.records.values():
+            for r in recs:
+                for k, v in r.items():
+                    if (k not in NOT_METRICS and not isinstance(v, bool | str | list)
+                            and isinstance(v, int | float)):
+                        keys.setdefault(k)
+        return list(keys)
+
+    def summary(self) -> dict[str, dict[str, Any]]:
+        """``{tracker: {metric: mean, …, "std": {metric: std}, "n_runs", "failed",
+        "per_scan": {scans, ospa, ospa_std, cardinality, cardinality_std,
+        cardinality_true, gospa, gospa_std}}}`` — means under the ``evaluate`` keys plus
+        ``t_avg``; NaN where no run has a value."""
+        keys = self.metric_keys()
+        out: dict[str, dict[str, Any]] = {}
+        for t in self.spec.trackers:
+            recs = self.records.get(t, [])
+            entry: dict[str, Any] = {}
+            std: dict[str, float] = {}
+            for k in keys:
+                vals = np.array([_num(r.get(k)) for r in recs], float)
+                entry[k], std[k] = mean_std(vals)
+            entry["std"] = std
+            entry["n_runs"] = len(recs)
+            entry["failed"] = sorted(self.failures.get(t, {}))
+            entry["per_scan"] = per_scan(recs)
+            out[t] = entry
+        return out
+
+
+def _num(v: Any) -> float:
+    return math.nan if v is None else float(v)
+
+
+def mean_std(vals: np.ndarray) -> tuple[float, float]:
+    """Mean and population std (``ddof=0``) of the finite values; NaN, NaN if none."""
+    vals = vals[np.isfinite(vals)]
+    if vals.size == 0:
+        return math.nan, math.nan
+    return float(vals.mean()), float(vals.std())
+
+
+def per_scan(recs: Sequence[Mapping[str, Any]]) -> dict[str, list[float]]:
+    """Per-scan mean ± std over runs, aligned on scan index (a scan missing from a run
+    does not count for it)."""
+    scans = sorted({int(k) for r in recs for k in r.get("scans") or []})
+    pos = {k: j for j, k in enumerate(scans)}
+    out: dict[str, list[float]] = {"scans": scans}
+    for key in ("ospa", "gospa", "cardinality", "cardinality_true"):
+        a = np.full((len(recs), len(scans)), np.nan)
+        for i, r in enumerate(recs):
+            if r.get(key) is None:
+                continue
+            for k, v in zip(r["scans"], r[key], strict=True):
+                a[i, pos[int(k)]] = np.nan if v is None else v
+        mean = np.full(len(scans), np.nan)
+        std = np.full(len(scans), np.nan)
+        for j in range(len(scans)):
+            mean[j], std[j] = mean_std(a[:, j])
+        out[key] = mean.tolist()
+        if key != "cardinality_true":
+            out[f"{key}_std"] = std.tolist()
+    return out
+
+
+def load_results(out_dir: str | os.PathLike[str]) -> MonteCarloResult:
+    """Read a study directory: its spec, its run files and its error files."""
+    out_dir = Path(out_dir)
+    path = out_dir / SPEC_FILE
+    if not path.is_file():
+        raise FileNotFoundError(f"{out_dir}: no {SPEC_FILE}; not a Monte-Carlo directory")
+    spec = MonteCarloSpec.from_dict(json.loads(path.read_text()))
+    store = run_store(out_dir)
+    records: dict[str, list[dict[str, Any]]] = {t: [] for t in spec.trackers}
+    failures: dict[str, dict[int, str]] = {t: {} for t in spec.trackers}
+    missing: list[tuple[str, int]] = []
+    for job in spec.jobs():
+        t, i = job.params["tracker"], job.params["run"]
+        if store.is_done(job):
+            records[t].append(store.load(job))
+        elif (error := store.error(job)) is not None:
+            failures[t][i] = error
+        else:
+            missing.append((t, i))
+    for t in spec.trackers:
+        records[t].sort(key=lambda r: r["run"])
+    return MonteCarloResult(spec, out_dir, records, failures, missing)

@@ -1,0 +1,63 @@
+"""The report of a Monte-Carlo study: ``summary.md`` (mean ± std per metric and tracker)
+and ``ospa_cardinality.png`` (per-scan OSPA and cardinality, mean ± std over runs)."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+from mhtrack.experiments.montecarlo import MonteCarloResult
+from mhtrack.io.atomic import atomic_write
+from mhtrack.reports.figures import save
+
+SUMMARY_FILE = "summary.md"
+FIGURE_FILE = "ospa_cardinality.png"
+
+
+def _fmt(v: float) -> str:
+    if not math.isfinite(v):
+        return "–"
+    return f"{v:.4g}"
+
+
+def summary_markdown(result: MonteCarloResult) -> str:
+    """``summary.md``: mean ± std per metric (rows) and tracker (columns), then the failed
+    and missing runs."""
+    s = result.summary()
+    spec = result.spec
+    lines = [
+        f"# Monte-Carlo: {spec.scenario_name}",
+        "",
+        f"{spec.runs} runs per tracker, base seed {spec.seed}; mean ± std over the "
+        "successful runs (population std, NaN ignored).",
+        "",
+        "| metric | " + " | ".join(spec.trackers) + " |",
+        "|---|" + "---|" * len(spec.trackers),
+    ]
+    for k in result.metric_keys():
+        cells = [f"{_fmt(s[t][k])} ± {_fmt(s[t]['std'][k])}" for t in spec.trackers]
+        lines.append(f"| {k} | " + " | ".join(cells) + " |")
+    lines.append("| runs ok | " + " | ".join(str(s[t]["n_runs"]) for t in spec.trackers)
+                 + " |")
+    failed = [(t, i) for t in spec.trackers for i in s[t]["failed"]]
+    if failed or result.missing:
+        lines += ["", "## Failed runs", ""]
+        lines += [f"* {t} run {i}: see `runs/{t}/run-{i}.error.txt`" for t, i in failed]
+        lines += [f"* {t} run {i}: not run" for t, i in result.missing]
+    return "\n".join(lines) + "\n"
+
+
+def write_montecarlo_report(result: MonteCarloResult) -> list[Path]:
+    """Write ``summary.md`` and (when some run has per-scan curves)
+    ``ospa_cardinality.png`` into the study directory; returns the paths written."""
+    from mhtrack.plotting.metrics import plot_ospa_cardinality
+
+    out = [atomic_write(result.out_dir / SUMMARY_FILE, summary_markdown(result))]
+    curves = {t: v["per_scan"] for t, v in result.summary().items() if v["per_scan"]["scans"]}
+    if curves:
+        spec = result.spec
+        cutoff = spec.run_kwargs.get("cutoff", 500.0)
+        title = f"{spec.scenario_name}: mean ± std over {spec.runs} runs"
+        out.append(save(plot_ospa_cardinality(curves, cutoff=cutoff, title=title),
+                        result.out_dir / FIGURE_FILE, dpi=130))
+    return out

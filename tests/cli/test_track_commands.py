@@ -178,7 +178,7 @@ def test_run_warns_when_mht_keeps_p1_kappa_on_denser_clutter(tmp_path, caplog):
 
 
 def test_run_takes_pd_and_sigma_of_a_single_cartesian_sensor():
-    from mhtrack.experiments.pipeline import MAX_TRACKER_PD, default_config
+    from mhtrack.build import MAX_TRACKER_PD, default_config
     from mhtrack.scenario import preset
     from mhtrack.scenario.spec import from_dict
 

@@ -4,8 +4,8 @@ import logging
 
 import pytest
 
+from mhtrack.build import birth_density_for_area, default_config
 from mhtrack.experiments import run_scenario
-from mhtrack.experiments.pipeline import birth_density_for_area, default_config
 from mhtrack.mht import MHTConfig
 from mhtrack.scenario import preset
 

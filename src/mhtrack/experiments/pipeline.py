@@ -27,6 +27,7 @@ from tqdm.auto import tqdm
 from mhtrack.build import (
     DEFAULT_CLUTTER_DENSITY,  # noqa: F401  (reproduce_p1 imports it from here until merged)
     TRACKER_FUSERS,
+    config_with,  # noqa: F401  (experiments/__init__, montecarlo, reproduce_p1: until merged)
     default_config,
     default_fusion,
     make_tracker,

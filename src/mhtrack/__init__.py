@@ -1,8 +1,9 @@
 """mhtrack — multiple-target tracking in unknown, varying clutter.
 
-Layers (each a sub-package; none imports a later one):
-``records``/``errors`` → ``models`` → ``scenario`` → ``clutter`` → ``mht`` →
-``initiation`` → ``metrics`` → ``io`` → ``experiments`` → ``plotting`` → ``cli``.
+Layers (data flows one way; no module imports a later layer):
+``records``/``errors``/``io`` → ``models`` → ``scenario``, ``clutter`` → ``mht``,
+``initiation`` → ``build`` (the tracker builder) → ``metrics`` → ``experiments`` →
+``plotting``, ``reports`` → ``cli``. ``names`` (every part's name list) imports nothing.
 """
 
 from mhtrack.records import PlotTable, Scan, TrackTable, TruthTable

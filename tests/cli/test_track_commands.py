@@ -1,8 +1,10 @@
 """``track`` and ``run`` end to end through the CLI."""
 
 import json
+from dataclasses import replace
 from pathlib import Path
 
+import numpy as np
 import pytest
 from click.testing import CliRunner
 
@@ -92,7 +94,25 @@ def test_track_polar_plots_uses_scenario_sensors(tmp_path):
     code, _stdout, stderr = invoke("track", str(tmp_path / "plots.csv"), "--out",
                                   str(tmp_path / "tracks.csv"), "--no-progress")
     assert code == 0, stderr
-    assert read_tracks(tmp_path / "tracks.csv") is not None
+    # the file read back is what the library's tracker gives on the polar plots read with
+    # the scenario's radars (fused: three sensors), column for column
+    from mhtrack.build import default_config, make_tracker
+    from mhtrack.experiments.pipeline import track
+    from mhtrack.io import read_plots
+    from mhtrack.scenario import load_scenario
+
+    sc = load_scenario(tmp_path / "scenario.toml")
+    plots = replace(read_plots(tmp_path / "plots.csv", sensors={s.id: s for s in sc.sensors}),
+                    scan_times=(sc.scan_indices(), sc.scan_times()))
+    assert plots.R is not None  # polar plots: each carries its own covariance
+    want = track(make_tracker("mht-agmm", default_config(sc)), plots,
+                 fusion="adaptive-kmeans").tracks
+    got = read_tracks(tmp_path / "tracks.csv")
+    assert len(got) == len(want) > 0
+    for f in ("scan", "track_id", "plot", "tentative"):
+        np.testing.assert_array_equal(getattr(got, f), getattr(want, f))
+    for f in ("time", "x", "y", "vx", "vy"):
+        np.testing.assert_allclose(getattr(got, f), getattr(want, f), rtol=1e-12)
 
 
 def test_unknown_tracker_is_a_usage_error():
@@ -112,11 +132,19 @@ def test_run_multiradar_with_modified_logic_birth(tmp_path):
 
 
 def test_run_multiradar_default_tracker_with_birth_and_explicit_fusion(tmp_path):
-    code, stdout, stderr = invoke("run", "multiradar", "--seed", "1", "--birth",
-                                  "modified-logic", "--fusion", "adaptive-kmeans", "--json",
-                                  "--no-progress", "--out", str(tmp_path))
-    assert code == 0, stderr
-    assert 0 < json.loads(stdout)["ospa_mean"] <= 500
+    """Three radars: the default tracker (mht-agmm) and fusion (adaptive K-means) are what
+    naming them explicitly gives, and fusing differs from tracking the raw plots."""
+    runs = {}
+    for name, extra in (("default", ()), ("explicit", ("--tracker", "mht-agmm", "--fusion",
+                                                       "adaptive-kmeans")),
+                        ("raw", ("--fusion", "none"))):
+        code, _, stderr = invoke("run", "multiradar", "--seed", "1", "--birth",
+                                      "modified-logic", *extra, "--json", "--no-progress",
+                                      "--out", str(tmp_path / name))
+        assert code == 0, stderr
+        runs[name] = (tmp_path / name / "tracks.csv").read_bytes()
+    assert runs["explicit"] == runs["default"]
+    assert runs["raw"] != runs["default"]
 
 
 def test_run_crossing_agmm_with_logic_birth(tmp_path):
@@ -178,7 +206,7 @@ def test_run_warns_when_mht_keeps_p1_kappa_on_denser_clutter(tmp_path, caplog):
 
 
 def test_run_takes_pd_and_sigma_of_a_single_cartesian_sensor():
-    from mhtrack.experiments.pipeline import MAX_TRACKER_PD, default_config
+    from mhtrack.build import MAX_TRACKER_PD, default_config
     from mhtrack.scenario import preset
     from mhtrack.scenario.spec import from_dict
 

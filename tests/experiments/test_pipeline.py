@@ -1,22 +1,38 @@
-"""The tracking pipeline's defaults: P1's new-target rate scaled to the surveillance area."""
+"""The tracking pipeline: simulate → build → track → evaluate, and the builder's defaults on
+real aircraft."""
 
 import logging
 
+import numpy as np
 import pytest
 
-from mhtrack.experiments import run_scenario
-from mhtrack.experiments.pipeline import birth_density_for_area, default_config
-from mhtrack.mht import MHTConfig
-from mhtrack.scenario import preset
+from mhtrack.build import default_config, make_tracker
+from mhtrack.experiments.pipeline import run_scenario, track
+from mhtrack.metrics import evaluate
+from mhtrack.scenario import preset, simulate
 
 
-def test_p1_region_gives_p1_birth_density():
-    # P1 §3: λv = 1e−7 per m² over [−4000, 4000]² m = 6.4e7 m²
-    assert default_config(preset("crossing")).new_target_density == pytest.approx(1e-7)
-    assert birth_density_for_area(6.4e7 * 100) == pytest.approx(1e-9)
-    assert default_config() == MHTConfig()
-    with pytest.raises(ValueError, match="area"):
-        birth_density_for_area(0.0)
+def test_run_scenario_is_simulate_build_track_evaluate():
+    """run_scenario's tracks are those of the builder's tracker run by ``track`` on the
+    simulation, and its evaluation scores them."""
+    sc = preset("crossing", scans=12)
+    r = run_scenario(sc, 4, "mht", clutter_density=2e-9)
+    sim = simulate(sc, seed=4)
+    trk = make_tracker("mht", default_config(sc), clutter_density=2e-9)
+    want = track(trk, sim.plots, name="mht").tracks
+    for f in ("scan", "track_id", "x", "y", "plot", "tentative"):
+        np.testing.assert_array_equal(getattr(r.run.tracks, f), getattr(want, f))
+    assert r.summary()["ospa"] == evaluate(want, sim.truth, plots=sim.plots).to_dict()["ospa"]
+    assert r.summary()["tracker"] == "mht" and r.summary()["output"] == "history"
+
+
+def test_unknown_fusion_or_output():
+    trk = make_tracker("mht")
+    scans = simulate(preset("crossing", scans=2), seed=0).plots
+    with pytest.raises(ValueError, match="unknown fusion 'kmeans'"):
+        track(trk, scans, fusion="kmeans")
+    with pytest.raises(ValueError, match=r"unknown output 'all'.*history, online"):
+        track(trk, scans, output="all")
 
 
 def test_real_aircraft_are_tracked_with_the_defaults(caplog):

@@ -2,17 +2,17 @@
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 import click
 
-from mhtrack.cli.common import echo_json, jsonable, load_scenario_arg, scenario_options
+from mhtrack.cli.common import echo_json, load_scenario_arg, scenario_options
+from mhtrack.names import CLUTTER_ESTIMATORS
 
 
 @click.command("clutter")
 @scenario_options
-@click.option("--estimator", type=click.Choice(["known", "gmm", "agmm"]), default="agmm",
+@click.option("--estimator", type=click.Choice(CLUTTER_ESTIMATORS), default="agmm",
               show_default=True, help="Clutter estimator to score.")
 @click.option("--clutter-density", type=click.FloatRange(min=0, min_open=True), default=None,
               help="κ (per m² per scan) of --estimator known [default: the scenario's true "
@@ -42,8 +42,10 @@ def clutter(scenario: str, seed: int, clutter: str | None, clutter_rate: float |
     true intensity: IAE = ∫|κ̂ − κ| per scan and the count error |M̂ − λ| (mean over
     scans). Writes DIR/clutter.json (per-scan arrays) and DIR/clutter.png (true and
     estimated intensity maps at one scan)."""
-    from mhtrack.clutter import make_estimator
-    from mhtrack.metrics.clutter import clutter_accuracy, uniform_guess
+    from mhtrack.build import make_clutter_estimator
+    from mhtrack.experiments.clutter_study import clutter_accuracy
+    from mhtrack.io.jsonsafe import dumps
+    from mhtrack.metrics.clutter import uniform_guess
     from mhtrack.plotting.clutter import plot_intensity_maps, save_maps
     from mhtrack.scenario import simulate
 
@@ -55,8 +57,9 @@ def clutter(scenario: str, seed: int, clutter: str | None, clutter_rate: float |
         raise click.BadParameter(f"scan {k_map} is not in {sc.first}..{sc.last}",
                                  param_hint="--map-scan")
     kappa = clutter_density if clutter_density is not None else uniform_guess(sim)
-    est = make_estimator(estimator, kappa=kappa, n_components=components, window=window,
-                         source="outside-gates" if oracle_gates else None)
+    est = make_clutter_estimator(estimator, kappa=kappa, n_components=components,
+                                 window=window,
+                                 source="outside-gates" if oracle_gates else None)
     acc = clutter_accuracy(est, sim, resolution=resolution, oracle_gates=oracle_gates,
                            map_scans=[k_map])
     summary = {"scenario": sc.name, "seed": seed, **acc.to_dict(), "map_scan": k_map}
@@ -64,7 +67,7 @@ def clutter(scenario: str, seed: int, clutter: str | None, clutter_rate: float |
         summary["clutter_density"] = kappa
     out = out if out is not None else Path("out") / f"{sc.name}-clutter-{estimator}-{seed}"
     out.mkdir(parents=True, exist_ok=True)
-    (out / "clutter.json").write_text(json.dumps(jsonable(summary), allow_nan=False, indent=1))
+    (out / "clutter.json").write_text(dumps(summary, indent=1))
     true, hat = acc.maps[k_map]
     z = sim.plots.z[sim.plots.scan == k_map]
     fig = plot_intensity_maps(

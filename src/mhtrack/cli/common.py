@@ -2,15 +2,12 @@
 
 from __future__ import annotations
 
-import json
-import math
 import sys
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
 import click
-import numpy as np
 
 
 def scenario_options(f: Callable[..., Any]) -> Callable[..., Any]:
@@ -57,24 +54,11 @@ def load_scenario_arg(
     )
 
 
-def jsonable(o: Any) -> Any:
-    if isinstance(o, dict):
-        return {str(k): jsonable(v) for k, v in o.items()}
-    if isinstance(o, list | tuple):
-        return [jsonable(v) for v in o]
-    if isinstance(o, np.ndarray):
-        return jsonable(o.tolist())
-    if isinstance(o, np.integer):
-        return int(o)
-    if isinstance(o, np.floating | float):
-        f = float(o)
-        return f if math.isfinite(f) else None
-    return o
-
-
 def echo_json(obj: Any) -> None:
     """Print one JSON object (NaN/inf become null so any JSON parser reads it)."""
-    click.echo(json.dumps(jsonable(obj), allow_nan=False))
+    from mhtrack.io.jsonsafe import dumps
+
+    click.echo(dumps(obj))
 
 
 def table_path(directory: Path, stem: str) -> Path | None:

@@ -11,6 +11,7 @@ from typing import Any
 import click
 
 from mhtrack.cli.common import echo_json, load_scenario_arg, scenario_options
+from mhtrack.names import BIRTHS, OUTPUTS, TRACKER_FUSIONS, TRACKERS
 
 
 def tracker_options(pd_flag: str) -> Callable[[Callable[..., Any]], Callable[..., Any]]:
@@ -20,8 +21,6 @@ def tracker_options(pd_flag: str) -> Callable[[Callable[..., Any]], Callable[...
 
 
 def _tracker_options(f: Callable[..., Any], pd_flag: str) -> Callable[..., Any]:
-    from mhtrack.cli.choices import TRACKERS
-
     opts = [
         click.option("--tracker", type=click.Choice(sorted(TRACKERS)), default="mht-agmm",
                      show_default=True, help="Tracker (and its clutter estimator)."),
@@ -52,8 +51,6 @@ def _tracker_options(f: Callable[..., Any], pd_flag: str) -> Callable[..., Any]:
 def birth_options(f: Callable[..., Any]) -> Callable[..., Any]:
     """``--birth``, ``--birth-theta`` and ``--fusion`` (birth process and plot fusion of
     the MHT; ``docs/mht.md``)."""
-    from mhtrack.cli.choices import BIRTHS, FUSIONS
-
     opts = [
         click.option("--birth", type=click.Choice(BIRTHS), default="every-plot",
                      show_default=True, help="Which plots start new track trees: every plot "
@@ -61,7 +58,7 @@ def birth_options(f: Callable[..., Any]) -> Callable[..., Any]:
         click.option("--birth-theta", "birth_theta", type=click.FloatRange(0, 180),
                      default=20.0, show_default=True,
                      help="Angle limit θ (degrees) of the modified initiators."),
-        click.option("--fusion", type=click.Choice(FUSIONS), default=None,
+        click.option("--fusion", type=click.Choice(TRACKER_FUSIONS), default=None,
                      help="Fuse each scan's plots before tracking [adaptive-kmeans with "
                      "more than one sensor, else none]."),
     ]
@@ -72,8 +69,6 @@ def birth_options(f: Callable[..., Any]) -> Callable[..., Any]:
 
 def output_option(f: Callable[..., Any]) -> Callable[..., Any]:
     """``--output history|online``: which rows a batch run reports (``docs/mht.md``)."""
-    from mhtrack.cli.choices import OUTPUTS
-
     return click.option(
         "--output", "output", type=click.Choice(OUTPUTS), default="history",
         show_default=True,
@@ -84,7 +79,9 @@ def output_option(f: Callable[..., Any]) -> Callable[..., Any]:
 
 
 def _check_clutter_density(tracker: str, clutter_density: float | None) -> None:
-    if clutter_density is not None and tracker != "mht":
+    from mhtrack.build import takes_clutter_density
+
+    if clutter_density is not None and not takes_clutter_density(tracker):
         raise click.UsageError(
             f"--clutter-density sets the known clutter intensity of --tracker mht; "
             f"--tracker {tracker} estimates it online"
@@ -105,7 +102,7 @@ def config_changes(tracker_pd: float | None, meas_sigma: float | None,
 def _config(base: Any, tracker_pd: float | None, meas_sigma: float | None,
             accel_sigma: float | None, birth_density: float | None, nscan: int | None,
             imm_accel_sigma: float | None) -> Any:
-    from mhtrack.experiments import config_with
+    from mhtrack.build import config_with
 
     return config_with(base, **config_changes(tracker_pd, meas_sigma, accel_sigma,
                                               birth_density, nscan, imm_accel_sigma))
@@ -132,7 +129,7 @@ def track(plots: Path, tracker: str, tracker_pd: float | None, meas_sigma: float
     """Run a tracker on a PLOTS file and write its tracks."""
     import numpy as np
 
-    from mhtrack.experiments.pipeline import default_config, default_fusion, make_tracker
+    from mhtrack.build import default_config, default_fusion, make_tracker
     from mhtrack.experiments.pipeline import track as run_tracker
     from mhtrack.io import read_plots, write_tracks
     from mhtrack.io.plots import check_scan_times
@@ -207,16 +204,16 @@ def run(scenario: str, seed: int, clutter: str | None, clutter_rate: float | Non
     Writes plots, truth, tracks, scenario.toml, metrics.json, scene.png (truth, plots,
     tracks) and metrics.png (OSPA and cardinality per scan) to the output directory.
     """
-    from mhtrack.experiments.pipeline import default_config, run_scenario
+    from mhtrack.build import capped_pd, default_config
+    from mhtrack.experiments.pipeline import run_scenario
     from mhtrack.io import write_plots, write_scenario_toml, write_tracks, write_truth
+    from mhtrack.io.jsonsafe import dumps
     from mhtrack.plotting.metrics import plot_ospa_cardinality
     from mhtrack.plotting.scene import plot_scene, save_figure
 
     sc = load_scenario_arg(scenario, clutter, clutter_rate, pd, scans)
     if tracker_pd is None and pd is not None:  # the scenario's P_D, as default_config caps it
-        from mhtrack.experiments.pipeline import MAX_TRACKER_PD
-
-        tracker_pd = min(pd, MAX_TRACKER_PD)
+        tracker_pd = capped_pd(pd)
     cfg = _config(default_config(sc), tracker_pd, meas_sigma, accel_sigma, birth_density,
                   nscan, imm_accel_sigma)
     _check_clutter_density(tracker, clutter_density)
@@ -233,7 +230,7 @@ def run(scenario: str, seed: int, clutter: str | None, clutter_rate: float | Non
     write_tracks(result.run.tracks, out / "tracks.csv")
     write_scenario_toml({"seed": seed, **sc.to_dict()}, out / "scenario.toml")
     summary = result.summary()
-    (out / "metrics.json").write_text(_json_text(summary))
+    (out / "metrics.json").write_text(dumps(summary, indent=1))
     title = f"{sc.name}, {tracker}, seed {seed}"
     save_figure(plot_scene(sim.plots, sim.truth, result.run.tracks, title=title),
                 out / "scene.png")
@@ -252,55 +249,34 @@ def run(scenario: str, seed: int, clutter: str | None, clutter_rate: float | Non
     click.echo(f"wrote {out}/ (plots, truth, tracks, metrics.json, scene.png, metrics.png)")
 
 
-#: Without a scenario, ``track`` takes the surveillance area from the box between these
-#: quantiles of the plots' x and y (so a few wild plots do not inflate it), and warns about
-#: plots lying farther outside that box than its own width (east-west) or height.
-AREA_QUANTILES = (0.005, 0.995)
-
-
 def _plots_area(plots: Path, table: Any) -> float:
-    """Surveillance area (m²) of a plots file with no scenario: the 0.5–99.5 % quantile
-    box of x and y (each side at least 1 m); warns about plots far outside it."""
-    import numpy as np
+    """Surveillance area (m²) of a plots file with no scenario
+    (:func:`~mhtrack.build.plots_area`); warns about plots far outside its box."""
+    from mhtrack.build import plots_area
 
-    (x0, x1), (y0, y1) = (np.quantile(v, AREA_QUANTILES) for v in (table.x, table.y))
-    wx, wy = max(float(x1 - x0), 1.0), max(float(y1 - y0), 1.0)
-    with np.errstate(over="ignore", invalid="ignore"):
-        far = ((table.x < x0 - wx) | (table.x > x1 + wx)
-               | (table.y < y0 - wy) | (table.y > y1 + wy))
-    n_far = int(np.count_nonzero(far))
-    if n_far:
+    box = plots_area(table.x, table.y)
+    if box.n_far:
         logging.getLogger("mhtrack").warning(
             "%s: %d of %d plots lie far outside the box holding the middle 99%% of the plots "
             "(x %.6g to %.6g m, y %.6g to %.6g m); the surveillance area (%.4g m²) is taken "
             "from that box — check those plots, or pass --scenario with the true region",
-            plots, n_far, len(table), x0, x1, y0, y1, wx * wy)
-    return wx * wy
+            plots, box.n_far, len(table), box.x0, box.x1, box.y0, box.y1, box.area)
+    return box.area
 
 
 def _warn_known_kappa(sc: Any, tracker: str, clutter_density: float | None) -> None:
-    """Warn when ``mht`` keeps P1's κ on a scenario whose clutter is 10× denser or sparser
-    (its plots are then mostly scored as targets, or targets as clutter)."""
-    if tracker != "mht" or clutter_density is not None:
+    """Warn when a known-clutter tracker keeps P1's κ on a scenario whose clutter is 10×
+    denser or sparser (:func:`~mhtrack.build.known_kappa_mismatch`)."""
+    from mhtrack.build import DEFAULT_CLUTTER_DENSITY, known_kappa_mismatch, takes_clutter_density
+
+    if not takes_clutter_density(tracker) or clutter_density is not None:
         return
-    import logging
-
-    from mhtrack.experiments.pipeline import DEFAULT_CLUTTER_DENSITY
-
-    mean = sc.mean_clutter_density()
-    if mean > 10 * DEFAULT_CLUTTER_DENSITY or 0 < mean < 0.1 * DEFAULT_CLUTTER_DENSITY:
+    mean = known_kappa_mismatch(sc)
+    if mean is not None:
         logging.getLogger("mhtrack").warning(
             "tracker mht assumes P1's clutter density %.3g per m²; this scenario's clutter "
             "averages %.3g per m² over its region: pass --clutter-density %.3g, or use "
             "mht-agmm, which estimates it", DEFAULT_CLUTTER_DENSITY, mean, mean)
-
-
-def _json_text(obj: Any) -> str:
-    import json
-
-    from mhtrack.cli.common import jsonable
-
-    return json.dumps(jsonable(obj), allow_nan=False, indent=1)
 
 
 COMMANDS = [track, run]

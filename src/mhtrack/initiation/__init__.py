@@ -18,6 +18,7 @@ from __future__ import annotations
 
 from typing import Any
 
+from mhtrack import names as _names
 from mhtrack.initiation.fusion import (
     FUSED,
     AdaptiveKMeansFusion,
@@ -45,27 +46,21 @@ from mhtrack.initiation.window import (
     sliding_windows,
 )
 
-#: Initiation methods by CLI name.
-INITIATORS: tuple[str, ...] = ("logic", "modified-logic", "hough", "modified-hough")
-#: Fusion methods by CLI name.
-FUSIONS: tuple[str, ...] = ("adaptive-kmeans", "kmeans", "none")
+# The name lists live in mhtrack.names, the name -> class mapping in mhtrack.build.
+# INITIATORS, FUSIONS and make_initiator stay importable from here only until the MHT's
+# initiator birth, experiments/p2, plotting/initiation and cli/initiation_commands import
+# them from mhtrack.names / mhtrack.build (issue 13 merge; then delete these lines).
+INITIATORS = _names.INITIATORS
+FUSIONS = _names.INITIATION_FUSIONS
 
 Initiator = LogicInitiator | HoughInitiator
 
 
 def make_initiator(method: str, *, theta_deg: float = 20.0, **params: Any) -> Initiator:
-    """The initiator named ``method`` (:data:`INITIATORS`); ``theta_deg`` is P2's angle
-    limit for the modified methods (ignored by the plain ones); ``params`` go to the
-    constructor (e.g. ``gate_radius``, ``v_min``, ``v_max``)."""
-    if method == "logic":
-        return LogicInitiator(angle_limit_deg=None, **params)
-    if method == "modified-logic":
-        return LogicInitiator(angle_limit_deg=theta_deg, **params)
-    if method == "hough":
-        return HoughInitiator(modified=False, angle_limit_deg=theta_deg, **params)
-    if method == "modified-hough":
-        return HoughInitiator(modified=True, angle_limit_deg=theta_deg, **params)
-    raise ValueError(f"unknown initiation method {method!r} (expected {', '.join(INITIATORS)})")
+    """:func:`mhtrack.build.make_initiator` (transitional, see above)."""
+    from mhtrack.build import make_initiator as build_initiator
+
+    return build_initiator(method, theta_deg=theta_deg, **params)
 
 
 __all__ = [

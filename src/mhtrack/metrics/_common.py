@@ -1,13 +1,17 @@
 """Boundary validation and scan alignment shared by the metrics (private).
 
 Everything here checks its input once and returns plain NumPy arrays; the metric
-functions trust those arrays afterwards.
+functions trust those arrays afterwards. :func:`~mhtrack.metrics.evaluate` checks a
+(tracks, truth) pair and groups both by scan once, into a :class:`ScanIndexed` value that
+every metric works on (``ospa_indexed``, ``clear_mot_indexed``, …); each metric's public
+function checks raw tables and builds one when called on its own.
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Iterator
+from dataclasses import dataclass
 
 import numpy as np
 import numpy.typing as npt
@@ -149,15 +153,40 @@ class ScanIndex:
         return self._hi - self._lo
 
 
-def per_scan_points(
-    tracks: TrackTable, truth: TruthTable, scans: np.ndarray
-) -> Iterator[tuple[np.ndarray, np.ndarray]]:
-    """Yield ``(truth positions, track positions)`` for each scan of ``scans``."""
-    ti = ScanIndex(truth.scan, truth.target_id, scans)
-    ki = ScanIndex(tracks.scan, tracks.track_id, scans)
-    tp, kp = truth.positions, tracks.positions
-    for k in range(len(scans)):
-        yield tp[ti.rows(k)], kp[ki.rows(k)]
+@dataclass(frozen=True)
+class ScanIndexed:
+    """Checked tracks and truth, with their rows grouped by the scans evaluated.
+
+    ``scans`` is sorted and holds every scan of either table (and any extra scans asked
+    for); ``track_rows.rows(k)`` / ``truth_rows.rows(k)`` are the rows at ``scans[k]``, in
+    ascending track / target id. Build it with :meth:`build` from checked tables.
+    """
+
+    tracks: TrackTable
+    truth: TruthTable
+    scans: np.ndarray
+    track_rows: ScanIndex
+    truth_rows: ScanIndex
+
+    def points(self) -> Iterator[tuple[np.ndarray, np.ndarray]]:
+        """Yield ``(truth positions, track positions)`` for each scan of ``scans``."""
+        tp, kp = self.truth.positions, self.tracks.positions
+        for k in range(len(self.scans)):
+            yield tp[self.truth_rows.rows(k)], kp[self.track_rows.rows(k)]
+
+    @classmethod
+    def build(cls, tracks: TrackTable, truth: TruthTable, scans: np.ndarray) -> ScanIndexed:
+        """Group checked tables by the sorted ``scans`` (which must hold every scan of
+        both; :func:`check_tables` first)."""
+        return cls(tracks, truth, scans, ScanIndex(tracks.scan, tracks.track_id, scans),
+                   ScanIndex(truth.scan, truth.target_id, scans))
+
+    def with_tracks(self, tracks: TrackTable) -> ScanIndexed:
+        """The same truth and scans with ``tracks`` — a subset of this value's tracks (e.g.
+        their online view), so already checked and within ``scans``."""
+        return ScanIndexed(tracks, self.truth, self.scans,
+                           ScanIndex(tracks.scan, tracks.track_id, self.scans),
+                           self.truth_rows)
 
 
 def all_scans(tracks: TrackTable, truth: TruthTable, scans: npt.ArrayLike | None) -> np.ndarray:

@@ -17,8 +17,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from mhtrack.metrics._common import check_match_distance, check_tables
-from mhtrack.metrics.clearmot import DEFAULT_MATCH_DISTANCE, MOTMatching, clear_mot
+from mhtrack.metrics._common import ScanIndexed, check_match_distance, check_tables, scan_union
+from mhtrack.metrics.clearmot import DEFAULT_MATCH_DISTANCE, MOTMatching, clear_mot_indexed
 from mhtrack.records import CLUTTER, NO_PLOT, PlotTable, TrackTable, TruthTable
 
 
@@ -162,9 +162,20 @@ def association_metrics(
     tracks, truth = check_tables(tracks, truth)
     if plots is not None and not isinstance(plots, PlotTable):
         raise TypeError(f"plots must be a PlotTable or None, got {type(plots).__name__}")
+    data = ScanIndexed.build(tracks, truth, scan_union(truth.scan, tracks.scan))
     if matching is None:
         d_match = check_match_distance(match_distance, "match_distance")
-        matching = clear_mot(tracks, truth, match_distance=d_match).matching
+        matching = clear_mot_indexed(data, d_match).matching
+    return association_indexed(data, plots, matching, match_distance, scan_period)
+
+
+def association_indexed(data: ScanIndexed, plots: PlotTable | None, matching: MOTMatching,
+                        match_distance: float = DEFAULT_MATCH_DISTANCE,
+                        scan_period: float | None = None) -> AssociationResult:
+    """:func:`association_metrics` on checked, scan-indexed tables (``data.scans`` holding
+    every scan of both) and ``plots`` (a :class:`PlotTable` or ``None``), given their
+    CLEAR-MOT ``matching``."""
+    tracks, truth = data.tracks, data.truth
     T = _scan_period(truth, plots) if scan_period is None else float(scan_period)
 
     has_origin = plots is not None and plots.origin is not None
@@ -175,9 +186,9 @@ def association_metrics(
 
     targets, breaks, life = _continuity(truth, matching, T)
     if tracks.tentative is not None and np.any(tracks.tentative):
-        online = tracks.online()
         d_online = check_match_distance(match_distance, "match_distance")
-        online_matching = clear_mot(online, truth, match_distance=d_online).matching
+        online_matching = clear_mot_indexed(data.with_tracks(tracks.online()),
+                                            d_online).matching
         delay = _confirm_delay(truth, online_matching)
     else:
         delay = _confirm_delay(truth, matching)

@@ -11,7 +11,7 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
-from mhtrack.metrics._common import ScanIndex, all_scans, check_tables
+from mhtrack.metrics._common import ScanIndexed, all_scans, check_tables
 from mhtrack.records import TrackTable, TruthTable
 
 
@@ -45,7 +45,13 @@ def cardinality_per_scan(
     CardinalityPerScan
     """
     tracks, truth = check_tables(tracks, truth)
-    idx = all_scans(tracks, truth, scans)
-    n_hat = ScanIndex(tracks.scan, tracks.track_id, idx).counts.astype(np.int64)
-    n = ScanIndex(truth.scan, truth.target_id, idx).counts.astype(np.int64)
-    return CardinalityPerScan(scan=idx, n_tracks=n_hat, n_true=n, error=np.abs(n_hat - n))
+    return cardinality_indexed(ScanIndexed.build(tracks, truth,
+                                                 all_scans(tracks, truth, scans)))
+
+
+def cardinality_indexed(data: ScanIndexed) -> CardinalityPerScan:
+    """:func:`cardinality_per_scan` on checked, scan-indexed tables."""
+    n_hat = data.track_rows.counts.astype(np.int64)
+    n = data.truth_rows.counts.astype(np.int64)
+    return CardinalityPerScan(scan=data.scans, n_tracks=n_hat, n_true=n,
+                              error=np.abs(n_hat - n))

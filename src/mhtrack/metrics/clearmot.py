@@ -15,7 +15,7 @@ import numpy as np
 from scipy.optimize import linear_sum_assignment
 
 from mhtrack.metrics._common import (
-    ScanIndex,
+    ScanIndexed,
     check_match_distance,
     check_tables,
     pairwise_distance,
@@ -132,10 +132,15 @@ def clear_mot(
     """
     tracks, truth = check_tables(tracks, truth)
     d_match = check_match_distance(match_distance, "match_distance")
+    return clear_mot_indexed(ScanIndexed.build(tracks, truth,
+                                               scan_union(truth.scan, tracks.scan)), d_match)
 
-    scans = scan_union(truth.scan, tracks.scan)
-    t_index = ScanIndex(truth.scan, truth.target_id, scans)
-    k_index = ScanIndex(tracks.scan, tracks.track_id, scans)
+
+def clear_mot_indexed(data: ScanIndexed, d_match: float) -> CLEARMOTResult:
+    """:func:`clear_mot` on checked, scan-indexed tables and a checked ``d_match`` (scans
+    of ``data`` with no truth or no track match nothing)."""
+    tracks, truth, scans = data.tracks, data.truth, data.scans
+    t_index, k_index = data.truth_rows, data.track_rows
     targets, target_dense = np.unique(np.asarray(truth.target_id, np.int64), return_inverse=True)
     track_id = np.asarray(tracks.track_id, np.int64)
     t_pos, k_pos = truth.positions, tracks.positions

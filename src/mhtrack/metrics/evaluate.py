@@ -14,7 +14,9 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from mhtrack.io.jsonsafe import to_jsonable
 from mhtrack.metrics._common import (
+    ScanIndexed,
     check_cutoff,
     check_match_distance,
     check_order,
@@ -23,11 +25,11 @@ from mhtrack.metrics._common import (
     plot_scans,
     scan_union,
 )
-from mhtrack.metrics.association import AssociationResult, association_metrics
-from mhtrack.metrics.cardinality import CardinalityPerScan, cardinality_per_scan
-from mhtrack.metrics.clearmot import CLEARMOTResult, clear_mot
-from mhtrack.metrics.gospa import GOSPAPerScan, gospa_per_scan
-from mhtrack.metrics.ospa import OSPAPerScan, ospa_per_scan
+from mhtrack.metrics.association import AssociationResult, association_indexed
+from mhtrack.metrics.cardinality import CardinalityPerScan, cardinality_indexed
+from mhtrack.metrics.clearmot import CLEARMOTResult, clear_mot_indexed
+from mhtrack.metrics.gospa import GOSPAPerScan, gospa_indexed
+from mhtrack.metrics.ospa import OSPAPerScan, ospa_indexed
 from mhtrack.records import PlotTable, TrackTable, TruthTable
 
 
@@ -231,20 +233,20 @@ def evaluate(
         c if match_distance is None else check_match_distance(match_distance, "match_distance")
     )
     idx = scan_union(truth.scan, tracks.scan, plot_scans(plots), check_scans(scans))
-    mot = clear_mot(tracks, truth, match_distance=d_match)
+    data = ScanIndexed.build(tracks, truth, idx)  # checked and indexed once, for every metric
+    mot = clear_mot_indexed(data, d_match)
     return Evaluation(
         cutoff=c,
         order=p,
         match_distance=d_match,
         scans=idx,
-        ospa=ospa_per_scan(tracks, truth, c, p, scans=idx),
-        gospa=gospa_per_scan(tracks, truth, c, p, scans=idx),
-        cardinality=cardinality_per_scan(tracks, truth, scans=idx),
+        ospa=ospa_indexed(data, c, p),
+        gospa=gospa_indexed(data, c, p),
+        cardinality=cardinality_indexed(data),
         clear_mot=mot,
         n_tracks=len(np.unique(tracks.track_id)),
         n_targets=len(np.unique(truth.target_id)),
-        association=association_metrics(tracks, truth, plots, matching=mot.matching,
-                                        match_distance=d_match),
+        association=association_indexed(data, plots, mot.matching, d_match),
     )
 
 
@@ -253,8 +255,9 @@ def _mean(a: np.ndarray) -> float:
 
 
 def _num(v: float) -> float | None:
-    """JSON-safe float: NaN and ±inf become ``None``."""
-    return float(v) if math.isfinite(v) else None
+    """JSON-safe float (:func:`~mhtrack.io.jsonsafe.to_jsonable`): NaN and ±inf become
+    ``None``."""
+    return to_jsonable(float(v))  # type: ignore[no-any-return]
 
 
 def _fmt(v: float, unit: str = "") -> str:

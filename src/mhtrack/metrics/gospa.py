@@ -14,6 +14,7 @@ import numpy as np
 import numpy.typing as npt
 
 from mhtrack.metrics._common import (
+    ScanIndexed,
     all_scans,
     as_points,
     assign_capped,
@@ -21,7 +22,6 @@ from mhtrack.metrics._common import (
     check_order,
     check_tables,
     pairwise_distance,
-    per_scan_points,
 )
 from mhtrack.records import TrackTable, TruthTable
 
@@ -145,14 +145,19 @@ def gospa_per_scan(
     tracks, truth = check_tables(tracks, truth)
     c = check_cutoff(c, "c")
     p = check_order(p, "p")
-    idx = all_scans(tracks, truth, scans)
-    res = [_gospa(X, Y, c, p) for X, Y in per_scan_points(tracks, truth, idx)]
+    return gospa_indexed(ScanIndexed.build(tracks, truth, all_scans(tracks, truth, scans)),
+                         c, p)
+
+
+def gospa_indexed(data: ScanIndexed, c: float, p: float) -> GOSPAPerScan:
+    """:func:`gospa_per_scan` on checked, scan-indexed tables and checked ``c``, ``p``."""
+    res = [_gospa(X, Y, c, p) for X, Y in data.points()]
 
     def col(name: str, dtype: type) -> np.ndarray:
         return np.array([getattr(r, name) for r in res], dtype=dtype)
 
     return GOSPAPerScan(
-        scan=idx,
+        scan=data.scans,
         distance=col("distance", np.float64),
         localisation=col("localisation", np.float64),
         missed=col("missed", np.float64),

@@ -13,6 +13,7 @@ import numpy as np
 import numpy.typing as npt
 
 from mhtrack.metrics._common import (
+    ScanIndexed,
     all_scans,
     as_points,
     assign_capped,
@@ -20,7 +21,6 @@ from mhtrack.metrics._common import (
     check_order,
     check_tables,
     pairwise_distance,
-    per_scan_points,
 )
 from mhtrack.records import TrackTable, TruthTable
 
@@ -128,10 +128,15 @@ def ospa_per_scan(
     tracks, truth = check_tables(tracks, truth)
     c = check_cutoff(c, "c")
     p = check_order(p, "p")
-    idx = all_scans(tracks, truth, scans)
-    res = [_ospa(X, Y, c, p) for X, Y in per_scan_points(tracks, truth, idx)]
+    return ospa_indexed(ScanIndexed.build(tracks, truth, all_scans(tracks, truth, scans)),
+                        c, p)
+
+
+def ospa_indexed(data: ScanIndexed, c: float, p: float) -> OSPAPerScan:
+    """:func:`ospa_per_scan` on checked, scan-indexed tables and checked ``c``, ``p``."""
+    res = [_ospa(X, Y, c, p) for X, Y in data.points()]
     return OSPAPerScan(
-        scan=idx,
+        scan=data.scans,
         distance=np.array([r.distance for r in res], dtype=np.float64),
         localisation=np.array([r.localisation for r in res], dtype=np.float64),
         cardinality=np.array([r.cardinality for r in res], dtype=np.float64),

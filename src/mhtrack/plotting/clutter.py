@@ -2,17 +2,14 @@
 
 from __future__ import annotations
 
-import matplotlib
-
-matplotlib.use("Agg")  # files only; no display needed
 from pathlib import Path
 
-import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.colors import LogNorm
 from matplotlib.figure import Figure
 
 from mhtrack.models.clutter import Region
+from mhtrack.plotting.scene import save_figure
 
 
 def plot_intensity_maps(
@@ -35,8 +32,8 @@ def plot_intensity_maps(
         raise ValueError(f"maps must be equal 2-D grids, got {true.shape} and {estimated.shape}")
     vmax = float(max(true.max(), estimated.max(), 1e-300))
     norm = LogNorm(vmin=vmax / dynamic_range, vmax=vmax)
-    fig, axes = plt.subplots(1, 2, figsize=(12, 5.4), sharex=True, sharey=True,
-                             layout="constrained")
+    fig = Figure(figsize=(12, 5.4), layout="constrained")
+    axes = fig.subplots(1, 2, sharex=True, sharey=True)
     extent = region.as_tuple()
     im = None
     for ax, grid, name in zip(axes, (true, estimated), titles, strict=True):
@@ -60,8 +57,4 @@ def plot_intensity_maps(
 def save_maps(fig: Figure, path: str | Path, *, dpi: int = 130) -> Path:
     """Write the figure of :func:`plot_intensity_maps` (its layout is already set) and
     close it."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=dpi)
-    plt.close(fig)
-    return path
+    return save_figure(fig, path, dpi=dpi, tight=False)

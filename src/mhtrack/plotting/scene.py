@@ -3,16 +3,17 @@
 Follows P1 Figs. 2–4: truth trajectories with ``o`` at the start and ``x`` at the end,
 plots as dots (clutter grey, target-originated coloured when ``origin`` is known), tracks
 as coloured lines labelled with their id.
+
+Figures are plain :class:`matplotlib.figure.Figure` objects (no pyplot state, no backend
+switch on import); :func:`save_figure` writes any figure, a pyplot one included.
 """
 
 from __future__ import annotations
 
+import sys
 from pathlib import Path
 
-import matplotlib
-
-matplotlib.use("Agg")  # files only; no display needed
-import matplotlib.pyplot as plt
+import matplotlib as mpl
 import numpy as np
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
@@ -62,7 +63,7 @@ def draw_tracks(ax: Axes, tracks: TrackTable, *, label_ids: bool = True) -> None
     """Tracks as coloured lines, one colour per track id, labelled at their end; rows
     reported only once the track was confirmed (``tentative``, the history output) are
     dotted."""
-    cmap = plt.get_cmap("tab10")
+    cmap = mpl.colormaps["tab10"]
     first = True
     tentative = (np.zeros(len(tracks), bool) if tracks.tentative is None
                  else np.asarray(tracks.tentative, bool))
@@ -93,7 +94,8 @@ def plot_scene(
 ) -> Figure:
     """One picture of whatever is given: plots, truth and tracks, equal axes in metres."""
     if ax is None:
-        fig, ax = plt.subplots(figsize=(7.5, 7))
+        fig = Figure(figsize=(7.5, 7))
+        ax = fig.add_subplot()
     else:
         fig = ax.figure
     if plots is not None and len(plots):
@@ -114,11 +116,22 @@ def plot_scene(
     return fig
 
 
-def save_figure(fig: Figure, path: str | Path, *, dpi: int = 130) -> Path:
-    """Write ``fig`` to ``path`` (format from the extension) and close it."""
+def save_figure(fig: Figure, path: str | Path, *, dpi: int = 130,
+                tight: bool = True) -> Path:
+    """Write ``fig`` to ``path`` (format from the extension; PNG by the Agg canvas, whatever
+    the interactive backend) after a tight layout (``tight``), and release it."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    fig.tight_layout()
+    if tight:
+        fig.tight_layout()
     fig.savefig(path, dpi=dpi)
-    plt.close(fig)
+    close_figure(fig)
     return path
+
+
+def close_figure(fig: Figure) -> None:
+    """Release ``fig``: a figure made by pyplot is closed there (a plain ``Figure`` holds
+    nothing beyond its own references). Does not import pyplot."""
+    pyplot = sys.modules.get("matplotlib.pyplot")
+    if pyplot is not None:
+        pyplot.close(fig)

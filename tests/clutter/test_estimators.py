@@ -1,4 +1,4 @@
-"""GMM and AGMM clutter estimators behind the ``ClutterEstimator`` protocol."""
+"""GMM and AGMM clutter estimators behind the ``ClutterEstimator`` interface."""
 
 import dataclasses
 import json

@@ -1,4 +1,4 @@
-"""Birth processes of the MHT (``mhtrack.mht.birth``) and fused plots for multi-radar
+"""Birth processes of the MHT (``mhtrack.mht.births``) and fused plots for multi-radar
 scenarios (``experiments.pipeline``)."""
 
 from __future__ import annotations

@@ -1,8 +1,7 @@
-"""GMM and AGMM clutter estimators behind the ``ClutterEstimator`` protocol."""
+"""GMM and AGMM clutter estimators behind the ``ClutterEstimator`` interface."""
 
 import dataclasses
 import json
-import time
 
 import numpy as np
 import pytest
@@ -208,15 +207,14 @@ def test_outside_gates_leaves_masked_plots_out() -> None:
     assert est_all.count_ == 33
 
 
-def test_thousands_of_plots_bounded_time_and_subsampled() -> None:
+def test_thousands_of_plots_are_subsampled() -> None:
+    """Above ``max_points`` the fit subsamples (its time: benchmarks/bench_clutter.py)."""
     rng = np.random.default_rng(0)
     z = np.concatenate((rng.uniform(-4000, 4000, (5000, 2)), rng.normal(0, 50, (5000, 2))))
     est = AGMMClutter(window=1)
-    est.update(Scan.from_positions(0, 0.0, z[:100]))  # warm up imports and caches
-    t0 = time.perf_counter()
+    est.update(Scan.from_positions(0, 0.0, z[:100]))
     est.update(Scan.from_positions(1, 1.0, z))
     kappa = est.intensity(z)
-    assert time.perf_counter() - t0 < 0.5
     assert est.n_subsampled_ == len(z) - est.max_points
     assert est.count_ == len(z)
     assert np.isfinite(kappa).all()

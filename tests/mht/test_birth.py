@@ -1,4 +1,4 @@
-"""Birth processes of the MHT (``mhtrack.mht.birth``) and fused plots for multi-radar
+"""Birth processes of the MHT (``mhtrack.mht.births``) and fused plots for multi-radar
 scenarios (``experiments.pipeline``)."""
 
 from __future__ import annotations
@@ -19,7 +19,8 @@ from mhtrack.experiments.pipeline import (
     run_scenario,
 )
 from mhtrack.mht import MHTConfig, MHTTracker
-from mhtrack.mht.birth import followed_by, score_upper_bound, sequence_score
+from mhtrack.mht.births.initiator import followed_by
+from mhtrack.mht.births.sequence import score_upper_bound, sequence_score
 from mhtrack.mht.scoring import miss_increment
 from mhtrack.records import Scan, TrackTable
 from mhtrack.scenario import preset, simulate
@@ -94,8 +95,7 @@ def test_sequence_score_equals_the_every_plot_branch_score(imm_sigma_v):
         score, peak = sequence_score(
             np.arange(1.0, 5.0), z, R, has, np.full((1, 4), kappa),
             p_detection=cfg.p_detection, new_target_density=cfg.new_target_density,
-            miss_dl=miss_increment(cfg.p_detection), v_max=cfg.v_max, sigma_v=cfg.sigma_v,
-            models=cfg.models)
+            miss_dl=miss_increment(cfg.p_detection), v_max=cfg.v_max, motion=cfg.motion)
         if has.all():
             assert score[0] == pytest.approx(L.score[full[0]], abs=1e-9)
             assert peak[0] == pytest.approx(L.peak[full[0]], abs=1e-9)

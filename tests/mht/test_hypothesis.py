@@ -1,15 +1,13 @@
 """Global hypothesis solvers against brute-force enumeration."""
 
-import time
-
 import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from hypothesis_reference import brute_force_best_hypothesis
 
 from mhtrack.mht import (
     best_hypothesis,
-    brute_force_best_hypothesis,
     solve_exact,
     solve_greedy,
     solve_milp,
@@ -131,10 +129,8 @@ def test_milp_on_a_large_cluster_and_its_time_limit():
     # a hard random cluster (818 leaves, ~15 s to prove) stops at the limit, unproven,
     # with an answer at least as good as greedy
     score, tree, window = _random_problem(5, 300, 8, 60, False)
-    t0 = time.perf_counter()
     sel, exact = solve_milp(score, tree, window, time_limit=0.3)
-    assert time.perf_counter() - t0 < 3.0
-    assert not exact
+    assert not exact  # stopped by the limit (its speed: benchmarks/bench_mht.py)
     _check_valid(sel, tree, window)
     assert score[sel].sum() >= score[solve_greedy(score, tree, window)].sum() - 1e-9
     hyp = best_hypothesis(score, tree, window, time_limit=0.3)

@@ -1,10 +1,12 @@
-"""The fast paths added to ``mhtrack.models.kalman`` for the MHT agree with the general
-functions they shortcut (``predict``, ``update``, ``gate``)."""
+"""The fast paths of the MHT (``mhtrack.models.kalman``, ``mhtrack.mht.gating``) agree
+with the general matrix forms they shortcut (``tests/reference/kalman_reference.py``)."""
 
+import kalman_reference as ref
 import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from mhtrack.mht.gating import gate_candidate_counts, gate_sweep, gate_threshold
 from mhtrack.models import kalman
 from mhtrack.models.motion import ConstantVelocity
 
@@ -25,7 +27,7 @@ def test_predict_cv_equals_predict(seed, dt):
     rng = np.random.default_rng(seed)
     x, P = _tracks(rng, 9)
     m = ConstantVelocity(10.0)
-    xa, Pa = kalman.predict(x, P, m.F(dt), m.Q(dt))
+    xa, Pa = ref.predict(x, P, m.F(dt), m.Q(dt))
     xb, Pb = kalman.predict_cv(x, P, dt, m.Q(dt))
     np.testing.assert_allclose(xb, xa, rtol=1e-12, atol=1e-9)
     np.testing.assert_allclose(Pb, Pa, rtol=1e-10, atol=1e-6)
@@ -42,7 +44,7 @@ def test_update_position_equals_update(seed, per_pair_R):
         R = B @ B.transpose(0, 2, 1) + np.eye(2) * 100
     else:
         R = np.array([[1e4, 300.0], [300.0, 2e4]])
-    xa, Pa = kalman.update(x, P, z, R)
+    xa, Pa = ref.update(x, P, z, R)
     xb, Pb = kalman.update_position(x, P, z, R)
     np.testing.assert_allclose(xb, xa, rtol=1e-9, atol=1e-6)
     np.testing.assert_allclose(Pb, Pa, rtol=1e-7, atol=1e-6 * np.abs(Pa).max())
@@ -60,14 +62,14 @@ def test_gate_sweep_equals_gate(seed, M, N, per_plot_R):
         R = B @ B.transpose(0, 2, 1) + np.eye(2) * 100
     else:
         R = np.eye(2) * 1e4
-    gamma = kalman.gate_threshold(0.999)
-    a = kalman.gate(x, P, z, R, gamma)
-    b = kalman.gate_sweep(x, P, z, R, gamma)
+    gamma = gate_threshold(0.999)
+    a = ref.gate(x, P, z, R, gamma)
+    b = gate_sweep(x, P, z, R, gamma)
     assert np.array_equal(a.track, b.track)
     assert np.array_equal(a.plot, b.plot)
     np.testing.assert_allclose(b.d2, a.d2, rtol=1e-12, atol=1e-12)
     np.testing.assert_allclose(b.loglik, a.loglik, rtol=1e-12, atol=1e-12)
-    counts = kalman.gate_candidate_counts(x, P, z, R, gamma)
+    counts = gate_candidate_counts(x, P, z, R, gamma)
     assert np.all(np.bincount(b.track, minlength=M) <= counts)
 
 
@@ -76,7 +78,7 @@ def test_gate_sweep_with_many_plots_matches_gate():
     x, P = _tracks(rng, 300)
     z = rng.uniform(-4000, 4000, (5000, 2))
     R = np.eye(2) * 1e4
-    a = kalman.gate(x, P, z, R, 13.8)
-    b = kalman.gate_sweep(x, P, z, R, 13.8)
+    a = ref.gate(x, P, z, R, 13.8)
+    b = gate_sweep(x, P, z, R, 13.8)
     assert len(a) > 1000
     assert np.array_equal(a.track, b.track) and np.array_equal(a.plot, b.plot)

@@ -136,7 +136,7 @@ def test_clusters_match_scipy_connected_components():
 
 
 def test_tentative_keep_is_walds_absolute_lower_threshold():
-    from mhtrack.mht.pruning import tentative_keep
+    from mhtrack.mht.sprt import tentative_keep
 
     score = np.array([-10.0, -9.0, -10.0, 3.0])
     tentative = np.array([True, True, False, True])

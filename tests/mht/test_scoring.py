@@ -97,8 +97,8 @@ def test_sprt_thresholds_are_walds():
     assert up == pytest.approx(math.log((1 - 1e-4) / 0.01))  # 4.6042
     assert down == pytest.approx(math.log(1e-4 / (1 - 0.01)))  # -9.2003
     trk = MHTTracker(MHTConfig(alpha=0.05, beta=0.2))
-    assert trk.confirm_threshold == pytest.approx(math.log(0.8 / 0.05))
-    assert trk.delete_threshold == pytest.approx(math.log(0.2 / 0.95))
+    assert trk.sprt.confirm_threshold == pytest.approx(math.log(0.8 / 0.05))
+    assert trk.sprt.delete_threshold == pytest.approx(math.log(0.2 / 0.95))
     with pytest.raises(ValueError):
         sprt_thresholds(0.6, 0.5)
 

@@ -3,7 +3,6 @@ save/restore, bounded bursts, input validation."""
 
 import dataclasses
 import logging
-import time
 import tracemalloc
 
 import numpy as np
@@ -156,10 +155,7 @@ def test_burst_of_ten_thousand_plots_is_bounded(crossing40, caplog):
     burst = Scan.from_positions(31, 31.0, rng.uniform(-4000, 4000, (10_000, 2)))
     caplog.clear()
     with caplog.at_level(logging.WARNING, logger="mhtrack.mht.tracker"):
-        t0 = time.perf_counter()
-        trk.step(burst)
-        elapsed = time.perf_counter() - t0
-    assert elapsed < 5.0
+        trk.step(burst)  # its time: benchmarks/bench_mht.py
     st = trk.last_stats
     assert st.n_plots == 10_000
     assert st.caps.get("max_births_per_scan") == 10_000 - trk.config.max_births_per_scan
@@ -278,7 +274,7 @@ def test_logic_confirmation_needs_hits_and_a_positive_score():
     best = logic.leaves.score.max()
     assert out_sprt == [0, 0, 0, 0, 0]
     assert out_logic == [0, 0, 0, 0, 1]
-    assert 0 < best < sprt.confirm_threshold
+    assert 0 < best < sprt.sprt.confirm_threshold
     floor_cfg = dataclasses.replace(MHTConfig(), confirm_hits=3, confirm_min_score=best + 0.1)
     high_floor = MHTTracker(floor_cfg, KnownClutter(1.5625e-7))
     assert [len(high_floor.step(s)) for s in scans] == [0, 0, 0, 0, 0]

@@ -1,4 +1,9 @@
-"""Batched Kalman filter against hand-worked values and a per-track reference loop."""
+"""The general-form Kalman filter and gate of ``tests/reference/kalman_reference.py``
+(what the library's fast paths are checked against) and the χ² gate threshold, against
+hand-worked values, scipy and a per-track textbook loop."""
+
+import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -6,8 +11,11 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.stats import chi2, multivariate_normal
 
-from mhtrack.models import kalman
+from mhtrack.mht.gating import gate_threshold
 from mhtrack.models.motion import ConstantVelocity, H
+
+sys.path.insert(0, str(Path(__file__).parents[1] / "reference"))
+import kalman_reference as kalman
 
 
 def test_cv_matrices_hand_worked():
@@ -23,9 +31,9 @@ def test_cv_matrices_hand_worked():
 
 
 def test_gate_threshold_is_chi2_quantile():
-    assert kalman.gate_threshold(0.99) == pytest.approx(-2 * np.log(0.01))
+    assert gate_threshold(0.99) == pytest.approx(-2 * np.log(0.01))
     with pytest.raises(ValueError, match="gate probability"):
-        kalman.gate_threshold(1.0)
+        gate_threshold(1.0)
 
 
 def _reference_update(x, P, z, R):
@@ -114,4 +122,4 @@ def test_two_point_init_covariance_by_monte_carlo():
 
 @pytest.mark.parametrize("p", [0.5, 0.9, 0.99, 0.999, 0.999999])
 def test_gate_threshold_matches_scipy_chi2(p):
-    assert kalman.gate_threshold(p) == pytest.approx(chi2.ppf(p, df=2), rel=1e-12)
+    assert gate_threshold(p) == pytest.approx(chi2.ppf(p, df=2), rel=1e-12)

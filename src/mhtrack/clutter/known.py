@@ -6,10 +6,11 @@ from typing import Any
 
 import numpy as np
 
+from mhtrack.clutter.base import ClutterEstimator
 from mhtrack.records import Scan
 
 
-class KnownClutter:
+class KnownClutter(ClutterEstimator):
     """``κ̂(z) = κ`` everywhere, whatever the scans say.
 
     Parameters

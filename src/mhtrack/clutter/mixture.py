@@ -26,6 +26,7 @@ from typing import Any, Literal
 
 import numpy as np
 
+from mhtrack.clutter.base import ClutterEstimator
 from mhtrack.clutter.em import (
     Mixture,
     PruneRule,
@@ -44,7 +45,7 @@ SOURCES: tuple[str, ...] = ("all", "outside-gates")
 CHI2_2_99 = 9.2103
 
 
-class MixtureClutter:
+class MixtureClutter(ClutterEstimator):
     """Online Gaussian-mixture clutter estimator (shared base of ``gmm`` and ``agmm``).
 
     Parameters

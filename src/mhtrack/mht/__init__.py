@@ -1,13 +1,15 @@
 """Track-oriented multiple hypothesis tracking (P1 §1.3): track trees of stacked leaves,
 log-likelihood-ratio scores, clustering, an exact global hypothesis, N-scan pruning and
-SPRT track management, with the clutter intensity from a pluggable estimator."""
+SPRT track management, with the motion model, the clutter estimator and the birth
+process as parts passed in (the cycle's stages: :mod:`mhtrack.mht.tracker`)."""
 
+from mhtrack.mht.births import Birth, BirthCandidates, EveryPlotBirth, InitiatorBirth
 from mhtrack.mht.clustering import cluster_trees, plot_keys
 from mhtrack.mht.config import MHTConfig
+from mhtrack.mht.gating import Gate, Gated, gate_sweep, gate_threshold
 from mhtrack.mht.hypothesis import (
     GlobalHypothesis,
     best_hypothesis,
-    brute_force_best_hypothesis,
     solve_exact,
     solve_greedy,
     solve_milp,
@@ -18,25 +20,34 @@ from mhtrack.mht.pruning import (
     cap_trees,
     n_scan_keep,
     score_drop_keep,
-    sprt_keep,
 )
-from mhtrack.mht.scoring import birth_score, miss_increment, sprt_thresholds, update_increment
-from mhtrack.mht.tracker import MHTTracker, StepStats
+from mhtrack.mht.report import StepStats
+from mhtrack.mht.scoring import birth_score, miss_increment, update_increment
+from mhtrack.mht.sprt import SPRT, sprt_keep, sprt_thresholds, tentative_keep
+from mhtrack.mht.tracker import MHTTracker
 from mhtrack.mht.tree import Leaves
 
 __all__ = [
+    "SPRT",
+    "Birth",
+    "BirthCandidates",
+    "EveryPlotBirth",
+    "Gate",
+    "Gated",
     "GlobalHypothesis",
+    "InitiatorBirth",
     "Leaves",
     "MHTConfig",
     "MHTTracker",
     "StepStats",
     "best_hypothesis",
     "birth_score",
-    "brute_force_best_hypothesis",
     "cap_leaves",
     "cap_leaves_per_tree",
     "cap_trees",
     "cluster_trees",
+    "gate_sweep",
+    "gate_threshold",
     "miss_increment",
     "n_scan_keep",
     "plot_keys",
@@ -46,5 +57,6 @@ __all__ = [
     "solve_milp",
     "sprt_keep",
     "sprt_thresholds",
+    "tentative_keep",
     "update_increment",
 ]

@@ -12,15 +12,14 @@ from dataclasses import asdict, dataclass, fields
 from typing import Any
 
 from mhtrack.models.imm import CVModelSet
+from mhtrack.models.motion import ConstantVelocity, MotionModel
+from mhtrack.names import BIRTHS
 
 #: Largest N-scan depth: every leaf keeps ``N + 1`` plot ids and the trees grow with ``N``;
 #: deeper than this only costs memory (P1 uses 3).
 MAX_N_SCAN = 20
 #: Largest tentative history kept (scans).
 MAX_HISTORY_SCANS = 1000
-
-#: Birth processes by name (:attr:`MHTConfig.birth`; ``mhtrack.mht.birth``).
-BIRTHS: tuple[str, ...] = ("every-plot", "logic", "modified-logic", "hough", "modified-hough")
 
 
 @dataclass(frozen=True)
@@ -95,7 +94,8 @@ class MHTConfig:
         solved greedily instead of exactly. Default 2 000.
     milp_time_limit : seconds HiGHS may spend on one cluster's integer programme; then
         its best answer so far (or greedy's, if better) is used. Default 0.5.
-    birth : which plots start new trees (``mhtrack.mht.birth``). ``"every-plot"`` (default,
+    birth : which plots start new trees (:mod:`mhtrack.mht.births`; one of
+        :data:`mhtrack.names.BIRTHS`). ``"every-plot"`` (default,
         P1 Fig. 1): every plot, one-point initialisation. ``"logic"``, ``"modified-logic"``,
         ``"hough"``, ``"modified-hough"``: P2's initiator over a sliding window of the last
         4 scans; a tree starts only from each newly initiated track, seeded with its
@@ -193,6 +193,13 @@ class MHTConfig:
         if self.imm_sigma_v <= 0:
             return None
         return CVModelSet((float(self.imm_sigma_v), float(self.sigma_v)), self.imm_mode_time)
+
+    @property
+    def motion(self) -> MotionModel:
+        """The motion model these parameters name: the IMM (:attr:`models`) when
+        ``imm_sigma_v > 0``, else a single constant-velocity model with ``sigma_v``."""
+        models = self.models
+        return ConstantVelocity(self.sigma_v) if models is None else models
 
     def to_json(self) -> str:
         """The configuration as a JSON string (exact round trip with :meth:`from_json`)."""

@@ -1,32 +1,27 @@
-"""Hypothesis management: SPRT deletion, score-drop pruning, N-scan pruning and hard caps.
+"""Hypothesis management: score-drop pruning, N-scan pruning and hard caps, and the two
+pruning stages of the tracker (:func:`prune_children`, :func:`prune_after_solve`).
 
-Every function takes arrays of leaves sorted by tree id and returns a boolean *keep*
-mask; the caps also return how many leaves (or trees) they removed, so the tracker can
-report every time a cap acts.
+Every rule takes arrays of leaves sorted by tree id and returns a boolean *keep* mask; the
+caps also return how many leaves (or trees) they removed, so the tracker can report every
+time a cap acts (SPRT deletion: :mod:`mhtrack.mht.sprt`).
 """
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
-from mhtrack.mht.tree import NO_PLOT, segment_ids, segment_max, segment_starts
-
-
-def sprt_keep(score: np.ndarray, peak: np.ndarray, delete_threshold: float) -> np.ndarray:
-    """Wald's SPRT deletion applied as a score drop: keep a leaf while
-    ``L − L_peak > ln(β/(1−α))`` (Blackman & Popoli 1999 §6.2). For a tentative leaf whose
-    score never rose, ``L_peak`` is its birth score, so this is Wald's test on the evidence
-    gathered since birth; for a confirmed track it detects the target's disappearance."""
-    return score - peak > delete_threshold
-
-
-def tentative_keep(score: np.ndarray, tentative: np.ndarray, delete_threshold: float) -> np.ndarray:
-    """Wald's lower SPRT threshold on the score itself for tentative (unconfirmed) leaves:
-    keep unless ``tentative`` and ``L ≤ ln(β/(1−α))`` (Blackman & Popoli 1999 §6.2 delete
-    tentative tracks on the absolute threshold, confirmed ones on the drop from the peak).
-    In dense clutter a tree born with ``L₀ = ln(λ_v P_D/(κ̂ + λ_v))`` far below the threshold is
-    then never grown, instead of branching for four scans until its drop reaches it."""
-    return ~(tentative & (score <= delete_threshold))
+from mhtrack.mht.config import MHTConfig
+from mhtrack.mht.sprt import SPRT
+from mhtrack.mht.tree import (
+    NO_PLOT,
+    Children,
+    Leaves,
+    segment_ids,
+    segment_max,
+    segment_starts,
+)
 
 
 def score_drop_keep(tree: np.ndarray, score: np.ndarray, drop: float) -> np.ndarray:
@@ -124,3 +119,42 @@ def n_scan_keep(tree: np.ndarray, oldest: np.ndarray, chosen: np.ndarray) -> np.
         taken = (up[j] == oldest) & (oldest != NO_PLOT)
         keep &= ~(taken & (ut[j] != tree))
     return keep
+
+
+def prune_children(leaves: Leaves, children: Children, n_births: int, sprt: SPRT,
+                   cfg: MHTConfig, caps: dict[str, int]) -> Children:
+    """Before the (costly) Kalman update: SPRT deletion, score-drop pruning within a
+    tree, then the caps on leaves per tree and on all leaves (``n_births`` of
+    ``max_leaves`` are kept for this scan's new trees)."""
+    children = children.take(sprt.keep(children.score, children.peak,
+                                       leaves.track[children.parent] < 0))
+    tree = leaves.tree[children.parent]
+    keep = score_drop_keep(tree, children.score, cfg.prune_drop)
+    children, tree = children.take(keep), tree[keep]
+    keep, cut = cap_leaves_per_tree(tree, children.score, cfg.max_leaves_per_tree)
+    if cut:
+        caps["max_leaves_per_tree"] = cut
+        children, tree = children.take(keep), tree[keep]
+    budget = max(cfg.max_leaves - n_births, 0)
+    confirmed = leaves.track[children.parent] >= 0
+    keep, cut = cap_leaves(children.score, confirmed, budget)
+    if cut:
+        caps["max_leaves"] = cut
+        children = children.take(keep)
+    return children
+
+
+def prune_after_solve(leaves: Leaves, chosen: np.ndarray, max_trees: int,
+                      caps: dict[str, int]) -> Leaves:
+    """N-scan pruning around the best hypothesis (leaf indices ``chosen``), then the cap
+    on trees; marks the surviving chosen leaves."""
+    is_chosen = np.zeros(len(leaves), bool)
+    is_chosen[chosen] = True
+    keep = n_scan_keep(leaves.tree, leaves.window[:, 0], chosen)
+    protected = is_chosen | (leaves.track >= 0)
+    keep_t, cut = cap_trees(leaves.tree[keep], leaves.score[keep], protected[keep], max_trees)
+    if cut:
+        caps["max_trees"] = cut
+        keep[np.flatnonzero(keep)[~keep_t]] = False
+    out = leaves.take(keep)
+    return replace(out, chosen=is_chosen[keep])

@@ -8,7 +8,8 @@
 ``p(z|T)`` is the Kalman innovation likelihood ``N(ν; 0, S)``, ``κ̂(z)`` the clutter
 intensity from the clutter estimator and ``λ_v`` the new-target density. A tree born from
 plot ``z`` starts at ``L₀ = ln(λ_v · P_D / (κ̂(z) + λ_v))`` (:func:`birth_score`).
-Track management is Wald's sequential probability ratio test on that score.
+Track management is Wald's sequential probability ratio test on that score
+(:mod:`mhtrack.mht.sprt`).
 """
 
 from __future__ import annotations
@@ -51,16 +52,3 @@ def birth_score(kappa: np.ndarray, p_detection: float, new_target_density: float
     beside their own plots). With the shared denominator the update wins iff
     ``g > λ_v (1 − P_D)``, whatever ``κ̂``. ``L₀ ≤ ln P_D``: a lone plot never confirms."""
     return math.log(new_target_density * p_detection) - np.log(kappa + new_target_density)
-
-
-def sprt_thresholds(alpha: float, beta: float) -> tuple[float, float]:
-    """Wald's SPRT thresholds ``(confirm, delete)`` on the log-likelihood ratio.
-
-    ``confirm = ln((1 − β)/α)``, ``delete = ln(β/(1 − α))`` with ``α`` the probability of
-    confirming a false track and ``β`` of deleting a true one (Wald 1947; Blackman &
-    Popoli 1999 §6.2). The tracker confirms when ``L ≥ confirm`` and deletes a leaf when
-    its drop from its own peak ``L − L_peak ≤ delete``.
-    """
-    if not (0 < alpha < 1 and 0 < beta < 1 and alpha + beta < 1):
-        raise ValueError(f"need 0 < alpha, beta and alpha + beta < 1, got {alpha}, {beta}")
-    return math.log((1 - beta) / alpha), math.log(beta / (1 - alpha))

@@ -12,11 +12,14 @@ object per leaf.
 from __future__ import annotations
 
 from dataclasses import dataclass, fields
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from mhtrack.models import imm, kalman
-from mhtrack.models.motion import POS, VEL
+from mhtrack.models.motion import POS, VEL, MotionModel, States
+
+if TYPE_CHECKING:
+    from mhtrack.mht.gating import Gated
 
 NO_PLOT = -1
 
@@ -92,6 +95,10 @@ class Leaves:
     def from_arrays(cls, arrays: dict[str, np.ndarray]) -> Leaves:
         return cls(**{f.name: np.asarray(arrays[f.name]) for f in fields(cls)})
 
+    def states(self) -> States:
+        """The leaves' filter states (``x, P`` and the per-model ``xm, Pm, mu``)."""
+        return States(self.x, self.P, self.xm, self.Pm, self.mu)
+
     @property
     def n_models(self) -> int:
         """IMM models per leaf (0: single constant-velocity model)."""
@@ -147,7 +154,7 @@ class Children:
 
 
 def propose_children(
-    leaves: Leaves, gated: kalman.Gated, miss_dl: float, update_dl: np.ndarray
+    leaves: Leaves, gated: Gated, miss_dl: float, update_dl: np.ndarray
 ) -> Children:
     """Each leaf spawns a miss child (``L + ΔL_miss``) and one child per gated plot
     (``L + ΔL_update``), P1 eqs. 4–5. ``update_dl`` is per gated pair."""
@@ -164,41 +171,27 @@ def propose_children(
 
 def grow_children(
     leaves: Leaves,
-    xp: np.ndarray,
-    Pp: np.ndarray,
+    pred: States,
     children: Children,
     z: np.ndarray,
     R: np.ndarray,
     rows: np.ndarray,
-    models: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None,
+    motion: MotionModel,
 ) -> Leaves:
-    """Materialise ``children`` as leaves: misses keep the prediction ``(xp, Pp)``, updates
-    get the Kalman update with their plot (``R`` shared (2, 2) or per plot (n, 2, 2)).
-    With an IMM, ``models = (x⁻, P⁻, μ̄)`` per leaf and model (:func:`imm.update`; a miss
-    keeps the predicted model states and probabilities) and ``x, P`` are their mixture."""
+    """Materialise ``children`` as leaves: misses keep the prediction ``pred``, updates get
+    the motion model's update with their plot (``R`` shared (2, 2) or per plot (n, 2, 2);
+    with an IMM, each model's update and ``x, P`` their mixture)."""
     par, plot = children.parent, children.plot
-    x = xp[par]
-    P = Pp[par]
+    st = pred.take(par)
     upd = np.flatnonzero(plot >= 0)
-    if models is None:
-        r = leaves.n_models
-        mu, xm, Pm = np.zeros((len(par), r)), np.zeros((len(par), r, 4)), np.zeros(
-            (len(par), r, 4, 4))
-    else:
-        xm, Pm, mu = models[0][par], models[1][par], models[2][par]
     if upd.size:
         pj = plot[upd]
-        Ru = R if R.ndim == 2 else R[pj]
-        if models is None:
-            x[upd], P[upd] = kalman.update_position(x[upd], P[upd], z[pj], Ru)
-        else:
-            xm[upd], Pm[upd], mu[upd] = imm.update(xm[upd], Pm[upd], mu[upd], z[pj], Ru)
-            x[upd], P[upd] = imm.combine(xm[upd], Pm[upd], mu[upd])
+        st.put(upd, motion.update(st.take(upd), z[pj], R if R.ndim == 2 else R[pj]))
     new_col = np.where(plot >= 0, rows[np.maximum(plot, 0)] if rows.size else NO_PLOT, NO_PLOT)
     window = np.concatenate((leaves.window[par, 1:], new_col[:, None]), axis=1)
     return Leaves(
-        x=x,
-        P=P,
+        x=st.x,
+        P=st.P,
         score=children.score,
         peak=children.peak,
         tree=leaves.tree[par],
@@ -207,9 +200,9 @@ def grow_children(
         n_updates=leaves.n_updates[par] + (plot >= 0),
         window=window,
         chosen=np.zeros(len(par), bool),
-        mu=mu,
-        xm=xm,
-        Pm=Pm,
+        mu=st.mu,
+        xm=st.xm,
+        Pm=st.Pm,
         node=np.full(len(par), -1, np.int64),
         parent=leaves.node[par],
     )
@@ -229,54 +222,26 @@ def one_point_state(z: np.ndarray, R: np.ndarray, v_max: float) -> tuple[np.ndar
     return x, P
 
 
-def birth_leaves(
-    z: np.ndarray,
-    R: np.ndarray,
-    rows: np.ndarray,
-    score: np.ndarray,
-    first_tree: int,
-    scan_index: int,
-    v_max: float,
-    width: int,
-    models: imm.CVModelSet | None = None,
+def new_trees(
+    states: States, score: np.ndarray, peak: np.ndarray, tree: np.ndarray, scan_index: int,
+    n_updates: np.ndarray, window: np.ndarray,
 ) -> Leaves:
-    """One new tree per plot, from :func:`one_point_state`; initial score ``score``
-    (the birth score, Blackman & Popoli 1999 §6.2). Tree ids ``first_tree, first_tree+1, …``.
-    With an IMM every model starts from that state, with equal probabilities.
-    """
-    n = len(z)
-    x, P = one_point_state(z, R, v_max)
-    window = np.full((n, width), NO_PLOT, np.int64)
-    window[:, -1] = rows
+    """Root leaves of new trees (tentative, not chosen, node ids not yet given)."""
+    n = len(score)
     return Leaves(
-        x=x,
-        P=P,
-        score=np.asarray(score, float),
-        peak=np.asarray(score, float).copy(),
-        tree=np.arange(first_tree, first_tree + n, dtype=np.int64),
+        x=states.x,
+        P=states.P,
+        score=score,
+        peak=peak,
+        tree=tree,
         track=np.full(n, -1, np.int64),
         birth=np.full(n, scan_index, np.int64),
-        n_updates=np.ones(n, np.int64),
+        n_updates=n_updates,
         window=window,
         chosen=np.zeros(n, bool),
-        **model_arrays(x, P, models),
-        **root_links(n),
+        mu=states.mu,
+        xm=states.xm,
+        Pm=states.Pm,
+        node=np.full(n, -1, np.int64),
+        parent=np.full(n, -1, np.int64),
     )
-
-
-def root_links(n: int) -> dict[str, np.ndarray]:
-    """``node, parent`` of ``n`` new roots: ids not yet given, no parent."""
-    return {"node": np.full(n, -1, np.int64), "parent": np.full(n, -1, np.int64)}
-
-
-def model_arrays(
-    x: np.ndarray, P: np.ndarray, models: imm.CVModelSet | None
-) -> dict[str, np.ndarray]:
-    """``mu, xm, Pm`` of new leaves with state ``x``, ``P``: every model at that state
-    with equal probabilities; empty trailing axes without an IMM."""
-    n = len(x)
-    if models is None:
-        return {"mu": np.zeros((n, 0)), "xm": np.zeros((n, 0, 4)), "Pm": np.zeros((n, 0, 4, 4))}
-    r = models.r
-    return {"mu": models.initial_mu(n), "xm": np.repeat(x[:, None], r, axis=1),
-            "Pm": np.repeat(P[:, None], r, axis=1)}

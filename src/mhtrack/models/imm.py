@@ -27,14 +27,18 @@ from dataclasses import dataclass
 import numpy as np
 
 from mhtrack.models import kalman
-from mhtrack.models.motion import ConstantVelocity
+from mhtrack.models.linalg2 import gaussian_loglik2, sym_mahalanobis2
+from mhtrack.models.motion import ConstantVelocity, MotionModel, States
 
 
 @dataclass(frozen=True)
-class CVModelSet:
+class CVModelSet(MotionModel):
     """``r`` constant-velocity models with acceleration noise stds ``sigmas`` (m/s²) and
     mean sojourn time ``mode_time`` (s) in a model: ``π_ii = exp(−dt/τ)``, the rest of
-    the row shared equally by the other models. Initial probabilities are equal."""
+    the row shared equally by the other models. Initial probabilities are equal.
+
+    As a :class:`~mhtrack.models.motion.MotionModel`: the IMM filter (module docstring),
+    scoring a plot by the mixture likelihood ``Σ_j μ̄_j N(z; H x⁻_j, S_j)``."""
 
     sigmas: tuple[float, ...]
     mode_time: float = 100.0
@@ -62,7 +66,7 @@ class CVModelSet:
         np.fill_diagonal(pi, stay)
         return pi
 
-    def predict(
+    def predict_models(
         self, xm: np.ndarray, Pm: np.ndarray, mu: np.ndarray, dt: float
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Mixing and per-model prediction: ``(x⁻, P⁻, μ̄)`` (module docstring)."""
@@ -78,6 +82,41 @@ class CVModelSet:
             xp[:, j], Pp[:, j] = kalman.predict_cv(x0[:, j], P0[:, j], dt,
                                                    ConstantVelocity(s).Q(dt))
         return xp, Pp, mubar
+
+    # ------------------------------------------------------------------ MotionModel
+    @property
+    def n_models(self) -> int:
+        return self.r
+
+    def predict(self, states: States, dt: float) -> States:
+        """Mixing and prediction of every model; ``x, P`` their mixture (for gating)."""
+        xm, Pm, mubar = self.predict_models(states.xm, states.Pm, states.mu, dt)
+        xp, Pp = combine(xm, Pm, mubar)
+        return States(xp, Pp, xm, Pm, mubar)
+
+    def update(self, states: States, z: np.ndarray, R: np.ndarray) -> States:
+        """Each model's update and the posterior probabilities (:func:`update`); ``x, P``
+        their mixture."""
+        xm, Pm, mu = update(states.xm, states.Pm, states.mu, z, R)
+        x, P = combine(xm, Pm, mu)
+        return States(x, P, xm, Pm, mu)
+
+    def gating_loglik(
+        self, pred: States, track: np.ndarray, plot: np.ndarray, z: np.ndarray,
+        R: np.ndarray, loglik: np.ndarray,
+    ) -> np.ndarray:
+        """The mixture likelihood ``ln Σ_j μ̄_j N(z; H x⁻_j, S_j)`` of the gated pairs."""
+        if len(track) == 0:
+            return loglik
+        ll = model_logliks(pred.xm[track], pred.Pm[track], z[plot],
+                           R if R.ndim == 2 else R[plot])
+        return mixture_loglik(pred.mu[track], ll)
+
+    def new_states(self, x: np.ndarray, P: np.ndarray) -> States:
+        """Every model at ``x``, ``P`` with equal probabilities."""
+        r = self.r
+        return States(x, P, np.repeat(x[:, None], r, axis=1), np.repeat(P[:, None], r, axis=1),
+                      self.initial_mu(len(x)))
 
 
 def combine(xm: np.ndarray, Pm: np.ndarray, mu: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -98,9 +137,8 @@ def model_logliks(xm: np.ndarray, Pm: np.ndarray, z: np.ndarray, R: np.ndarray) 
     s11 = Pm[..., 2, 2] + Rb[..., 1, 1]
     n0 = z[:, None, 0] - xm[..., 0]
     n1 = z[:, None, 1] - xm[..., 2]
-    det = s00 * s11 - s01 * s01
-    d2 = (s11 * n0 * n0 - 2 * s01 * n0 * n1 + s00 * n1 * n1) / det
-    return -0.5 * (d2 + np.log(det)) - kalman.LOG_2PI
+    d2, det = sym_mahalanobis2(n0, n1, s00, s01, s11)
+    return gaussian_loglik2(d2, det)
 
 
 def mixture_loglik(mubar: np.ndarray, ll: np.ndarray) -> np.ndarray:

@@ -1,15 +1,23 @@
-"""Constant-velocity motion model (P1 §1.1, eq. 1).
+"""Motion models: the constant-velocity model (P1 §1.1, eq. 1) and the interface through
+which the MHT predicts, scores and updates its leaves (:class:`MotionModel`).
 
 State ``x = [x, vx, y, vy]``; ``F = blkdiag(F1, F1)`` with ``F1 = [[1, T], [0, 1]]`` and
 ``Q = blkdiag(Q1, Q1)·σv²`` with ``Q1 = [[T⁴/4, T³/2], [T³/2, T²]]`` (piecewise-constant
 white acceleration, Bar-Shalom et al. 2001 §6.3.3).
+
+A :class:`MotionModel` works on :class:`States`: the stacked states of many tracks, with
+``r`` per-model arrays when the model is a mixture (the IMM, :mod:`mhtrack.models.imm`)
+and ``r = 0`` for a single filter (:class:`ConstantVelocity`).
 """
 
 from __future__ import annotations
 
+from abc import ABC, abstractmethod
 from dataclasses import dataclass
 
 import numpy as np
+
+from mhtrack.models import kalman
 
 #: Measurement matrix of a position sensor, ``H = [[1,0,0,0],[0,0,1,0]]`` (P1 §1.1).
 H = np.array([[1.0, 0.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0]])
@@ -18,10 +26,68 @@ POS = np.array([0, 2])
 VEL = np.array([1, 3])
 
 
+@dataclass(frozen=True, slots=True)
+class States:
+    """Stacked track states: ``x`` (M, 4), ``P`` (M, 4, 4) — for a mixture their
+    moment-matched Gaussian — and per model ``xm`` (M, r, 4), ``Pm`` (M, r, 4, 4), ``mu``
+    (M, r) (``r = 0``: a single model)."""
+
+    x: np.ndarray
+    P: np.ndarray
+    xm: np.ndarray
+    Pm: np.ndarray
+    mu: np.ndarray
+
+    def take(self, idx: np.ndarray) -> States:
+        """Rows ``idx`` (copies)."""
+        return States(self.x[idx], self.P[idx], self.xm[idx], self.Pm[idx], self.mu[idx])
+
+    def put(self, idx: np.ndarray, other: States) -> None:
+        """Overwrite rows ``idx`` with ``other``'s rows (in place)."""
+        self.x[idx], self.P[idx] = other.x, other.P
+        self.xm[idx], self.Pm[idx], self.mu[idx] = other.xm, other.Pm, other.mu
+
+
+class MotionModel(ABC):
+    """What the MHT needs of a motion model: predict, score a plot, update, start a track.
+
+    Required: :attr:`n_models`, :meth:`predict`, :meth:`update`. Optional hooks (defaults
+    for a single Gaussian filter): :meth:`gating_loglik`, :meth:`new_states`.
+    """
+
+    @property
+    @abstractmethod
+    def n_models(self) -> int:
+        """``r``, the per-model arrays each track carries (0 for a single filter)."""
+
+    @abstractmethod
+    def predict(self, states: States, dt: float) -> States:
+        """The states ``dt`` seconds later (``x, P`` are what gating uses)."""
+
+    @abstractmethod
+    def update(self, states: States, z: np.ndarray, R: np.ndarray) -> States:
+        """Each predicted row updated with its plot ``z`` (K, 2); ``R`` (2, 2) or (K, 2, 2)."""
+
+    def gating_loglik(
+        self, pred: States, track: np.ndarray, plot: np.ndarray, z: np.ndarray,
+        R: np.ndarray, loglik: np.ndarray,
+    ) -> np.ndarray:
+        """``ln p(z|T)`` of the gated pairs (``track``, ``plot``) for the track score.
+        Default: ``loglik``, the Gaussian innovation log-likelihood of ``x, P`` computed
+        by the gate — exact for a single filter."""
+        return loglik
+
+    def new_states(self, x: np.ndarray, P: np.ndarray) -> States:
+        """States of new tracks starting at ``x``, ``P``. Default: no per-model arrays."""
+        n = len(x)
+        return States(x, P, np.zeros((n, 0, 4)), np.zeros((n, 0, 4, 4)), np.zeros((n, 0)))
+
+
 @dataclass(frozen=True)
-class ConstantVelocity:
+class ConstantVelocity(MotionModel):
     """Nearly-constant-velocity model with acceleration noise standard deviation ``sigma_v``
-    (m/s²); P1 uses ``σv² = 100``."""
+    (m/s²); P1 uses ``σv² = 100``. As a :class:`MotionModel`, the Kalman filter of
+    :mod:`mhtrack.models.kalman`."""
 
     sigma_v: float = 10.0
 
@@ -43,3 +109,18 @@ class ConstantVelocity:
     def propagate(self, x: np.ndarray, dt: float) -> np.ndarray:
         """Noise-free propagation of states ``x`` (…, 4) by ``dt``."""
         return x @ self.F(dt).T
+
+    # ------------------------------------------------------------------ MotionModel
+    @property
+    def n_models(self) -> int:
+        return 0
+
+    def predict(self, states: States, dt: float) -> States:
+        """Kalman prediction (:func:`~mhtrack.models.kalman.predict_cv`)."""
+        xp, Pp = kalman.predict_cv(states.x, states.P, dt, self.Q(dt))
+        return States(xp, Pp, states.xm, states.Pm, states.mu)
+
+    def update(self, states: States, z: np.ndarray, R: np.ndarray) -> States:
+        """Kalman update (:func:`~mhtrack.models.kalman.update_position`)."""
+        x, P = kalman.update_position(states.x, states.P, z, R)
+        return States(x, P, states.xm, states.Pm, states.mu)

@@ -1,13 +1,9 @@
-"""Birth processes of the MHT: which plots start new track trees (``docs/mht.md``).
+"""P2's initiators as the MHT's birth process (``logic``, ``modified-logic``, ``hough``,
+``modified-hough``; P2 §2–3, ``docs/mht.md``).
 
-* ``every-plot`` (default, P1 Fig. 1): every plot of the scan starts a tree with the
-  one-point birth score ``ln(λ_v P_D / (κ̂ + λ_v))`` (:func:`~mhtrack.mht.scoring.birth_score`)
-  — implemented in :meth:`~mhtrack.mht.tracker.MHTTracker._births`.
-* ``logic`` / ``modified-logic`` / ``hough`` / ``modified-hough`` (P2 §2–3 as the MHT's
-  birth process, :class:`InitiatorBirth`): the tracker keeps a sliding window of the last
-  ``N = 4`` scans' plots, runs the P2 initiator on it every scan, and starts a tree only
-  for each initiated track that has a plot at the current scan and that no existing leaf
-  already follows.
+The tracker keeps a sliding window of the last ``N = 4`` scans' plots, runs the P2
+initiator on it every scan, and starts a tree only for each initiated track that has a plot
+at the current scan and that no existing leaf already follows.
 
 Window contents. The current scan enters with all its plots; once the scan's best global
 hypothesis is known, the plots used by the chosen leaves of *confirmed* tracks are removed
@@ -20,15 +16,8 @@ the third scan.
 Seeding. A new tree's leaf gets the initiator's least-squares state and covariance at the
 current scan (:func:`~mhtrack.initiation.window.least_squares_state`), and its window
 columns hold the initiated plots (row ids) at the scans the leaf window covers, so the
-global hypothesis sees the plots it used and no plot is used twice.
-
-Birth score. The log-likelihood ratio of the initiated plot sequence "target vs clutter"
-computed with the MHT's own scoring and Kalman machinery: the one-point birth score of its
-first plot, then, scan by scan, a constant-velocity prediction and ``ΔL = ln(1 − P_D)`` on
-a miss or ``ΔL = ln p(z|T) + ln P_D − ln(κ̂(z) + λ_v)`` on a plot (``κ̂`` as estimated
-when that plot's scan was processed), the Kalman update of the one-point initialisation
-(:func:`sequence_score`). It is the score an every-plot tree would give the same branch,
-so the SPRT thresholds keep their meaning; ``peak`` is the running maximum along it.
+global hypothesis sees the plots it used and no plot is used twice. Its score is the
+sequence's log-likelihood ratio (:func:`~mhtrack.mht.births.sequence.sequence_score`).
 
 Deduplication. An initiated track is dropped when an existing leaf (after this scan's
 growth) has, at every scan where the track has a plot and the leaf window reaches, that
@@ -39,135 +28,18 @@ Everything is stored in arrays (:meth:`InitiatorBirth.arrays`), saved with the t
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 
 from mhtrack.initiation import Initiator, make_initiator
 from mhtrack.initiation.window import Window
-from mhtrack.mht.config import BIRTHS
-from mhtrack.mht.scoring import birth_score, update_increment
-from mhtrack.mht.tree import one_point_state
-from mhtrack.models import imm, kalman
-from mhtrack.models.imm import CVModelSet
-from mhtrack.models.motion import ConstantVelocity
+from mhtrack.mht.births.base import Birth, BirthCandidates
+from mhtrack.mht.births.sequence import score_upper_bound, sequence_score
+from mhtrack.mht.pruning import cap_leaves_per_tree, score_drop_keep
+from mhtrack.models.motion import MotionModel
+from mhtrack.names import INITIATORS
 from mhtrack.records import Scan
 
 NO_PLOT = -1
-EVERY_PLOT = "every-plot"
-
-
-@dataclass(frozen=True, slots=True)
-class BirthCandidates:
-    """New trees proposed by a birth process (one row each): state ``x`` (n, 4), ``P``
-    (n, 4, 4) at the current scan, ``score`` and ``peak``, ``window`` (n, width) plot row
-    ids at scans ``k−N … k`` and ``n_updates`` (plots on the branch)."""
-
-    x: np.ndarray
-    P: np.ndarray
-    score: np.ndarray
-    peak: np.ndarray
-    window: np.ndarray
-    n_updates: np.ndarray
-
-    def __len__(self) -> int:
-        return int(self.score.shape[0])
-
-    def take(self, idx: np.ndarray) -> BirthCandidates:
-        return BirthCandidates(self.x[idx], self.P[idx], self.score[idx], self.peak[idx],
-                               self.window[idx], self.n_updates[idx])
-
-    @classmethod
-    def empty(cls, width: int) -> BirthCandidates:
-        f = np.zeros(0)
-        return cls(np.zeros((0, 4)), np.zeros((0, 4, 4)), f, f.copy(),
-                   np.zeros((0, width), np.int64), np.zeros(0, np.int64))
-
-
-def sequence_score(
-    times: np.ndarray,
-    z: np.ndarray,
-    R: np.ndarray,
-    has: np.ndarray,
-    kappa: np.ndarray,
-    *,
-    p_detection: float,
-    new_target_density: float,
-    miss_dl: float,
-    v_max: float,
-    sigma_v: float,
-    models: CVModelSet | None = None,
-) -> tuple[np.ndarray, np.ndarray]:
-    """Score ``L`` and running peak of plot sequences, as an every-plot tree would score
-    the branch (module docstring); with ``models``, by the IMM's mixture likelihood.
-
-    ``times`` (N,) scan times; per sequence and scan ``z`` (n, N, 2), ``R`` (n, N, 2, 2),
-    ``has`` (n, N) plot present, ``kappa`` (n, N) clutter intensity at the plot. Every
-    sequence needs at least one plot.
-    """
-    n, N = has.shape
-    # one filter loop for both motion models: the single CV model is kept as r = 1 model
-    # arrays, whose one-term mixture likelihood is its own likelihood
-    r = 1 if models is None else models.r
-    motion = ConstantVelocity(sigma_v)
-    xm, Pm, mu = np.zeros((n, r, 4)), np.zeros((n, r, 4, 4)), np.ones((n, r))
-    L, peak = np.zeros(n), np.full(n, -np.inf)
-    started = np.zeros(n, bool)
-    for s in range(N):
-        if s and started.any():
-            dt = float(times[s] - times[s - 1])
-            if models is None:
-                xm[started, 0], Pm[started, 0] = kalman.predict_cv(
-                    xm[started, 0], Pm[started, 0], dt, motion.Q(dt))
-            else:
-                xm[started], Pm[started], mu[started] = models.predict(
-                    xm[started], Pm[started], mu[started], dt)
-        h = has[:, s]
-        new = h & ~started
-        if new.any():
-            x0, P0 = one_point_state(z[new, s], R[new, s], v_max)
-            xm[new], Pm[new] = x0[:, None], P0[:, None]
-            if models is not None:
-                mu[new] = models.initial_mu(int(new.sum()))
-            L[new] = birth_score(kappa[new, s], p_detection, new_target_density)
-        upd = h & started
-        if upd.any():
-            zu, Ru = z[upd, s], R[upd, s]
-            ll = imm.model_logliks(xm[upd], Pm[upd], zu, Ru)
-            L[upd] += update_increment(imm.mixture_loglik(mu[upd], ll), kappa[upd, s],
-                                       p_detection, new_target_density)
-            if models is None:
-                xm[upd, 0], Pm[upd, 0] = kalman.update_position(xm[upd, 0], Pm[upd, 0], zu, Ru)
-            else:
-                xm[upd], Pm[upd], mu[upd] = imm.update(xm[upd], Pm[upd], mu[upd], zu, Ru)
-        L[started & ~h] += miss_dl
-        started |= new
-        peak = np.where(started, np.maximum(peak, L), peak)
-    return L, peak
-
-
-def score_upper_bound(
-    has: np.ndarray,
-    R: np.ndarray,
-    kappa: np.ndarray,
-    *,
-    p_detection: float,
-    new_target_density: float,
-    miss_dl: float,
-) -> np.ndarray:
-    """An upper bound of :func:`sequence_score` without any Kalman step: the innovation
-    covariance ``S = HPHᵀ + R`` has ``det S ≥ det R`` and ``d² ≥ 0`` (for each IMM model,
-    hence for their mixture), so an update adds at
-    most ``ln P_D − ln(κ̂ + λ_v) − ln 2π − ½ ln det R``. Sequences whose bound is below the
-    birth floor cannot pass it and are dropped before they are scored."""
-    n, N = has.shape
-    first = np.argmax(has, axis=1)
-    after = np.arange(N)[None, :] > first[:, None]
-    det = R[..., 0, 0] * R[..., 1, 1] - R[..., 0, 1] * R[..., 1, 0]
-    up = (np.log(p_detection) - np.log(kappa + new_target_density) - kalman.LOG_2PI
-          - 0.5 * np.log(det))
-    L0 = birth_score(kappa[np.arange(n), first], p_detection, new_target_density)
-    return L0 + np.where(after & has, up, 0.0).sum(axis=1) + miss_dl * (after & ~has).sum(axis=1)
 
 
 def followed_by(cand: np.ndarray, leaves: np.ndarray) -> np.ndarray:
@@ -193,37 +65,46 @@ def followed_by(cand: np.ndarray, leaves: np.ndarray) -> np.ndarray:
     return out
 
 
-class InitiatorBirth:
+class InitiatorBirth(Birth):
     """A P2 initiator over a sliding window of the last ``n_scans`` scans as the MHT's
     birth process (module docstring).
 
     Parameters
     ----------
     method : ``"logic"``, ``"modified-logic"``, ``"hough"`` or ``"modified-hough"``.
+    motion : the tracker's motion model (filter and plot likelihood of the score).
     theta_deg : angle limit of the modified methods (P2: 20°).
     width : columns of the leaf window (``n_scan + 1``).
-    p_detection, new_target_density, miss_dl, v_max, sigma_v, models : the tracker's
-        scoring and initialisation parameters (:func:`sequence_score`).
+    p_detection, new_target_density, miss_dl, v_max : the tracker's scoring and
+        initialisation parameters (:func:`~mhtrack.mht.births.sequence.sequence_score`).
     floor : initiated tracks scoring ``L ≤ floor`` are not born (the tracker passes its
         SPRT deletion threshold ``ln(β/(1−α))``: Wald's lower test on the sequence).
+    max_per_scan : most initiated tracks proposed per scan (highest scores, then
+        initiator order).
+    prune_drop, max_leaves_per_tree : a new tree's leaves are pruned as children are
+        (score drop within the tree, leaves per tree).
     n_scans, min_plots : window ``N`` and plots ``M`` (P2: 4, 3).
     """
 
-    def __init__(self, method: str, *, theta_deg: float, width: int, p_detection: float,
-                 new_target_density: float, miss_dl: float, v_max: float, sigma_v: float,
-                 floor: float, n_scans: int = 4, min_plots: int = 3,
-                 models: CVModelSet | None = None) -> None:
-        if method not in BIRTHS or method == EVERY_PLOT:
+    def __init__(self, method: str, motion: MotionModel, *, theta_deg: float, width: int,
+                 p_detection: float, new_target_density: float, miss_dl: float,
+                 v_max: float, floor: float, max_per_scan: int, prune_drop: float,
+                 max_leaves_per_tree: int, n_scans: int = 4, min_plots: int = 3) -> None:
+        if method not in INITIATORS:
             raise ValueError(f"unknown initiator birth {method!r}")
+        super().__init__(motion)
         self.method = method
         self.theta_deg = float(theta_deg)
         self.width = width
         self.n_scans = n_scans
         self.min_plots = min_plots
         self.floor = float(floor)
+        self.max_per_scan = max_per_scan
+        self.prune_drop = prune_drop
+        self.max_leaves_per_tree = max_leaves_per_tree
         self._score_params = dict(p_detection=p_detection,
                                   new_target_density=new_target_density, miss_dl=miss_dl,
-                                  v_max=v_max, sigma_v=sigma_v, models=models)
+                                  v_max=v_max, motion=motion)
         # the window: per scan index, time, plot count; per plot z, R, row id, κ̂
         self.scan_index = np.zeros(0, np.int64)
         self.scan_time = np.zeros(0)
@@ -284,7 +165,19 @@ class InitiatorBirth:
 
     # ------------------------------------------------------------------ births
     def propose(self, scan: Scan, z: np.ndarray, R: np.ndarray, rows: np.ndarray,
-                kappa: np.ndarray) -> BirthCandidates:
+                kappa: np.ndarray, in_gates: np.ndarray | None,
+                caps: dict[str, int]) -> BirthCandidates:
+        """The initiated tracks with a plot at this scan (:meth:`initiate`); over
+        ``max_per_scan``, the highest birth scores (then initiator order)."""
+        cand = self.initiate(scan, z, R, rows, kappa)
+        cap = self.max_per_scan
+        if len(cand) > cap:
+            caps["max_births_per_scan"] = len(cand) - cap
+            cand = cand.take(np.sort(np.argsort(-cand.score, kind="stable")[:cap]))
+        return cand
+
+    def initiate(self, scan: Scan, z: np.ndarray, R: np.ndarray, rows: np.ndarray,
+                 kappa: np.ndarray) -> BirthCandidates:
         """Add the scan to the window, run the initiator and return the initiated tracks
         that have a plot at this scan, seeded and scored (module docstring)."""
         self._push(int(scan.index), float(scan.time), z, R, rows, kappa)
@@ -325,11 +218,23 @@ class InitiatorBirth:
         window[:, self.width - k:] = rows_seq[:, m - k:]
         return BirthCandidates(x, P, score, peak, window, has.sum(axis=1).astype(np.int64))
 
-    def select(self, cand: BirthCandidates, leaf_window: np.ndarray
+    def select(self, cand: BirthCandidates, leaf_window: np.ndarray,
+               caps: dict[str, int]) -> tuple[BirthCandidates, np.ndarray]:
+        """Drop candidates already followed by a leaf and repeats of one leaf window, group
+        the rest by their plot at the current scan — one new tree per group (module
+        docstring) — and prune each group as children are (score drop, leaves per tree):
+        ``(candidates sorted by group, group index)``."""
+        cand, group = self._group(cand, leaf_window)
+        keep = score_drop_keep(group, cand.score, self.prune_drop)
+        cand, group = cand.take(keep), group[keep]
+        keep, cut = cap_leaves_per_tree(group, cand.score, self.max_leaves_per_tree)
+        if cut:
+            caps["max_leaves_per_tree"] = caps.get("max_leaves_per_tree", 0) + cut
+            cand, group = cand.take(keep), group[keep]
+        return cand, group
+
+    def _group(self, cand: BirthCandidates, leaf_window: np.ndarray
                ) -> tuple[BirthCandidates, np.ndarray]:
-        """Drop candidates already followed by a leaf and repeats of one leaf window, then
-        group the rest by their plot at the current scan: ``(candidates sorted by group,
-        group index 0…g−1)`` — one new tree per group (module docstring)."""
         if len(cand) == 0:
             return cand, np.zeros(0, np.int64)
         keep = ~followed_by(cand.window, leaf_window)

@@ -1,0 +1,97 @@
+"""The birth process of the MHT: which plots start new track trees, and how.
+
+A birth process is a part of the tracker, passed in like the motion model and the clutter
+estimator. Every scan the tracker calls
+
+1. :meth:`Birth.propose` after the clutter intensity is known: the candidate new trees'
+   first leaves (:class:`BirthCandidates`); their count is reserved in ``max_leaves``;
+2. :meth:`Birth.seed` once the existing leaves have grown: the new trees' leaves
+   (:meth:`Birth.select` may drop candidates that existing leaves already follow and group
+   the rest into trees);
+3. :meth:`Birth.forget_used` after the best global hypothesis, with the plots of the
+   confirmed tracks (optional hook, a no-op by default).
+
+A process that keeps state across scans saves it through :meth:`Birth.arrays` and
+:meth:`Birth.set_arrays` (optional hooks; by default it has none).
+"""
+
+from __future__ import annotations
+
+from abc import ABC, abstractmethod
+from dataclasses import dataclass
+
+import numpy as np
+
+from mhtrack.mht.numbering import Counter
+from mhtrack.mht.tree import Leaves, new_trees
+from mhtrack.models.motion import MotionModel
+from mhtrack.records import Scan
+
+
+@dataclass(frozen=True, slots=True)
+class BirthCandidates:
+    """New trees' first leaves proposed by a birth process (one row each): state ``x``
+    (n, 4), ``P`` (n, 4, 4) at the current scan, ``score`` and ``peak``, ``window``
+    (n, width) plot row ids at scans ``k−N … k`` and ``n_updates`` (plots on the branch)."""
+
+    x: np.ndarray
+    P: np.ndarray
+    score: np.ndarray
+    peak: np.ndarray
+    window: np.ndarray
+    n_updates: np.ndarray
+
+    def __len__(self) -> int:
+        return int(self.score.shape[0])
+
+    def take(self, idx: np.ndarray) -> BirthCandidates:
+        return BirthCandidates(self.x[idx], self.P[idx], self.score[idx], self.peak[idx],
+                               self.window[idx], self.n_updates[idx])
+
+    @classmethod
+    def empty(cls, width: int) -> BirthCandidates:
+        f = np.zeros(0)
+        return cls(np.zeros((0, 4)), np.zeros((0, 4, 4)), f, f.copy(),
+                   np.zeros((0, width), np.int64), np.zeros(0, np.int64))
+
+
+class Birth(ABC):
+    """A birth process (module docstring). ``motion`` gives new leaves their per-model
+    arrays (:meth:`~mhtrack.models.motion.MotionModel.new_states`)."""
+
+    def __init__(self, motion: MotionModel) -> None:
+        self.motion = motion
+
+    @abstractmethod
+    def propose(self, scan: Scan, z: np.ndarray, R: np.ndarray, rows: np.ndarray,
+                kappa: np.ndarray, in_gates: np.ndarray | None,
+                caps: dict[str, int]) -> BirthCandidates:
+        """Candidate new trees from the scan's plots ``z`` (n, 2), covariances ``R``
+        ((2, 2) or (n, 2, 2)), row ids ``rows``, clutter intensity ``kappa`` (n,) and the
+        plots in confirmed tracks' gates (``None``: no confirmed track). A cap that acts
+        adds its count to ``caps``."""
+
+    def select(self, cand: BirthCandidates, leaf_window: np.ndarray,
+               caps: dict[str, int]) -> tuple[BirthCandidates, np.ndarray]:
+        """Which candidates start trees, given the grown leaves' windows ``leaf_window``:
+        ``(candidates, tree index 0…g−1 of each, ascending)``. Default: all, one tree each."""
+        return cand, np.arange(len(cand), dtype=np.int64)
+
+    def seed(self, scan: Scan, cand: BirthCandidates, leaf_window: np.ndarray,
+             trees: Counter, caps: dict[str, int]) -> Leaves:
+        """The new trees' leaves: :meth:`select`, then consecutive tree ids from ``trees``."""
+        cand, group = self.select(cand, leaf_window, caps)
+        first = trees.take(int(group.max()) + 1 if len(cand) else 0)
+        return new_trees(self.motion.new_states(cand.x, cand.P), cand.score, cand.peak,
+                         first + group, int(scan.index), cand.n_updates, cand.window)
+
+    def forget_used(self, window: np.ndarray) -> None:  # noqa: B027 (optional hook)
+        """Optional hook: the leaf windows (m, width) of the confirmed tracks' chosen leaves
+        at this scan, whose plots are a target's. Default: nothing."""
+
+    def arrays(self) -> dict[str, np.ndarray]:
+        """State to save with the tracker (as ``birth__*`` arrays). Default: none."""
+        return {}
+
+    def set_arrays(self, arrays: dict[str, np.ndarray]) -> None:  # noqa: B027 (optional hook)
+        """Restore what :meth:`arrays` returned. Default: nothing."""

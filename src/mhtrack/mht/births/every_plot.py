@@ -1,0 +1,57 @@
+"""The ``every-plot`` birth process (P1 Fig. 1): every plot of the scan starts a tree."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from mhtrack.mht.births.base import Birth, BirthCandidates
+from mhtrack.mht.scoring import birth_score
+from mhtrack.mht.tree import NO_PLOT, one_point_state
+from mhtrack.models.motion import MotionModel
+from mhtrack.records import Scan
+
+
+class EveryPlotBirth(Birth):
+    """Every plot whose birth score ``ln(λ_v P_D / (κ̂ + λ_v))`` is above ``floor`` (the SPRT
+    deletion threshold: a tentative tree at or below it would be deleted at once,
+    :func:`~mhtrack.mht.sprt.tentative_keep`) starts a tree from its one-point state
+    (:func:`~mhtrack.mht.tree.one_point_state`). Over ``max_per_scan`` plots, those outside
+    confirmed tracks' gates go first, then those with the highest birth score (then scan
+    order).
+
+    Parameters
+    ----------
+    motion : the tracker's motion model.
+    p_detection, new_target_density : ``P_D`` and ``λ_v`` of the birth score.
+    floor : the lowest birth score that starts a tree.
+    v_max : largest target speed (the one-point velocity variance ``(v_max/2)²``).
+    width : columns of the leaf window (``n_scan + 1``).
+    max_per_scan : most trees started per scan.
+    """
+
+    def __init__(self, motion: MotionModel, *, p_detection: float, new_target_density: float,
+                 floor: float, v_max: float, width: int, max_per_scan: int) -> None:
+        super().__init__(motion)
+        self.p_detection = p_detection
+        self.new_target_density = new_target_density
+        self.floor = floor
+        self.v_max = v_max
+        self.width = width
+        self.max_per_scan = max_per_scan
+
+    def propose(self, scan: Scan, z: np.ndarray, R: np.ndarray, rows: np.ndarray,
+                kappa: np.ndarray, in_gates: np.ndarray | None,
+                caps: dict[str, int]) -> BirthCandidates:
+        score = birth_score(kappa, self.p_detection, self.new_target_density)
+        sel = np.flatnonzero(score > self.floor)
+        if sel.size > self.max_per_scan:
+            gated_first = np.zeros(len(z), bool) if in_gates is None else in_gates
+            order = sel[np.lexsort((-score[sel], gated_first[sel]))]
+            caps["max_births_per_scan"] = sel.size - self.max_per_scan
+            sel = np.sort(order[: self.max_per_scan])
+        n = sel.size
+        x, P = one_point_state(z[sel], R if R.ndim == 2 else R[sel], self.v_max)
+        window = np.full((n, self.width), NO_PLOT, np.int64)
+        window[:, -1] = rows[sel]
+        start = np.asarray(score[sel], float)
+        return BirthCandidates(x, P, start, start.copy(), window, np.ones(n, np.int64))

@@ -1,0 +1,195 @@
+"""Gating: which leaf–plot pairs are close enough to be a track's update (P1 §1.3).
+
+For a predicted leaf ``(x⁻, P⁻)`` and a plot ``z`` with covariance ``R``::
+
+    ν = z − H x⁻,   S = H P⁻ Hᵀ + R,   d² = νᵀ S⁻¹ ν  ≤  γ
+    ln p(z|T) = −½ d² − ½ ln det S − ln 2π        (innovation log-likelihood)
+
+``d²`` is χ² with 2 degrees of freedom, so ``γ = −2 ln(1 − P_G)`` holds a fraction ``P_G``
+of true plots (:func:`gate_threshold`). The pairs are found by a sweep over plot strips
+(:func:`gate_sweep`) without forming the M × N matrix; :class:`Gate` is the tracker's
+stage: the work budget ``max_gated_pairs`` and the motion model's likelihood for the score.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from mhtrack.mht.tree import Leaves
+from mhtrack.models.linalg2 import gaussian_loglik2, sym_mahalanobis2
+from mhtrack.models.motion import MotionModel, States
+
+
+def gate_threshold(probability: float) -> float:
+    """χ² gate ``γ`` with 2 degrees of freedom holding ``probability`` of true plots."""
+    if not 0.0 < probability < 1.0:
+        raise ValueError(f"gate probability must be in (0, 1), got {probability}")
+    # χ² with 2 d.o.f. is exponential with mean 2: P(d² ≤ γ) = 1 − exp(−γ/2), so the
+    # quantile is exact in closed form (and needs no scipy.stats at import time).
+    return -2.0 * math.log1p(-probability)
+
+
+@dataclass(frozen=True, slots=True)
+class Gated:
+    """Track–plot pairs inside the gate: ``track[i]`` with ``plot[i]``, their Mahalanobis
+    distance ``d2`` and log-likelihood ``loglik = ln p(z|T)``."""
+
+    track: np.ndarray
+    plot: np.ndarray
+    d2: np.ndarray
+    loglik: np.ndarray
+
+    def __len__(self) -> int:
+        return len(self.track)
+
+
+def plot_covariances(R: np.ndarray, n: int) -> tuple[np.ndarray, bool]:
+    """``(R, shared)``: one (2, 2) covariance for all ``n`` plots, or (n, 2, 2)."""
+    R = np.asarray(R, float)
+    if R.shape == (2, 2):
+        return R, True
+    if R.shape != (n, 2, 2):
+        raise ValueError(f"R must be (2, 2) or ({n}, 2, 2), got {R.shape}")
+    return R, False
+
+
+def _sweep_boxes(
+    x: np.ndarray, P: np.ndarray, z: np.ndarray, R: np.ndarray, shared: bool, gamma: float
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Candidate search of :func:`gate_sweep`: for each (track, strip) query, the range
+    ``lo:hi`` of the plots in ``order`` inside the track's gate box. Returns
+    ``(tq, lo, hi, order)``."""
+    M, N = len(x), len(z)
+    # box half-widths with the largest plot covariance (a superset; exact test later)
+    rxx = R[0, 0] if shared else R[:, 0, 0].max()
+    ryy = R[1, 1] if shared else R[:, 1, 1].max()
+    hx = np.sqrt(gamma * (P[:, 0, 0] + rxx)) * (1 + 1e-9) + 1e-9
+    hy = np.sqrt(gamma * (P[:, 2, 2] + ryy)) * (1 + 1e-9) + 1e-9
+    x0 = float(z[:, 0].min())
+    y0 = float(z[:, 1].min())
+    height = float(z[:, 1].max()) - y0 + 1.0  # keys of different strips never interleave
+    # strip width: the mean box width, but at most ~4·sqrt(N) strips
+    width = max(2 * float(hx.mean()), float(np.ptp(z[:, 0])) / (4 * np.sqrt(N) + 1), 1e-6)
+    col = np.floor((z[:, 0] - x0) / width).astype(np.int64)
+    order = np.lexsort((z[:, 1], col))
+    key = col[order] * height + (z[order, 1] - y0)
+    n_cols = int(col.max()) + 1
+    c_lo = np.clip(np.floor((x[:, 0] - hx - x0) / width).astype(np.int64), 0, n_cols)
+    c_hi = np.clip(np.floor((x[:, 0] + hx - x0) / width).astype(np.int64), -1, n_cols - 1)
+    nc = np.maximum(c_hi - c_lo + 1, 0)
+    tq = np.repeat(np.arange(M, dtype=np.int64), nc)
+    cq = np.repeat(c_lo - np.cumsum(nc) + nc, nc) + np.arange(int(nc.sum()))
+    ylo = np.clip(x[tq, 2] - hy[tq] - y0, -0.5, height - 0.5)
+    yhi = np.clip(x[tq, 2] + hy[tq] - y0, -0.5, height - 0.5)
+    lo = np.searchsorted(key, cq * height + ylo, side="left")
+    hi = np.searchsorted(key, cq * height + yhi, side="right")
+    return tq, lo, hi, order
+
+
+def gate_candidate_counts(
+    x: np.ndarray, P: np.ndarray, z: np.ndarray, R: np.ndarray, gamma: float
+) -> np.ndarray:
+    """Per track, how many plots :func:`gate_sweep` will test exactly (those in its gate's
+    bounding box) — an upper bound on its gated plots, found without forming any pair.
+    Lets a caller bound the work of gating before doing it."""
+    x = np.asarray(x, float).reshape(-1, 4)
+    z = np.asarray(z, float).reshape(-1, 2)
+    R, shared = plot_covariances(R, len(z))
+    if len(x) == 0 or len(z) == 0:
+        return np.zeros(len(x), np.int64)
+    tq, lo, hi, _ = _sweep_boxes(x, P, z, R, shared, gamma)
+    return np.bincount(tq, weights=hi - lo, minlength=len(x)).astype(np.int64)
+
+
+def gate_sweep(
+    x: np.ndarray, P: np.ndarray, z: np.ndarray, R: np.ndarray, gamma: float
+) -> Gated:
+    """Every track–plot pair with ``d² ≤ γ`` and its innovation log-likelihood, ordered by
+    track then plot; ``x`` (M, 4), ``P`` (M, 4, 4) predicted, ``z`` (N, 2), ``R`` (2, 2)
+    or (N, 2, 2).
+
+    The gate ellipse ``νᵀ S⁻¹ ν ≤ γ`` lies inside the box ``|νx| ≤ √(γ S_xx)``,
+    ``|νy| ≤ √(γ S_yy)``. Plots are bucketed into vertical strips and sorted by ``y``
+    within each; every track looks up, in each strip its box overlaps, the plots in its
+    ``y`` range with one vectorised ``searchsorted``. Work and memory are
+    O(M·strips-per-box + pairs in boxes), whatever M × N is.
+    """
+    x = np.asarray(x, float).reshape(-1, 4)
+    z = np.asarray(z, float).reshape(-1, 2)
+    M, N = len(x), len(z)
+    R, shared = plot_covariances(R, N)
+    e = np.zeros(0, np.int64)
+    if M == 0 or N == 0:
+        return Gated(e, e, np.zeros(0), np.zeros(0))
+    tq, lo, hi, order = _sweep_boxes(x, P, z, R, shared, gamma)
+    cnt = hi - lo
+    ti = np.repeat(tq, cnt)
+    pj = order[np.repeat(lo - np.cumsum(cnt) + cnt, cnt) + np.arange(int(cnt.sum()))]
+    if ti.size == 0:
+        return Gated(e, e, np.zeros(0), np.zeros(0))
+    if shared:
+        s00 = P[ti, 0, 0] + R[0, 0]
+        s01 = P[ti, 0, 2] + R[0, 1]
+        s11 = P[ti, 2, 2] + R[1, 1]
+    else:
+        s00 = P[ti, 0, 0] + R[pj, 0, 0]
+        s01 = P[ti, 0, 2] + R[pj, 0, 1]
+        s11 = P[ti, 2, 2] + R[pj, 1, 1]
+    n0 = z[pj, 0] - x[ti, 0]
+    n1 = z[pj, 1] - x[ti, 2]
+    d2, det = sym_mahalanobis2(n0, n1, s00, s01, s11)
+    keep = d2 <= gamma
+    ti, pj, d2, det = ti[keep], pj[keep], d2[keep], det[keep]
+    # pairs are grouped by track already; timsort on the nearly sorted key is ~linear
+    o = np.argsort(ti * N + pj, kind="stable")
+    ti, pj, d2, det = ti[o], pj[o], d2[o], det[o]
+    return Gated(ti, pj, d2, gaussian_loglik2(d2, det))
+
+
+class Gate:
+    """The gating stage: every predicted leaf against every plot, with bounded work.
+
+    When the leaves' gate boxes hold more than ``max_pairs`` candidate pairs (a clutter
+    burst), leaves of confirmed trees and then the best-scoring leaves are gated first
+    until the budget is spent; the others only get a miss child this scan (counted in
+    ``caps["max_gated_pairs"]``). The pairs' ``loglik`` is the motion model's
+    (:meth:`~mhtrack.models.motion.MotionModel.gating_loglik`: the IMM's mixture).
+    """
+
+    def __init__(self, probability: float, max_pairs: int) -> None:
+        self.gamma = gate_threshold(probability)
+        self.max_pairs = int(max_pairs)
+
+    def __call__(self, leaves: Leaves, pred: States, z: np.ndarray, R: np.ndarray,
+                 motion: MotionModel, caps: dict[str, int]) -> Gated:
+        g = self._pairs(leaves, pred.x, pred.P, z, R, caps)
+        return Gated(g.track, g.plot, g.d2,
+                     motion.gating_loglik(pred, g.track, g.plot, z, R, g.loglik))
+
+    def _pairs(self, leaves: Leaves, xp: np.ndarray, Pp: np.ndarray, z: np.ndarray,
+               R: np.ndarray, caps: dict[str, int]) -> Gated:
+        budget = self.max_pairs
+        if len(leaves) * len(z) <= budget:
+            return gate_sweep(xp, Pp, z, R, self.gamma)
+        counts = gate_candidate_counts(xp, Pp, z, R, self.gamma)
+        if counts.sum() <= budget:
+            return gate_sweep(xp, Pp, z, R, self.gamma)
+        order = np.lexsort((-leaves.score, leaves.track < 0))
+        sel = np.sort(order[np.cumsum(counts[order]) <= budget])
+        caps["max_gated_pairs"] = len(leaves) - sel.size
+        g = gate_sweep(xp[sel], Pp[sel], z, R, self.gamma)
+        return Gated(sel[g.track], g.plot, g.d2, g.loglik)
+
+
+def plots_in_confirmed_gates(leaves: Leaves, gated: Gated, n_plots: int) -> np.ndarray | None:
+    """Mask of plots inside the gate of a confirmed track reported at the last scan, or
+    ``None`` when there is none (the clutter estimator's ``in_track_gates``)."""
+    reported = leaves.chosen & (leaves.track >= 0)
+    if not reported.any():
+        return None
+    mask = np.zeros(n_plots, bool)
+    mask[gated.plot[reported[gated.track]]] = True
+    return mask

@@ -1,0 +1,70 @@
+"""The report stage: what one scan tells the user — the confirmed tracks of the best
+global hypothesis (:func:`report`) and the step's statistics (:class:`StepStats`)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from mhtrack.mht.hypothesis import GlobalHypothesis
+from mhtrack.mht.tree import Leaves
+from mhtrack.records import Scan, TrackTable
+
+
+@dataclass(frozen=True)
+class StepStats:
+    """What one :meth:`~mhtrack.mht.tracker.MHTTracker.step` did.
+
+    ``caps`` maps each hard cap that acted to how many leaves (``max_leaves_per_tree``,
+    ``max_leaves``), trees (``max_trees``), plots or initiated tracks
+    (``max_births_per_scan``) or clusters (``max_cluster_size``) it cut; empty when none
+    acted. ``n_births`` counts the trees started at this scan.
+    """
+
+    scan: int
+    n_plots: int
+    n_leaves: int
+    n_trees: int
+    n_clusters: int
+    largest_cluster: int
+    n_confirmed: int
+    time_s: float
+    caps: dict[str, int] = field(default_factory=dict)
+    n_births: int = 0
+
+    @classmethod
+    def of(cls, scan: Scan, n_plots: int, leaves: Leaves, births: Leaves,
+           hyp: GlobalHypothesis, out: TrackTable, time_s: float,
+           caps: dict[str, int]) -> StepStats:
+        return cls(scan=int(scan.index), n_plots=n_plots, n_leaves=len(leaves),
+                   n_trees=leaves.n_trees, n_clusters=hyp.n_clusters,
+                   largest_cluster=hyp.largest_cluster, n_confirmed=len(out), time_s=time_s,
+                   caps=caps, n_births=int(np.unique(births.tree).size))
+
+
+def confirmed_windows(leaves: Leaves) -> np.ndarray:
+    """Leaf windows (m, N+1) of the confirmed tracks in the best hypothesis: the plots
+    they used at scans ``k−N … k``."""
+    return leaves.window[leaves.chosen & (leaves.track >= 0)]
+
+
+def report(scan: Scan, leaves: Leaves) -> TrackTable:
+    """Confirmed tracks of the best hypothesis at ``scan``, ordered by track id."""
+    sel = np.flatnonzero(leaves.chosen & (leaves.track >= 0))
+    sel = sel[np.argsort(leaves.track[sel], kind="stable")]
+    x = leaves.x[sel]
+    n = sel.size
+    return TrackTable(
+        scan=np.full(n, int(scan.index), np.int64),
+        time=np.full(n, float(scan.time)),
+        track_id=leaves.track[sel],
+        x=x[:, 0].copy(),
+        y=x[:, 2].copy(),
+        vx=x[:, 1].copy(),
+        vy=x[:, 3].copy(),
+        plot=leaves.window[sel, -1].copy(),
+        score=leaves.score[sel].copy(),
+        P=leaves.P[sel].copy(),
+        tentative=np.zeros(n, bool),
+    )

@@ -1,0 +1,63 @@
+"""The scan check at the library boundary: every plot the tracker takes is finite, inside
+the frame, with a unique row id and a valid covariance, and scans come in time order."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from mhtrack.models.linalg2 import det2
+from mhtrack.records import MAX_COORDINATE, Scan
+
+
+def validate_scan(
+    scan: Scan, default_R: np.ndarray, last_time: float | None, last_index: int | None
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(z, R, rows)`` of ``scan``: positions (n, 2), covariances — ``default_R`` (2, 2)
+    when the scan has none, else (n, 2, 2) with unset (all-NaN) ones replaced by it — and
+    row ids (n,). Raises ``ValueError`` saying what is wrong and where."""
+    z = np.asarray(scan.z, dtype=float).reshape(-1, 2)
+    n = len(z)
+    rows = np.asarray(scan.rows, dtype=np.int64).reshape(-1)
+    if rows.size != n:
+        raise ValueError(f"scan {scan.index}: {rows.size} row ids for {n} plots")
+    if not np.isfinite(scan.time):
+        raise ValueError(f"scan {scan.index}: time {scan.time} is not finite")
+    if last_time is not None and not scan.time > last_time:
+        raise ValueError(
+            f"scan {scan.index}: time {scan.time} s is not after the previous scan "
+            f"({last_index}, {last_time} s); dt must be > 0"
+        )
+    bad = ~np.isfinite(z).all(axis=1)
+    if bad.any():
+        i = int(np.flatnonzero(bad)[0])
+        raise ValueError(
+            f"scan {scan.index}: plot row {int(rows[i])} has a non-finite position "
+            f"{z[i].tolist()}"
+        )
+    far = np.abs(z).max(axis=1) > MAX_COORDINATE if n else np.zeros(0, bool)
+    if far.any():
+        i = int(np.flatnonzero(far)[0])
+        raise ValueError(
+            f"scan {scan.index}: plot row {int(rows[i])} lies at {z[i].tolist()} m, "
+            f"beyond ±{MAX_COORDINATE:g} m of the frame's origin (a unit or parsing "
+            "error?)"
+        )
+    if n > 1 and np.unique(rows).size != n:
+        raise ValueError(f"scan {scan.index}: plot row ids are not unique")
+    if scan.R is None:
+        return z, default_R, rows
+    R = np.asarray(scan.R, dtype=float)
+    if R.shape != (n, 2, 2):
+        raise ValueError(f"scan {scan.index}: R has shape {R.shape}, expected ({n}, 2, 2)")
+    unset = np.isnan(R).all(axis=(1, 2))  # PlotTable.from_scans: "use the tracker's R"
+    if unset.any():
+        R = R.copy()
+        R[unset] = default_R
+    bad = ~(np.isfinite(R).all(axis=(1, 2)) & (R[:, 0, 0] > 0) & (det2(R) > 0))
+    if bad.any():
+        i = int(np.flatnonzero(bad)[0])
+        raise ValueError(
+            f"scan {scan.index}: plot row {int(rows[i])} has an invalid covariance "
+            f"{R[i].tolist()}"
+        )
+    return z, R, rows

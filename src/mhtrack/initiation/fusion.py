@@ -31,7 +31,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from mhtrack.initiation.kmeans import (
-    _lmax,
     _means,
     adaptive_initial_centres,
     dissimilarity_threshold,
@@ -40,6 +39,7 @@ from mhtrack.initiation.kmeans import (
     merge_compatible_clusters,
     sorted_distances,
 )
+from mhtrack.models.linalg2 import lmax2
 from mhtrack.records import CLUTTER, Scan
 
 #: ``Scan.sensor`` value of a fused plot made of two or more radars' plots.
@@ -293,7 +293,7 @@ class AdaptiveKMeansFusion(_Fusion):
             # two plots of one target differ by N(0, R_i + R_j): farther than
             # sqrt(γ·2·max λmax(R)) fails the gate whatever their direction
             cap = None if Ra is None or gamma is None or not len(za) else float(
-                np.sqrt(gamma * 2.0 * _lmax(Ra).max()))
+                np.sqrt(gamma * 2.0 * lmax2(Ra).max()))
         elif cap is not None and not (isinstance(cap, int | float) and cap > 0):
             raise ValueError(f"max_threshold must be > 0, 'auto' or None, got {cap!r}")
         self.threshold_cap_ = cap

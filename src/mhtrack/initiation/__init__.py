@@ -1,10 +1,13 @@
 """Multi-radar plot fusion and track initiation (P2; ``docs/initiation.md``).
 
+* :mod:`~mhtrack.initiation.base` — the parts' interfaces: :class:`Fuser` (``fit`` →
+  ``fuse(scan)``) and :class:`Initiator` (``find_tracks`` → the one ``initiate(window)``);
 * :mod:`~mhtrack.initiation.kmeans` — the clustering: standard K-means (P2 §1.1), the
   adaptive initial centres (P2 §1.2), the one-plot-per-radar repair, the merge;
-* :mod:`~mhtrack.initiation.fusion` — plot fusion: :class:`AdaptiveKMeansFusion` (P2 §1.2)
-  and :class:`KMeansFusion` (random initial centres, P2 §1.1); each ``fuse(scan)`` returns
-  a :class:`FusedScan` (one fused plot per cluster);
+* :mod:`~mhtrack.initiation.fused` — the fused output: :class:`FusedScan` (one fused plot
+  per cluster), :func:`fuse_clusters`, :func:`majority_origin`;
+* :mod:`~mhtrack.initiation.fusion` — the fusers :class:`AdaptiveKMeansFusion` (P2 §1.2)
+  and :class:`KMeansFusion` (random initial centres, P2 §1.1);
 * :mod:`~mhtrack.initiation.window` — sliding windows of ``N`` scans, the
   :class:`InitiatedTracks` record, least-squares initial states;
 * :mod:`~mhtrack.initiation.logic` — :class:`LogicInitiator` (3/4 logic, and the modified
@@ -18,15 +21,9 @@ from __future__ import annotations
 
 from typing import Any
 
-from mhtrack.initiation.fusion import (
-    FUSED,
-    AdaptiveKMeansFusion,
-    FusedScan,
-    KMeansFusion,
-    fuse_clusters,
-    majority_origin,
-    split_inconsistent,
-)
+from mhtrack.initiation.base import Fuser, Initiator
+from mhtrack.initiation.fused import FUSED, FusedScan, fuse_clusters, majority_origin
+from mhtrack.initiation.fusion import AdaptiveKMeansFusion, KMeansFusion, split_inconsistent
 from mhtrack.initiation.hough import HoughInitiator
 from mhtrack.initiation.kmeans import (
     adaptive_initial_centres,
@@ -50,8 +47,6 @@ INITIATORS: tuple[str, ...] = ("logic", "modified-logic", "hough", "modified-hou
 #: Fusion methods by CLI name.
 FUSIONS: tuple[str, ...] = ("adaptive-kmeans", "kmeans", "none")
 
-Initiator = LogicInitiator | HoughInitiator
-
 
 def make_initiator(method: str, *, theta_deg: float = 20.0, **params: Any) -> Initiator:
     """The initiator named ``method`` (:data:`INITIATORS`); ``theta_deg`` is P2's angle
@@ -74,6 +69,7 @@ __all__ = [
     "INITIATORS",
     "AdaptiveKMeansFusion",
     "FusedScan",
+    "Fuser",
     "HoughInitiator",
     "InitiatedTracks",
     "Initiator",

@@ -21,7 +21,7 @@ import numpy as np
 import tomli_w
 
 from mhtrack.errors import InputError
-from mhtrack.io._tabular import PathArg
+from mhtrack.io._source import PathArg
 
 _AT = re.compile(r"\s*\(at line (\d+), column (\d+)\)\s*$")
 #: A message that starts with a key path: ``T: …``, ``targets[2].birth: …``.

@@ -8,6 +8,7 @@ problem is, in the form::
     plots.parquet, row 15 (0-based), column 'x': value 'nan' is not finite
     plots.csv: missing required column(s) 'y'
     scenario.toml, line 3, column 9: Expected '=' after a key in a key/value pair
+    scenario.toml: targets[2].birth: must be <= death (50 > 40)
 
 CSV line numbers are those a text editor shows (the header is line 1); Parquet rows are
 0-based, the same indices that the ``plot`` column of a tracks file uses. The CLI catches
@@ -37,6 +38,7 @@ class InputError(ValueError):
     line : 1-based CSV line, or TOML line (``None`` when not about one line).
     row : 0-based data-row index (CSV and Parquet), when about one row.
     column : the CSV/Parquet column name, when about one column.
+    key : the key path in a TOML file (``targets[2].birth``), when about one key.
     """
 
     def __init__(
@@ -47,9 +49,11 @@ class InputError(ValueError):
         line: int | None = None,
         row: int | None = None,
         column: str | None = None,
+        key: str | None = None,
     ) -> None:
         super().__init__(message)
         self.file = file
         self.line = line
         self.row = row
         self.column = column
+        self.key = key

@@ -392,7 +392,7 @@ def test_toml_unterminated_and_missing_and_bad_utf8(tmp_path: Path) -> None:
     path.write_bytes(b'a = 1\nb = "\xff"\n')
     with pytest.raises(InputError) as info:
         read_toml(path)
-    assert str(info.value) == f"{path}, line 2: not valid UTF-8 text"
+    assert str(info.value) == f"{path}, line 2: not valid UTF-8 text (byte 0xff)"
 
 
 def test_toml_none_is_refused(tmp_path: Path) -> None:

@@ -10,6 +10,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
+from mhtrack.errors import InputError
 from mhtrack.models.clutter import (
     GaussianMixtureClutter,
     Region,
@@ -315,22 +316,34 @@ def test_validation_errors_name_the_key_path(path, value, message):
 def test_load_scenario_errors_name_the_file(tmp_path):
     f = tmp_path / "bad.toml"
     f.write_text('T = "x"\n')
-    with pytest.raises(ValueError, match=r"bad\.toml: clutter: missing"):
+    with pytest.raises(InputError, match=r"bad\.toml: clutter: missing") as info:
         load_scenario(f)
+    assert (info.value.file, info.value.key) == (str(f), "clutter")
+    text = EXAMPLE.read_text()
+    assert "\nT = 1.0\n" in text
+    f.write_text(text.replace("\nT = 1.0\n", "\nT = -1.0\n"))
+    with pytest.raises(InputError) as info:
+        load_scenario(f)
+    assert str(info.value).startswith(f"{f}: T: ") and info.value.key == "T"
     f.write_text("T = = 1\n")
-    with pytest.raises(ValueError, match=r"bad\.toml: not valid TOML"):
+    with pytest.raises(InputError) as info:
         load_scenario(f)
+    assert str(info.value) == f"{f}, line 1, column 5: Invalid value"
+    assert info.value.line == 1
+    with pytest.raises(InputError) as info:
+        load_scenario(tmp_path / "none.toml")
+    assert str(info.value) == f"{tmp_path / 'none.toml'}: no such file"
 
 
 def test_load_scenario_bad_utf8_names_the_file_and_bom_is_accepted(tmp_path):
     text = EXAMPLE.read_bytes()
     f = tmp_path / "latin1.toml"
     f.write_bytes(text.replace(b'name = "drifting-clutter"', b'name = "caf\xe9"'))
-    msg = r"latin1\.toml: not valid UTF-8 text \(byte 0xe9 on line 6\)"
-    with pytest.raises(ValueError, match=msg):
+    with pytest.raises(InputError) as info:
         load_scenario(f)
+    assert str(info.value) == f"{f}, line 6: not valid UTF-8 text (byte 0xe9)"
     f.write_bytes(bytes(range(256)))
-    with pytest.raises(ValueError, match=r"latin1\.toml: not valid UTF-8 text"):
+    with pytest.raises(InputError, match=r"latin1\.toml, line 2: not valid UTF-8 text "):
         load_scenario(f)
     bom = tmp_path / "bom.toml"
     bom.write_bytes(b"\xef\xbb\xbf" + text)

@@ -30,8 +30,7 @@ _gaussian_mixture.py``), with optional sample weights ``s_i``:
 objective of P1 eq. 7, which EM never decreases — rather than P1's ``Q`` (eq. 10): at the
 E-step they differ by the entropy of the responsibilities, and ``L`` is what scikit-learn
 monitors (and returns from ``score``), so the two codes can be checked against each other.
-
-All arithmetic is closed-form 2×2 (determinant, inverse) on whole ``(n, K)`` arrays.
+All 2×2 arithmetic is closed-form (:mod:`mhtrack.models.linalg2`) on whole ``(n, K)`` arrays.
 """
 
 from __future__ import annotations
@@ -41,7 +40,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-LOG_2PI = float(np.log(2.0 * np.pi))
+from mhtrack.models.linalg2 import LOG_2PI, det2, sym_det2, sym_mahalanobis2
+
 _EPS10 = 10.0 * np.finfo(float).eps  # sklearn adds this to n_j so that no n_j is 0
 
 #: A pruning rule: normalised Gaussian weights (K,) → mask of the components to keep.
@@ -111,18 +111,14 @@ class Mixture:
         if len(z) * max(self.n_components, 1) <= 65_536:
             return np.exp(self.log_pdf(z))
         out = self.background_weight * np.exp(self.log_background(z))
-        a, b, c = (self.covariances[:, 0, 0], self.covariances[:, 0, 1],
-                   self.covariances[:, 1, 1])
-        det = a * c - b * b
-        norm = self.weights / (2.0 * np.pi * np.sqrt(det))
+        a, b, c = self.covariances[:, 0, 0], self.covariances[:, 0, 1], self.covariances[:, 1, 1]
+        norm = self.weights / (2.0 * np.pi * np.sqrt(sym_det2(a, b, c)))
         r = np.sqrt(1490.0)
         for j in range(self.n_components):
-            dx = z[:, 0] - self.means[j, 0]
-            dy = z[:, 1] - self.means[j, 1]
+            dx, dy = z[:, 0] - self.means[j, 0], z[:, 1] - self.means[j, 1]
             sel = np.flatnonzero((np.abs(dx) <= r * np.sqrt(a[j]))
                                  & (np.abs(dy) <= r * np.sqrt(c[j])))
-            x, y = dx[sel], dy[sel]
-            q = (c[j] * x * x - 2.0 * b[j] * x * y + a[j] * y * y) / det[j]
+            q, _ = sym_mahalanobis2(dx[sel], dy[sel], a[j], b[j], c[j])
             out[sel] += norm[j] * np.exp(-0.5 * q)
         return out
 
@@ -177,24 +173,21 @@ def logsumexp_rows(a: np.ndarray) -> np.ndarray:
 
 
 def gaussian_log_pdf(z: np.ndarray, means: np.ndarray, covariances: np.ndarray) -> np.ndarray:
-    """(n, K) ``log N(z_i; μ_j, Σ_j)`` in closed form for 2×2 covariances:
-    ``−log 2π − ½ log|Σ| − ½ dᵀΣ⁻¹d`` with ``Σ⁻¹ = [[c, −b], [−b, a]] / (ac − b²)``."""
-    a = covariances[:, 0, 0]
-    b = covariances[:, 0, 1]
-    c = covariances[:, 1, 1]
-    det = a * c - b * b
-    dx = z[:, 0:1] - means[:, 0]
-    dy = z[:, 1:2] - means[:, 1]
-    maha = (c * dx * dx - 2.0 * b * dx * dy + a * dy * dy) / det
+    """(n, K) ``log N(z_i; μ_j, Σ_j) = −log 2π − ½ log|Σ| − ½ dᵀΣ⁻¹d`` (this sum order, not
+    :func:`~mhtrack.models.linalg2.gaussian_loglik2`'s, which rounds differently)."""
+    maha, det = _maha_det(z, means, covariances)
     return -LOG_2PI - 0.5 * np.log(det) - 0.5 * maha
 
 
 def mahalanobis2(z: np.ndarray, means: np.ndarray, covariances: np.ndarray) -> np.ndarray:
-    """(n, K) squared Mahalanobis distances ``dᵀΣ_j⁻¹d``."""
-    a, b, c = covariances[:, 0, 0], covariances[:, 0, 1], covariances[:, 1, 1]
-    dx = z[:, 0:1] - means[:, 0]
-    dy = z[:, 1:2] - means[:, 1]
-    return (c * dx * dx - 2.0 * b * dx * dy + a * dy * dy) / (a * c - b * b)
+    """(n, K) squared Mahalanobis distances ``dᵀΣ_j⁻¹d`` of every plot to every component."""
+    return _maha_det(z, means, covariances)[0]
+
+
+def _maha_det(z: np.ndarray, means: np.ndarray, cov: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(n, K) ``dᵀΣ_j⁻¹d`` and (K,) ``|Σ_j|`` (``linalg2.sym_mahalanobis2``)."""
+    return sym_mahalanobis2(z[:, 0:1] - means[:, 0], z[:, 1:2] - means[:, 1],
+                            cov[:, 0, 0], cov[:, 0, 1], cov[:, 1, 1])
 
 
 def e_step(
@@ -305,9 +298,7 @@ def fit_em(
                          reg_covar=reg_covar, background_floor=background_floor)
         keep = nk >= min_points
         if min_contrast > 0 and mix.background_box is not None:
-            c = mix.covariances
-            det = c[:, 0, 0] * c[:, 1, 1] - c[:, 0, 1] * c[:, 1, 0]
-            peak = mix.weights / (2.0 * np.pi * np.sqrt(det))
+            peak = mix.weights / (2.0 * np.pi * np.sqrt(det2(mix.covariances)))
             keep &= peak >= min_contrast * mix.background_weight / mix.background_area
         if bic and mix.background_box is not None and mix.n_components:
             n_eff = float(len(z) if sample_weight is None else sample_weight.sum())

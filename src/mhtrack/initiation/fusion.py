@@ -1,10 +1,11 @@
-"""Multi-radar plot fusion (P2 §1): fused plots and the K-means fusion estimators.
+"""Multi-radar plot fusion (P2 §1): the K-means fusers.
 
 At one scan the plots of ``N_s`` radars lie in tight blobs round the targets (P2 §1). The
 clustering (:mod:`mhtrack.initiation.kmeans`) groups them, one cluster per target, and
-each cluster becomes one *fused plot*; this module turns a scan into its fused scan.
+each cluster becomes one *fused plot* (:mod:`mhtrack.initiation.fused`).
 
-Estimators (scikit-learn style ``fit``; ``fuse(scan)`` returns a :class:`FusedScan`):
+Fusers (:class:`~mhtrack.initiation.base.Fuser`: scikit-learn style ``fit``;
+``fuse(scan)`` returns a :class:`~mhtrack.initiation.fused.FusedScan`):
 
 * :class:`AdaptiveKMeansFusion` (P2 §1.2): adaptive initial centres, standard K-means,
   the one-plot-per-radar repair, then the merge of compatible clusters (ours); its
@@ -14,24 +15,23 @@ Estimators (scikit-learn style ``fit``; ``fuse(scan)`` returns a :class:`FusedSc
   plots (seeded), standard K-means, and the same one-plot-per-radar repair with ``ε(k)``
   of its own ``k``, but no merge.
 
-Fused plot: the cluster centre ``z̄ = (1/n) Σ z_i`` with ``R̄ = (1/n²) Σ R_i`` (the
-covariance of a mean of independent plots) — P2's choice — or, with
-``weighting="information"``, ``P = (Σ R_i⁻¹)⁻¹``, ``z = P Σ R_i⁻¹ z_i``. A cluster of one
-plot is that plot, unchanged. Origin of a fused plot (simulations): the target id with the
-most plots in the cluster (ties: the lower id) unless clutter plots are strictly more
-numerous, then ``−1`` (clutter-dominated).
+Cluster consistency (ours, optional): :func:`split_inconsistent`.
 """
 
 from __future__ import annotations
 
-import abc
 from collections.abc import Sequence
-from dataclasses import dataclass
 
 import numpy as np
 
+from mhtrack.initiation.base import Fuser
+from mhtrack.initiation.fused import (
+    WEIGHTINGS,
+    # TEMPORARY, for the merge: initiation/runs.py (helper "runner" moves it) imports
+    # FusedScan from here; drop it once runs.py imports it from mhtrack.initiation.
+    FusedScan,  # noqa: F401
+)
 from mhtrack.initiation.kmeans import (
-    _lmax,
     _means,
     adaptive_initial_centres,
     dissimilarity_threshold,
@@ -40,79 +40,7 @@ from mhtrack.initiation.kmeans import (
     merge_compatible_clusters,
     sorted_distances,
 )
-from mhtrack.records import CLUTTER, Scan
-
-#: ``Scan.sensor`` value of a fused plot made of two or more radars' plots.
-FUSED = -1
-WEIGHTINGS = ("mean", "information")
-
-
-# ---------------------------------------------------------------------- fused output
-def fuse_clusters(
-    z: np.ndarray,
-    labels: np.ndarray,
-    R: np.ndarray | None = None,
-    *,
-    weighting: str = "mean",
-) -> tuple[np.ndarray, np.ndarray | None]:
-    """One fused plot per cluster ``0..k−1`` and its covariance.
-
-    ``"mean"`` (P2): ``z̄ = (1/n) Σ z_i``, ``R̄ = (1/n²) Σ R_i``. ``"information"``:
-    ``P = (Σ R_i⁻¹)⁻¹``, ``z = P Σ R_i⁻¹ z_i``. A one-plot cluster gives that plot and its
-    ``R`` exactly in both cases. Without ``R`` the plots count as equally accurate, where
-    both weightings give the plain centre (and no covariance).
-    """
-    if weighting not in WEIGHTINGS:
-        raise ValueError(f"weighting must be one of {WEIGHTINGS}, got {weighting!r}")
-    z = np.asarray(z, float).reshape(-1, 2)
-    labels = np.asarray(labels, np.int64)
-    k = int(labels.max()) + 1 if len(labels) else 0
-    zc, n = _means(z, labels, k)
-    if R is None:
-        return zc, None
-    R = np.asarray(R, float).reshape(-1, 2, 2)
-    if weighting == "mean":
-        Rs = np.zeros((k, 2, 2))
-        np.add.at(Rs, labels, R)
-        Rc = Rs / (n**2)[:, None, None]
-    else:
-        W = np.linalg.inv(R)
-        Wsum = np.zeros((k, 2, 2))
-        np.add.at(Wsum, labels, W)
-        wz = np.zeros((k, 2))
-        np.add.at(wz, labels, np.einsum("nij,nj->ni", W, z))
-        Rc = np.linalg.inv(Wsum)
-        zc = np.einsum("kij,kj->ki", Rc, wz)
-    single = n == 1
-    if single.any():  # exactly the plot: no rounding from inverting twice
-        first = np.full(k, -1, np.int64)
-        first[labels[::-1]] = np.arange(len(labels))[::-1]
-        zc[single] = z[first[single]]
-        Rc[single] = R[first[single]]
-    return zc, 0.5 * (Rc + np.swapaxes(Rc, 1, 2))
-
-
-def majority_origin(origin: np.ndarray, labels: np.ndarray, k: int) -> np.ndarray:
-    """Origin of each fused plot: the target id with the most plots in the cluster (ties:
-    the lower id), or ``−1`` when its clutter plots are strictly more numerous."""
-    origin = np.asarray(origin, np.int64)
-    out = np.full(k, CLUTTER, np.int64)
-    if len(origin) == 0:
-        return out
-    n_clutter = np.bincount(labels[origin < 0], minlength=k)
-    t = origin >= 0
-    if t.any():
-        pairs, counts = np.unique(
-            np.column_stack((labels[t], origin[t])), axis=0, return_counts=True
-        )
-        # per label: max count, ties to the lower id → sort by (label, −count, id)
-        o = np.lexsort((pairs[:, 1], -counts, pairs[:, 0]))
-        pairs, counts = pairs[o], counts[o]
-        first = np.r_[True, pairs[1:, 0] != pairs[:-1, 0]]
-        lab, oid, cnt = pairs[first, 0], pairs[first, 1], counts[first]
-        win = cnt >= n_clutter[lab]
-        out[lab[win]] = oid[win]
-    return out
+from mhtrack.models.linalg2 import lmax2
 
 
 def split_inconsistent(
@@ -121,7 +49,7 @@ def split_inconsistent(
     """Labels with every cluster made statistically consistent (ours).
 
     The plots of one point, independent with covariances ``R_i``, scatter round its
-    information-weighted estimate ``ẑ`` (:func:`fuse_clusters`) so that
+    information-weighted estimate ``ẑ`` (:func:`~mhtrack.initiation.fused.fuse_clusters`) so that
     ``T = Σ (z_i − ẑ)ᵀ R_i⁻¹ (z_i − ẑ)`` is χ² with ``2(n − 1)`` degrees of freedom
     (the residual sum of a weighted least-squares fit; Bar-Shalom, Willett & Tian 2011,
     multisensor measurement association). While ``T`` exceeds its ``probability``
@@ -159,36 +87,12 @@ def split_inconsistent(
     return labels
 
 
-# ---------------------------------------------------------------------- estimators
-@dataclass(frozen=True, slots=True)
-class FusedScan:
-    """Result of fusing one scan.
+class _KMeansFuser(Fuser):
+    """What the two K-means fusers share: the parameter and plot checks, and the end of
+    :meth:`fit` (one-plot-per-radar repair, optional merge, the fitted attributes)."""
 
-    ``scan`` holds one plot per cluster: ``z`` the fused position, ``R`` its covariance,
-    ``sensor`` the radar id for a one-plot cluster or :data:`FUSED` (−1), ``rows`` the
-    index of the fused plot in this scan (``0..k−1``; the input plots are mapped by
-    ``labels``), ``origin`` the majority origin (:func:`majority_origin`) when known.
-    ``labels[i]`` is the cluster of input plot ``i``; ``threshold`` the final ``ε``.
-    """
-
-    scan: Scan
-    labels: np.ndarray
-    threshold: float
-
-    @property
-    def n_clusters(self) -> int:
-        return len(self.scan)
-
-
-class _Fusion(abc.ABC):
-    """Shared ``fit`` output handling and :meth:`fuse` (scikit-learn style); subclasses
-    implement :meth:`fit`."""
-
-    weighting: str
     max_iter: int
     cluster_centers_: np.ndarray
-    labels_: np.ndarray
-    threshold_: float
     n_iter_: int
 
     def _check(self, z: object, sensor: object) -> tuple[np.ndarray, np.ndarray]:
@@ -196,17 +100,7 @@ class _Fusion(abc.ABC):
             raise ValueError(f"weighting must be one of {WEIGHTINGS}, got {self.weighting!r}")
         if not (isinstance(self.max_iter, int) and self.max_iter >= 1):
             raise ValueError(f"max_iter must be an integer >= 1, got {self.max_iter!r}")
-        za = np.asarray(z, float)
-        if za.size == 0:
-            za = za.reshape(0, 2)
-        if za.ndim != 2 or za.shape[1] != 2:
-            raise ValueError(f"plots must have shape (n, 2), got {za.shape}")
-        if not np.isfinite(za).all():
-            raise ValueError("plots contain non-finite coordinates")
-        s = np.zeros(len(za), np.int64) if sensor is None else np.asarray(sensor).reshape(-1)
-        if len(s) != len(za):
-            raise ValueError(f"sensor has {len(s)} entries for {len(za)} plots")
-        return za, s
+        return self.check_plots(z, sensor)
 
     def _finish(self, z: np.ndarray, sensor: np.ndarray, labels: np.ndarray, eps: float,
                 n_iter: int, adaptive: bool, R: np.ndarray | None = None,
@@ -225,27 +119,8 @@ class _Fusion(abc.ABC):
     def n_clusters_(self) -> int:
         return len(self.cluster_centers_)
 
-    @abc.abstractmethod
-    def fit(self, z: np.ndarray, sensor: np.ndarray | None = None,
-            R: np.ndarray | None = None) -> _Fusion:
-        """Cluster plots ``z`` (n, 2) of radars ``sensor`` with covariances ``R``."""
 
-    def fuse(self, scan: Scan) -> FusedScan:
-        """Cluster ``scan``'s plots and return the fused scan (see :class:`FusedScan`)."""
-        self.fit(scan.z, scan.sensor, scan.R)
-        labels = self.labels_
-        k = self.n_clusters_
-        z, R = fuse_clusters(scan.z, labels, scan.R, weighting=self.weighting)
-        n = np.bincount(labels, minlength=k)
-        sensor = np.full(k, FUSED, np.int64)
-        single = n == 1
-        sensor[labels[single[labels]]] = scan.sensor[single[labels]]
-        origin = None if scan.origin is None else majority_origin(scan.origin, labels, k)
-        fused = Scan(scan.index, scan.time, z, sensor, np.arange(k, dtype=np.int64), R, origin)
-        return FusedScan(fused, labels, self.threshold_)
-
-
-class AdaptiveKMeansFusion(_Fusion):
+class AdaptiveKMeansFusion(_KMeansFuser):
     """P2 §1.2 adaptive K-means plot fusion (:mod:`mhtrack.initiation.kmeans`): the number
     of clusters and the initial centres from the sorted distances ``D``, then standard
     K-means, then the one-plot-per-radar repair, then the merge of compatible clusters.
@@ -293,7 +168,7 @@ class AdaptiveKMeansFusion(_Fusion):
             # two plots of one target differ by N(0, R_i + R_j): farther than
             # sqrt(γ·2·max λmax(R)) fails the gate whatever their direction
             cap = None if Ra is None or gamma is None or not len(za) else float(
-                np.sqrt(gamma * 2.0 * _lmax(Ra).max()))
+                np.sqrt(gamma * 2.0 * lmax2(Ra).max()))
         elif cap is not None and not (isinstance(cap, int | float) and cap > 0):
             raise ValueError(f"max_threshold must be > 0, 'auto' or None, got {cap!r}")
         self.threshold_cap_ = cap
@@ -310,7 +185,7 @@ class AdaptiveKMeansFusion(_Fusion):
         return self
 
 
-class KMeansFusion(_Fusion):
+class KMeansFusion(_KMeansFuser):
     """Standard K-means plot fusion (P2 §1.1): ``n_clusters`` initial centres drawn at
     random among the plots (without replacement, ``numpy.random.default_rng(random_state)``),
     then Lloyd iterations, then the one-plot-per-radar repair with the threshold

@@ -34,24 +34,13 @@ all in another is dropped. The initial state is the least-squares line fit of
 
 from __future__ import annotations
 
-from collections.abc import Sequence
-
 import numpy as np
 
-from mhtrack.initiation.logic import check_common
-from mhtrack.initiation.window import (
-    NO_PLOT,
-    InitiatedTracks,
-    Window,
-    last_slot,
-    least_squares_state,
-    previous_plot,
-    remove_dominated,
-)
-from mhtrack.records import Scan
+from mhtrack.initiation.base import Initiator, check_window_and_speeds
+from mhtrack.initiation.window import NO_PLOT, Window, last_slot, previous_plot
 
 
-class HoughInitiator:
+class HoughInitiator(Initiator):
     """Hough-transform initiation, plain or modified (module docstring).
 
     Parameters
@@ -80,8 +69,10 @@ class HoughInitiator:
         self.n_scans = n_scans
         self.region = region
 
-    def _validate(self) -> None:
-        check_common(self.n_scans, max(2, min(self.votes, self.n_scans)), self.v_min,
+    def check_parameters(self) -> None:
+        """The accumulator, window and constraint parameters (``ValueError`` naming the
+        bad one)."""
+        check_window_and_speeds(self.n_scans, max(2, min(self.votes, self.n_scans)), self.v_min,
                      self.v_max)
         for name in ("n_theta", "n_rho"):
             v = getattr(self, name)
@@ -101,7 +92,7 @@ class HoughInitiator:
         """Votes of the window: ``(votes (N_θ, N_ρ), theta (N_θ,), rho_edges (N_ρ+1,),
         centre (2,))``; ``votes[j, b]`` = number of distinct scans with a plot in cell
         ``(j, b)``."""
-        self._validate()
+        self.check_parameters()
         cell, _, theta, edges, centre = self._cells(w)
         counts = self._distinct_votes(cell, w.slot)
         return counts.reshape(self.n_theta, self.n_rho), theta, edges, centre
@@ -137,19 +128,9 @@ class HoughInitiator:
         return seen.reshape(n_cells, self.n_scans).sum(axis=1)
 
     # ------------------------------------------------------------------ tracks
-    def initiate(self, scans: Sequence[Scan] | Window) -> InitiatedTracks:
-        """Tracks started in the window of ``scans`` (``n_scans`` scans, in time order)."""
-        self._validate()
-        w = scans if isinstance(scans, Window) else Window.from_scans(scans)
-        if w.n_scans != self.n_scans:
-            raise ValueError(f"window has {w.n_scans} scans, expected {self.n_scans}")
-        flat = self._tracks(w)
-        flat = flat[remove_dominated(flat)] if len(flat) else flat
-        x, P = least_squares_state(w, flat)
-        plots = np.where(flat >= 0, w.index[np.maximum(flat, 0)], NO_PLOT)
-        return InitiatedTracks(w.scans, float(w.times[-1]), plots, flat, x, P)
-
-    def _tracks(self, w: Window) -> np.ndarray:
+    def find_tracks(self, w: Window) -> np.ndarray:
+        """Plain: per detected cell, its plot nearest the line at each voting scan;
+        modified: every constrained plot sequence per cell (module docstring)."""
         N = self.n_scans
         empty = np.full((0, N), NO_PLOT, np.int64)
         if len(w) == 0:

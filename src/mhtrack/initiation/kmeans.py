@@ -65,20 +65,18 @@ those clusters and to clusters holding no plot of that radar; a plot with no all
 centre left opens its own cluster (a split). One pass suffices; the labels that did not
 break the rule are kept (:func:`enforce_one_plot_per_sensor`).
 
-The fused output and the estimators (``FUSED``, ``FusedScan``, ``fuse_clusters``,
-``majority_origin``, ``AdaptiveKMeansFusion``, ``KMeansFusion``) live in
-:mod:`mhtrack.initiation.fusion`; they are still importable from here (lazily, through the
-module ``__getattr__``, since :mod:`~mhtrack.initiation.fusion` imports this module).
+The fused output and the estimators live in :mod:`mhtrack.initiation.fusion`, which
+imports this module (never the other way round). 2×2 algebra: :mod:`mhtrack.models.linalg2`.
 """
 
 from __future__ import annotations
-
-from typing import Any
 
 import numpy as np
 from scipy.optimize import linear_sum_assignment
 from scipy.spatial import cKDTree
 from scipy.spatial.distance import pdist
+
+from mhtrack.models.linalg2 import lmax2, mahalanobis2
 
 
 # ---------------------------------------------------------------------- building blocks
@@ -124,20 +122,6 @@ def _cluster_cov(R: np.ndarray, labels: np.ndarray, k: int) -> np.ndarray:
         return Rc / (n**2)[:, None, None]
 
 
-def _mahalanobis2(delta: np.ndarray, S: np.ndarray) -> np.ndarray:
-    """``Δᵀ S⁻¹ Δ`` over stacked 2-vectors and symmetric 2×2 matrices."""
-    a, b, d = S[..., 0, 0], S[..., 0, 1], S[..., 1, 1]
-    x, y = delta[..., 0], delta[..., 1]
-    return (d * x * x - 2 * b * x * y + a * y * y) / (a * d - b * b)
-
-
-def _lmax(S: np.ndarray) -> np.ndarray:
-    """Largest eigenvalue of stacked symmetric 2×2 matrices."""
-    tr = S[..., 0, 0] + S[..., 1, 1]
-    det = S[..., 0, 0] * S[..., 1, 1] - S[..., 0, 1] ** 2
-    return 0.5 * tr + np.sqrt(np.maximum(0.25 * tr * tr - det, 0.0))
-
-
 def _gated_assignment(
     z: np.ndarray,
     centres: np.ndarray,
@@ -165,7 +149,7 @@ def _gated_assignment(
     stat = R is not None and Rc is not None and gamma is not None
     radius = eps
     if stat:
-        radius = max(eps, float(np.sqrt(gamma * (_lmax(R).max() + _lmax(Rc).max()))))
+        radius = max(eps, float(np.sqrt(gamma * (lmax2(R).max() + lmax2(Rc).max()))))
     near = cKDTree(centres).query_ball_point(z, radius * (1 + 1e-12) + 1e-9)
     cols = np.unique(np.fromiter((j for h in near for j in h), np.int64))
     if cols.size == 0:
@@ -174,7 +158,7 @@ def _gated_assignment(
     d2 = (delta**2).sum(-1)
     allowed = d2 <= eps * eps
     if stat:
-        dm = _mahalanobis2(delta, R[:, None] + Rc[None, cols])  # type: ignore[index]
+        dm, _ = mahalanobis2(delta, R[:, None] + Rc[None, cols])  # type: ignore[index]
         allowed |= dm <= gamma
         stay = float(gamma)  # type: ignore[arg-type]
         cost = np.minimum(dm, stay * (1 - 1e-9))  # allowed by ε only: just below "stay"
@@ -370,7 +354,7 @@ def merge_compatible_clusters(
         if maha:
             Rc = _cluster_cov(R, labels, k)  # type: ignore[arg-type]
             # d² ≤ γ needs ‖Δ‖² ≤ γ·λmax(R̄a + R̄b) ≤ γ·2·max λmax(R̄)
-            radius = float(np.sqrt(gamma * 2.0 * _lmax(Rc).max()))  # type: ignore[operator]
+            radius = float(np.sqrt(gamma * 2.0 * lmax2(Rc).max()))  # type: ignore[operator]
         else:
             radius = eps
         pairs = cKDTree(centres).query_pairs(radius, output_type="ndarray")
@@ -379,7 +363,7 @@ def merge_compatible_clusters(
         if len(pairs):
             delta = centres[pairs[:, 0]] - centres[pairs[:, 1]]
             if maha:
-                d = _mahalanobis2(delta, Rc[pairs[:, 0]] + Rc[pairs[:, 1]])
+                d, _ = mahalanobis2(delta, Rc[pairs[:, 0]] + Rc[pairs[:, 1]])
                 keep = d <= gamma
             else:
                 d = np.hypot(delta[:, 0], delta[:, 1])
@@ -402,21 +386,3 @@ def merge_compatible_clusters(
         into = ar.copy()
         into[nn[mutual]] = ar[mutual]
         labels = into[labels]
-
-
-# ---------------------------------------------------------------------- moved names
-#: Public names moved to :mod:`mhtrack.initiation.fusion`, re-exported here lazily.
-_FUSION_NAMES = frozenset({
-    "FUSED", "WEIGHTINGS", "AdaptiveKMeansFusion", "FusedScan", "KMeansFusion",
-    "fuse_clusters", "majority_origin",
-})
-
-
-def __getattr__(name: str) -> Any:
-    """``kmeans.X`` for a name that moved to :mod:`mhtrack.initiation.fusion` (imported on
-    first use: ``fusion`` imports this module, so an eager re-export would be circular)."""
-    if name in _FUSION_NAMES:
-        from mhtrack.initiation import fusion
-
-        return getattr(fusion, name)
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -34,26 +34,14 @@ from itertools import chain
 import numpy as np
 from scipy.spatial import cKDTree
 
+from mhtrack.initiation.base import Initiator, check_window_and_speeds
 from mhtrack.initiation.window import (
     NO_PLOT,
-    InitiatedTracks,
     Window,
     last_slot,
-    least_squares_state,
     previous_plot,
     remove_dominated,
 )
-from mhtrack.records import Scan
-
-
-def check_common(n_scans: int, min_plots: int, v_min: float, v_max: float) -> None:
-    """Validate the window and velocity-gate parameters shared by the initiators."""
-    if not (isinstance(n_scans, int) and n_scans >= 2):
-        raise ValueError(f"n_scans must be an integer >= 2, got {n_scans!r}")
-    if not (isinstance(min_plots, int) and 2 <= min_plots <= n_scans):
-        raise ValueError(f"min_plots must be an integer in [2, n_scans], got {min_plots!r}")
-    if not (0 <= v_min < v_max and np.isfinite(v_max)):
-        raise ValueError(f"need 0 <= v_min < v_max < inf, got v_min={v_min}, v_max={v_max}")
 
 
 def leg_angle(new: np.ndarray, prev: np.ndarray) -> np.ndarray:
@@ -79,7 +67,7 @@ def _ball(tree: cKDTree, centres: np.ndarray, radius: np.ndarray | float,
     return q, j
 
 
-class LogicInitiator:
+class LogicInitiator(Initiator):
     """M/N logic initiation, plain (P2's 3/4 logic) or modified with the angle constraint
     ``α ≤ θ`` (P2 §2.1) — see the module docstring.
 
@@ -101,28 +89,16 @@ class LogicInitiator:
         self.n_scans = n_scans
         self.min_plots = min_plots
 
-    def _validate(self) -> None:
-        check_common(self.n_scans, self.min_plots, self.v_min, self.v_max)
+    def check_parameters(self) -> None:
+        """The window, gate and angle parameters (``ValueError`` naming the bad one)."""
+        check_window_and_speeds(self.n_scans, self.min_plots, self.v_min, self.v_max)
         if not self.gate_radius > 0:
             raise ValueError(f"gate_radius must be > 0, got {self.gate_radius!r}")
         a = self.angle_limit_deg
         if a is not None and not 0 <= a <= 180:
             raise ValueError(f"angle_limit_deg must be in [0, 180] or None, got {a!r}")
 
-    def initiate(self, scans: Sequence[Scan] | Window) -> InitiatedTracks:
-        """Tracks started in the window of ``scans`` (``n_scans`` scans, in time order)."""
-        self._validate()
-        w = scans if isinstance(scans, Window) else Window.from_scans(scans)
-        if w.n_scans != self.n_scans:
-            raise ValueError(f"window has {w.n_scans} scans, expected {self.n_scans}")
-        flat = self._tracks(w)
-        keep = remove_dominated(flat)
-        flat = flat[keep]
-        x, P = least_squares_state(w, flat)
-        plots = np.where(flat >= 0, w.index[np.maximum(flat, 0)], NO_PLOT)
-        return InitiatedTracks(w.scans, float(w.times[-1]), plots, flat, x, P)
-
-    def _tracks(self, w: Window) -> np.ndarray:
+    def find_tracks(self, w: Window) -> np.ndarray:
         """The window's tracks at this initiator's angle limit (θ = π, no limit, for the
         plain logic: a leg angle is never above π)."""
         theta = np.pi if self.angle_limit_deg is None else np.radians(self.angle_limit_deg)

@@ -24,6 +24,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from mhtrack.models.linalg2 import inv2
 from mhtrack.records import Scan
 
 NO_PLOT = -1
@@ -93,17 +94,6 @@ class Window:
             start=np.concatenate(([0], np.cumsum(n))).astype(np.int64),
             R_inv=inv2(np.asarray(R, float)),
         )
-
-
-def inv2(A: np.ndarray) -> np.ndarray:
-    """Inverse of stacked 2×2 matrices (closed form)."""
-    det = A[..., 0, 0] * A[..., 1, 1] - A[..., 0, 1] * A[..., 1, 0]
-    inv = np.empty(A.shape)
-    inv[..., 0, 0] = A[..., 1, 1] / det
-    inv[..., 1, 1] = A[..., 0, 0] / det
-    inv[..., 0, 1] = -A[..., 0, 1] / det
-    inv[..., 1, 0] = -A[..., 1, 0] / det
-    return inv
 
 
 def sliding_windows(scans: Sequence[Scan], n_scans: int = 4) -> Iterator[list[Scan]]:

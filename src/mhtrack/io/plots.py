@@ -11,19 +11,9 @@ from collections.abc import Mapping
 import numpy as np
 import pyarrow as pa
 
-from mhtrack.io._tabular import (
-    FLOAT,
-    INT,
-    Frame,
-    PathArg,
-    Source,
-    check_scan_order,
-    float_array,
-    int_array,
-    num,
-    read_frame,
-    write_frame,
-)
+from mhtrack.io._checks import check_scan_order, num
+from mhtrack.io._frame import FLOAT, INT, Frame, float_array, int_array, read_frame, write_frame
+from mhtrack.io._source import PathArg, Source
 from mhtrack.models.sensors import CartesianSensor, PolarRadar
 from mhtrack.records import MAX_COORDINATE, PlotTable
 

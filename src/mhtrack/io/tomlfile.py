@@ -1,8 +1,12 @@
-"""TOML files for the CLI: scenario and configuration dictionaries.
+"""TOML files: the one reader (scenarios, configurations) and the scenario writer.
 
 Read with :mod:`tomllib` (UTF-8, with or without a byte-order mark); written with
-``tomli-w``. Floats are written in shortest
-round-trip form, so a written scenario reads back exactly.
+``tomli-w``. Floats are written in shortest round-trip form, so a written scenario reads
+back exactly. Every reading problem is an :class:`~mhtrack.errors.InputError` in the one
+message style of :mod:`mhtrack.errors`, ``<file>[, line L[, column C]]: <problem>``, e.g.
+``s.toml, line 4, column 6: Expected '=' after a key in a key/value pair`` or
+``s.toml, line 6: not valid UTF-8 text (byte 0xe9)``; a reader of the parsed dict reports
+a bad value as ``<file>: <key path>: <problem>`` (:func:`key_error`).
 """
 
 from __future__ import annotations
@@ -17,9 +21,11 @@ import numpy as np
 import tomli_w
 
 from mhtrack.errors import InputError
-from mhtrack.io._tabular import PathArg
+from mhtrack.io._source import PathArg
 
 _AT = re.compile(r"\s*\(at line (\d+), column (\d+)\)\s*$")
+#: A message that starts with a key path: ``T: …``, ``targets[2].birth: …``.
+_KEY = re.compile(r"^[A-Za-z_][\w-]*(\[\d+\])*(\.[\w-]+(\[\d+\])*)*: ")
 
 
 def read_toml(path: PathArg) -> dict[str, Any]:
@@ -45,7 +51,8 @@ def read_toml(path: PathArg) -> dict[str, Any]:
     except UnicodeDecodeError as e:
         line = text_line(data, e.start)
         raise InputError(
-            f"{name}, line {line}: not valid UTF-8 text", file=name, line=line
+            f"{name}, line {line}: not valid UTF-8 text (byte 0x{data[e.start]:02x})",
+            file=name, line=line,
         ) from None
     try:
         return tomllib.loads(text)
@@ -60,6 +67,15 @@ def read_toml(path: PathArg) -> dict[str, Any]:
             ) from None
         message = message.replace(" (at end of document)", "")
         raise InputError(f"{name}, end of file: {message}", file=name) from None
+
+
+def key_error(path: PathArg, error: ValueError) -> InputError:
+    """``<file>: <key path>: <problem>`` for a ``ValueError`` raised while reading the dict
+    of the TOML file ``path`` (its message starts with the key path, e.g. ``T: must be
+    > 0``); the key path is kept in :attr:`InputError.key`."""
+    message = str(error)
+    key = message.split(": ", 1)[0] if _KEY.match(message) else None
+    return InputError(f"{path}: {message}", file=str(path), key=key)
 
 
 def text_line(data: bytes, offset: int) -> int:

@@ -6,18 +6,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from mhtrack.io._tabular import (
-    FLOAT,
-    INT,
-    PathArg,
-    check_scan_order,
-    check_unique,
-    float_array,
-    int_array,
-    num,
-    read_frame,
-    write_frame,
-)
+from mhtrack.io._checks import check_scan_order, check_unique, num
+from mhtrack.io._frame import FLOAT, INT, float_array, int_array, read_frame, write_frame
+from mhtrack.io._source import PathArg
 from mhtrack.records import TruthTable
 
 REQUIRED = ("scan", "time", "target_id", "x", "y", "vx", "vy")

@@ -1,7 +1,8 @@
 """Scenario simulation: targets, sensors and clutter → plots and truth.
 
 * :class:`Scenario` (``spec``) — the frozen description of a run, with a validated
-  dict/TOML form (:meth:`Scenario.to_dict`, :func:`from_dict`, :func:`load_scenario`);
+  dict/TOML form (:meth:`Scenario.to_dict`, :func:`from_dict`, :func:`load_scenario`;
+  the dict form of its parts in ``dictform``, its bounds in ``limits``);
 * :class:`Target`, :class:`RecordedTarget` (``targets``) — constant-velocity or recorded truth;
 * :func:`simulate` (``simulate``) — plots and truth from a scenario and a seed;
 * :func:`preset`, :data:`PRESETS` (``presets``) — the reference scenarios of SPEC §6 and
@@ -13,19 +14,13 @@
 Scan ``k`` is at time ``t = k·T``. See ``docs/scenarios.md``.
 """
 
+from mhtrack.scenario.dictform import CLUTTER_KINDS, SENSOR_KINDS, clutter_to_dict
 from mhtrack.scenario.geodesy import geodetic_to_enu
 from mhtrack.scenario.opensky import OpenSkyTruth, aircraft_ids, load_opensky
 from mhtrack.scenario.overrides import OVERRIDES, apply_overrides, default_mixture
 from mhtrack.scenario.presets import PRESET_OVERRIDES, PRESETS, preset
 from mhtrack.scenario.simulate import Simulation, simulate, simulate_truth
-from mhtrack.scenario.spec import (
-    CLUTTER_KINDS,
-    SENSOR_KINDS,
-    Scenario,
-    clutter_to_dict,
-    from_dict,
-    load_scenario,
-)
+from mhtrack.scenario.spec import Scenario, from_dict, load_scenario
 from mhtrack.scenario.targets import AnyTarget, RecordedTarget, Target
 
 __all__ = [

@@ -8,11 +8,11 @@ ignored, so a CLI can pass unset options through. Overrides:
   clutter by :func:`default_mixture` with the same rate;
 * ``clutter_rate`` — mean clutter count per scan **per sensor** (``>= 0``; for time-varying
   clutter every keyframe gets this rate); a rate that would make the simulation exceed
-  :data:`~mhtrack.scenario.spec.MAX_PLOTS` plots is refused with the message naming
+  :data:`~mhtrack.scenario.limits.MAX_PLOTS` plots is refused with the message naming
   ``clutter.rate`` that a TOML file gets (the check is in :class:`Scenario`);
 * ``pd`` — detection probability of every sensor;
 * ``scans`` — number of scans from the first one, at most
-  :data:`~mhtrack.scenario.spec.MAX_SCANS` (the targets are not changed: those
+  :data:`~mhtrack.scenario.limits.MAX_SCANS` (the targets are not changed: those
   outside the new range are simply not simulated);
 * ``truth_sigma_v`` — truth acceleration noise σv (m/s²);
 * ``sigma_range`` — range σ (m) of every polar sensor (error if there is none).
@@ -34,7 +34,9 @@ from mhtrack.models.clutter import (
 )
 from mhtrack.models.sensors import MAX_SIGMA, PolarRadar
 from mhtrack.scenario import _check as ck
-from mhtrack.scenario.spec import MAX_SCANS, MAX_SIGMA_V, ClutterSpec, Scenario
+from mhtrack.scenario.dictform import ClutterSpec
+from mhtrack.scenario.limits import MAX_SCANS, MAX_SIGMA_V
+from mhtrack.scenario.spec import Scenario
 
 #: Overrides accepted by :func:`apply_overrides`.
 OVERRIDES: tuple[str, ...] = (

@@ -1,10 +1,9 @@
-"""Column tables in CSV or Parquet files, read with errors that say where.
+"""Column tables in CSV or Parquet files: read with located errors, and written.
 
-Internal machinery for :mod:`mhtrack.io.plots`, :mod:`~mhtrack.io.truth` and
-:mod:`~mhtrack.io.tracks`: choose the format from the file extension, parse with pyarrow,
-turn every pyarrow or OS error into an :class:`~mhtrack.errors.InputError`, and offer
-vectorised checks that report the first offending row (CSV: the line a text editor shows,
-header = line 1; Parquet: the 0-based row index).
+:func:`read_frame` parses a file with pyarrow and turns every pyarrow or OS error into a
+located :class:`~mhtrack.errors.InputError`; :class:`Frame` converts its columns to NumPy
+with vectorised checks that report the first offending row; :func:`write_frame` writes
+columns as CSV (shortest round-trip numbers) or Parquet.
 """
 
 from __future__ import annotations
@@ -12,8 +11,6 @@ from __future__ import annotations
 import csv
 import re
 from collections.abc import Callable, Mapping, Sequence
-from os import PathLike
-from pathlib import Path
 from typing import NoReturn
 
 import numpy as np
@@ -23,126 +20,15 @@ import pyarrow.csv as pacsv
 import pyarrow.parquet as pq
 
 from mhtrack.errors import InputError
+from mhtrack.io._source import PathArg, Source, file_format
 
-PathArg = str | PathLike[str]
-
-FORMATS = {".csv": "csv", ".parquet": "parquet"}
+#: Column kinds of a schema.
 INT, FLOAT = "int", "float"
 
 _CONVERSION = re.compile(
     r"In CSV column #(\d+): CSV conversion error to (\w+): invalid value '(.*)'", re.S
 )
 _FIELD_COUNT = re.compile(r"Expected (\d+) columns, got (\d+)")
-
-
-def file_format(path: PathArg) -> str:
-    """``"csv"`` or ``"parquet"`` from the extension of ``path``; anything else is an error."""
-    suffix = Path(path).suffix.lower()
-    if suffix not in FORMATS:
-        shown = repr(suffix) if suffix else "no extension"
-        raise InputError(
-            f"{path}: unknown file type ({shown}); use a .csv or .parquet file",
-            file=str(path),
-        )
-    return FORMATS[suffix]
-
-
-class Source:
-    """A file being read: its name as the user gave it, its format, and how to locate rows."""
-
-    def __init__(self, path: PathArg) -> None:
-        self.name = str(path)
-        self.path = Path(path)
-        self.format = file_format(path)
-        self._lines: np.ndarray | None = None
-
-    def check_readable(self) -> None:
-        """Raise :class:`InputError` unless the path is a readable, non-empty file."""
-        p = self.path
-        if not p.exists():
-            raise self.error("no such file")
-        if p.is_dir():
-            raise self.error("is a directory, not a file")
-        try:
-            with p.open("rb") as fh:
-                fh.read(1)
-        except OSError as e:
-            raise self.error(f"cannot read ({e.strerror or e})") from None
-        if p.stat().st_size == 0:
-            raise self.error("file is empty")
-
-    def error(
-        self,
-        problem: str,
-        *,
-        row: int | None = None,
-        column: str | None = None,
-        line: int | None = None,
-    ) -> InputError:
-        """An :class:`InputError` for ``problem`` at data ``row`` (0-based) and ``column``."""
-        where = [self.name]
-        if row is not None and self.format == "csv" and line is None:
-            line = self.line_of(row)
-        if line is not None:
-            where.append(f"line {line}")
-        elif row is not None:
-            where.append(f"row {row}" + (" (0-based)" if self.format == "parquet" else ""))
-        if column is not None:
-            where.append(f"column {column!r}")
-        return InputError(
-            ", ".join(where) + ": " + problem, file=self.name, line=line, row=row, column=column
-        )
-
-    def where(self, row: int) -> str:
-        """``"line 17"`` (CSV) or ``"row 15"`` (Parquet) for data row ``row``."""
-        if self.format == "csv":
-            line = self.line_of(row)
-            if line is not None:
-                return f"line {line}"
-        return f"row {row}"
-
-    # -- CSV line numbers (computed only when an error needs one) ------------------------
-    def _scan_lines(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-        buf = np.frombuffer(self.path.read_bytes(), np.uint8)
-        lf = buf == ord("\n")
-        cr = buf == ord("\r")
-        bare_cr = cr & ~np.concatenate((lf[1:], [False]))  # old-Mac line end
-        nl = np.flatnonzero(lf | bare_cr)
-        starts = np.concatenate(([0], nl + 1))
-        ends = np.concatenate((nl, [buf.size]))
-        length = ends - starts
-        has = length > 0
-        crlf = np.zeros(length.size, bool)
-        crlf[has] = cr[ends[has] - 1]
-        nonempty = np.flatnonzero(length - crlf > 0)  # pyarrow skips empty lines
-        return buf, starts, ends, nonempty
-
-    def line_at_offset(self, offset: int) -> tuple[int, int]:
-        """(1-based line, 0-based field index) of byte ``offset`` of a CSV file."""
-        buf, starts, _ends, _nonempty = self._scan_lines()
-        i = int(np.searchsorted(starts, offset, side="right")) - 1
-        field = int(np.count_nonzero(buf[starts[i] : offset] == ord(",")))
-        return i + 1, field
-
-    def line_of(self, row: int) -> int | None:
-        """1-based line of data row ``row`` of a CSV file (the header is the first non-empty
-        line), or ``None`` when it cannot be told."""
-        if self._lines is None:
-            self._lines = self._scan_lines()[3] + 1
-        i = row + 1
-        return int(self._lines[i]) if 0 <= i < self._lines.size else None
-
-    def line_with_field_count_not(self, n_fields: int) -> int | None:
-        """First data line whose number of comma-separated fields is not ``n_fields``
-        (``None`` if the file has quotes, where counting commas is not reliable)."""
-        buf, starts, ends, nonempty = self._scan_lines()
-        if np.any(buf == ord('"')):
-            return None
-        commas = np.flatnonzero(buf == ord(","))
-        data = nonempty[1:]
-        count = np.searchsorted(commas, ends[data]) - np.searchsorted(commas, starts[data])
-        bad = np.flatnonzero(count != n_fields - 1)
-        return int(data[bad[0]]) + 1 if bad.size else None
 
 
 def _csv_header(src: Source) -> list[str]:
@@ -352,78 +238,6 @@ def write_frame(path: PathArg, columns: Mapping[str, pa.Array]) -> None:
             pq.write_table(table, str(path))
     except OSError as e:
         raise InputError(f"{path}: cannot write ({e.strerror or e})", file=str(path)) from None
-
-
-def num(v: object) -> str:
-    """A number for a message: integers as digits, floats in shortest round-trip form."""
-    if isinstance(v, np.integer | int):
-        return str(int(v))
-    return repr(float(v))  # type: ignore[arg-type]
-
-
-def check_scan_order(frame: Frame, scan: np.ndarray, time: np.ndarray) -> None:
-    """Scans non-decreasing; one time per scan; times never going back from scan to scan."""
-    if scan.size < 2:
-        return
-    src = frame.src
-    after = np.concatenate(([False], scan[1:] < scan[:-1]))  # no np.diff: int64 overflow
-    frame.check(
-        after,
-        "scan",
-        lambda r: (
-            f"scan {num(scan[r])} after scan {num(scan[r - 1])} ({src.where(r - 1)}); "
-            "rows must be in non-decreasing scan order"
-        ),
-    )
-    same = np.concatenate(([False], scan[1:] == scan[:-1]))
-    changed = np.concatenate(([False], time[1:] != time[:-1]))
-    back = np.concatenate(([False], time[1:] < time[:-1]))
-    first = np.maximum.accumulate(np.where(same, 0, np.arange(scan.size)))
-
-    def differs(r: int) -> str:
-        f = int(first[r])
-        return (
-            f"time {num(time[r])} differs from time {num(time[f])} of scan {num(scan[r])} on "
-            f"{src.where(f)}; all rows of a scan must have the same time"
-        )
-
-    frame.check(same & changed, "time", differs)
-    frame.check(
-        ~same & back,
-        "time",
-        lambda r: (
-            f"time goes backwards: {num(time[r])} at scan {num(scan[r])} after "
-            f"{num(time[r - 1])} at scan {num(scan[r - 1])} ({src.where(r - 1)})"
-        ),
-    )
-    frame.check(
-        ~same & ~changed & (np.arange(scan.size) > 0),
-        "time",
-        lambda r: (
-            f"scan {num(scan[r])} has time {num(time[r])} s, not after scan "
-            f"{num(scan[r - 1])}'s ({src.where(r - 1)}); times must strictly increase "
-            "with scan number"
-        ),
-    )
-
-
-def check_unique(frame: Frame, scan: np.ndarray, ids: np.ndarray, column: str) -> None:
-    """No id twice within one scan (``scan`` already known to be sorted)."""
-    if ids.size < 2:
-        return
-    order = np.lexsort((np.arange(ids.size), ids, scan))
-    s, i = scan[order], ids[order]
-    dup = (s[1:] == s[:-1]) & (i[1:] == i[:-1])
-    rows = np.flatnonzero(dup)
-    if rows.size:
-        k = rows[np.argmin(order[rows + 1])]  # lexsort keeps file order among equal keys
-        earlier, later = int(order[k]), int(order[k + 1])
-        raise frame.src.error(
-            f"{column} {num(ids[later])} appears twice in scan {num(scan[later])} "
-            f"(also on {frame.src.where(earlier)})",
-            row=later,
-            column=column,
-        )
 
 
 def int_array(values: np.ndarray, missing: np.ndarray | None = None) -> pa.Array:

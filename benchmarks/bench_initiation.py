@@ -17,8 +17,9 @@ import time
 import numpy as np
 from sklearn.cluster import KMeans
 
+from mhtrack.build import make_initiator
 from mhtrack.experiments.initiation_runs import run_initiation
-from mhtrack.initiation import AdaptiveKMeansFusion, make_initiator
+from mhtrack.initiation import AdaptiveKMeansFusion
 from mhtrack.scenario import preset, simulate
 
 PAPER_T = {"logic": 0.17, "modified-logic": 0.18, "hough": 114.5, "modified-hough": 7.29}

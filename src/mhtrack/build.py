@@ -37,9 +37,8 @@ from mhtrack.clutter.agmm import AGMMClutter
 from mhtrack.clutter.base import ClutterEstimator
 from mhtrack.clutter.gmm import GMMClutter
 from mhtrack.clutter.known import KnownClutter
+from mhtrack.initiation.factory import INITIATOR_CLASSES, make_initiator
 from mhtrack.initiation.fusion import AdaptiveKMeansFusion, KMeansFusion
-from mhtrack.initiation.hough import HoughInitiator
-from mhtrack.initiation.logic import LogicInitiator
 from mhtrack.mht import MHTConfig, MHTTracker
 from mhtrack.models.sensors import CartesianSensor
 from mhtrack.scenario import Scenario
@@ -250,31 +249,6 @@ def default_fusion(n_sensors: int) -> str:
     """The tracker's fusion: ``"adaptive-kmeans"`` with more than one sensor (the MHT
     assumes at most one plot per target per scan), else ``"none"``."""
     return "adaptive-kmeans" if n_sensors > 1 else "none"
-
-
-# ---------------------------------------------------------------------- initiators
-
-#: Initiator name (:data:`mhtrack.names.INITIATORS`) → its class and the constructor
-#: arguments that make the named variant (P2 §2.1, §3.2: the modified methods add the
-#: angle limit θ; the plain logic has none, the plain Hough keeps θ for its lines).
-INITIATOR_CLASSES: dict[str, tuple[type[Any], dict[str, Any]]] = {
-    "logic": (LogicInitiator, {"angle_limit_deg": None}),
-    "modified-logic": (LogicInitiator, {}),
-    "hough": (HoughInitiator, {"modified": False}),
-    "modified-hough": (HoughInitiator, {"modified": True}),
-}
-
-
-def make_initiator(method: str, *, theta_deg: float = 20.0,
-                   **params: Any) -> LogicInitiator | HoughInitiator:
-    """The initiator named ``method`` (:data:`INITIATOR_CLASSES`); ``theta_deg`` is P2's
-    angle limit for the modified methods (ignored by the plain logic); ``params`` go to
-    the constructor (e.g. ``gate_radius``, ``v_min``, ``v_max``)."""
-    if method not in INITIATOR_CLASSES:
-        raise ValueError(f"unknown initiation method {method!r} "
-                         f"(expected {', '.join(INITIATOR_CLASSES)})")
-    cls, variant = INITIATOR_CLASSES[method]
-    return cls(**{"angle_limit_deg": theta_deg, **variant}, **params)  # type: ignore[no-any-return]
 
 
 __all__ = [

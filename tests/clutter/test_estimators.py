@@ -8,12 +8,12 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from mhtrack.build import make_clutter_estimator as make_estimator
 from mhtrack.clutter import (
     AGMMClutter,
     ClutterEstimator,
     GMMClutter,
     KnownClutter,
-    make_estimator,
 )
 from mhtrack.clutter.em import fit_em, kmeanspp_centres, mixture_from_centres
 from mhtrack.models.clutter import GaussianMixtureClutter, Region

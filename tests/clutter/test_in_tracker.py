@@ -7,10 +7,11 @@ import numpy as np
 import pytest
 from click.testing import CliRunner
 
+from mhtrack.build import make_tracker
 from mhtrack.cli.clutter_commands import clutter
 from mhtrack.clutter import AGMMClutter, GMMClutter
-from mhtrack.experiments.pipeline import TRACKERS, make_tracker
 from mhtrack.mht import MHTConfig, MHTTracker
+from mhtrack.names import TRACKERS
 from mhtrack.scenario import preset, simulate
 
 

@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 from click.testing import CliRunner
 
+from mhtrack.build import make_initiator
 from mhtrack.cli.reproduce_commands import reproduce
 from mhtrack.experiments.initiation_runs import fused_scans, run_initiation
 from mhtrack.experiments.jobs import run_seeds
@@ -14,7 +15,7 @@ from mhtrack.experiments.p2 import reproduce_p2
 from mhtrack.experiments.p2.aggregate import aggregate
 from mhtrack.experiments.p2.constants import FIGURES, THETAS_DEG
 from mhtrack.experiments.p2.jobs import make_jobs, p2_scenario, run_job
-from mhtrack.initiation import Window, make_initiator, sliding_windows
+from mhtrack.initiation import Window, sliding_windows
 from mhtrack.initiation.logic import leg_angle, sweep_modified_logic
 from mhtrack.metrics.initiation import initiable_targets, initiation_metrics, track_targets
 from mhtrack.reports.p2 import write_p2_report

@@ -4,6 +4,7 @@
 import numpy as np
 import pytest
 
+from mhtrack.build import make_initiator
 from mhtrack.initiation import (
     FUSED,
     Fuser,
@@ -11,7 +12,6 @@ from mhtrack.initiation import (
     Initiator,
     LogicInitiator,
     Window,
-    make_initiator,
 )
 from mhtrack.records import Scan
 

@@ -3,7 +3,8 @@
 import numpy as np
 import pytest
 
-from mhtrack.initiation import HoughInitiator, Window, make_initiator
+from mhtrack.build import make_initiator
+from mhtrack.initiation import HoughInitiator, Window
 from mhtrack.records import Scan
 
 

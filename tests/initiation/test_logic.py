@@ -3,7 +3,8 @@
 import numpy as np
 import pytest
 
-from mhtrack.initiation import LogicInitiator, Window, leg_angle, make_initiator
+from mhtrack.build import make_initiator
+from mhtrack.initiation import LogicInitiator, Window, leg_angle
 from mhtrack.records import Scan
 
 FAR = np.array([[5000.0, -5000.0], [-6000.0, 7000.0]])  # clutter nowhere near

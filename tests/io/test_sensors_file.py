@@ -189,7 +189,7 @@ def test_not_utf8_and_syntax_errors_name_file_and_line(tmp_path):
     path = write(tmp_path, edit({}).encode().replace(b"# a comment", b"# caf\xe9"))
     with pytest.raises(InputError) as e:
         read_sensors(path)
-    assert str(e.value) == f"{path}, line 6: not valid UTF-8 text"
+    assert str(e.value) == f"{path}, line 6: not valid UTF-8 text (byte 0xe9)"
     assert e.value.line == 6
     path = write(tmp_path, edit({12: "pd = "}))
     with pytest.raises(InputError) as e:

@@ -10,14 +10,9 @@ import numpy as np
 import pytest
 from crossing_fixture import same_tracks
 
+from mhtrack.build import default_config, default_fusion, make_tracker
 from mhtrack.clutter import KnownClutter
-from mhtrack.experiments.pipeline import (
-    default_config,
-    default_fusion,
-    fuse_scan,
-    make_tracker,
-    run_scenario,
-)
+from mhtrack.experiments.pipeline import fuse_scan, run_scenario
 from mhtrack.mht import MHTConfig, MHTTracker
 from mhtrack.mht.births.initiator import followed_by
 from mhtrack.mht.births.sequence import score_upper_bound, sequence_score

@@ -36,7 +36,7 @@ def _params_of(decorator: Callable[[Callable[..., Any]], Callable[..., Any]],
 
 
 def _trackers(ctx: click.Context, param: click.Parameter, value: str) -> tuple[str, ...]:
-    from mhtrack.cli.choices import TRACKERS
+    from mhtrack.names import TRACKERS
 
     names = tuple(n.strip() for n in value.split(",") if n.strip())
     bad = [n for n in names if n not in TRACKERS]

@@ -110,8 +110,8 @@ def initiate(scenario: str, seed: int, clutter: str | None, clutter_rate: float 
              weighting: str, as_json: bool, progress: bool, figure: Path | None) -> None:
     """Start tracks on every 4-scan window of SCENARIO and score them (P2's metrics):
     p_true, p_false, false tracks per run, time per window."""
+    from mhtrack.build import make_initiator
     from mhtrack.experiments.initiation_runs import run_initiation
-    from mhtrack.initiation import make_initiator
     from mhtrack.metrics.initiation import initiable_targets, initiation_metrics, track_targets
 
     if v_min >= v_max:

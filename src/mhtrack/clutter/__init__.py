@@ -4,8 +4,10 @@
 * :class:`GMMClutter` — EM-fitted GMM with a fixed deletion threshold (MHT-GMM);
 * :class:`AGMMClutter` — P1's adaptive GMM (eq. 12 pruning; MHT-AGMM);
 * :mod:`mhtrack.clutter.em` — the shared EM core; :class:`MixtureClutter` — the shared
-  online machinery (window, warm start, uniform background, Poisson ML count);
-* :func:`make_estimator` — any of them by name (:data:`ESTIMATORS`).
+  online machinery (window, warm start, uniform background, Poisson ML count).
+
+By name: :func:`mhtrack.build.make_clutter_estimator` (names in
+:data:`mhtrack.names.CLUTTER_ESTIMATORS`).
 
 See ``docs/clutter.md``.
 """
@@ -16,10 +18,8 @@ from mhtrack.clutter.em import EMResult, Mixture, fit_em
 from mhtrack.clutter.gmm import GMMClutter, keep_above
 from mhtrack.clutter.known import KnownClutter
 from mhtrack.clutter.mixture import MixtureClutter
-from mhtrack.clutter.registry import ESTIMATORS, make_estimator
 
 __all__ = [
-    "ESTIMATORS",
     "AGMMClutter",
     "ClutterEstimator",
     "EMResult",
@@ -30,5 +30,4 @@ __all__ = [
     "fit_em",
     "keep_above",
     "keep_mass",
-    "make_estimator",
 ]

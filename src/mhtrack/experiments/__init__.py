@@ -12,26 +12,15 @@ from mhtrack.experiments.montecarlo import (
     run_job,
     run_montecarlo,
 )
-from mhtrack.experiments.pipeline import (
-    TRACKERS,
-    ScenarioRun,
-    TrackingRun,
-    config_with,
-    make_tracker,
-    run_scenario,
-    track,
-)
+from mhtrack.experiments.pipeline import ScenarioRun, TrackingRun, run_scenario, track
 
 __all__ = [
-    "TRACKERS",
     "MonteCarloResult",
     "MonteCarloSpec",
     "ScenarioRun",
     "SpecMismatchError",
     "TrackingRun",
-    "config_with",
     "load_results",
-    "make_tracker",
     "run_job",
     "run_montecarlo",
     "run_scenario",

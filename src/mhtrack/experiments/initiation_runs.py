@@ -21,11 +21,12 @@ from typing import Any
 import numpy as np
 from tqdm.auto import tqdm
 
+from mhtrack.build import make_initiator
 from mhtrack.experiments.jobs import run_seeds
-from mhtrack.initiation import INITIATORS, make_initiator
-from mhtrack.initiation.fusion import AdaptiveKMeansFusion, FusedScan, KMeansFusion
+from mhtrack.initiation.fused import FusedScan
+from mhtrack.initiation.fusion import AdaptiveKMeansFusion, KMeansFusion
 from mhtrack.initiation.window import Window, sliding_windows
-from mhtrack.names import CLUSTER_METHODS, INITIATION_FUSIONS
+from mhtrack.names import CLUSTER_METHODS, INITIATION_FUSIONS, INITIATORS
 from mhtrack.records import Scan, TruthTable
 from mhtrack.scenario import Scenario, simulate
 

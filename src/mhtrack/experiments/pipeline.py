@@ -25,9 +25,7 @@ import numpy as np
 from tqdm.auto import tqdm
 
 from mhtrack.build import (
-    DEFAULT_CLUTTER_DENSITY,  # noqa: F401  (reproduce_p1 imports it from here until merged)
     TRACKER_FUSERS,
-    config_with,  # noqa: F401  (experiments/__init__, montecarlo, reproduce_p1: until merged)
     default_config,
     default_fusion,
     make_tracker,
@@ -36,11 +34,7 @@ from mhtrack.build import (
 from mhtrack.initiation.fusion import AdaptiveKMeansFusion
 from mhtrack.metrics import Evaluation, evaluate
 from mhtrack.mht import MHTConfig, MHTTracker, StepStats
-from mhtrack.names import (
-    OUTPUTS,
-    TRACKER_FUSIONS,
-    TRACKERS,  # noqa: F401  (experiments/__init__, montecarlo: until merged)
-)
+from mhtrack.names import OUTPUTS, TRACKER_FUSIONS
 from mhtrack.records import PlotTable, Scan, TrackTable
 from mhtrack.scenario import Scenario, Simulation, simulate
 

@@ -25,12 +25,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from mhtrack.initiation.base import Fuser
-from mhtrack.initiation.fused import (
-    WEIGHTINGS,
-    # TEMPORARY, for the merge: initiation/runs.py (helper "runner" moves it) imports
-    # FusedScan from here; drop it once runs.py imports it from mhtrack.initiation.
-    FusedScan,  # noqa: F401
-)
+from mhtrack.initiation.fused import WEIGHTINGS
 from mhtrack.initiation.kmeans import (
     _means,
     adaptive_initial_centres,

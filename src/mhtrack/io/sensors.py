@@ -21,7 +21,7 @@ from typing import Any
 import tomli_w
 
 from mhtrack.errors import InputError
-from mhtrack.io._tabular import PathArg
+from mhtrack.io._source import PathArg
 from mhtrack.io.atomic import atomic_write
 from mhtrack.io.tomlfile import read_toml
 from mhtrack.models.radars import RadarSensor, SensorFieldError, SensorSet

@@ -210,7 +210,7 @@ def _is_best(table: Mapping[str, Mapping[str, Mapping[str, float]]], t: str, m: 
 
 # ---------------------------------------------------------------------------- report
 def settings_text(spec: MonteCarloSpec) -> str:
-    from mhtrack.experiments.pipeline import DEFAULT_CLUTTER_DENSITY, config_with
+    from mhtrack.build import DEFAULT_CLUTTER_DENSITY, config_with
 
     sc = Scenario.from_dict(spec.scenario)
     d = spec.scenario

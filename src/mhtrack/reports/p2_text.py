@@ -23,7 +23,7 @@ from mhtrack.experiments.p2.constants import (
     SIGMA0,
     THETA0,
 )
-from mhtrack.initiation import INITIATORS
+from mhtrack.names import INITIATORS
 
 
 def _f(v: float | None, d: int = 3) -> str:

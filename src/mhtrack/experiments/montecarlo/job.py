@@ -24,7 +24,8 @@ def run_job(job: Mapping[str, Any]) -> dict[str, Any]:
     scalar of :meth:`~mhtrack.experiments.pipeline.ScenarioRun.summary` plus ``tracker``,
     ``run``, ``seed``, ``base_seed``, ``scenario``, ``job_hash``, mappings such as ``caps``
     as JSON text, and the per-scan lists :data:`PER_SCAN_KEYS`. Plain data only."""
-    from mhtrack.experiments.pipeline import config_with, default_config, run_scenario
+    from mhtrack.build import config_with, default_config
+    from mhtrack.experiments.pipeline import run_scenario
     from mhtrack.scenario import Scenario
 
     scenario = Scenario.from_dict(job["scenario"])

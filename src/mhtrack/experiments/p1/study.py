@@ -98,7 +98,8 @@ def reproduce_p1(
     the ``crossing`` preset (tests use a shortened one). Raises
     :class:`~mhtrack.experiments.montecarlo.SpecMismatchError` if ``out_dir/montecarlo``
     holds another study."""
-    from mhtrack.experiments.pipeline import config_with, run_scenario
+    from mhtrack.build import config_with
+    from mhtrack.experiments.pipeline import run_scenario
 
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)

@@ -16,7 +16,7 @@ from mhtrack.experiments.p2.constants import (
     SIGMA0,
     THETA0,
 )
-from mhtrack.initiation import INITIATORS
+from mhtrack.names import INITIATORS
 
 
 def _ratio(a: float, b: float) -> float | None:

@@ -45,9 +45,10 @@ from mhtrack.experiments.initiation_runs import (
 )
 from mhtrack.experiments.jobs import SPACED, Job, JsonRecords, run_seed
 from mhtrack.experiments.p2.constants import CHUNK, LOGIC_PARAMS, RATE0, SIGMA0, THETA0
-from mhtrack.initiation import INITIATORS, Window
+from mhtrack.initiation import Window
 from mhtrack.initiation.logic import sweep_modified_logic
 from mhtrack.metrics.initiation import initiable_targets, track_targets
+from mhtrack.names import INITIATORS
 from mhtrack.scenario import Scenario, preset, simulate
 
 #: How a job's counts are stored: ``DIR/jobs/<name>.json``.

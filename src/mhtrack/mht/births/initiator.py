@@ -30,7 +30,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from mhtrack.initiation import Initiator, make_initiator
+from mhtrack.initiation import Initiator
+from mhtrack.initiation.factory import make_initiator
 from mhtrack.initiation.window import Window
 from mhtrack.mht.births.base import Birth, BirthCandidates
 from mhtrack.mht.births.sequence import score_upper_bound, sequence_score

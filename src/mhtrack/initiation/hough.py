@@ -72,8 +72,8 @@ class HoughInitiator(Initiator):
     def check_parameters(self) -> None:
         """The accumulator, window and constraint parameters (``ValueError`` naming the
         bad one)."""
-        check_window_and_speeds(self.n_scans, max(2, min(self.votes, self.n_scans)), self.v_min,
-                     self.v_max)
+        check_window_and_speeds(self.n_scans, max(2, min(self.votes, self.n_scans)),
+                                self.v_min, self.v_max)
         for name in ("n_theta", "n_rho"):
             v = getattr(self, name)
             if not (isinstance(v, int) and v >= 1):

@@ -211,3 +211,14 @@ def first_time_mismatch(
         return None
     i = int(bad[0])
     return int(common[i]), float(ta[i]), float(tb[i])
+
+
+def checked_distance_input(
+    tracks: object, truth: object, c: float, p: float, scans: npt.ArrayLike | None
+) -> tuple[ScanIndexed, float, float]:
+    """The boundary check of the OSPA-family metrics: tables checked and indexed by the
+    scans of :func:`all_scans`, cut-off ``c > 0`` and order ``p ≥ 1`` checked."""
+    tracks, truth = check_tables(tracks, truth)
+    c = check_cutoff(c, "c")
+    p = check_order(p, "p")
+    return ScanIndexed.build(tracks, truth, all_scans(tracks, truth, scans)), c, p

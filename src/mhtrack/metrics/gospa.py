@@ -15,12 +15,11 @@ import numpy.typing as npt
 
 from mhtrack.metrics._common import (
     ScanIndexed,
-    all_scans,
     as_points,
     assign_capped,
     check_cutoff,
     check_order,
-    check_tables,
+    checked_distance_input,
     pairwise_distance,
 )
 from mhtrack.records import TrackTable, TruthTable
@@ -142,11 +141,7 @@ def gospa_per_scan(
     -------
     GOSPAPerScan
     """
-    tracks, truth = check_tables(tracks, truth)
-    c = check_cutoff(c, "c")
-    p = check_order(p, "p")
-    return gospa_indexed(ScanIndexed.build(tracks, truth, all_scans(tracks, truth, scans)),
-                         c, p)
+    return gospa_indexed(*checked_distance_input(tracks, truth, c, p, scans))
 
 
 def gospa_indexed(data: ScanIndexed, c: float, p: float) -> GOSPAPerScan:

@@ -14,12 +14,11 @@ import numpy.typing as npt
 
 from mhtrack.metrics._common import (
     ScanIndexed,
-    all_scans,
     as_points,
     assign_capped,
     check_cutoff,
     check_order,
-    check_tables,
+    checked_distance_input,
     pairwise_distance,
 )
 from mhtrack.records import TrackTable, TruthTable
@@ -125,11 +124,7 @@ def ospa_per_scan(
     -------
     OSPAPerScan
     """
-    tracks, truth = check_tables(tracks, truth)
-    c = check_cutoff(c, "c")
-    p = check_order(p, "p")
-    return ospa_indexed(ScanIndexed.build(tracks, truth, all_scans(tracks, truth, scans)),
-                        c, p)
+    return ospa_indexed(*checked_distance_input(tracks, truth, c, p, scans))
 
 
 def ospa_indexed(data: ScanIndexed, c: float, p: float) -> OSPAPerScan:

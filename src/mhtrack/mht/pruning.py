@@ -13,10 +13,10 @@ from dataclasses import replace
 import numpy as np
 
 from mhtrack.mht.config import MHTConfig
+from mhtrack.mht.extend import Children
 from mhtrack.mht.sprt import SPRT
 from mhtrack.mht.tree import (
     NO_PLOT,
-    Children,
     Leaves,
     segment_ids,
     segment_max,

@@ -44,6 +44,7 @@ from mhtrack.clutter.known import KnownClutter
 from mhtrack.mht.births import Birth, make_birth
 from mhtrack.mht.caps import CapWarnings, solver_caps
 from mhtrack.mht.config import MHTConfig
+from mhtrack.mht.extend import grow_children, propose_children
 from mhtrack.mht.gating import Gate, plots_in_confirmed_gates
 from mhtrack.mht.history import TentativeHistory
 from mhtrack.mht.hypothesis import best_hypothesis
@@ -56,7 +57,7 @@ from mhtrack.mht.report import StepStats, confirmed_windows, report
 from mhtrack.mht.scoring import miss_increment, update_increment
 from mhtrack.mht.sprt import SPRT
 from mhtrack.mht.state import load_state, save_state
-from mhtrack.mht.tree import Leaves, grow_children, propose_children
+from mhtrack.mht.tree import Leaves
 from mhtrack.mht.validate import validate_scan
 from mhtrack.models.motion import MotionModel
 from mhtrack.records import PlotTable, Scan, TrackTable

@@ -2,7 +2,8 @@
 
 A *track tree* grows from one plot; each of its *leaves* is one track hypothesis (the
 chain of plots or misses from the root to now). Each scan every leaf spawns a miss child
-and one child per plot in its gate, and every plot starts a new tree (P1 §1.3, Fig. 1).
+and one child per plot in its gate (:mod:`mhtrack.mht.extend`), and new trees start
+from plots (:mod:`mhtrack.mht.births`) (P1 §1.3, Fig. 1).
 
 Leaves are kept sorted by tree id, so a tree is a contiguous segment and per-tree
 reductions are ``np.maximum.reduceat`` over segment starts. Nothing here holds a Python
@@ -12,14 +13,10 @@ object per leaf.
 from __future__ import annotations
 
 from dataclasses import dataclass, fields
-from typing import TYPE_CHECKING
 
 import numpy as np
 
-from mhtrack.models.motion import POS, VEL, MotionModel, States
-
-if TYPE_CHECKING:
-    from mhtrack.mht.gating import Gated
+from mhtrack.models.motion import POS, VEL, States
 
 NO_PLOT = -1
 
@@ -131,81 +128,6 @@ def segment_max(values: np.ndarray, starts: np.ndarray, seg: np.ndarray) -> np.n
     if values.size == 0:
         return values.copy()
     return np.maximum.reduceat(values, starts)[seg]
-
-
-@dataclass(frozen=True, slots=True)
-class Children:
-    """Candidate children of the leaves before their Kalman update (cheap to prune).
-
-    ``parent`` indexes the parent leaf, ``plot`` the plot within the scan (``-1``: miss);
-    rows are ordered by parent, the miss first, then plots in scan order.
-    """
-
-    parent: np.ndarray
-    plot: np.ndarray
-    score: np.ndarray
-    peak: np.ndarray
-
-    def __len__(self) -> int:
-        return int(self.parent.shape[0])
-
-    def take(self, idx: np.ndarray) -> Children:
-        return Children(self.parent[idx], self.plot[idx], self.score[idx], self.peak[idx])
-
-
-def propose_children(
-    leaves: Leaves, gated: Gated, miss_dl: float, update_dl: np.ndarray
-) -> Children:
-    """Each leaf spawns a miss child (``L + ΔL_miss``) and one child per gated plot
-    (``L + ΔL_update``), P1 eqs. 4–5. ``update_dl`` is per gated pair."""
-    n = len(leaves)
-    parent = np.concatenate((np.arange(n, dtype=np.int64), gated.track))
-    plot = np.concatenate((np.full(n, NO_PLOT, np.int64), gated.plot))
-    score = np.concatenate((leaves.score + miss_dl, leaves.score[gated.track] + update_dl))
-    # gated pairs are sorted by (leaf, plot); a stable sort on the parent puts the miss
-    # first and keeps the plot order.
-    order = np.argsort(parent, kind="stable")
-    parent, plot, score = parent[order], plot[order], score[order]
-    return Children(parent, plot, score, np.maximum(leaves.peak[parent], score))
-
-
-def grow_children(
-    leaves: Leaves,
-    pred: States,
-    children: Children,
-    z: np.ndarray,
-    R: np.ndarray,
-    rows: np.ndarray,
-    motion: MotionModel,
-) -> Leaves:
-    """Materialise ``children`` as leaves: misses keep the prediction ``pred``, updates get
-    the motion model's update with their plot (``R`` shared (2, 2) or per plot (n, 2, 2);
-    with an IMM, each model's update and ``x, P`` their mixture)."""
-    par, plot = children.parent, children.plot
-    st = pred.take(par)
-    upd = np.flatnonzero(plot >= 0)
-    if upd.size:
-        pj = plot[upd]
-        st.put(upd, motion.update(st.take(upd), z[pj], R if R.ndim == 2 else R[pj]))
-    new_col = np.where(plot >= 0, rows[np.maximum(plot, 0)] if rows.size else NO_PLOT, NO_PLOT)
-    window = np.concatenate((leaves.window[par, 1:], new_col[:, None]), axis=1)
-    return Leaves(
-        x=st.x,
-        P=st.P,
-        score=children.score,
-        peak=children.peak,
-        tree=leaves.tree[par],
-        track=leaves.track[par],
-        birth=leaves.birth[par],
-        n_updates=leaves.n_updates[par] + (plot >= 0),
-        window=window,
-        chosen=np.zeros(len(par), bool),
-        mu=st.mu,
-        xm=st.xm,
-        Pm=st.Pm,
-        node=np.full(len(par), -1, np.int64),
-        parent=leaves.node[par],
-    )
 
 
 def one_point_state(z: np.ndarray, R: np.ndarray, v_max: float) -> tuple[np.ndarray,

@@ -9,6 +9,10 @@ Conventions (all layers):
 * positions in metres in a local east-north frame, ``x`` east and ``y`` north;
 * a state vector is ``[x, vx, y, vy]`` (P1 §1.1);
 * scan indices are integers, times in seconds, non-decreasing with the scan index;
+* synchronous data (the papers): every plot of a scan has the scan's time; asynchronous
+  data (rotating radars, SPEC §8): every plot has its own ``time`` and the "scan" is a
+  *frame* of one sensor's plots over a short time (:mod:`mhtrack.frames`), flagged by
+  ``PlotTable.timed`` and carried to the tracker as ``Scan.t``;
 * ``origin`` of a plot is the id of the target that produced it, or ``-1`` for clutter;
 * ``plot`` of a track state is the **row index in the plot table** (0-based, the order of
   the rows in the plots file) of the plot the track used at that scan, or ``-1`` on a miss.
@@ -62,6 +66,9 @@ class Scan:
     R : (n, 2, 2) measurement covariance of each plot, or ``None`` when the tracker's own
         Cartesian ``R`` applies (Cartesian sensors).
     origin : (n,) target id or ``-1`` for clutter; ``None`` when unknown (real data).
+    t : (n,) each plot's own time (s) for asynchronous data (a frame of a rotating radar);
+        ``None`` when every plot has the scan's ``time`` (synchronous scans). With ``t``,
+        ``time`` is the frame's reference time, the latest plot time.
     """
 
     index: int
@@ -71,6 +78,11 @@ class Scan:
     rows: np.ndarray
     R: np.ndarray | None = None
     origin: np.ndarray | None = None
+    t: np.ndarray | None = None
+
+    def plot_times(self) -> np.ndarray:
+        """(n,) the time of each plot: ``t``, or the scan's ``time`` for every plot."""
+        return np.full(len(self), float(self.time)) if self.t is None else self.t
 
     def __len__(self) -> int:
         return int(self.z.shape[0])
@@ -97,6 +109,10 @@ class PlotTable:
 
     ``scan_times`` optionally lists ``(scan, time)`` of every scan, including scans with
     no plot; :meth:`scans` uses it so an empty scan still reaches the tracker.
+
+    ``timed`` marks asynchronous data: each row's ``time`` is the plot's own time and
+    ``scan`` the index of its *frame* (:func:`mhtrack.frames.make_frames`); rows are sorted
+    by frame, then time, and :meth:`scans` yields each frame with ``Scan.t``.
     """
 
     scan: np.ndarray
@@ -109,6 +125,7 @@ class PlotTable:
     origin: np.ndarray | None = None
     R: np.ndarray | None = None
     scan_times: tuple[np.ndarray, np.ndarray] | None = field(default=None, repr=False)
+    timed: bool = False
 
     def __post_init__(self) -> None:
         n = len(self.scan)
@@ -139,6 +156,9 @@ class PlotTable:
             return self.scan_times
         if len(self.scan) == 0:
             return np.zeros(0, np.int64), np.zeros(0)
+        if self.timed:  # a frame's time is its latest plot's; frames are never empty
+            present, first = np.unique(self.scan, return_index=True)
+            return present, np.maximum.reduceat(self.time, first)
         present, first = np.unique(self.scan, return_index=True)
         idx = np.arange(present[0], present[-1] + 1)
         return idx, np.interp(idx, present, self.time[first])
@@ -158,6 +178,7 @@ class PlotTable:
                 rows=np.arange(s.start, s.stop, dtype=np.int64),
                 R=None if self.R is None else self.R[s],
                 origin=None if self.origin is None else self.origin[s],
+                t=self.time[s] if self.timed else None,
             )
 
     @classmethod

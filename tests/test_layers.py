@@ -4,6 +4,7 @@ run-time imports between mhtrack's modules form no cycle (read from the source w
 from __future__ import annotations
 
 import ast
+import itertools
 from pathlib import Path
 
 SRC = Path(__file__).resolve().parents[1] / "src" / "mhtrack"
@@ -97,5 +98,5 @@ def test_no_import_cycle() -> None:
             dfs(node)
     # a package's __init__ importing its own submodules is how packages export names
     real = [c for c in cycles if not any(
-        b.startswith(a + ".") or a.startswith(b + ".") for a, b in zip(c, c[1:]))]
+        b.startswith(a + ".") or a.startswith(b + ".") for a, b in itertools.pairwise(c))]
     assert not real, "\n".join(" -> ".join(c) for c in real)

@@ -4,9 +4,8 @@ per-track, per-model implementation written out with explicit matrices."""
 from __future__ import annotations
 
 import math
-import sys
-from pathlib import Path
 
+import kalman_reference as kalman
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -14,9 +13,6 @@ from hypothesis import strategies as st
 
 from mhtrack.models import imm
 from mhtrack.models.motion import ConstantVelocity
-
-sys.path.insert(0, str(Path(__file__).parents[1] / "reference"))
-import kalman_reference as kalman
 
 H = np.array([[1.0, 0, 0, 0], [0, 0, 1.0, 0]])
 

@@ -2,9 +2,7 @@
 (what the library's fast paths are checked against) and the χ² gate threshold, against
 hand-worked values, scipy and a per-track textbook loop."""
 
-import sys
-from pathlib import Path
-
+import kalman_reference as kalman
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -13,9 +11,6 @@ from scipy.stats import chi2, multivariate_normal
 
 from mhtrack.mht.gating import gate_threshold
 from mhtrack.models.motion import ConstantVelocity, H
-
-sys.path.insert(0, str(Path(__file__).parents[1] / "reference"))
-import kalman_reference as kalman
 
 
 def test_cv_matrices_hand_worked():

@@ -24,6 +24,7 @@ WGS-84 ellipsoid). Real radars, as a sensors file describes them, are in
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+
 import numpy as np
 
 from mhtrack.errors import short_number

@@ -38,11 +38,11 @@ from typing import Any
 import numpy as np
 
 from mhtrack.models.clutter import (
+    ClutterPatch,
     GaussianMixtureClutter,
     Region,
     UniformClutter,
 )
-from mhtrack.models.clutter import ClutterPatch
 from mhtrack.models.sensors import CartesianSensor, PolarRadar, RotatingRadar
 from mhtrack.scenario import _check as ck
 from mhtrack.scenario import opensky

@@ -47,8 +47,8 @@ from mhtrack.models.sensors import RotatingRadar
 from mhtrack.records import CLUTTER, PlotTable
 from mhtrack.scenario.trajectory import Segment
 
-#: Convergence tolerance of the crossing-time iteration (s).
-TIME_TOL = 1e-6
+#: Convergence tolerance of the crossing-time iteration (s): 10 ns.
+TIME_TOL = 1e-8
 #: Most fixed-point steps per crossing.
 MAX_ITER = 30
 

@@ -231,3 +231,15 @@ def test_sensor_set_round_trips_through_a_sensors_file(tmp_path):
                                                                     200e3)
     write_sensors(ss, tmp_path / "s.toml")
     assert read_sensors(tmp_path / "s.toml") == ss
+
+
+def test_example_toml_loads_and_simulates():
+    from pathlib import Path
+
+    from mhtrack.scenario import load_scenario
+
+    path = Path(__file__).parents[2] / "docs" / "examples" / "rotating-pair.toml"
+    sc = load_scenario(path)
+    assert sc.rotating and [s.period for s in sc.sensors] == [6.0, 10.0]
+    sim = simulate(sc, seed=1)
+    assert set(np.unique(sim.plots.origin[sim.plots.origin >= 0])) == {1, 2, 3}

@@ -154,3 +154,29 @@ def test_evaluate_refuses_tracks_and_truth_of_different_times(crossing, tmp_path
     code, _, stderr = invoke("evaluate", str(truth), str(truth), "--plots",
                              str(crossing / "plots.csv"))
     assert code == 0, stderr
+
+
+def test_simulate_rotating_radars_writes_timed_plots_truth_and_sensors(tmp_path):
+    from mhtrack.io.sensors import read_sensors
+    from mhtrack.models.geodesy import LocalFrame
+    from mhtrack.scenario import preset, simulate
+
+    code, stdout, stderr = invoke("simulate", "opensky-radars", "--seed", "1", "--scans", "7",
+                                  "--out", str(tmp_path))
+    assert code == 0, stderr
+    assert "3 rotating radars over 60 s" in stdout
+    plots, truth = _rows(tmp_path / "plots.csv"), _rows(tmp_path / "truth.csv")
+    assert list(plots[0]) == ["time", "sensor", "range", "bearing", "origin"]
+    assert {"time", "target_id", "lat", "lon", "vx", "vy", "x", "y"} <= set(truth[0])
+    sim = simulate(preset("opensky-radars", scans=7), seed=1)
+    assert len(plots) == len(sim.plots)
+    np.testing.assert_array_equal([float(r["range"]) for r in plots], sim.plots.range)
+    ss = read_sensors(tmp_path / "sensors.toml")
+    assert ss == sim.scenario.sensor_set()
+    # lat/lon of the truth are its x, y on the ellipsoid; vx, vy east/north keep the speed
+    frame = LocalFrame(*ss.origin)
+    x, y = frame.to_local([float(r["lat"]) for r in truth], [float(r["lon"]) for r in truth])
+    np.testing.assert_allclose(x, [float(r["x"]) for r in truth], atol=1e-3)
+    np.testing.assert_allclose(y, [float(r["y"]) for r in truth], atol=1e-3)
+    speed = np.hypot([float(r["vx"]) for r in truth], [float(r["vy"]) for r in truth])
+    np.testing.assert_allclose(speed, np.hypot(sim.truth.vx, sim.truth.vy), rtol=1e-3)

@@ -392,10 +392,17 @@ def test_scenario_constructor_validates():
 
 def test_docs_toml_example_is_valid():
     text = (EXAMPLE.parents[1] / "scenarios.md").read_text(encoding="utf-8")
-    block = text.split("```toml\n", 1)[1].split("```", 1)[0]
+    blocks = [b.split("```", 1)[0] for b in text.split("```toml\n")[1:]]
+    block = next(b for b in blocks if 'name = "drifting-clutter"' in b)
     s = from_dict(tomllib.loads(block))
     assert s.name == "drifting-clutter" and len(s.sensors) == 2
     assert isinstance(s.clutter, TimeVaryingClutter)
+    # the rotating-radar fragment completes to a valid scenario
+    frag = next(b for b in blocks if "period = 6.0" in b)
+    d = tomllib.loads(frag)
+    d.update(T=1.0, scans=[0, 10], region={"xmin": -1e5, "xmax": 1e5, "ymin": -1e5,
+                                           "ymax": 1e5})
+    assert from_dict(d).rotating
 
 
 def test_cli_record_with_seed_reads_back():

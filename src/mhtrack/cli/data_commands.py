@@ -19,13 +19,20 @@ from mhtrack.cli.common import echo_json, load_scenario_arg, scenario_options, t
 def simulate(scenario: str, seed: int, clutter: str | None, clutter_rate: float | None,
              pd: float | None, scans: int | None, out: Path, fmt: str) -> None:
     """Simulate SCENARIO (a preset or a TOML file) and write DIR/plots, DIR/truth and the
-    full parameters in DIR/scenario.toml."""
+    full parameters in DIR/scenario.toml.
+
+    With rotating radars (e.g. opensky-radars): DIR/plots (time, sensor, range, bearing,
+    origin; no scan), DIR/truth (scan = sample, time, target_id, x, y, lat, lon, vx, vy
+    east/north m/s) and DIR/sensors.toml for `mhtrack track --sensors`."""
     from mhtrack.io import write_plots, write_scenario_toml, write_truth
     from mhtrack.scenario import simulate as run_simulation
 
     sc = load_scenario_arg(scenario, clutter, clutter_rate, pd, scans)
     sim = run_simulation(sc, seed=seed)
     out.mkdir(parents=True, exist_ok=True)
+    if sc.rotating:
+        _write_rotating(sim, out, fmt)
+        return
     write_plots(sim.plots, out / f"plots.{fmt}")
     write_truth(sim.truth, out / f"truth.{fmt}")
     write_scenario_toml({"seed": seed, **sc.to_dict()}, out / "scenario.toml")
@@ -34,6 +41,42 @@ def simulate(scenario: str, seed: int, clutter: str | None, clutter_rate: float 
     click.echo(
         f"{sc.name}: {n_scans} scans, {len(sim.plots)} plots ({n_clutter} clutter), "
         f"{len(set(sim.truth.target_id.tolist()))} targets -> {out}"
+    )
+
+
+def _write_rotating(sim: Any, out: Path, fmt: str) -> None:
+    """The files of a rotating-radar simulation (``mhtrack simulate --help``).
+
+    Stand-in until ``mhtrack.io.write_plots`` writes timed tables without ``scan`` and
+    ``write_truth`` takes the ``frame`` (issue 14, helper io14): these two tables are
+    written here with the io layer's column writer; the lead replaces the two
+    ``write_frame`` calls by ``write_plots`` / ``write_truth(..., frame=frame)``.
+    """
+    from mhtrack.io import write_scenario_toml
+    from mhtrack.io._frame import float_array, int_array, write_frame
+    from mhtrack.io.sensors import write_sensors
+
+    sc, plots, truth = sim.scenario, sim.plots, sim.truth
+    sensor_set = sc.sensor_set()
+    frame = sensor_set.frame()
+    write_frame(out / f"plots.{fmt}", {
+        "time": float_array(plots.time), "sensor": int_array(plots.sensor),
+        "range": float_array(plots.range), "bearing": float_array(plots.bearing),
+        "origin": int_array(plots.origin)})
+    lat, lon = frame.to_geodetic(truth.x, truth.y)
+    ve, vn = frame.velocity_to_geodetic(truth.x, truth.y, truth.vx, truth.vy)
+    write_frame(out / f"truth.{fmt}", {
+        "scan": int_array(truth.scan), "time": float_array(truth.time),
+        "target_id": int_array(truth.target_id), "x": float_array(truth.x),
+        "y": float_array(truth.y), "lat": float_array(lat), "lon": float_array(lon),
+        "vx": float_array(ve), "vy": float_array(vn)})
+    write_sensors(sensor_set, out / "sensors.toml")
+    write_scenario_toml({"seed": sim.seed, **sc.to_dict()}, out / "scenario.toml")
+    n_clutter = int((plots.origin < 0).sum())
+    t0, t1 = sc.first * sc.T, sc.last * sc.T
+    click.echo(
+        f"{sc.name}: {len(sc.sensors)} rotating radars over {t1 - t0:g} s, {len(plots)} "
+        f"plots ({n_clutter} clutter), {len(set(truth.target_id.tolist()))} targets -> {out}"
     )
 
 

@@ -245,3 +245,59 @@ def _interpolate(
         covariances=_lerp(a.covariances, b.covariances, t),
         background=float(_lerp(a.background, b.background, t)),
     )
+
+
+# ---------------------------------------------------------------- a rotating radar's clutter
+@dataclass(frozen=True)
+class ClutterPatch:
+    """A clump of a rotating radar's clutter in its own range–bearing: per rotation a
+    Poisson number (mean ``rate``) of plots with range ``~ N(range, sigma_range²)`` (m)
+    and bearing ``~ N(bearing, sigma_bearing_deg²)`` (degrees clockwise from north,
+    wrapped to ``[0, 360)``). Ranges ``<= 0`` or beyond the radar's ``max_range`` are
+    dropped (a Poisson thinning: the count stays Poisson, its mean is the mass inside)."""
+
+    range: float
+    bearing: float
+    sigma_range: float
+    sigma_bearing_deg: float
+    rate: float
+
+    def __post_init__(self) -> None:
+        for key in ("range", "bearing", "sigma_range", "sigma_bearing_deg", "rate"):
+            v = float(getattr(self, key))
+            if not np.isfinite(v):
+                raise ValueError(f"{key}: must be finite, got {v}")
+            object.__setattr__(self, key, v)
+        for key in ("sigma_range", "sigma_bearing_deg"):
+            if getattr(self, key) <= 0:
+                raise ValueError(f"{key}: must be > 0, got {getattr(self, key):g}")
+        if self.rate < 0:
+            raise ValueError(f"rate: must be >= 0, got {self.rate:g}")
+
+
+def sample_range_azimuth(
+    rng: np.random.Generator,
+    rate: float,
+    max_range: float | None,
+    patches: tuple[ClutterPatch, ...] = (),
+) -> tuple[np.ndarray, np.ndarray]:
+    """One rotation of a radar's clutter: ``(range m, bearing deg)`` arrays.
+
+    Uniform part: ``N ~ Poisson(rate)`` plots, range ``~ U(0, max_range)`` and bearing
+    ``~ U(0, 360)`` — uniform in range–azimuth, so the density per unit *area* falls as
+    ``1/r``, as a radar's range–azimuth cells do. Then each :class:`ClutterPatch` in turn.
+    ``max_range`` may be ``None`` only when ``rate == 0``.
+    """
+    n = int(rng.poisson(rate)) if rate > 0 else 0
+    if n and max_range is None:
+        raise ValueError("uniform range-azimuth clutter needs the radar's max_range")
+    r = [rng.random(n) * (max_range or 0.0)]
+    b = [rng.random(n) * 360.0]
+    for p in patches:
+        k = int(rng.poisson(p.rate)) if p.rate > 0 else 0
+        rp = p.range + p.sigma_range * rng.normal(size=k)
+        bp = (p.bearing + p.sigma_bearing_deg * rng.normal(size=k)) % 360.0
+        keep = (rp > 0) & (rp <= (np.inf if max_range is None else max_range))
+        r.append(rp[keep])
+        b.append(bp[keep])
+    return np.concatenate(r), np.concatenate(b)

@@ -15,21 +15,21 @@ Gaussian errors ``σr`` and ``σb``. Its plots are turned into Cartesian positio
 
 The tracker then uses a linear Kalman update with the converted plot and this ``R``.
 
-Real radars, as a sensors file describes them, are in :mod:`mhtrack.models.radars`.
+A :class:`RotatingRadar` is a polar radar whose beam turns: it sees a target once per
+rotation, when the beam crosses it (:mod:`mhtrack.scenario.sweep` simulates it on the
+WGS-84 ellipsoid). Real radars, as a sensors file describes them, are in
+:mod:`mhtrack.models.radars`.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING
 
 import numpy as np
 
 from mhtrack.errors import short_number
+from mhtrack.models.clutter import ClutterPatch
 from mhtrack.records import MAX_COORDINATE
-
-if TYPE_CHECKING:
-    pass
 
 #: Largest Cartesian ``sigma`` and polar ``sigma_range`` accepted (m): 1000 km, far beyond
 #: any real sensor, and small enough that ``σ²`` and the plots stay finite.
@@ -162,4 +162,94 @@ class PolarRadar:
         return self.convert(self.to_polar(z))
 
 
-Sensor = CartesianSensor | PolarRadar
+@dataclass(frozen=True, kw_only=True)
+class RotatingRadar:
+    """A 2-D radar whose beam turns clockwise with ``period`` (s); ``phase`` is the beam's
+    bearing at ``t = 0`` (degrees clockwise from north), so at time ``t`` the beam points
+    at ``β(t) = phase + 360 t / period`` (mod 360).
+
+    Its site is ``lat``/``lon`` (WGS-84 degrees) or ``position`` (x, y m in the scenario's
+    local frame), exactly one of them. It measures geodesic ground range (σ
+    ``sigma_range`` m) and azimuth (σ ``sigma_bearing_deg``), sees only up to
+    ``max_range`` (m, ``None``: unlimited), and draws its own clutter per rotation:
+    ``clutter_rate`` plots uniform in range–azimuth over its coverage plus
+    ``clutter_patches`` (:func:`~mhtrack.models.clutter.sample_range_azimuth`).
+    """
+
+    id: int
+    period: float
+    sigma_range: float
+    sigma_bearing_deg: float
+    phase: float = 0.0
+    lat: float | None = None
+    lon: float | None = None
+    position: tuple[float, float] | None = None
+    max_range: float | None = None
+    clutter_rate: float = 0.0
+    clutter_patches: tuple[ClutterPatch, ...] = ()
+    kind: str = field(default="polar", init=False)
+
+    def __post_init__(self) -> None:
+        w = f"sensor {self.id}"
+        for key in ("period", "sigma_range", "sigma_bearing_deg", "phase", "clutter_rate",
+                    "lat", "lon", "max_range"):
+            v = getattr(self, key)
+            if v is None:
+                continue
+            try:
+                x = float(v)
+            except (TypeError, ValueError):
+                raise ValueError(f"{w}: {key} must be a number, got {v!r}") from None
+            if not np.isfinite(x):
+                raise ValueError(f"{w}: {key} must be finite, got {v!r}")
+            object.__setattr__(self, key, x)
+        if not self.period > 0:
+            raise ValueError(f"{w}: period must be > 0 s, got {self.period:g}")
+        if not _in_range(self.sigma_range, MAX_SIGMA):
+            raise ValueError(f"{w}: sigma_range must be > 0 and <= {short_number(MAX_SIGMA)} m, "
+                             f"got {self.sigma_range}")
+        if not _in_range(self.sigma_bearing_deg, MAX_SIGMA_BEARING_DEG):
+            raise ValueError(f"{w}: sigma_bearing_deg must be > 0 and <= "
+                             f"{short_number(MAX_SIGMA_BEARING_DEG)} degrees, "
+                             f"got {self.sigma_bearing_deg}")
+        if (self.lat is None) != (self.lon is None):
+            raise ValueError(f"{w}: lat and lon give the site together")
+        if (self.lat is None) == (self.position is None):
+            raise ValueError(f"{w}: give the site once: lat/lon or position")
+        if self.lat is not None and not (-90 <= self.lat <= 90 and -180 <= self.lon <= 180):
+            raise ValueError(f"{w}: lat/lon must be within [-90, 90] x [-180, 180] degrees, "
+                             f"got ({self.lat:g}, {self.lon:g})")
+        if self.position is not None:
+            pos = tuple(float(v) for v in self.position)
+            if len(pos) != 2 or not all(np.isfinite(v) and abs(v) <= MAX_COORDINATE
+                                        for v in pos):
+                raise ValueError(f"{w}: position must be two finite coordinates within "
+                                 f"±{short_number(MAX_COORDINATE)} m, got {self.position!r}")
+            object.__setattr__(self, "position", pos)
+        if self.max_range is not None and not self.max_range > 0:
+            raise ValueError(f"{w}: max_range must be > 0 m, got {self.max_range:g}")
+        if self.clutter_rate < 0:
+            raise ValueError(f"{w}: clutter_rate must be >= 0, got {self.clutter_rate:g}")
+        if self.clutter_rate > 0 and self.max_range is None:
+            raise ValueError(f"{w}: clutter_rate > 0 needs max_range (the coverage the "
+                             "uniform clutter spreads over)")
+        patches = tuple(self.clutter_patches)
+        if not all(isinstance(p, ClutterPatch) for p in patches):
+            raise ValueError(f"{w}: clutter_patches must be ClutterPatch records")
+        object.__setattr__(self, "clutter_patches", patches)
+
+    @property
+    def rate_deg(self) -> float:
+        """The beam's turning rate ``ω = 360 / period`` (degrees per second)."""
+        return 360.0 / self.period
+
+    def beam(self, t: np.ndarray | float) -> np.ndarray:
+        """The beam's bearing ``β(t) = (phase + ω t) mod 360`` (degrees) at times ``t``."""
+        return np.mod(self.phase + self.rate_deg * np.asarray(t, float), 360.0)
+
+    def mean_clutter(self) -> float:
+        """Upper bound of the mean clutter count per rotation (patches before thinning)."""
+        return self.clutter_rate + sum(p.rate for p in self.clutter_patches)
+
+
+Sensor = CartesianSensor | PolarRadar | RotatingRadar

@@ -26,16 +26,19 @@ from mhtrack.models.sensors import (
     MAX_SIGMA_BEARING_DEG,
     CartesianSensor,
     PolarRadar,
+    RotatingRadar,
     Sensor,
 )
 from mhtrack.records import MAX_COORDINATE
 from mhtrack.scenario import _check as ck
 from mhtrack.scenario.limits import (
+    MAX_T,
     check_period,
     check_scan_range,
     check_sigma_v,
     check_state,
 )
+from mhtrack.scenario.radardict import rotating_from, rotating_to_dict
 from mhtrack.scenario.targets import AnyTarget, RecordedTarget, Target
 
 ClutterSpec = UniformClutter | GaussianMixtureClutter | TimeVaryingClutter
@@ -59,6 +62,8 @@ def region_to_dict(r: Region) -> dict[str, float]:
 
 def sensor_to_dict(s: Sensor, pd: float) -> dict[str, Any]:
     """Dict form of a sensor with its detection probability ``pd``."""
+    if isinstance(s, RotatingRadar):
+        return rotating_to_dict(s, pd)
     if isinstance(s, PolarRadar):
         return {
             "kind": "polar",
@@ -103,8 +108,9 @@ def clutter_to_dict(c: ClutterSpec) -> dict[str, Any]:
 
 
 # ---------------------------------------------------------------------- from dict
-_TOP_REQUIRED = {"T", "scans", "region", "sensors", "clutter"}
-_TOP_OPTIONAL = {"name", "description", "targets", "truth_sigma_v", "seed"}
+_TOP_REQUIRED = {"T", "scans", "region", "sensors"}
+_TOP_OPTIONAL = {"name", "description", "targets", "truth_sigma_v", "seed", "clutter",
+                 "origin", "truth_dt"}
 
 
 def scenario_fields(d: Mapping[str, Any]) -> dict[str, Any]:
@@ -119,7 +125,11 @@ def scenario_fields(d: Mapping[str, Any]) -> dict[str, Any]:
     scenario's own checks, e.g. unique ids, run when it is built from these fields).
     """
     d = ck.table(d, "")
-    ck.keys(d, "", _TOP_REQUIRED, _TOP_OPTIONAL)
+    raw = d.get("sensors")
+    rotating = isinstance(raw, list | tuple) and any(
+        isinstance(x, Mapping) and "period" in x for x in raw)
+    # rotating radars draw their own clutter: the region's model is optional then
+    ck.keys(d, "", _TOP_REQUIRED | (set() if rotating else {"clutter"}), _TOP_OPTIONAL)
     if "seed" in d:
         ck.integer(d["seed"], "seed", lo=0)
     name = ck.string(d.get("name", "custom"), "name")
@@ -142,8 +152,22 @@ def scenario_fields(d: Mapping[str, Any]) -> dict[str, Any]:
         _target_from(t, f"targets[{i}]", first, last)
         for i, t in enumerate(_list(d.get("targets", []), "targets"))
     ]
-    clutter = _clutter_from(d["clutter"], "clutter", region)
+    if "clutter" in d:
+        clutter = _clutter_from(d["clutter"], "clutter", region)
+    else:
+        clutter = UniformClutter(region, 0.0)
+    extra: dict[str, Any] = {}
+    if "origin" in d:
+        o = ck.table(d["origin"], "origin")
+        ck.keys(o, "origin", {"lat", "lon"})
+        extra["origin"] = (ck.number(o["lat"], "origin.lat", lo=-90.0, hi=90.0, unit="degrees"),
+                           ck.number(o["lon"], "origin.lon", lo=-180.0, hi=180.0,
+                                     unit="degrees"))
+    if "truth_dt" in d:
+        extra["truth_dt"] = ck.number(d["truth_dt"], "truth_dt", lo=0.0, lo_open=True, hi=MAX_T,
+                                      unit="s")
     return {
+        **extra,
         "name": name,
         "description": description,
         "region": region,
@@ -188,6 +212,8 @@ def _kind(d: Mapping[str, Any], path: str, kinds: tuple[str, ...]) -> str:
 def _sensor_from(v: object, path: str) -> tuple[Sensor, float]:
     d = ck.table(v, path)
     kind = _kind(d, path, SENSOR_KINDS)
+    if kind == "polar" and "period" in d:
+        return rotating_from(d, path)
     if kind == "cartesian":
         ck.keys(d, path, {"kind", "id", "sigma", "pd"})
         sid = ck.integer(d["id"], f"{path}.id", lo=0)

@@ -26,11 +26,15 @@ import io
 from dataclasses import dataclass
 from functools import lru_cache
 from importlib import resources
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from mhtrack.scenario.geodesy import geodetic_to_enu, local_to_reference_velocity
 from mhtrack.scenario.targets import RecordedTarget
+
+if TYPE_CHECKING:
+    from mhtrack.models.geodesy import LocalFrame
 
 #: Data file inside the package.
 DATA_FILE = "opensky_plane_states.csv"
@@ -88,7 +92,9 @@ def _read_rows() -> dict[str, np.ndarray]:
     return cols
 
 
-def load_opensky(max_position_age: float | None = None) -> OpenSkyTruth:
+def load_opensky(
+    max_position_age: float | None = None, frame: LocalFrame | None = None
+) -> OpenSkyTruth:
     """Read the packaged CSV and convert it as described in the module docstring.
 
     Parameters
@@ -96,6 +102,10 @@ def load_opensky(max_position_age: float | None = None) -> OpenSkyTruth:
     max_position_age : drop rows whose position is older than this (s) at the grid time
         (``time − lastposupdate``); ``None`` keeps every row (the default: an aircraft
         exists at a scan iff it has a row there).
+    frame : instead of the ENU plane, put the aircraft in this azimuthal-equidistant
+        :class:`~mhtrack.models.geodesy.LocalFrame` (pyproj): position
+        ``frame.to_local(lat, lon)``, velocity ``frame.velocity_to_local`` (east/north
+        → grid axes), then the same dead reckoning — the frame of rotating radars.
     """
     c = _read_rows()
     keep = np.ones(len(c["time"]), bool)
@@ -113,9 +123,15 @@ def load_opensky(max_position_age: float | None = None) -> OpenSkyTruth:
     rank[order] = np.arange(1, len(names) + 1)
     tid = rank[np.searchsorted(names, icao)]
 
-    enu = geodetic_to_enu(lat, lon, *REFERENCE)
-    v = local_to_reference_velocity(c["x_speed"][keep], c["y_speed"][keep], lat, lon, *REFERENCE)
-    pos = enu[:, :2] + v * age[:, None]
+    if frame is None:
+        enu = geodetic_to_enu(lat, lon, *REFERENCE)[:, :2]
+        v = local_to_reference_velocity(c["x_speed"][keep], c["y_speed"][keep], lat, lon,
+                                        *REFERENCE)
+    else:
+        enu = np.column_stack(frame.to_local(lat, lon))
+        v = np.column_stack(frame.velocity_to_local(lat, lon, c["x_speed"][keep],
+                                                    c["y_speed"][keep]))
+    pos = enu + v * age[:, None]
     scan = np.rint((time - T0) / PERIOD).astype(np.int64)
     s = np.lexsort((tid, scan))
     return OpenSkyTruth(

@@ -16,6 +16,9 @@ ignored, so a CLI can pass unset options through. Overrides:
   outside the new range are simply not simulated);
 * ``truth_sigma_v`` — truth acceleration noise σv (m/s²);
 * ``sigma_range`` — range σ (m) of every polar sensor (error if there is none).
+
+For rotating radars (their own clutter per rotation) ``clutter_rate`` is every radar's
+uniform range–azimuth rate per rotation, and ``clutter`` is refused.
 """
 
 from __future__ import annotations
@@ -32,7 +35,7 @@ from mhtrack.models.clutter import (
     TimeVaryingClutter,
     UniformClutter,
 )
-from mhtrack.models.sensors import MAX_SIGMA, PolarRadar
+from mhtrack.models.sensors import MAX_SIGMA, PolarRadar, RotatingRadar
 from mhtrack.scenario import _check as ck
 from mhtrack.scenario.dictform import ClutterSpec
 from mhtrack.scenario.limits import MAX_SCANS, MAX_SIGMA_V
@@ -89,6 +92,14 @@ def apply_overrides(scenario: Scenario, **overrides: Any) -> Scenario:
     s = scenario
     changes: dict[str, Any] = {}
     clutter = s.clutter
+    if s.rotating and ("clutter" in ov or "clutter_rate" in ov):
+        if "clutter" in ov:
+            raise ValueError("clutter: rotating radars draw their own clutter in range and "
+                             "azimuth; only clutter_rate (per rotation) can be changed")
+        rate = ck.number(ov.pop("clutter_rate"), "clutter_rate", lo=0.0)
+        with ck.at("clutter_rate"):
+            changes["sensors"] = tuple(dataclasses.replace(x, clutter_rate=rate)
+                                       for x in s.sensors)
     if "clutter" in ov:
         kind = ov["clutter"]
         if kind not in ("uniform", "gmm"):
@@ -116,10 +127,11 @@ def apply_overrides(scenario: Scenario, **overrides: Any) -> Scenario:
         sr = ck.number(
             ov["sigma_range"], "sigma_range", lo=0.0, lo_open=True, hi=MAX_SIGMA, unit="m"
         )
-        if not any(isinstance(x, PolarRadar) for x in s.sensors):
+        polar = PolarRadar | RotatingRadar
+        if not any(isinstance(x, polar) for x in s.sensors):
             raise ValueError(f"sigma_range: scenario {s.name!r} has no polar sensor")
         changes["sensors"] = tuple(
-            dataclasses.replace(x, sigma_range=sr) if isinstance(x, PolarRadar) else x
-            for x in s.sensors
+            dataclasses.replace(x, sigma_range=sr) if isinstance(x, polar) else x
+            for x in changes.get("sensors", s.sensors)
         )
     return dataclasses.replace(s, **changes)

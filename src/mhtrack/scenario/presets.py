@@ -17,6 +17,11 @@
   ``T = 10`` s, scans 0–120; two polar radars near Heathrow and Manchester airports,
   ``σr = 50 m``, ``σθ = 0.15°``, ``P_D = 0.9``; Gaussian-mixture clutter of three
   components plus a 20 % uniform background, ``λ = 20`` per scan per radar *(all ours)*.
+* ``opensky-radars``: the same aircraft (in the azimuthal-equidistant frame about
+  ``opensky.REFERENCE``) seen by three rotating radars at real radar sites — Heathrow,
+  Clee Hill, RAF Waddington — with periods 4, 10, 12 s, their own noises, ``P_D`` and
+  clutter (uniform in range–azimuth and one patch each), 1200 s *(all ours;*
+  :data:`OPENSKY_ROTATING_RADARS`, ``docs/scenarios.md``).
 
 Overrides (``None`` values are ignored, so a CLI can pass unset options through):
 ``clutter`` (``"uniform"``: a uniform model over the region with the same rate;
@@ -33,11 +38,12 @@ from typing import Any
 import numpy as np
 
 from mhtrack.models.clutter import (
+    ClutterPatch,
     GaussianMixtureClutter,
     Region,
     UniformClutter,
 )
-from mhtrack.models.sensors import CartesianSensor, PolarRadar
+from mhtrack.models.sensors import CartesianSensor, PolarRadar, RotatingRadar
 from mhtrack.scenario import _check as ck
 from mhtrack.scenario import opensky
 from mhtrack.scenario.geodesy import geodetic_to_enu
@@ -46,7 +52,8 @@ from mhtrack.scenario.spec import Scenario
 from mhtrack.scenario.targets import Target
 
 #: Names accepted by :func:`preset`.
-PRESETS: tuple[str, ...] = ("crossing", "crossing-wide", "multiradar", "opensky")
+PRESETS: tuple[str, ...] = ("crossing", "crossing-wide", "multiradar", "opensky",
+                            "opensky-radars")
 #: Keyword overrides accepted by :func:`preset`.
 PRESET_OVERRIDES: tuple[str, ...] = (*OVERRIDES, "heading_seed")
 
@@ -220,6 +227,56 @@ def _opensky(n_scans: int | None) -> Scenario:
     )
 
 
+# ------------------------------------------------------------------ opensky-radars
+#: Rotating radars of ``opensky-radars`` (ours): name, (lat, lon) of a real radar site,
+#: period (s), phase (°), σr (m), σθ (°), P_D, clutter rate per rotation (uniform in
+#: range–azimuth) and one clutter patch (range m, bearing °, σr m, σθ °, rate per rotation).
+OPENSKY_ROTATING_RADARS = (
+    ("Heathrow", (51.4775, -0.4614), 4.0, 0.0, 30.0, 0.08, 0.95, 20.0,
+     (110_000.0, 200.0, 15_000.0, 8.0, 8.0)),  # sea clutter, English Channel off the Solent
+    ("Clee Hill", (52.3983, -2.5986), 10.0, 120.0, 50.0, 0.12, 0.90, 20.0,
+     (25_000.0, 90.0, 5_000.0, 15.0, 6.0)),  # ground clutter, Wyre Forest / Birmingham side
+    ("Waddington", (53.1662, -0.5239), 12.0, 240.0, 80.0, 0.20, 0.85, 20.0,
+     (75_000.0, 95.0, 12_000.0, 10.0, 8.0)),  # sea clutter over the Wash
+)
+#: Instrumented range of the three radars (m, ours: an en-route radar's 160 NM).
+OPENSKY_RADAR_MAX_RANGE = 300_000.0
+
+
+def _opensky_radars(n_scans: int | None) -> Scenario:
+    from mhtrack.models.geodesy import LocalFrame  # pyproj: imported only when used
+
+    data = opensky.load_opensky(frame=LocalFrame(*opensky.REFERENCE))
+    first = 0
+    last = int(data.scan.max()) if n_scans is None else first + n_scans - 1
+    radars = tuple(
+        RotatingRadar(id=i, lat=site[0], lon=site[1], period=period, phase=phase,
+                      sigma_range=sr, sigma_bearing_deg=sb, max_range=OPENSKY_RADAR_MAX_RANGE,
+                      clutter_rate=rate, clutter_patches=(ClutterPatch(*patch),))
+        for i, (_, site, period, phase, sr, sb, _pd, rate, patch)
+        in enumerate(OPENSKY_ROTATING_RADARS, 1)
+    )
+    return Scenario(
+        name="opensky-radars",
+        description=(
+            "Real ADS-B aircraft (OpenSky Network, see mhtrack/data/ATTRIBUTION.md) seen by "
+            "three rotating radars at Heathrow (4 s), Clee Hill (10 s) and Waddington "
+            "(12 s), plots timed by the beam, range/bearing on WGS-84; sensors, clutter "
+            "and frame origin (lat/lon "
+            f"{opensky.REFERENCE}) are our choice."
+        ),
+        region=OPENSKY_REGION,
+        T=opensky.PERIOD,
+        scans=(first, last),
+        targets=data.targets(first, last),
+        sensors=radars,
+        pd=tuple(r[6] for r in OPENSKY_ROTATING_RADARS),
+        clutter=UniformClutter(OPENSKY_REGION, 0.0),
+        origin=opensky.REFERENCE,
+        truth_dt=1.0,
+    )
+
+
 # ------------------------------------------------------------------ preset()
 def preset(name: str, **overrides: Any) -> Scenario:
     """The named reference scenario (see the module docstring), with overrides
@@ -241,6 +298,8 @@ def preset(name: str, **overrides: Any) -> Scenario:
     elif name == "multiradar":
         seed = ck.integer(ov.pop("heading_seed", MULTIRADAR_HEADING_SEED), "heading_seed", lo=0)
         s = _multiradar(n_scans, seed)
-    else:
+    elif name == "opensky":
         s = _opensky(n_scans)
+    else:
+        s = _opensky_radars(n_scans)
     return apply_overrides(s, **ov)

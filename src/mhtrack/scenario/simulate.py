@@ -17,6 +17,11 @@ with a ``SeedSequence(seed, spawn_key=…)`` whose key is built from integers on
 of one sensor at one scan. The output therefore depends on nothing but the seed and the
 scenario — not on dict order or Python's hash seed — and adding a sensor or a target
 leaves the draws of the others unchanged.
+
+Rotating radars (:class:`~mhtrack.models.sensors.RotatingRadar`, a scenario whose sensors
+have a ``period``) are simulated by :mod:`mhtrack.scenario.sweep` instead: plots timed by
+the beam, on the WGS-84 ellipsoid, the truth sampled every ``truth_dt`` seconds along
+:mod:`mhtrack.scenario.trajectory`'s continuous trajectories.
 """
 
 from __future__ import annotations
@@ -30,6 +35,7 @@ from mhtrack.models.sensors import PolarRadar
 from mhtrack.records import CLUTTER, PlotTable, TruthTable
 from mhtrack.scenario.spec import Scenario
 from mhtrack.scenario.targets import Target
+from mhtrack.scenario.trajectory import sample_truth, segments
 
 _TRUTH_STREAM = 0
 _PLOT_STREAM = 1
@@ -38,7 +44,9 @@ _PLOT_STREAM = 1
 @dataclass(frozen=True, eq=False)
 class Simulation:
     """Result of :func:`simulate`: the plots (sorted by scan, then sensor id; ``origin`` =
-    target id or −1), the truth (sorted by scan, then target id), and what made them."""
+    target id or −1), the truth (sorted by scan, then target id), and what made them.
+    With rotating radars the plots are timed (``plots.timed``, ``scan`` = frame) and the
+    truth's ``scan`` is the sample index."""
 
     scenario: Scenario
     seed: int
@@ -93,10 +101,13 @@ def simulate(scenario: Scenario, seed: int = 0) -> Simulation:
     every scan (empty scans included); ``range``/``bearing`` (m, degrees clockwise from
     north; NaN on Cartesian rows) when any sensor is polar; per-plot ``R`` unless all
     sensors are Cartesian with one σ (then the tracker's own ``R = σ² I`` applies).
+    Rotating radars: :func:`simulate_rotating`.
     """
     if isinstance(seed, bool) or not isinstance(seed, int | np.integer) or seed < 0:
         raise ValueError(f"seed: expected an integer >= 0, got {seed!r}")
     seed = int(seed)
+    if scenario.rotating:
+        return simulate_rotating(scenario, seed)
     truth = simulate_truth(scenario, seed)
     sensors = sorted(zip(scenario.sensors, scenario.pd, strict=True), key=lambda s: s[0].id)
     any_polar = any(isinstance(s, PolarRadar) for s, _ in sensors)
@@ -149,4 +160,28 @@ def simulate(scenario: Scenario, seed: int = 0) -> Simulation:
         R=np.concatenate(parts["R"]).reshape(-1, 2, 2) if keep_R else None,
         scan_times=(scenario.scan_indices(), scenario.scan_times()),
     )
+    return Simulation(scenario=scenario, seed=seed, plots=plots, truth=truth)
+
+
+def simulate_rotating(scenario: Scenario, seed: int = 0) -> Simulation:
+    """Simulate a scenario of rotating radars over ``[first·T, last·T]`` seconds.
+
+    ``plots``: a timed :class:`PlotTable` (``time`` = when the beam crossed the plot;
+    ``scan`` = frame of :func:`~mhtrack.frames.make_frames`; ``range``, ``bearing`` as
+    measured; ``x, y, R`` in the scenario's local frame; ``origin``), see
+    :mod:`mhtrack.scenario.sweep`. ``truth``: every ``truth_dt`` seconds from the start
+    (``scan`` = sample index), the targets alive then, on their Hermite trajectories
+    (:mod:`mhtrack.scenario.trajectory`) in the local frame.
+    """
+    from mhtrack.scenario.sweep import rotating_plots  # pyproj: imported only when used
+
+    grid = simulate_truth(scenario, seed)
+    segs = segments(grid)
+    sensor_set = scenario.sensor_set()
+    frame = sensor_set.frame()
+    sites = {s.id: sensor_set.site_latlon(s.id) for s in scenario.sensors}
+    window = (float(scenario.first * scenario.T), float(scenario.last * scenario.T))
+    radars = sorted(zip(scenario.sensors, scenario.pd, strict=True), key=lambda s: s[0].id)
+    plots = rotating_plots(radars, frame, sites, segs, window, seed)  # type: ignore[arg-type]
+    truth = sample_truth(segs, *window, scenario.truth_dt)
     return Simulation(scenario=scenario, seed=seed, plots=plots, truth=truth)

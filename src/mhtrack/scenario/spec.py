@@ -22,7 +22,7 @@ from __future__ import annotations
 import os
 from collections.abc import Mapping
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -33,7 +33,7 @@ from mhtrack.models.clutter import (
     TimeVaryingClutter,
     UniformClutter,
 )
-from mhtrack.models.sensors import CartesianSensor, PolarRadar, Sensor
+from mhtrack.models.sensors import CartesianSensor, PolarRadar, RotatingRadar, Sensor
 from mhtrack.scenario import _check as ck
 from mhtrack.scenario.dictform import (
     ClutterSpec,
@@ -46,6 +46,7 @@ from mhtrack.scenario.dictform import (
 from mhtrack.scenario.limits import (
     MAX_PLOTS,
     MAX_SCANS,
+    MAX_T,
     check_period,
     check_region,
     check_scan_range,
@@ -53,6 +54,9 @@ from mhtrack.scenario.limits import (
     check_state,
 )
 from mhtrack.scenario.targets import AnyTarget, RecordedTarget, Target
+
+if TYPE_CHECKING:
+    from mhtrack.models.radars import SensorSet
 
 
 @dataclass(frozen=True, eq=False, kw_only=True)
@@ -72,6 +76,10 @@ class Scenario:
     clutter : uniform, Gaussian-mixture or time-varying clutter model, drawn per sensor.
     truth_sigma_v : acceleration noise σv (m/s²) on the truth of :class:`Target` s
         (``Q(T)·σv²``, P1 §1.1); 0 = exact straight lines (default).
+    origin : ``(lat, lon)`` WGS-84 degrees of the local frame's tangent point, or None
+        (then the first sensor with ``lat``/``lon``): the geodetic frame of
+        :meth:`sensor_set` and of rotating radars.
+    truth_dt : with rotating radars, the truth is sampled every ``truth_dt`` s (default 1).
     description : free text (where the parameters come from).
 
     Two scenarios compare equal when their dict forms are equal, numbers to 1e-12
@@ -88,6 +96,8 @@ class Scenario:
     targets: tuple[AnyTarget, ...] = ()
     truth_sigma_v: float = 0.0
     description: str = field(default="")
+    origin: tuple[float, float] | None = None
+    truth_dt: float = 1.0
 
     def __post_init__(self) -> None:
         ck.string(self.name, "name")
@@ -107,8 +117,9 @@ class Scenario:
             raise ValueError("sensors: at least one sensor is needed")
         seen: set[int] = set()
         for i, s in enumerate(sensors):
-            if not isinstance(s, CartesianSensor | PolarRadar):
-                raise ValueError(f"sensors[{i}]: expected a CartesianSensor or PolarRadar")
+            if not isinstance(s, CartesianSensor | PolarRadar | RotatingRadar):
+                raise ValueError(f"sensors[{i}]: expected a CartesianSensor, PolarRadar or "
+                                 "RotatingRadar")
             sid = ck.integer(s.id, f"sensors[{i}].id", lo=0)
             if sid in seen:
                 raise ValueError(f"sensors[{i}].id: duplicate id {sid}")
@@ -136,6 +147,8 @@ class Scenario:
                 f"scenario region {self.region.as_tuple()}"
             )
 
+        self._check_rotating()
+
         targets = tuple(self.targets)
         tids: set[int] = set()
         for i, t in enumerate(targets):
@@ -151,6 +164,38 @@ class Scenario:
                     check_state(row, f"targets[{i}].states[{j}]")
         object.__setattr__(self, "targets", targets)
         self._check_size()
+
+    def _check_rotating(self) -> None:
+        """Rotating radars: all sensors rotate, the region clutter is off (they draw their
+        own), and there is a geodetic origin (``origin`` or a radar's ``lat``/``lon``)."""
+        if self.origin is not None:
+            o = tuple(self.origin)
+            if len(o) != 2:
+                raise ValueError(f"origin: expected (lat, lon), got {self.origin!r}")
+            lat = ck.number(o[0], "origin.lat", lo=-90.0, hi=90.0, unit="degrees")
+            lon = ck.number(o[1], "origin.lon", lo=-180.0, hi=180.0, unit="degrees")
+            object.__setattr__(self, "origin", (lat, lon))
+        object.__setattr__(self, "truth_dt", ck.number(
+            self.truth_dt, "truth_dt", lo=0.0, lo_open=True, hi=MAX_T, unit="s"))
+        if not self.rotating:
+            return
+        for i, s in enumerate(self.sensors):
+            if not isinstance(s, RotatingRadar):
+                raise ValueError(
+                    f"sensors[{i}]: a {s.kind} sensor without a period cannot be mixed with "
+                    "rotating radars (give every sensor a period, or none)")
+        if self.mean_clutter_rate() > 0:
+            raise ValueError(
+                "clutter.rate: rotating radars draw their own clutter per rotation "
+                "(sensors[].clutter_rate, sensors[].clutter_patches); the region's "
+                "clutter model must have rate 0")
+        if self.origin is None and all(s.lat is None for s in self.sensors):  # type: ignore[union-attr]
+            raise ValueError("origin: rotating radars are placed on the WGS-84 ellipsoid: "
+                             "give origin = {lat, lon} or a radar's lat/lon")
+        n_steps = (self.last - self.first) * self.T / self.truth_dt
+        if n_steps > MAX_SCANS:
+            raise ValueError(f"truth_dt: {n_steps:.3g} truth samples, more than "
+                             f"{MAX_SCANS} (MAX_SCANS)")
 
     def _check_size(self) -> None:
         """Refuse a scenario whose simulation would not fit in memory (:data:`MAX_PLOTS`)
@@ -171,12 +216,20 @@ class Scenario:
             else:
                 target_scans += sum(first <= k <= last for k in t.scans)
         clutter = n_sensors * self.mean_clutter_rate() * self.n_scans
-        total = clutter + n_sensors * target_scans
+        looks = float(n_sensors)  # plots per target and scan
+        if self.rotating:  # one look and one clutter draw per rotation
+            turns = [self.T / s.period for s in self.sensors]  # type: ignore[union-attr]
+            looks = sum(turns)
+            clutter = self.n_scans * sum(
+                n * s.mean_clutter() for n, s in zip(turns, self.sensors, strict=True))  # type: ignore[union-attr]
+        total = clutter + looks * target_scans
         if total <= MAX_PLOTS:
             return
         c = self.clutter
-        if clutter < n_sensors * target_scans:
+        if clutter < looks * target_scans:
             key = "targets"
+        elif self.rotating:
+            key = "sensors[].clutter_rate"
         elif isinstance(c, TimeVaryingClutter):
             i = int(np.argmax([m.rate_per_scan for _, m in c.keyframes]))
             key = f"clutter.keyframes[{i}].rate"
@@ -185,12 +238,25 @@ class Scenario:
         raise ValueError(
             f"{key}: a simulation would give about {ck.fmt(float(f'{total:.3g}'))} plots "
             f"({n_sensors} sensor(s) × mean clutter rate {ck.fmt(self.mean_clutter_rate())} "
-            f"× {self.n_scans} scans + {n_sensors * target_scans} target plots), more than "
+            f"× {self.n_scans} scans + {ck.fmt(looks * target_scans)} target plots), more than "
             f"the maximum {ck.fmt(MAX_PLOTS)} (MAX_PLOTS); lower the clutter rate or the "
             f"number of scans"
         )
 
     # ------------------------------------------------------------------ derived values
+    @property
+    def rotating(self) -> bool:
+        """The sensors are rotating radars (plots timed by the beam, SPEC §8)."""
+        return any(isinstance(s, RotatingRadar) for s in self.sensors)
+
+    def sensor_set(self) -> SensorSet:
+        """The sensors as :class:`~mhtrack.models.radars.SensorSet` (what a sensors file
+        holds) with this scenario's ``origin``; see
+        :func:`mhtrack.scenario.radarset.to_sensor_set`."""
+        from mhtrack.scenario.radarset import to_sensor_set
+
+        return to_sensor_set(self.origin, self.sensors, self.pd)  # type: ignore[arg-type]
+
     @property
     def first(self) -> int:
         return self.scans[0]
@@ -233,7 +299,13 @@ class Scenario:
     # ------------------------------------------------------------------ dict form
     def to_dict(self) -> dict[str, Any]:
         """Plain nested dict (tables, lists, strings, numbers) — the TOML schema of
-        ``docs/scenarios.md``; :func:`from_dict` reads it back to an equal scenario."""
+        ``docs/scenarios.md``; :func:`from_dict` reads it back to an equal scenario.
+        ``origin`` is written when set and ``truth_dt`` for rotating radars only."""
+        extra: dict[str, Any] = {}
+        if self.origin is not None:
+            extra["origin"] = {"lat": self.origin[0], "lon": self.origin[1]}
+        if self.rotating:
+            extra["truth_dt"] = float(self.truth_dt)
         return {
             "name": self.name,
             "description": self.description,
@@ -244,6 +316,7 @@ class Scenario:
             "sensors": [sensor_to_dict(s, p) for s, p in zip(self.sensors, self.pd, strict=True)],
             "targets": [target_to_dict(t) for t in self.targets],
             "clutter": clutter_to_dict(self.clutter),
+            **extra,
         }
 
     @classmethod

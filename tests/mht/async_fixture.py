@@ -99,7 +99,7 @@ def simulate_async(radars: list[Radar] | None = None, x0: np.ndarray | None = No
     cols: dict[str, list[np.ndarray]] = {k: [] for k in ("t", "s", "z", "R", "o")}
     for rad in radars:
         omega = 360.0 / rad.period
-        n_rot = int(math.ceil(duration / rad.period)) + 1
+        n_rot = math.ceil(duration / rad.period) + 1
         k0 = math.floor(rad.phase_deg / 360.0)  # rotation k: beam in [360k, 360(k+1))
         for k in range(n_rot):
             t_start = (360.0 * (k + k0) - rad.phase_deg) / omega

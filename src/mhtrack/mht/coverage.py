@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import math
 from abc import ABC, abstractmethod
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -28,6 +29,25 @@ from mhtrack.records import Scan
 #: Largest ``P_D`` a coverage assumes (as ``mhtrack.build.MAX_TRACKER_PD``): at ``P_D = 1``
 #: a single lost plot would cost ``ln 0``.
 MAX_COVERAGE_PD = 0.999
+#: Widest band (degrees) on each edge of a swept sector where a look is uncertain.
+MAX_EDGE_DEG = 10.0
+
+
+@dataclass(frozen=True, slots=True)
+class Looks:
+    """What a frame's sensor saw of each leaf: ``pd`` (L,) its ``P_D`` (0: not looked
+    at; gating and the update use it) and ``certain`` (L,) whether the look is sure enough
+    to score a miss — a leaf on the edge of the swept sector may be seen by this frame or
+    by the sensor's next one, so its miss costs nothing (``ln(1 − 0)``) while a plot may
+    still update it."""
+
+    pd: np.ndarray
+    certain: np.ndarray
+
+    @property
+    def miss_pd(self) -> np.ndarray:
+        """``P_D`` of the miss increment: ``pd`` where certain, else 0."""
+        return np.where(self.certain, self.pd, 0.0)
 
 
 class Coverage(ABC):
@@ -39,9 +59,10 @@ class Coverage(ABC):
     """
 
     @abstractmethod
-    def detection(self, scan: Scan, x: np.ndarray, time: np.ndarray) -> np.ndarray:
-        """``P_D`` (L,) of ``scan``'s sensor for leaves with states ``x`` (L, 4) at their
-        own times ``time`` (L,); 0 where the sensor did not look. Called once per frame."""
+    def detection(self, scan: Scan, x: np.ndarray, P: np.ndarray,
+                  time: np.ndarray) -> Looks:
+        """:class:`Looks` of ``scan``'s sensor at leaves with states ``x`` (L, 4), ``P``
+        (L, 4, 4) at their own times ``time`` (L,). Called once per frame."""
 
     @abstractmethod
     def plot_pd(self, scan: Scan) -> float:
@@ -64,8 +85,9 @@ class Everywhere(Coverage):
             raise ValueError(f"p_detection must be in (0, 1), got {p_detection}")
         self.p_detection = float(p_detection)
 
-    def detection(self, scan: Scan, x: np.ndarray, time: np.ndarray) -> np.ndarray:
-        return np.full(len(x), self.p_detection)
+    def detection(self, scan: Scan, x: np.ndarray, P: np.ndarray,
+                  time: np.ndarray) -> Looks:
+        return Looks(np.full(len(x), self.p_detection), np.ones(len(x), bool))
 
     def plot_pd(self, scan: Scan) -> float:
         return self.p_detection
@@ -94,6 +116,14 @@ class RadarCoverage(Coverage):
     leaves' alike; they differ from geodesic azimuths by the meridian convergence, which
     cancels between the two). A sensor without a period (or without a site) looks at
     everything within range every frame.
+
+    *Sector edges.* A leaf whose bearing is within ``band`` of either edge of the swept
+    sector — ``3σ`` of its own bearing (``√max(Pxx, Pyy)/r``) plus ``3σθ`` of the radar,
+    at most :data:`MAX_EDGE_DEG` — may be seen by this frame or by the sensor's next one:
+    it is looked at (gated, ``P_D`` for an update) by both, but a miss is scored only
+    where the look is certain (:class:`Looks`). Measured on the tests' two radars: with
+    sharp edges 24 of 202 target plots fell on a leaf the coverage had given to the
+    neighbouring frame (a duplicate track each time); with the band, none.
     """
 
     def __init__(self, sensors: SensorSet, *, max_pd: float = MAX_COVERAGE_PD) -> None:
@@ -118,7 +148,8 @@ class RadarCoverage(Coverage):
     def plot_pd(self, scan: Scan) -> float:
         return min(self.sensors.sensor(self._sensor_id(scan)).pd, self.max_pd)
 
-    def detection(self, scan: Scan, x: np.ndarray, time: np.ndarray) -> np.ndarray:
+    def detection(self, scan: Scan, x: np.ndarray, P: np.ndarray,
+                  time: np.ndarray) -> Looks:
         sid = self._sensor_id(scan)
         sensor = self.sensors.sensor(sid)
         pd = min(sensor.pd, self.max_pd)
@@ -130,7 +161,7 @@ class RadarCoverage(Coverage):
         x = np.asarray(x, float).reshape(-1, 4)
         looked = np.ones(len(x), bool)
         if site is None:
-            return np.where(looked, pd, 0.0)
+            return Looks(np.full(len(x), pd), looked)
         dt = tf - np.asarray(time, float)
         px = x[:, 0] + x[:, 1] * dt - site[0]
         py = x[:, 2] + x[:, 3] * dt - site[1]
@@ -148,8 +179,15 @@ class RadarCoverage(Coverage):
                 q0 = grid_bearing(px + x[:, 1] * d0, py + x[:, 3] * d0)
                 phi_f = (a_f - grid_bearing(px, py)) % 360.0
                 phi_0 = (a_f - omega * span - q0) % 360.0
-                looked &= phi_f < phi_0
-        return np.where(looked, pd, 0.0)
+                sig = np.sqrt(np.maximum(P[:, 0, 0], P[:, 2, 2])) / np.maximum(
+                    np.hypot(px, py), 1.0)
+                band = np.minimum(3.0 * np.degrees(sig) + 3.0 * (sensor.sigma_bearing_deg
+                                                                 or 0.0), MAX_EDGE_DEG)
+                crossed = phi_f < phi_0
+                certain = crossed & (phi_f >= band) & (phi_0 <= 360.0 - band)
+                possible = crossed | (phi_f > 360.0 - band) | (phi_0 < band)
+                return Looks(np.where(looked & possible, pd, 0.0), looked & certain)
+        return Looks(np.where(looked, pd, 0.0), looked)
 
     def arrays(self) -> dict[str, np.ndarray]:
         ids = sorted(self._last_end)

@@ -3,8 +3,9 @@ and gating each leaf against each plot at the plot's own time.
 
 *Looked-at trees.* A tree is stepped by a frame when its sensor looked at one of its
 leaves (:class:`~mhtrack.mht.coverage.Coverage`, ``P_D > 0``); its leaves then all get a
-miss child (``ln(1 − P_D·P_G)`` with each leaf's own ``P_D``, 0 for a leaf the beam did
-not reach) and their plot children, and the window of every leaf of the tree shifts by
+miss child (``ln(1 − P_D·P_G)``, each leaf with its own ``P_D``: 0 for a leaf the beam
+did not or may not have reached, :class:`~mhtrack.mht.coverage.Looks`) and their plot
+children, and the window of every leaf of the tree shifts by
 one column. The other trees are carried unchanged: no child, no prediction, no score
 change, no window shift. N-scan pruning therefore counts a tree's *looks* — the scans
 of the target in P1's sense — whatever the number of frames of other sectors and radars
@@ -23,6 +24,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from mhtrack.mht.coverage import Looks
 from mhtrack.mht.gating import Gate, Gated
 from mhtrack.mht.tree import Leaves, segment_ids
 from mhtrack.models.linalg2 import gaussian_loglik2, sym_mahalanobis2
@@ -37,13 +39,15 @@ def looked_trees(tree: np.ndarray, pd: np.ndarray) -> np.ndarray:
     return np.maximum.reduceat((pd > 0).astype(np.int8), starts)[seg] > 0
 
 
-def split_looked(leaves: Leaves, pd: np.ndarray) -> tuple[Leaves, np.ndarray, Leaves]:
-    """``(looked, pd of their leaves, idle)``: the leaves of the trees the frame looked at
-    and the others (the same object when every tree was looked at)."""
-    mask = looked_trees(leaves.tree, pd)
+def split_looked(leaves: Leaves, looks: Looks) -> tuple[Leaves, Looks, Leaves]:
+    """``(looked, their looks, idle)``: the leaves of the trees the frame looked at
+    (``P_D > 0`` at one of their leaves) and the others (the same objects when every tree
+    was looked at)."""
+    mask = looked_trees(leaves.tree, looks.pd)
     if mask.all():
-        return leaves, pd, leaves.take(np.zeros(0, np.int64))
-    return leaves.take(mask), pd[mask], leaves.take(~mask)
+        return leaves, looks, leaves.take(np.zeros(0, np.int64))
+    return (leaves.take(mask), Looks(looks.pd[mask], looks.certain[mask]),
+            leaves.take(~mask))
 
 
 def merge_by_tree(stepped: Leaves, idle: Leaves) -> Leaves:

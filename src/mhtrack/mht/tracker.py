@@ -143,16 +143,17 @@ class MHTTracker:
         caps: dict[str, int] = {}
         z, R, rows = validate_scan(scan, self._R, self._last_time, self._last_index)
         previous = Reported.of(self._leaves)
-        pd = self.coverage.detection(scan, self._leaves.x, self._leaves.time)
-        leaves, pd, idle = split_looked(self._leaves, pd)
+        looks = self.coverage.detection(scan, self._leaves.x, self._leaves.P,
+                                        self._leaves.time)
+        leaves, looks, idle = split_looked(self._leaves, looks)
         pred = predict_leaves(self.motion, leaves, ftime)
-        gated, pair_pred = gate_looked(self.gate, leaves, pred, pd, z, R, scan.t, ftime,
+        gated, pair_pred = gate_looked(self.gate, leaves, pred, looks.pd, z, R, scan.t, ftime,
                                        self.motion, caps)
         in_gates = plots_in_confirmed_gates(leaves, gated, len(z))
         kappa = clutter_intensity(self.clutter, scan, z, in_gates, cfg.min_clutter_density)
         update_dl = update_increment(gated.loglik, kappa[gated.plot],
                                      self.coverage.plot_pd(scan), cfg.new_target_density)
-        children = propose_children(leaves, gated, miss_increments(pd, self._miss_pg),
+        children = propose_children(leaves, gated, miss_increments(looks.miss_pd, self._miss_pg),
                                     update_dl)
         cand = self.birth.propose(scan, z, R, rows, kappa, in_gates, caps)
         children = prune_children(leaves, children, len(cand) + len(idle), self.sprt, cfg,

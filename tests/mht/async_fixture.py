@@ -75,10 +75,12 @@ class AsyncSim:
         return np.column_stack((x[:, 0] + x[:, 1] * t, x[:, 2] + x[:, 3] * t))
 
 
-def default_targets(n: int = 5, seed: int = 0) -> np.ndarray:
+def default_targets(n: int = 5, seed: int = 0, extent: float = 25_000.0,
+                    speeds: tuple[float, float] = (100.0, 250.0)) -> np.ndarray:
+    """``n`` constant-velocity targets, ``[x, vx, y, vy]`` at t = 0, within ``±extent``."""
     rng = np.random.default_rng(seed)
-    pos = rng.uniform(-25_000, 25_000, (n, 2))
-    speed = rng.uniform(100, 250, n)
+    pos = rng.uniform(-extent, extent, (n, 2))
+    speed = rng.uniform(*speeds, n)
     head = rng.uniform(0, 2 * np.pi, n)
     return np.column_stack((pos[:, 0], speed * np.sin(head), pos[:, 1], speed * np.cos(head)))
 

@@ -37,9 +37,12 @@ from mhtrack.clutter.agmm import AGMMClutter
 from mhtrack.clutter.base import ClutterEstimator
 from mhtrack.clutter.gmm import GMMClutter
 from mhtrack.clutter.known import KnownClutter
+from mhtrack.clutter.per_sensor import PerSensorClutter
 from mhtrack.initiation.factory import INITIATOR_CLASSES, make_initiator
 from mhtrack.initiation.fusion import AdaptiveKMeansFusion, KMeansFusion
 from mhtrack.mht import MHTConfig, MHTTracker
+from mhtrack.mht.coverage import RadarCoverage
+from mhtrack.models.radars import SensorSet
 from mhtrack.models.sensors import CartesianSensor
 from mhtrack.scenario import Scenario
 
@@ -91,19 +94,34 @@ def make_tracker(
     clutter_density: float | None = None,
     birth: str | None = None,
     theta_deg: float | None = None,
+    sensors: SensorSet | None = None,
 ) -> MHTTracker:
     """A fresh tracker by name (:data:`TRACKER_ESTIMATORS`).
 
     ``clutter_density``: the known κ (per m² per scan) of ``mht`` (default
     :data:`DEFAULT_CLUTTER_DENSITY`; ignored by the trackers that estimate it).
     ``birth`` (:data:`mhtrack.names.BIRTHS`) and ``theta_deg`` override ``config.birth`` /
-    ``config.birth_theta_deg`` when given."""
+    ``config.birth_theta_deg`` when given.
+
+    ``sensors``: the radars of asynchronous plots (frames of one sensor each,
+    :mod:`mhtrack.frames`). The tracker then scores each leaf with the ``P_D`` of the
+    frame's radar where its beam swept (:class:`~mhtrack.mht.coverage.RadarCoverage`),
+    and estimates clutter per radar, a rotation at a time
+    (:class:`~mhtrack.clutter.per_sensor.PerSensorClutter`, the tracker's estimator per
+    radar; ``known``: κ per m² per look)."""
     if name not in TRACKER_ESTIMATORS:
         raise ValueError(f"unknown tracker {name!r} "
                          f"(expected one of {', '.join(TRACKER_ESTIMATORS)})")
     config = config_with(config, birth=birth, birth_theta_deg=theta_deg)
     kappa = clutter_density if takes_clutter_density(name) else None
-    return MHTTracker(config, make_clutter_estimator(TRACKER_ESTIMATORS[name], kappa=kappa))
+    estimator = TRACKER_ESTIMATORS[name]
+    if sensors is None:
+        return MHTTracker(config, make_clutter_estimator(estimator, kappa=kappa))
+    clutter = PerSensorClutter(
+        lambda: make_clutter_estimator(estimator, kappa=kappa),
+        {s.id: s.period for s in sensors.sensors},
+        initial=DEFAULT_CLUTTER_DENSITY if kappa is None else kappa)
+    return MHTTracker(config, clutter, coverage=RadarCoverage(sensors))
 
 
 # ---------------------------------------------------------------------- defaults

@@ -34,6 +34,7 @@ from mhtrack.build import (
 from mhtrack.initiation.fusion import AdaptiveKMeansFusion
 from mhtrack.metrics import Evaluation, evaluate
 from mhtrack.mht import MHTConfig, MHTTracker, StepStats
+from mhtrack.models.radars import SensorSet
 from mhtrack.names import OUTPUTS, TRACKER_FUSIONS
 from mhtrack.records import PlotTable, Scan, TrackTable
 from mhtrack.scenario import Scenario, Simulation, simulate
@@ -92,17 +93,26 @@ class TrackingRun:
         return total
 
 
-
-
 def track(
-    tracker: MHTTracker, scans: PlotTable | Iterable[Scan], *, name: str = "mht",
+    tracker: MHTTracker | str, scans: PlotTable | Iterable[Scan], *, name: str = "mht",
     progress: bool = False, fusion: str = "none", output: str = "history",
+    sensors: SensorSet | None = None, config: MHTConfig | None = None,
 ) -> TrackingRun:
     """Run ``tracker`` over ``scans`` (a :class:`PlotTable` or scans), one step per scan;
     with ``fusion="adaptive-kmeans"`` each scan is fused first (module docstring).
-    ``output``: one of :data:`OUTPUTS`."""
+    ``output``: one of :data:`OUTPUTS`.
+
+    A timed table (``PlotTable.timed``: plots with their own times, several radars) is
+    stepped frame by frame, unfused. ``tracker`` may be a tracker name; it is then built
+    by :func:`~mhtrack.build.make_tracker` with ``config`` and ``sensors`` (the radars'
+    coverage and per-radar clutter)."""
     if output not in OUTPUTS:
         raise ValueError(f"unknown output {output!r} (expected one of {', '.join(OUTPUTS)})")
+    if isinstance(tracker, str):
+        name, tracker = tracker, make_tracker(tracker, config, sensors=sensors)
+    if isinstance(scans, PlotTable) and scans.timed and fusion != "none":
+        raise ValueError("plots with their own times are tracked frame by frame, one "
+                         f"sensor per frame: use fusion 'none', not {fusion!r}")
     total = None
     if isinstance(scans, PlotTable):
         total = scans.n_scans

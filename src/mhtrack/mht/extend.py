@@ -21,36 +21,41 @@ from mhtrack.models.motion import MotionModel, States
 class Children:
     """Candidate children of the leaves before their Kalman update (cheap to prune).
 
-    ``parent`` indexes the parent leaf, ``plot`` the plot within the scan (``-1``: miss);
-    rows are ordered by parent, the miss first, then plots in scan order.
+    ``parent`` indexes the parent leaf, ``plot`` the plot within the scan (``-1``: miss),
+    ``pair`` the gated pair (``-1``: miss); rows are ordered by parent, the miss first,
+    then plots in scan order.
     """
 
     parent: np.ndarray
     plot: np.ndarray
     score: np.ndarray
     peak: np.ndarray
+    pair: np.ndarray
 
     def __len__(self) -> int:
         return int(self.parent.shape[0])
 
     def take(self, idx: np.ndarray) -> Children:
-        return Children(self.parent[idx], self.plot[idx], self.score[idx], self.peak[idx])
+        return Children(self.parent[idx], self.plot[idx], self.score[idx], self.peak[idx],
+                        self.pair[idx])
 
 
 def propose_children(
-    leaves: Leaves, gated: Gated, miss_dl: float, update_dl: np.ndarray
+    leaves: Leaves, gated: Gated, miss_dl: float | np.ndarray, update_dl: np.ndarray
 ) -> Children:
     """Each leaf spawns a miss child (``L + ΔL_miss``) and one child per gated plot
-    (``L + ΔL_update``), P1 eqs. 4–5. ``update_dl`` is per gated pair."""
+    (``L + ΔL_update``), P1 eqs. 4–5. ``update_dl`` is per gated pair, ``miss_dl`` one
+    value or one per leaf (its sensor coverage's ``P_D``)."""
     n = len(leaves)
     parent = np.concatenate((np.arange(n, dtype=np.int64), gated.track))
     plot = np.concatenate((np.full(n, NO_PLOT, np.int64), gated.plot))
+    pair = np.concatenate((np.full(n, -1, np.int64), np.arange(len(gated), dtype=np.int64)))
     score = np.concatenate((leaves.score + miss_dl, leaves.score[gated.track] + update_dl))
     # gated pairs are sorted by (leaf, plot); a stable sort on the parent puts the miss
     # first and keeps the plot order.
     order = np.argsort(parent, kind="stable")
-    parent, plot, score = parent[order], plot[order], score[order]
-    return Children(parent, plot, score, np.maximum(leaves.peak[parent], score))
+    parent, plot, score, pair = parent[order], plot[order], score[order], pair[order]
+    return Children(parent, plot, score, np.maximum(leaves.peak[parent], score), pair)
 
 
 def grow_children(
@@ -61,16 +66,26 @@ def grow_children(
     R: np.ndarray,
     rows: np.ndarray,
     motion: MotionModel,
+    time: float,
+    pair_pred: States | None = None,
+    plot_time: np.ndarray | None = None,
 ) -> Leaves:
-    """Materialise ``children`` as leaves: misses keep the prediction ``pred``, updates get
-    the motion model's update with their plot (``R`` shared (2, 2) or per plot (n, 2, 2);
-    with an IMM, each model's update and ``x, P`` their mixture)."""
+    """Materialise ``children`` as leaves: misses keep the prediction ``pred`` (at the
+    frame's ``time``), updates get the motion model's update with their plot (``R``
+    shared (2, 2) or per plot (n, 2, 2); with an IMM, each model's update and ``x, P``
+    their mixture). With asynchronous plots the update starts from ``pair_pred``, the
+    parent predicted to its plot's own time (one row per gated pair), and the child's
+    time is the plot's, ``plot_time`` (n,)."""
     par, plot = children.parent, children.plot
     st = pred.take(par)
+    child_time = np.full(len(par), float(time))
     upd = np.flatnonzero(plot >= 0)
     if upd.size:
         pj = plot[upd]
-        st.put(upd, motion.update(st.take(upd), z[pj], R if R.ndim == 2 else R[pj]))
+        start = st.take(upd) if pair_pred is None else pair_pred.take(children.pair[upd])
+        st.put(upd, motion.update(start, z[pj], R if R.ndim == 2 else R[pj]))
+        if plot_time is not None:
+            child_time[upd] = plot_time[pj]
     new_col = np.where(plot >= 0, rows[np.maximum(plot, 0)] if rows.size else NO_PLOT, NO_PLOT)
     window = np.concatenate((leaves.window[par, 1:], new_col[:, None]), axis=1)
     return Leaves(
@@ -89,4 +104,5 @@ def grow_children(
         Pm=st.Pm,
         node=np.full(len(par), -1, np.int64),
         parent=leaves.node[par],
+        time=child_time,
     )

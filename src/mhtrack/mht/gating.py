@@ -165,12 +165,14 @@ class Gate:
 
     def __call__(self, leaves: Leaves, pred: States, z: np.ndarray, R: np.ndarray,
                  motion: MotionModel, caps: dict[str, int]) -> Gated:
-        g = self._pairs(leaves, pred.x, pred.P, z, R, caps)
+        g = self.pairs(leaves, pred.x, pred.P, z, R, caps)
         return Gated(g.track, g.plot, g.d2,
                      motion.gating_loglik(pred, g.track, g.plot, z, R, g.loglik))
 
-    def _pairs(self, leaves: Leaves, xp: np.ndarray, Pp: np.ndarray, z: np.ndarray,
-               R: np.ndarray, caps: dict[str, int]) -> Gated:
+    def pairs(self, leaves: Leaves, xp: np.ndarray, Pp: np.ndarray, z: np.ndarray,
+              R: np.ndarray, caps: dict[str, int]) -> Gated:
+        """The pairs of :func:`gate_sweep` of states ``xp``, ``Pp`` within the work budget
+        (class docstring), with the Gaussian ``loglik`` of ``xp, Pp``."""
         budget = self.max_pairs
         if len(leaves) * len(z) <= budget:
             return gate_sweep(xp, Pp, z, R, self.gamma)

@@ -43,6 +43,7 @@ class _Logged:
     P: np.ndarray
     plot: np.ndarray
     score: np.ndarray
+    t: np.ndarray  # each leaf's own time
 
     @classmethod
     def of(cls, scan: int, time: float, leaves: Leaves) -> _Logged:
@@ -53,7 +54,7 @@ class _Logged:
             node = leaves.node[sel]
         return cls(np.array([scan], np.int64), np.array([time], float), node,
                    leaves.parent[sel], leaves.x[sel], leaves.P[sel], leaves.window[sel, -1],
-                   leaves.score[sel])
+                   leaves.score[sel], leaves.time[sel])
 
 
 class TentativeHistory:
@@ -94,10 +95,14 @@ class TentativeHistory:
         parts: list[TrackTable] = []
         for i in range(len(self._log) - 1, -1, -1):
             log = self._log[i]
-            if cur.size == 0 or log.node.size == 0:
-                break  # every chain has ended (an ancestor is logged at every scan)
+            if cur.size == 0:
+                break  # every chain has ended
+            if log.node.size == 0:
+                continue
             j = np.minimum(np.searchsorted(log.node, cur), log.node.size - 1)
             found = log.node[j] == cur
+            # a leaf a frame did not step is logged at an older frame: look further back
+            wait_cur, wait_tid = cur[~found], tid[~found]
             j, tid = j[found], tid[found]
             plot = log.plot[j]
             ok = (plot < 0) | ~np.isin(plot, self._claimed[i])
@@ -111,13 +116,15 @@ class TentativeHistory:
             x = log.x[j]
             n = j.size
             parts.append(TrackTable(
-                scan=np.repeat(log.scan, n), time=np.repeat(log.time, n), track_id=tid,
+                scan=np.repeat(log.scan, n), time=log.t[j], track_id=tid,
                 x=x[:, 0].copy(), y=x[:, 2].copy(), vx=x[:, 1].copy(), vy=x[:, 3].copy(),
                 plot=plot, score=log.score[j], P=log.P[j],
                 tentative=np.ones(n, bool)))
             cur = log.parent[j]
             live = cur >= 0
             cur, tid = cur[live], tid[live]
+            if wait_cur.size:
+                cur, tid = np.concatenate((cur, wait_cur)), np.concatenate((tid, wait_tid))
         parts.reverse()
         return TrackTable.concat(parts).sorted()
 
@@ -136,6 +143,8 @@ class TentativeHistory:
         self._log.clear()
         self._claimed.clear()
         for i in range(int(arrays["count"][0]) if "count" in arrays else 0):
-            self._log.append(_Logged(**{f.name: np.asarray(arrays[f"{i}__{f.name}"])
-                                        for f in fields(_Logged)}))
+            got = {f.name: np.asarray(arrays[f"{i}__{f.name}"]) for f in fields(_Logged)
+                   if f"{i}__{f.name}" in arrays}
+            got.setdefault("t", np.full(got["node"].size, float(got["time"][0])))
+            self._log.append(_Logged(**got))
             self._claimed.append(np.asarray(arrays[f"{i}__claimed"], np.int64))

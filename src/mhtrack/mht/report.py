@@ -49,15 +49,20 @@ def confirmed_windows(leaves: Leaves) -> np.ndarray:
     return leaves.window[leaves.chosen & (leaves.track >= 0)]
 
 
-def report(scan: Scan, leaves: Leaves) -> TrackTable:
-    """Confirmed tracks of the best hypothesis at ``scan``, ordered by track id."""
-    sel = np.flatnonzero(leaves.chosen & (leaves.track >= 0))
+def report(scan: Scan, leaves: Leaves, stepped: np.ndarray | None = None) -> TrackTable:
+    """Confirmed tracks of the best hypothesis at ``scan``, ordered by track id; each row
+    at its state's own time (``Leaves.time``). ``stepped`` (mask): only the leaves this
+    frame stepped (a frame of one radar's sector reports the tracks it looked at)."""
+    rep = leaves.chosen & (leaves.track >= 0)
+    if stepped is not None:
+        rep &= stepped
+    sel = np.flatnonzero(rep)
     sel = sel[np.argsort(leaves.track[sel], kind="stable")]
     x = leaves.x[sel]
     n = sel.size
     return TrackTable(
         scan=np.full(n, int(scan.index), np.int64),
-        time=np.full(n, float(scan.time)),
+        time=leaves.time[sel].copy(),
         track_id=leaves.track[sel],
         x=x[:, 0].copy(),
         y=x[:, 2].copy(),

@@ -30,6 +30,18 @@ def miss_increment(p_detection: float, gate_probability: float | None = None) ->
     return math.log1p(-p_detection * pg)
 
 
+def miss_increments(p_detection: np.ndarray, gate_probability: float | None = None
+                    ) -> np.ndarray:
+    """:func:`miss_increment` per leaf, each with its own ``P_D`` (the frame's sensor's
+    coverage, :mod:`mhtrack.mht.coverage`); ``P_D = 0`` (not looked at) gives 0. Computed
+    once per distinct ``P_D`` with :func:`miss_increment`, so a constant ``P_D`` gives
+    exactly the scalar increment."""
+    pd = np.asarray(p_detection, float)
+    values, inverse = np.unique(pd, return_inverse=True)
+    return np.array([miss_increment(float(v), gate_probability) for v in values],
+                    float)[inverse.reshape(-1)] if pd.size else np.zeros(0)
+
+
 def update_increment(
     loglik: np.ndarray, kappa: np.ndarray, p_detection: float, new_target_density: float
 ) -> np.ndarray:

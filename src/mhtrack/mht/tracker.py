@@ -3,17 +3,21 @@
 The tracking cycle, one stage per line of :meth:`MHTTracker.step`::
 
     validate         validate.validate_scan          the scan at the library boundary
+    coverage         coverage.Coverage               P_D of each leaf (0: sensor did not look)
+    looked-at trees  timed.split_looked              trees the frame steps; others carried
     predict          predict.predict_leaves          all leaves to the scan time (motion model)
-    gate             gating.Gate                     every leaf against every plot, ln p(z|T)
+    gate             timed.gate_looked               every leaf against every plot (each at
+                                                       its plot's own time), ln p(z|T)
     clutter          intensity.clutter_intensity     κ̂(z) of the scan's plots (estimator)
     score            scoring.update_increment        ΔL of every gated pair
-    extend trees     tree.propose_children           miss + one child per gated plot
+    extend trees     extend.propose_children         miss + one child per gated plot
     propose births   births.Birth.propose            new trees' first leaves (birth process)
     prune children   pruning.prune_children          SPRT deletion, score drop, caps — before
                                                      the (costly) update
-    grow             tree.grow_children              the children's filter update
+    grow             extend.grow_children            the children's filter update
     seed births      births.Birth.seed               the new trees, with tree ids
     number nodes     numbering.number_nodes          leaf ids for the history links
+    merge            timed.merge_by_tree             the trees the frame did not step back
     global hyp.      hypothesis.best_hypothesis      clusters → best compatible leaves
     N-scan pruning   pruning.prune_after_solve       decide scan k − N; cap on trees
     hand over        identity.hand_over              a track follows its plots
@@ -26,9 +30,12 @@ The tracking cycle, one stage per line of :meth:`MHTTracker.step`::
     caps             caps.CapWarnings                log the hard caps that acted
 
 The motion model (:class:`~mhtrack.models.motion.MotionModel`: CV or IMM), the clutter
-estimator (:class:`~mhtrack.clutter.base.ClutterEstimator`) and the birth process
-(:class:`~mhtrack.mht.births.base.Birth`) are parts passed in; saving and restoring is
-:mod:`mhtrack.mht.state`.
+estimator (:class:`~mhtrack.clutter.base.ClutterEstimator`), the birth process
+(:class:`~mhtrack.mht.births.base.Birth`) and the sensors' coverage
+(:class:`~mhtrack.mht.coverage.Coverage`) are parts passed in; saving and restoring is
+:mod:`mhtrack.mht.state`. Synchronous scans are the special case of frames whose plots
+all have the frame's time and whose sensor looks at every leaf (``docs/mht.md``,
+*Asynchronous plots*).
 """
 
 from __future__ import annotations
@@ -44,6 +51,7 @@ from mhtrack.clutter.known import KnownClutter
 from mhtrack.mht.births import Birth, make_birth
 from mhtrack.mht.caps import CapWarnings, solver_caps
 from mhtrack.mht.config import MHTConfig
+from mhtrack.mht.coverage import Coverage, Everywhere
 from mhtrack.mht.extend import grow_children, propose_children
 from mhtrack.mht.gating import Gate, plots_in_confirmed_gates
 from mhtrack.mht.history import TentativeHistory
@@ -54,9 +62,10 @@ from mhtrack.mht.numbering import Counter, number_nodes
 from mhtrack.mht.predict import predict_leaves
 from mhtrack.mht.pruning import prune_after_solve, prune_children
 from mhtrack.mht.report import StepStats, confirmed_windows, report
-from mhtrack.mht.scoring import miss_increment, update_increment
+from mhtrack.mht.scoring import miss_increments, update_increment
 from mhtrack.mht.sprt import SPRT
 from mhtrack.mht.state import load_state, save_state
+from mhtrack.mht.timed import gate_looked, merge_by_tree, split_looked
 from mhtrack.mht.tree import Leaves
 from mhtrack.mht.validate import validate_scan
 from mhtrack.models.motion import MotionModel
@@ -75,6 +84,9 @@ class MHTTracker:
         constant-velocity model when ``imm_sigma_v = 0``).
     birth : the birth process; default the one ``config.birth`` names
         (:func:`~mhtrack.mht.births.make_birth`).
+    coverage : the sensors' coverage (:mod:`mhtrack.mht.coverage`); default
+        :class:`~mhtrack.mht.coverage.Everywhere` with ``config.p_detection`` (every leaf
+        looked at every scan: P1's scans).
 
     Examples
     --------
@@ -86,17 +98,18 @@ class MHTTracker:
     def __init__(
         self, config: MHTConfig | None = None, clutter: ClutterEstimator | None = None, *,
         motion: MotionModel | None = None, birth: Birth | None = None,
+        coverage: Coverage | None = None,
     ) -> None:
         self.config = cfg = MHTConfig() if config is None else config
         self.clutter: ClutterEstimator = KnownClutter() if clutter is None else clutter
         self.motion: MotionModel = cfg.motion if motion is None else motion
-        self.birth: Birth = make_birth(cfg, self.motion) if birth is None else birth
+        self.coverage: Coverage = Everywhere(cfg.p_detection) if coverage is None else coverage
+        self.birth: Birth = (make_birth(cfg, self.motion, self.coverage.plot_pd)
+                             if birth is None else birth)
         self.sprt = SPRT.from_config(cfg)
         self.gate = Gate(cfg.gate_probability, cfg.max_gated_pairs)
         self._R = np.eye(2) * cfg.sigma_w**2
-        self._miss_dl = miss_increment(
-            cfg.p_detection, cfg.gate_probability if cfg.miss_uses_gate_probability else None
-        )
+        self._miss_pg = cfg.gate_probability if cfg.miss_uses_gate_probability else None
         self._leaves = Leaves.empty(cfg.n_scan + 1, self.motion.n_models)
         self._last_time: float | None = None
         self._last_index: int | None = None
@@ -126,44 +139,51 @@ class MHTTracker:
         :attr:`last_backfill`; a warning is logged (once) when a hard cap acted.
         """
         t0 = time.perf_counter()
-        cfg, leaves = self.config, self._leaves
+        cfg, ftime = self.config, float(scan.time)
         caps: dict[str, int] = {}
         z, R, rows = validate_scan(scan, self._R, self._last_time, self._last_index)
-        previous = Reported.of(leaves)
-        pred = predict_leaves(self.motion, leaves, self._dt(scan))
-        gated = self.gate(leaves, pred, z, R, self.motion, caps)
+        previous = Reported.of(self._leaves)
+        looks = self.coverage.detection(scan, self._leaves.x, self._leaves.P,
+                                        self._leaves.time)
+        leaves, looks, idle = split_looked(self._leaves, looks)
+        pred = predict_leaves(self.motion, leaves, ftime)
+        gated, pair_pred = gate_looked(self.gate, leaves, pred, looks.pd, z, R, scan.t, ftime,
+                                       self.motion, caps)
         in_gates = plots_in_confirmed_gates(leaves, gated, len(z))
         kappa = clutter_intensity(self.clutter, scan, z, in_gates, cfg.min_clutter_density)
-        update_dl = update_increment(gated.loglik, kappa[gated.plot], cfg.p_detection,
-                                     cfg.new_target_density)
-        children = propose_children(leaves, gated, self._miss_dl, update_dl)
+        update_dl = update_increment(gated.loglik, kappa[gated.plot],
+                                     self.coverage.plot_pd(scan), cfg.new_target_density)
+        children = propose_children(leaves, gated, miss_increments(looks.miss_pd, self._miss_pg),
+                                    update_dl)
         cand = self.birth.propose(scan, z, R, rows, kappa, in_gates, caps)
-        children = prune_children(leaves, children, len(cand), self.sprt, cfg, caps)
-        grown = grow_children(leaves, pred, children, z, R, rows, self.motion)
+        children = prune_children(leaves, children, len(cand) + len(idle), self.sprt, cfg,
+                                  caps)
+        grown = grow_children(leaves, pred, children, z, R, rows, self.motion, ftime,
+                              pair_pred, scan.t)
         births = self.birth.seed(scan, cand, grown.window, self.trees, caps)
-        leaves = number_nodes(Leaves.concat(grown, births), self.nodes)
+        first_node = self.nodes.next
+        leaves = merge_by_tree(number_nodes(Leaves.concat(grown, births), self.nodes), idle)
         hyp = best_hypothesis(leaves.score, leaves.tree, leaves.window, cfg.max_cluster_size,
                               cfg.milp_time_limit)
         solver_caps(hyp, caps)
         leaves = prune_after_solve(leaves, hyp.leaves, cfg.max_trees, caps)
+        # the leaves this frame stepped (new node ids); None: all of them
+        is_new = None if len(idle) == 0 else leaves.node >= first_node
         first_new = self.tracks.next
         leaves = hand_over(leaves, previous)
         leaves = confirm(leaves, self.sprt.confirms(leaves), self.tracks)
         self.last_backfill = self._history.backfill(leaves, newly_confirmed(leaves, first_new))
-        self._history.record(int(scan.index), float(scan.time), leaves)
+        self._history.record(int(scan.index), ftime,
+                             leaves if is_new is None else leaves.take(is_new))
         used = confirmed_windows(leaves)
         self.birth.forget_used(used)
         self.clutter.forget(np.isin(rows, used[:, -1]))
-        self._leaves, self._last_time, self._last_index = leaves, float(scan.time), int(scan.index)
-        out = report(scan, leaves)
+        self._leaves, self._last_time, self._last_index = leaves, ftime, int(scan.index)
+        out = report(scan, leaves, is_new)
         self.last_stats = StepStats.of(scan, len(z), leaves, births, hyp, out,
                                        time.perf_counter() - t0, caps)
         self._cap_warnings(int(scan.index), caps)
         return out
-
-    def _dt(self, scan: Scan) -> float | None:
-        """Seconds since the last scan (``None`` before the first)."""
-        return None if self._last_time is None else float(scan.time) - self._last_time
 
     def run(
         self, scans: Iterable[Scan] | PlotTable, stats: list[StepStats] | None = None,
@@ -190,7 +210,7 @@ class MHTTracker:
     def save(self, path: str | PathLike[str]) -> None:
         """Write the full state to one ``.npz`` (no pickle; :mod:`mhtrack.mht.state`)."""
         parts = {"leaves": self._leaves.arrays(), "birth": self.birth.arrays(),
-                 "history": self._history.arrays()}
+                 "history": self._history.arrays(), "coverage": self.coverage.arrays()}
         save_state(path, parts, self.clutter, self.config, {
             "last_time": self._last_time, "last_index": self._last_index,
             "next_tree": self.trees.next, "next_track": self.tracks.next,
@@ -200,18 +220,23 @@ class MHTTracker:
     def load(
         cls, path: str | PathLike[str], clutter: ClutterEstimator | None = None, *,
         motion: MotionModel | None = None, birth: Birth | None = None,
+        coverage: Coverage | None = None,
     ) -> MHTTracker:
         """Restore a tracker written by :meth:`save`. ``clutter`` is an estimator of the
         same kind (its state is overwritten); it may be omitted for the ``known`` one.
-        ``motion`` and ``birth`` as in the constructor (the saved birth state is loaded
-        into ``birth``)."""
+        ``motion``, ``birth`` and ``coverage`` as in the constructor (the saved birth and
+        coverage states are loaded into them)."""
         saved = load_state(path, clutter)
-        trk = cls(saved.config, saved.clutter, motion=motion, birth=birth)
+        trk = cls(saved.config, saved.clutter, motion=motion, birth=birth, coverage=coverage)
         meta = saved.meta
-        trk._leaves = Leaves.from_arrays(saved.part("leaves"))
+        leaves = saved.part("leaves")
+        if "time" not in leaves:  # saved before leaves had their own times
+            leaves["time"] = np.full(len(leaves["score"]), meta["last_time"] or 0.0)
+        trk._leaves = Leaves.from_arrays(leaves)
         trk._last_time, trk._last_index = meta["last_time"], meta["last_index"]
         trk.trees, trk.tracks = Counter(meta["next_tree"]), Counter(meta["next_track"])
         trk.nodes = Counter(meta["next_node"])
         trk._history.set_arrays(saved.part("history"))
         trk.birth.set_arrays(saved.part("birth"))
+        trk.coverage.set_arrays(saved.part("coverage"))
         return trk

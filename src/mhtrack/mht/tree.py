@@ -45,6 +45,9 @@ class Leaves:
         the leaf it grew from (``-1`` for a tree's root). New leaves get ``-1`` here and
         their ids from the tracker; they link a track back to its tentative past
         (:mod:`mhtrack.mht.history`).
+    time : (L,) time (s) of the leaf's state ``x, P``: its last plot's own time, or the
+        time of the frame that last predicted it (a miss). With synchronous scans every
+        leaf's time is the last scan's.
     """
 
     x: np.ndarray
@@ -62,6 +65,7 @@ class Leaves:
     Pm: np.ndarray
     node: np.ndarray
     parent: np.ndarray
+    time: np.ndarray
 
     def __len__(self) -> int:
         return int(self.score.shape[0])
@@ -73,7 +77,7 @@ class Leaves:
         f = np.zeros(0)
         return cls(np.zeros((0, 4)), np.zeros((0, 4, 4)), f, f, i, i, i, i,
                    np.zeros((0, width), np.int64), np.zeros(0, bool), np.zeros((0, r)),
-                   np.zeros((0, r, 4)), np.zeros((0, r, 4, 4)), i, i)
+                   np.zeros((0, r, 4)), np.zeros((0, r, 4, 4)), i, i, f)
 
     def take(self, idx: np.ndarray) -> Leaves:
         """Rows ``idx`` (an index array or boolean mask), in that order."""
@@ -146,9 +150,10 @@ def one_point_state(z: np.ndarray, R: np.ndarray, v_max: float) -> tuple[np.ndar
 
 def new_trees(
     states: States, score: np.ndarray, peak: np.ndarray, tree: np.ndarray, scan_index: int,
-    n_updates: np.ndarray, window: np.ndarray,
+    n_updates: np.ndarray, window: np.ndarray, time: np.ndarray,
 ) -> Leaves:
-    """Root leaves of new trees (tentative, not chosen, node ids not yet given)."""
+    """Root leaves of new trees (tentative, not chosen, node ids not yet given) with
+    states at ``time`` (n,)."""
     n = len(score)
     return Leaves(
         x=states.x,
@@ -166,4 +171,5 @@ def new_trees(
         Pm=states.Pm,
         node=np.full(n, -1, np.int64),
         parent=np.full(n, -1, np.int64),
+        time=np.asarray(time, float),
     )

@@ -22,11 +22,19 @@ def validate_scan(
         raise ValueError(f"scan {scan.index}: {rows.size} row ids for {n} plots")
     if not np.isfinite(scan.time):
         raise ValueError(f"scan {scan.index}: time {scan.time} is not finite")
-    if last_time is not None and not scan.time > last_time:
+    timed = scan.t is not None
+    # frames of two radars may end at the same time; scans must move on
+    if last_time is not None and not (scan.time >= last_time if timed
+                                      else scan.time > last_time):
         raise ValueError(
             f"scan {scan.index}: time {scan.time} s is not after the previous scan "
             f"({last_index}, {last_time} s); dt must be > 0"
         )
+    if timed:
+        t = np.asarray(scan.t, float).reshape(-1)
+        if t.size != n or not np.isfinite(t).all() or (t > scan.time).any():
+            raise ValueError(f"scan {scan.index}: plot times must be {n} finite values "
+                             f"<= the frame's time {scan.time} s")
     bad = ~np.isfinite(z).all(axis=1)
     if bad.any():
         i = int(np.flatnonzero(bad)[0])

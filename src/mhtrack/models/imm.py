@@ -59,20 +59,35 @@ class CVModelSet(MotionModel):
         """Equal model probabilities for ``n`` new tracks, (n, r)."""
         return np.full((n, self.r), 1.0 / self.r)
 
-    def transition(self, dt: float) -> np.ndarray:
-        """Mode transition matrix ``π`` (r, r) for a scan interval ``dt``."""
-        stay = math.exp(-dt / self.mode_time)
-        pi = np.full((self.r, self.r), (1.0 - stay) / (self.r - 1))
-        np.fill_diagonal(pi, stay)
+    def transition(self, dt: float | np.ndarray) -> np.ndarray:
+        """Mode transition matrix ``π`` (r, r) for a scan interval ``dt``, or (M, r, r) for
+        one interval per row; ``π_ii = exp(−|dt|/τ)`` (a negative ``dt``, a plot slightly
+        older than the track, still lets the mode change)."""
+        if np.ndim(dt) == 0:
+            stay = math.exp(-dt / self.mode_time)
+            pi = np.full((self.r, self.r), (1.0 - stay) / (self.r - 1))
+            np.fill_diagonal(pi, stay)
+            return pi
+        stay = np.exp(-np.abs(np.asarray(dt, float)) / self.mode_time)
+        pi = np.repeat(((1.0 - stay) / (self.r - 1))[:, None, None], self.r, axis=1)
+        pi = np.repeat(pi, self.r, axis=2)
+        idx = np.arange(self.r)
+        pi[:, idx, idx] = stay[:, None]
         return pi
 
     def predict_models(
-        self, xm: np.ndarray, Pm: np.ndarray, mu: np.ndarray, dt: float
+        self, xm: np.ndarray, Pm: np.ndarray, mu: np.ndarray, dt: float | np.ndarray
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Mixing and per-model prediction: ``(x⁻, P⁻, μ̄)`` (module docstring)."""
+        """Mixing and per-model prediction: ``(x⁻, P⁻, μ̄)`` (module docstring); ``dt``
+        one interval or one per row."""
         pi = self.transition(dt)
-        mubar = mu @ pi  # (M, r)
-        w = pi[None, :, :] * mu[:, :, None] / np.maximum(mubar, 1e-300)[:, None, :]  # (M,i,j)
+        if pi.ndim == 2:
+            mubar = mu @ pi  # (M, r)
+            pim = pi[None, :, :]
+        else:
+            mubar = np.einsum("mi,mij->mj", mu, pi)
+            pim = pi
+        w = pim * mu[:, :, None] / np.maximum(mubar, 1e-300)[:, None, :]  # (M,i,j)
         x0 = np.einsum("mij,mia->mja", w, xm)
         d = xm[:, :, None, :] - x0[:, None, :, :]  # (M, i, j, 4)
         P0 = np.einsum("mij,miab->mjab", w, Pm) + np.einsum("mij,mija,mijb->mjab", w, d, d)
@@ -88,7 +103,7 @@ class CVModelSet(MotionModel):
     def n_models(self) -> int:
         return self.r
 
-    def predict(self, states: States, dt: float) -> States:
+    def predict(self, states: States, dt: float | np.ndarray) -> States:
         """Mixing and prediction of every model; ``x, P`` their mixture (for gating)."""
         xm, Pm, mubar = self.predict_models(states.xm, states.Pm, states.mu, dt)
         xp, Pp = combine(xm, Pm, mubar)

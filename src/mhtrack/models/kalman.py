@@ -23,16 +23,23 @@ from mhtrack.models.linalg2 import sym_det2
 
 
 def predict_cv(
-    x: np.ndarray, P: np.ndarray, dt: float, Q: np.ndarray
+    x: np.ndarray, P: np.ndarray, dt: float | np.ndarray, Q: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray]:
     """Prediction with the constant-velocity ``F(dt) = I + dt·E``: ``x⁻ = F x``,
     ``P⁻ = F P Fᵀ + Q`` done as two row/column updates ``P[pos] += dt·P[vel]`` on the
-    whole stack."""
+    whole stack. ``dt`` is one interval, or one per row (M,) with ``Q`` (M, 4, 4)
+    (asynchronous plots: each track to its own plot's time)."""
     xp = x.copy()
-    xp[:, 0::2] += dt * x[:, 1::2]
     Pp = P.copy()
-    Pp[:, 0::2, :] += dt * Pp[:, 1::2, :]
-    Pp[:, :, 0::2] += dt * Pp[:, :, 1::2]
+    if np.ndim(dt) == 0:
+        xp[:, 0::2] += dt * x[:, 1::2]
+        Pp[:, 0::2, :] += dt * Pp[:, 1::2, :]
+        Pp[:, :, 0::2] += dt * Pp[:, :, 1::2]
+    else:
+        d = np.asarray(dt, float)
+        xp[:, 0::2] += d[:, None] * x[:, 1::2]
+        Pp[:, 0::2, :] += d[:, None, None] * Pp[:, 1::2, :]
+        Pp[:, :, 0::2] += d[:, None, None] * Pp[:, :, 1::2]
     Pp += Q
     return xp, 0.5 * (Pp + np.swapaxes(Pp, -1, -2))
 

@@ -61,8 +61,12 @@ class MotionModel(ABC):
         """``r``, the per-model arrays each track carries (0 for a single filter)."""
 
     @abstractmethod
-    def predict(self, states: States, dt: float) -> States:
-        """The states ``dt`` seconds later (``x, P`` are what gating uses)."""
+    def predict(self, states: States, dt: float | np.ndarray) -> States:
+        """The states ``dt`` seconds later (``x, P`` are what gating uses); ``dt`` one
+        interval for all rows or one per row (M,) — asynchronous plots, each track
+        predicted to its own plot's time. A negative ``dt`` (a plot slightly older than
+        the track's state, frames of two radars overlapping) moves the mean back and
+        still adds process noise (``Q`` is a positive semi-definite function of ``dt``)."""
 
     @abstractmethod
     def update(self, states: States, z: np.ndarray, R: np.ndarray) -> States:
@@ -101,10 +105,18 @@ class ConstantVelocity(MotionModel):
         f1 = np.array([[1.0, dt], [0.0, 1.0]])
         return np.kron(np.eye(2), f1)
 
-    def Q(self, dt: float) -> np.ndarray:
-        """Process noise covariance ``Q(T)`` (P1 §1.1)."""
-        q1 = np.array([[dt**4 / 4, dt**3 / 2], [dt**3 / 2, dt**2]])
-        return np.kron(np.eye(2), q1) * self.sigma_v**2
+    def Q(self, dt: float | np.ndarray) -> np.ndarray:
+        """Process noise covariance ``Q(T)`` (P1 §1.1); (4, 4), or (M, 4, 4) for a per-row
+        ``dt`` (M,)."""
+        if np.ndim(dt) == 0:
+            q1 = np.array([[dt**4 / 4, dt**3 / 2], [dt**3 / 2, dt**2]])
+            return np.kron(np.eye(2), q1) * self.sigma_v**2
+        d = np.asarray(dt, float)
+        q = np.zeros((d.size, 4, 4))
+        q[:, 0, 0] = q[:, 2, 2] = d**4 / 4
+        q[:, 0, 1] = q[:, 1, 0] = q[:, 2, 3] = q[:, 3, 2] = d**3 / 2
+        q[:, 1, 1] = q[:, 3, 3] = d**2
+        return q * self.sigma_v**2
 
     def propagate(self, x: np.ndarray, dt: float) -> np.ndarray:
         """Noise-free propagation of states ``x`` (…, 4) by ``dt``."""
@@ -115,7 +127,7 @@ class ConstantVelocity(MotionModel):
     def n_models(self) -> int:
         return 0
 
-    def predict(self, states: States, dt: float) -> States:
+    def predict(self, states: States, dt: float | np.ndarray) -> States:
         """Kalman prediction (:func:`~mhtrack.models.kalman.predict_cv`)."""
         xp, Pp = kalman.predict_cv(states.x, states.P, dt, self.Q(dt))
         return States(xp, Pp, states.xm, states.Pm, states.mu)

@@ -9,6 +9,8 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 from mhtrack.mht.births.base import Birth, BirthCandidates
 from mhtrack.mht.births.every_plot import EveryPlotBirth
 from mhtrack.mht.births.initiator import InitiatorBirth
@@ -17,17 +19,21 @@ from mhtrack.mht.scoring import miss_increment
 from mhtrack.mht.sprt import sprt_thresholds
 from mhtrack.models.motion import MotionModel
 from mhtrack.names import EVERY_PLOT
+from mhtrack.records import Scan
 
 
-def make_birth(cfg: MHTConfig, motion: MotionModel) -> Birth:
+def make_birth(cfg: MHTConfig, motion: MotionModel,
+               plot_pd: Callable[[Scan], float] | None = None) -> Birth:
     """The birth process ``cfg.birth`` with the configuration's parameters; new trees
-    start only above the SPRT deletion threshold ``ln(β/(1−α))``."""
+    start only above the SPRT deletion threshold ``ln(β/(1−α))``. ``plot_pd``: the
+    ``P_D`` of a scan's sensor for the every-plot birth score (``None``:
+    ``cfg.p_detection``)."""
     floor = sprt_thresholds(cfg.alpha, cfg.beta)[1]
     if cfg.birth == EVERY_PLOT:
         return EveryPlotBirth(motion, p_detection=cfg.p_detection,
                               new_target_density=cfg.new_target_density, floor=floor,
                               v_max=cfg.v_max, width=cfg.n_scan + 1,
-                              max_per_scan=cfg.max_births_per_scan)
+                              max_per_scan=cfg.max_births_per_scan, plot_pd=plot_pd)
     return InitiatorBirth(
         cfg.birth, motion, theta_deg=cfg.birth_theta_deg, width=cfg.n_scan + 1,
         p_detection=cfg.p_detection, new_target_density=cfg.new_target_density,

@@ -32,7 +32,8 @@ from mhtrack.records import Scan
 class BirthCandidates:
     """New trees' first leaves proposed by a birth process (one row each): state ``x``
     (n, 4), ``P`` (n, 4, 4) at the current scan, ``score`` and ``peak``, ``window``
-    (n, width) plot row ids at scans ``k−N … k`` and ``n_updates`` (plots on the branch)."""
+    (n, width) plot row ids at scans ``k−N … k``, ``n_updates`` (plots on the branch) and
+    ``time`` (n,) the states' times (``None``: the scan's time)."""
 
     x: np.ndarray
     P: np.ndarray
@@ -40,13 +41,15 @@ class BirthCandidates:
     peak: np.ndarray
     window: np.ndarray
     n_updates: np.ndarray
+    time: np.ndarray | None = None
 
     def __len__(self) -> int:
         return int(self.score.shape[0])
 
     def take(self, idx: np.ndarray) -> BirthCandidates:
         return BirthCandidates(self.x[idx], self.P[idx], self.score[idx], self.peak[idx],
-                               self.window[idx], self.n_updates[idx])
+                               self.window[idx], self.n_updates[idx],
+                               None if self.time is None else self.time[idx])
 
     @classmethod
     def empty(cls, width: int) -> BirthCandidates:
@@ -82,8 +85,9 @@ class Birth(ABC):
         """The new trees' leaves: :meth:`select`, then consecutive tree ids from ``trees``."""
         cand, group = self.select(cand, leaf_window, caps)
         first = trees.take(int(group.max()) + 1 if len(cand) else 0)
+        time = np.full(len(cand), float(scan.time)) if cand.time is None else cand.time
         return new_trees(self.motion.new_states(cand.x, cand.P), cand.score, cand.peak,
-                         first + group, int(scan.index), cand.n_updates, cand.window)
+                         first + group, int(scan.index), cand.n_updates, cand.window, time)
 
     def forget_used(self, window: np.ndarray) -> None:  # noqa: B027 (optional hook)
         """Optional hook: the leaf windows (m, width) of the confirmed tracks' chosen leaves

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 
 from mhtrack.mht.births.base import Birth, BirthCandidates
@@ -27,10 +29,15 @@ class EveryPlotBirth(Birth):
     v_max : largest target speed (the one-point velocity variance ``(v_max/2)²``).
     width : columns of the leaf window (``n_scan + 1``).
     max_per_scan : most trees started per scan.
+    plot_pd : ``P_D`` of the sensor of a scan's plots (``None``: ``p_detection``), e.g.
+        :meth:`mhtrack.mht.coverage.Coverage.plot_pd` for frames of several radars.
+
+    A tree starts at its plot's own time (``Scan.plot_times``).
     """
 
     def __init__(self, motion: MotionModel, *, p_detection: float, new_target_density: float,
-                 floor: float, v_max: float, width: int, max_per_scan: int) -> None:
+                 floor: float, v_max: float, width: int, max_per_scan: int,
+                 plot_pd: Callable[[Scan], float] | None = None) -> None:
         super().__init__(motion)
         self.p_detection = p_detection
         self.new_target_density = new_target_density
@@ -38,11 +45,13 @@ class EveryPlotBirth(Birth):
         self.v_max = v_max
         self.width = width
         self.max_per_scan = max_per_scan
+        self.plot_pd = plot_pd
 
     def propose(self, scan: Scan, z: np.ndarray, R: np.ndarray, rows: np.ndarray,
                 kappa: np.ndarray, in_gates: np.ndarray | None,
                 caps: dict[str, int]) -> BirthCandidates:
-        score = birth_score(kappa, self.p_detection, self.new_target_density)
+        pd = self.p_detection if self.plot_pd is None else self.plot_pd(scan)
+        score = birth_score(kappa, pd, self.new_target_density)
         sel = np.flatnonzero(score > self.floor)
         if sel.size > self.max_per_scan:
             gated_first = np.zeros(len(z), bool) if in_gates is None else in_gates
@@ -54,4 +63,5 @@ class EveryPlotBirth(Birth):
         window = np.full((n, self.width), NO_PLOT, np.int64)
         window[:, -1] = rows[sel]
         start = np.asarray(score[sel], float)
-        return BirthCandidates(x, P, start, start.copy(), window, np.ones(n, np.int64))
+        return BirthCandidates(x, P, start, start.copy(), window, np.ones(n, np.int64),
+                               scan.plot_times()[sel])

@@ -1,0 +1,105 @@
+"""Frames of asynchronous plots (:mod:`mhtrack.frames`): which trees a frame looks at,
+and gating each leaf against each plot at the plot's own time.
+
+*Looked-at trees.* A tree is stepped by a frame when its sensor looked at one of its
+leaves (:class:`~mhtrack.mht.coverage.Coverage`, ``P_D > 0``); its leaves then all get a
+miss child (``ln(1 − P_D·P_G)``, each leaf with its own ``P_D``: 0 for a leaf the beam
+did not or may not have reached, :class:`~mhtrack.mht.coverage.Looks`) and their plot
+children, and the window of every leaf of the tree shifts by
+one column. The other trees are carried unchanged: no child, no prediction, no score
+change, no window shift. N-scan pruning therefore counts a tree's *looks* — the scans
+of the target in P1's sense — whatever the number of frames of other sectors and radars
+in between (:func:`split_looked`).
+
+*Timed gating* (Blackman & Popoli 1999 §16.2; Stone Soup predicts each track to each
+detection's timestamp): the pairs are first found against the leaves predicted to the
+frame's time ``t_f`` with a gate that holds every plot time of the frame — the exact gate
+``νᵀ S⁻¹ ν ≤ γ`` moved by at most ``d = (|v| + 3σ_v)(t_f − t_min)`` lies inside
+``νᵀ (2S + 2d²/γ I)⁻¹ ν ≤ γ`` (Minkowski sum of two ellipses, ``E(A) ⊕ E(B) ⊂ E(2A + 2B)``)
+— then each candidate pair is predicted from the leaf's own time to its plot's time and
+tested exactly (:func:`gate_timed`).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from mhtrack.mht.coverage import Looks
+from mhtrack.mht.gating import Gate, Gated
+from mhtrack.mht.tree import Leaves, segment_ids
+from mhtrack.models.linalg2 import gaussian_loglik2, sym_mahalanobis2
+from mhtrack.models.motion import MotionModel, States
+
+
+def looked_trees(tree: np.ndarray, pd: np.ndarray) -> np.ndarray:
+    """Mask over leaves (sorted by ``tree``): the leaf's tree has a leaf with ``pd > 0``."""
+    if tree.size == 0:
+        return np.zeros(0, bool)
+    starts, seg = segment_ids(tree)
+    return np.maximum.reduceat((pd > 0).astype(np.int8), starts)[seg] > 0
+
+
+def split_looked(leaves: Leaves, looks: Looks) -> tuple[Leaves, Looks, Leaves]:
+    """``(looked, their looks, idle)``: the leaves of the trees the frame looked at
+    (``P_D > 0`` at one of their leaves) and the others (the same objects when every tree
+    was looked at)."""
+    mask = looked_trees(leaves.tree, looks.pd)
+    if mask.all():
+        return leaves, looks, leaves.take(np.zeros(0, np.int64))
+    return (leaves.take(mask), Looks(looks.pd[mask], looks.certain[mask]),
+            leaves.take(~mask))
+
+
+def merge_by_tree(stepped: Leaves, idle: Leaves) -> Leaves:
+    """The ``stepped`` and ``idle`` leaves (disjoint trees, each sorted by tree) as one
+    store sorted by tree (``stepped`` itself when there is no idle leaf)."""
+    if len(idle) == 0:
+        return stepped
+    both = Leaves.concat(stepped, idle)
+    return both.take(np.argsort(both.tree, kind="stable"))
+
+
+def gate_looked(gate: Gate, leaves: Leaves, pred: States, pd: np.ndarray, z: np.ndarray,
+                R: np.ndarray, t: np.ndarray | None, time: float, motion: MotionModel,
+                caps: dict[str, int]) -> tuple[Gated, States | None]:
+    """Gated pairs of the leaves with ``pd > 0`` (indices into ``leaves``) and, for timed
+    plots (``t`` not all ``time``), each pair's state predicted to its plot's time."""
+    sub = None if (pd > 0).all() else np.flatnonzero(pd > 0)
+    lv, pr = (leaves, pred) if sub is None else (leaves.take(sub), pred.take(sub))
+    if t is None or (t == time).all():
+        g, pair_pred = gate(lv, pr, z, R, motion, caps), None
+    else:
+        g, pair_pred = gate_timed(gate, lv, pr, z, R, t, time, motion, caps)
+    if sub is not None:
+        g = Gated(sub[g.track], g.plot, g.d2, g.loglik)
+    return g, pair_pred
+
+
+def gate_timed(gate: Gate, leaves: Leaves, pred: States, z: np.ndarray, R: np.ndarray,
+               t: np.ndarray, time: float, motion: MotionModel,
+               caps: dict[str, int]) -> tuple[Gated, States]:
+    """Coarse gate at the frame's ``time``, then the exact gate of each candidate pair
+    at its plot's time (module docstring). Returns the pairs (ordered by leaf, then plot)
+    and their predicted states."""
+    gamma = gate.gamma
+    span = max(time - float(t.min()), 0.0) if t.size else 0.0
+    P = pred.P
+    speed = np.hypot(pred.x[:, 1], pred.x[:, 3]) + 3.0 * np.sqrt(
+        np.maximum(P[:, 1, 1], P[:, 3, 3]))
+    extra = 2.0 * (speed * span) ** 2 / gamma
+    Pc = 2.0 * P
+    Pc[:, 0, 0] += extra
+    Pc[:, 2, 2] += extra
+    coarse = gate.pairs(leaves, pred.x, Pc, z, 2.0 * R, caps)
+    ti, pj = coarse.track, coarse.plot
+    pp = motion.predict(leaves.states().take(ti), t[pj] - leaves.time[ti])
+    Rp = R if R.ndim == 2 else R[pj]
+    d2, det = sym_mahalanobis2(z[pj, 0] - pp.x[:, 0], z[pj, 1] - pp.x[:, 2],
+                               pp.P[:, 0, 0] + Rp[..., 0, 0], pp.P[:, 0, 2] + Rp[..., 0, 1],
+                               pp.P[:, 2, 2] + Rp[..., 1, 1])
+    keep = np.flatnonzero(d2 <= gamma)
+    pp = pp.take(keep)
+    ti, pj, d2, det = ti[keep], pj[keep], d2[keep], det[keep]
+    k = np.arange(keep.size)
+    loglik = motion.gating_loglik(pp, k, pj, z, R, gaussian_loglik2(d2, det))
+    return Gated(ti, pj, d2, loglik), pp

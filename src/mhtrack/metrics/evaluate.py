@@ -123,8 +123,8 @@ class Evaluation:
         delay ``delay_mean, delay_max`` (scans) with ``delay`` per target (by ascending
         target id, ``None`` for a target never confirmed). Per-scan lists (aligned
         with ``scans``): ``scans, ospa, gospa, cardinality`` (number of tracks),
-        ``cardinality_true``. Issue 14's keys: ``at``, ``max_age_s`` (``None`` with
-        ``"scans"``), ``coverage`` and ``n_track_ids``.
+        ``cardinality_true``. Issue 14's keys: ``at``, ``coverage``, ``n_track_ids`` and,
+        with ``at = "truth-times"`` only, ``max_age_s``.
         """
         m = self.clear_mot
         return {
@@ -149,7 +149,7 @@ class Evaluation:
             "n_truth": m.n_truth,
             **self._association_dict(),
             "at": self.at,
-            "max_age_s": None if self.max_age_s is None else _num(self.max_age_s),
+            **({} if self.max_age_s is None else {"max_age_s": _num(self.max_age_s)}),
             "coverage": _num(self.coverage),
             "n_track_ids": self.n_track_ids,
             "scans": [int(s) for s in self.scans],

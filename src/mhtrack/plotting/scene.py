@@ -135,7 +135,8 @@ def set_distance_axes(ax: Axes, units: str) -> None:
         return
     if units != "km":
         raise ValueError(f"units must be 'm', 'km' or None, got {units!r}")
-    km = FuncFormatter(lambda v, _pos: f"{v / 1000.0:g}")
+    minus = "\u2212" if mpl.rcParams["axes.unicode_minus"] else "-"  # as ScalarFormatter
+    km = FuncFormatter(lambda v, _pos: f"{v / 1000.0:g}".replace("-", minus))
     ax.xaxis.set_major_formatter(km)
     ax.yaxis.set_major_formatter(km)
     ax.set_xlabel("x east (km)")

@@ -6,7 +6,10 @@
 * :func:`clear_mot` — MOTA, MOTP, identity switches, fragmentations (Bernardin &
   Stiefelhagen 2008);
 * :func:`association_metrics` — P1 Table 3's Rcc, Rmc, Rfg and track life Lmin/Lavg/Lmax;
-* :func:`evaluate` — all of the above for one run.
+* :func:`tracks_at_times` — asynchronous tracks at the truth's times (latest state no
+  older than ``max_age_s``, predicted with constant velocity);
+* :func:`evaluate` — all of the above for one run (asynchronous tracks scored at the
+  truth's times).
 
 Definitions and conventions: ``docs/metrics.md``.
 """
@@ -22,9 +25,11 @@ from mhtrack.metrics.clearmot import (
 from mhtrack.metrics.evaluate import Evaluation, evaluate
 from mhtrack.metrics.gospa import GOSPAPerScan, GOSPAResult, gospa, gospa_per_scan
 from mhtrack.metrics.ospa import OSPAPerScan, OSPAResult, ospa, ospa_per_scan
+from mhtrack.metrics.resample import DEFAULT_MAX_AGE_S, tracks_at_times
 
 __all__ = [
     "DEFAULT_MATCH_DISTANCE",
+    "DEFAULT_MAX_AGE_S",
     "AssociationResult",
     "CLEARMOTResult",
     "CardinalityPerScan",
@@ -42,4 +47,5 @@ __all__ = [
     "gospa_per_scan",
     "ospa",
     "ospa_per_scan",
+    "tracks_at_times",
 ]

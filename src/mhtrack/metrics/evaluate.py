@@ -1,8 +1,10 @@
 """One call that scores a tracker's output against the truth with every metric.
 
-:func:`evaluate` aligns tracks and truth on scan indices and runs OSPA, GOSPA,
-cardinality, CLEAR-MOT and P1 Table 3's association metrics; :class:`Evaluation` holds the
-results and renders them as a JSON-able dict or a plain-text table.
+:func:`evaluate` aligns tracks and truth — on scan indices when they share their scans, or
+at the truth's times (:func:`~mhtrack.metrics.resample.tracks_at_times`) when the tracks
+are asynchronous — and runs OSPA, GOSPA, cardinality, CLEAR-MOT and P1 Table 3's
+association metrics; :class:`Evaluation` holds the results and renders them as a JSON-able
+dict or a plain-text table.
 """
 
 from __future__ import annotations
@@ -30,6 +32,15 @@ from mhtrack.metrics.cardinality import CardinalityPerScan, cardinality_indexed
 from mhtrack.metrics.clearmot import CLEARMOTResult, clear_mot_indexed
 from mhtrack.metrics.gospa import GOSPAPerScan, gospa_indexed
 from mhtrack.metrics.ospa import OSPAPerScan, ospa_indexed
+from mhtrack.metrics.resample import (
+    DEFAULT_MAX_AGE_S,
+    Alignment,
+    alignment,
+    check_max_age,
+    is_synchronous,
+    tracks_at_times,
+    truth_times,
+)
 from mhtrack.records import PlotTable, TrackTable, TruthTable
 
 
@@ -42,14 +53,20 @@ class Evaluation:
     cutoff, order, match_distance : float
         OSPA/GOSPA ``c`` (m) and ``p``; CLEAR-MOT ``d_match`` (m).
     scans : (K,) int array
-        Scan indices evaluated (union of truth, tracks, plots and explicit scans).
+        Scan indices evaluated: with ``at = "scans"`` the union of truth, tracks, plots and
+        explicit scans; with ``at = "truth-times"`` the truth's scans.
     ospa, gospa, cardinality : per-scan results on ``scans``.
     clear_mot : CLEARMOTResult
     n_tracks, n_targets : int
-        Distinct track ids and distinct target ids.
+        Distinct track ids in the tracker output and distinct target ids in the truth.
     association : AssociationResult or None
         P1 Table 3's Rcc, Rmc, Rfg, Lmin/Lavg/Lmax on the CLEAR-MOT matching (``rcc`` and
-        ``rmc`` are NaN unless the plots with their ``origin`` were given).
+        ``rmc`` are NaN unless the plots with their ``origin`` were given and share the
+        truth's scans).
+    at : {"scans", "truth-times"}
+        How the tracks were aligned with the truth (see :func:`evaluate`).
+    max_age_s : float or None
+        Largest age of a track state used at a truth time (s); ``None`` with ``"scans"``.
     """
 
     cutoff: float
@@ -63,6 +80,21 @@ class Evaluation:
     n_tracks: int
     n_targets: int
     association: AssociationResult | None = None
+    at: Alignment = "scans"
+    max_age_s: float | None = None
+
+    @property
+    def n_track_ids(self) -> int:
+        """Distinct track ids in the tracker output (the issue's name for ``n_tracks``)."""
+        return self.n_tracks
+
+    @property
+    def coverage(self) -> float:
+        """Fraction of truth states (target, scan) matched to a track by CLEAR-MOT within
+        the matching distance, ``n_matches / n_truth`` (switches included); NaN without
+        truth."""
+        m = self.clear_mot
+        return m.n_matches / m.n_truth if m.n_truth else float("nan")
 
     @property
     def ospa_mean(self) -> float:
@@ -91,7 +123,8 @@ class Evaluation:
         delay ``delay_mean, delay_max`` (scans) with ``delay`` per target (by ascending
         target id, ``None`` for a target never confirmed). Per-scan lists (aligned
         with ``scans``): ``scans, ospa, gospa, cardinality`` (number of tracks),
-        ``cardinality_true``.
+        ``cardinality_true``. Issue 14's keys: ``at``, ``coverage``, ``n_track_ids`` and,
+        with ``at = "truth-times"`` only, ``max_age_s``.
         """
         m = self.clear_mot
         return {
@@ -115,6 +148,10 @@ class Evaluation:
             "n_false": m.n_false,
             "n_truth": m.n_truth,
             **self._association_dict(),
+            "at": self.at,
+            **({} if self.max_age_s is None else {"max_age_s": _num(self.max_age_s)}),
+            "coverage": _num(self.coverage),
+            "n_track_ids": self.n_track_ids,
             "scans": [int(s) for s in self.scans],
             "ospa": [float(v) for v in self.ospa.distance],
             "gospa": [float(v) for v in self.gospa.distance],
@@ -130,6 +167,12 @@ class Evaluation:
         delay = [] if a.delay is None else [_num(float(v)) for v in a.delay]
         return {**{k: _num(getattr(a, k)) for k in keys}, "delay": delay}
 
+    def _alignment_rows(self) -> list[tuple[str, str]]:
+        if self.at == "scans":
+            return []
+        return [("aligned at", f"truth times, states <= {_fmt(self.max_age_s or 0.0)} s old "
+                 "predicted (CV)")]
+
     def to_table(self, *, per_scan: bool = False) -> str:
         """Plain-text (ASCII) table of the summary metrics, for a terminal.
 
@@ -140,6 +183,7 @@ class Evaluation:
         c, p = _fmt(self.cutoff), _fmt(self.order)
         rows = [
             ("scans", str(len(self.scans))),
+            *self._alignment_rows(),
             ("true targets (distinct ids)", str(self.n_targets)),
             ("tracks (distinct ids)", str(self.n_tracks)),
             (f"OSPA mean (c={c} m, p={p})", _fmt(self.ospa_mean, " m")),
@@ -149,6 +193,7 @@ class Evaluation:
             ("cardinality error mean |n_est - n|", _fmt(self.cardinality_error_mean)),
             (f"MOTA (match distance {_fmt(self.match_distance)} m)", _fmt(m.mota)),
             ("MOTP (mean matched distance)", _fmt(m.motp, " m")),
+            ("coverage (matched truth states)", _fmt(self.coverage)),
             ("identity switches", str(m.id_switches)),
             ("fragmentations", str(m.fragmentations)),
             (
@@ -195,13 +240,23 @@ def evaluate(
     order: float = 2.0,
     match_distance: float | None = None,
     scans: npt.ArrayLike | None = None,
+    at: str | None = None,
+    max_age_s: float = DEFAULT_MAX_AGE_S,
 ) -> Evaluation:
     """Score ``tracks`` against ``truth``: OSPA, GOSPA (α = 2), cardinality, CLEAR-MOT and
     P1 Table 3's Rcc, Rmc, Rfg, Lmin/Lavg/Lmax (:func:`association_metrics`).
 
-    Scans evaluated are the sorted union of the truth's scans, the tracks' scans, every
+    **Alignment** (``at``). ``"scans"``: tracks and truth are compared scan by scan; the
+    scans evaluated are the sorted union of the truth's scans, the tracks' scans, every
     scan of ``plots`` (empty scans included) and ``scans``; a scan with neither truth nor
-    tracks has OSPA = GOSPA = 0 and cardinality error 0. Means are over these scans.
+    tracks has OSPA = GOSPA = 0 and cardinality error 0. ``"truth-times"``: at each of the
+    truth's scans (time ``t``) every track contributes its latest state at or before ``t``
+    no older than ``max_age_s``, predicted to ``t`` with constant velocity
+    (:func:`~mhtrack.metrics.resample.tracks_at_times`); the scans evaluated are the
+    truth's. ``None`` (default): ``"scans"`` when the tables share their scans (every track
+    row at a truth scan has that scan's time, plots untimed and agreeing likewise —
+    :func:`~mhtrack.metrics.resample.is_synchronous`), else ``"truth-times"``. Means are
+    over the scans evaluated.
 
     Parameters
     ----------
@@ -220,7 +275,12 @@ def evaluate(
     match_distance : float, optional
         CLEAR-MOT matching distance ``d_match`` (m); defaults to ``cutoff``.
     scans : array_like of int, optional
-        Extra scan indices (e.g. every scan of the run).
+        Extra scan indices (e.g. every scan of the run); ``"scans"`` alignment only.
+    at : {"scans", "truth-times"} or None
+        The alignment (above); ``None`` chooses it.
+    max_age_s : float, default 15.0
+        Largest age (s) of a track state used at a truth time, ``>= 0``
+        (``"truth-times"`` only).
 
     Returns
     -------
@@ -232,7 +292,21 @@ def evaluate(
     d_match = (
         c if match_distance is None else check_match_distance(match_distance, "match_distance")
     )
-    idx = scan_union(truth.scan, tracks.scan, plot_scans(plots), check_scans(scans))
+    extra = check_scans(scans)
+    p_scans = plot_scans(plots)  # also type-checks plots
+    age = check_max_age(max_age_s)
+    how = alignment(tracks, truth, plots, at)
+    n_tracks = len(np.unique(tracks.track_id))
+    if how == "scans":
+        idx = scan_union(truth.scan, tracks.scan, p_scans, extra)
+    else:
+        if len(extra):
+            raise ValueError("scans applies to at='scans' only (with 'truth-times' the "
+                             "truth's scans are evaluated)")
+        idx, t_idx = truth_times(truth)
+        tracks = tracks_at_times(tracks, t_idx, idx, age)
+        if plots is not None and not is_synchronous(tracks, truth, plots):
+            plots = None  # frames of timed plots are not the truth's scans: no Rcc/Rmc
     data = ScanIndexed.build(tracks, truth, idx)  # checked and indexed once, for every metric
     mot = clear_mot_indexed(data, d_match)
     return Evaluation(
@@ -244,9 +318,11 @@ def evaluate(
         gospa=gospa_indexed(data, c, p),
         cardinality=cardinality_indexed(data),
         clear_mot=mot,
-        n_tracks=len(np.unique(tracks.track_id)),
+        n_tracks=n_tracks,
         n_targets=len(np.unique(truth.target_id)),
         association=association_indexed(data, plots, mot.matching, d_match),
+        at=how,
+        max_age_s=None if how == "scans" else age,
     )
 
 

@@ -1,8 +1,9 @@
-"""Pictures of a scene: truth, plots (clutter grey) and tracks, in the local frame (m).
+"""Pictures of a scene: truth, plots (clutter grey), tracks and radar sites, in the local
+east-north frame, axes in metres or (wide geographic scenes) kilometres.
 
 Follows P1 Figs. 2–4: truth trajectories with ``o`` at the start and ``x`` at the end,
 plots as dots (clutter grey, target-originated coloured when ``origin`` is known), tracks
-as coloured lines labelled with their id.
+as coloured lines labelled with their id; radar sites as labelled triangles.
 
 Figures are plain :class:`matplotlib.figure.Figure` objects (no pyplot state, no backend
 switch on import); :func:`save_figure` writes any figure, a pyplot one included.
@@ -10,17 +11,30 @@ switch on import); :func:`save_figure` writes any figure, a pyplot one included.
 
 from __future__ import annotations
 
+import math
 import sys
+from collections.abc import Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import matplotlib as mpl
 import numpy as np
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
+from matplotlib.ticker import FuncFormatter
 
 from mhtrack.records import PlotTable, TrackTable, TruthTable
 
+if TYPE_CHECKING:
+    from mhtrack.models.radars import SensorSet
+
 TRUTH_STYLE = {"color": "black", "lw": 1.2, "alpha": 0.8}
+
+#: ``units=None`` draws kilometres when the scene's larger side exceeds this (m).
+KM_ABOVE_M = 20_000.0
+
+#: A radar site to draw: ``(x, y, label)``, local frame (m).
+Site = tuple[float, float, str]
 
 
 def _segments(ids: np.ndarray, scan: np.ndarray) -> list[np.ndarray]:
@@ -84,6 +98,51 @@ def draw_tracks(ax: Axes, tracks: TrackTable, *, label_ids: bool = True) -> None
         first = False
 
 
+def draw_sites(ax: Axes, sites: Sequence[Site]) -> None:
+    """Radar sites: a triangle at each ``(x, y)`` (local frame, m), labelled."""
+    if not sites:
+        return
+    xs = [float(s[0]) for s in sites]
+    ys = [float(s[1]) for s in sites]
+    ax.plot(xs, ys, "^", color="tab:red", mec="black", ms=9, ls="none", zorder=5,
+            label="radar sites")
+    for x, y, (_, _, label) in zip(xs, ys, sites, strict=True):
+        ax.annotate(str(label), (x, y), fontsize=8, xytext=(5, -10),
+                    textcoords="offset points", zorder=5)
+
+
+def sensor_sites(sensors: SensorSet) -> list[Site]:
+    """``(x, y, "radar <id>")`` of every sensor of ``sensors`` that has a site, in the
+    set's local frame (:meth:`SensorSet.site_xy`)."""
+    return [(*sensors.site_xy(s.id), f"radar {s.id}") for s in sensors.sensors if s.has_site]
+
+
+def scene_units(ax: Axes) -> str:
+    """``"km"`` when the data drawn on ``ax`` span more than :data:`KM_ABOVE_M` along x or
+    y, else ``"m"``."""
+    lim = ax.dataLim
+    span = max(lim.width, lim.height)
+    return "km" if math.isfinite(span) and span > KM_ABOVE_M else "m"
+
+
+def set_distance_axes(ax: Axes, units: str) -> None:
+    """Label the east/north axes in ``units`` (``"m"`` or ``"km"``); the data stay in
+    metres, kilometre tick labels are the metre values / 1000."""
+    if units == "m":
+        ax.set_xlabel("x east (m)")
+        ax.set_ylabel("y north (m)")
+        ax.ticklabel_format(style="plain", useOffset=False)
+        return
+    if units != "km":
+        raise ValueError(f"units must be 'm', 'km' or None, got {units!r}")
+    minus = "\u2212" if mpl.rcParams["axes.unicode_minus"] else "-"  # as ScalarFormatter
+    km = FuncFormatter(lambda v, _pos: f"{v / 1000.0:g}".replace("-", minus))
+    ax.xaxis.set_major_formatter(km)
+    ax.yaxis.set_major_formatter(km)
+    ax.set_xlabel("x east (km)")
+    ax.set_ylabel("y north (km)")
+
+
 def plot_scene(
     plots: PlotTable | None = None,
     truth: TruthTable | None = None,
@@ -91,8 +150,17 @@ def plot_scene(
     *,
     title: str = "",
     ax: Axes | None = None,
+    sites: Sequence[Site] | None = None,
+    units: str | None = None,
 ) -> Figure:
-    """One picture of whatever is given: plots, truth and tracks, equal axes in metres."""
+    """One picture of whatever is given: plots, truth, tracks and radar ``sites`` (a list of
+    ``(x, y, label)`` in the local frame, e.g. :func:`sensor_sites`), equal axes.
+
+    ``units``: ``"m"``, ``"km"``, or ``None`` — kilometres when the scene spans more than
+    20 km (:func:`scene_units`), metres otherwise. Draws on a new
+    :class:`~matplotlib.figure.Figure` (or on ``ax``), never on pyplot's state."""
+    if units not in (None, "m", "km"):
+        raise ValueError(f"units must be 'm', 'km' or None, got {units!r}")
     if ax is None:
         fig = Figure(figsize=(7.5, 7))
         ax = fig.add_subplot()
@@ -104,10 +172,10 @@ def plot_scene(
         draw_truth(ax, truth)
     if tracks is not None and len(tracks):
         draw_tracks(ax, tracks)
+    if sites:
+        draw_sites(ax, sites)
     ax.set_aspect("equal", adjustable="datalim")
-    ax.set_xlabel("x east (m)")
-    ax.set_ylabel("y north (m)")
-    ax.ticklabel_format(style="plain", useOffset=False)
+    set_distance_axes(ax, scene_units(ax) if units is None else units)
     ax.grid(True, lw=0.3, alpha=0.5)
     if title:
         ax.set_title(title)

@@ -50,6 +50,11 @@ MAX_GAP = 10_000
 MAX_EMPTY_RATIO = 10
 
 
+def is_timed(path: PathArg) -> bool:
+    """The plots file has no ``scan`` column: timed plots (located errors if unreadable)."""
+    return "scan" not in column_names(path)
+
+
 def read_plots(
     path: PathArg, sensors: SensorSet | SensorRegistry | None = None, *,
     reorder_window_s: float = DEFAULT_REORDER_WINDOW_S,

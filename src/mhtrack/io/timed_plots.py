@@ -110,8 +110,8 @@ def _check_order(f: Frame, time: np.ndarray, window: float) -> None:
         m = before[r - 1]
         at = int(np.flatnonzero(time[:r] == m)[0])
         return (f"time {f.text('time', r)} is {m - time[r]:.6g} s before time "
-                f"{f.text('time', at)} on {f.src.where(at)}, beyond the reorder window of {window:g} s; sort the "
-                "rows by time (or widen reorder_window_s)")
+                f"{f.text('time', at)} on {f.src.where(at)}, beyond the reorder window of "
+                f"{window:g} s; sort the rows by time (or widen reorder_window_s)")
 
     f.check(late, "time", text)
 

@@ -72,6 +72,8 @@ def seconds(f: Frame, name: str = "time") -> np.ndarray:
     try:
         ns = pc.cast(text, _NS)
     except (pa.ArrowInvalid, pa.ArrowNotImplementedError):
+        ns = None
+    if ns is None:
         r = _first_failure(text, lambda a: pc.cast(a, _NS))
         f.fail(_bad_iso(text[r].as_py()), row=r, column=name)
     return posix_seconds(ns.view(pa.int64()).to_numpy(zero_copy_only=False))
@@ -90,6 +92,8 @@ def _numbers(f: Frame, name: str, text: pa.Array) -> np.ndarray:
     try:
         v = pc.cast(text, pa.float64()).to_numpy(zero_copy_only=False)
     except pa.ArrowInvalid:
+        v = None
+    if v is None:
         r = _first_failure(text, lambda a: pc.cast(a, pa.float64()))
         f.fail(f"value {text[r].as_py()!r} is not a number (the first row's time "
                f"{text[0].as_py()!r} is seconds, so every row's must be)", row=r, column=name)

@@ -93,6 +93,9 @@ BAD = [
      "is seconds, so every row's must be)"),
     ("range-negative", edit(3, "range", "-5"),
      "line 5, column 'range': range -5.0 m is negative"),
+    ("range-absurd", edit(0, "range", "1.5e8"),
+     "line 2, column 'range': range 150000000.0 m is beyond 20000 km, half-way round the "
+     "Earth (a unit error?)"),
     ("bearing-outside", edit(0, "bearing", "361"),
      "line 2, column 'bearing': bearing 361.0 is outside [0, 360] degrees (clockwise from "
      "north)"),

@@ -25,6 +25,9 @@ from mhtrack.records import MAX_COORDINATE, PlotTable
 #: Rows may come out of time order by at most this much (s) by default (network jitter
 #: between radars): a row's time must be ≥ the largest time of the rows above it − window.
 DEFAULT_REORDER_WINDOW_S = 2.0
+#: Largest range accepted (m): 20 000 km, about half a meridian (20 003.9 km) — farther
+#: than any point of the Earth from the site along the ground.
+MAX_RANGE_M = 2e7
 
 REQUIRED = ("time", "sensor")
 COLUMNS = {"time": TIME, "sensor": INT, "range": FLOAT, "bearing": FLOAT, "x": FLOAT,
@@ -133,6 +136,8 @@ def _range_bearing(f: Frame) -> tuple[np.ndarray | None, np.ndarray | None]:
     if rng is None or bearing is None:
         return None, None
     f.check(rng < 0, "range", lambda r: f"range {num(rng[r])} m is negative")
+    f.check(rng > MAX_RANGE_M, "range", lambda r: f"range {num(rng[r])} m is beyond "
+            f"{MAX_RANGE_M / 1e3:.0f} km, half-way round the Earth (a unit error?)")
     f.check((bearing < 0) | (bearing > 360), "bearing", lambda r: f"bearing "
             f"{num(bearing[r])} is outside [0, 360] degrees (clockwise from north)")
     for name, a, b in (("bearing", rng, bearing), ("range", bearing, rng)):

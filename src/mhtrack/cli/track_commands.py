@@ -267,9 +267,10 @@ def run(scenario: str, seed: int, clutter: str | None, clutter_rate: float | Non
     out = out if out is not None else Path("out") / f"{sc.name}-{tracker}{suffix}-{seed}"
     out.mkdir(parents=True, exist_ok=True)
     sim = result.simulation
+    frame = _output_frame(sc, sim.plots)
     write_plots(sim.plots, out / "plots.csv")
-    write_truth(sim.truth, out / "truth.csv")
-    write_tracks(result.run.tracks, out / "tracks.csv")
+    write_truth(sim.truth, out / "truth.csv", frame)
+    write_tracks(result.run.tracks, out / "tracks.csv", frame, plots=sim.plots)
     write_scenario_toml({"seed": seed, **sc.to_dict()}, out / "scenario.toml")
     summary = result.summary()
     (out / "metrics.json").write_text(dumps(summary, indent=1))
@@ -289,6 +290,15 @@ def run(scenario: str, seed: int, clutter: str | None, clutter_rate: float | Non
     if result.run.caps:
         click.echo(f"hard caps acted: {result.run.caps}")
     click.echo(f"wrote {out}/ (plots, truth, tracks, metrics.json, scene.png, metrics.png)")
+
+
+def _output_frame(sc: Any, plots: Any) -> Any:
+    """The local frame of a simulation's geodetic radars (timed plots), for the lat/lon
+    columns of its truth and tracks files; ``None`` for synchronous scans."""
+    if not plots.timed:
+        return None
+    sensor_set = sc.sensor_set()
+    return sensor_set.frame() if sensor_set.reference is not None else None
 
 
 def _plots_area(plots: Path, table: Any) -> float:

@@ -93,9 +93,8 @@ def read_plots(
         return read_timed_plots(path, sensors, reorder_window_s=reorder_window_s)
     if isinstance(sensors, SensorSet):
         raise Source(path).error(
-            "has a 'scan' column: scans are read with a scenario's sensors (--scenario); a "
-            "sensors file is for timed plots, one time per plot and no 'scan' column",
-            column="scan")
+            "scans are read with a scenario's sensors (--scenario); a sensors file is for "
+            "timed plots (one time per plot, no 'scan' column)", column="scan")
     f = read_frame(path, COLUMNS, REQUIRED, "plots")
     if f.n == 0:
         f.fail("no rows (a plots file needs at least one plot)")

@@ -113,6 +113,10 @@ class PlotTable:
     ``timed`` marks asynchronous data: each row's ``time`` is the plot's own time and
     ``scan`` the index of its *frame* (:func:`mhtrack.frames.make_frames`); rows are sorted
     by frame, then time, and :meth:`scans` yields each frame with ``Scan.t``.
+
+    ``file_row`` optionally maps each row to its 0-based row in the file it was read from
+    (a timed file is re-sorted on reading); ``None`` when the rows are in file order.
+    Tracks refer to the table's rows (``Scan.rows``); writers translate them to file rows.
     """
 
     scan: np.ndarray
@@ -126,10 +130,12 @@ class PlotTable:
     R: np.ndarray | None = None
     scan_times: tuple[np.ndarray, np.ndarray] | None = field(default=None, repr=False)
     timed: bool = False
+    file_row: np.ndarray | None = field(default=None, repr=False)
 
     def __post_init__(self) -> None:
         n = len(self.scan)
-        for name in ("time", "sensor", "x", "y", "range", "bearing", "origin", "R"):
+        for name in ("time", "sensor", "x", "y", "range", "bearing", "origin", "R",
+                     "file_row"):
             v = getattr(self, name)
             if v is not None and len(v) != n:
                 raise ValueError(f"PlotTable column {name!r} has {len(v)} rows, expected {n}")

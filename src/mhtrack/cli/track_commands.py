@@ -116,7 +116,16 @@ def _config(base: Any, tracker_pd: float | None, meas_sigma: float | None,
 @click.option("--scenario", "scenario_file", type=click.Path(exists=True, dir_okay=False,
               path_type=Path), default=None,
               help="Scenario TOML giving the sensors (needed for polar plots) and all scan "
-              "times [default: scenario.toml beside PLOTS, if any].")
+              "times [default: scenario.toml beside PLOTS, if any, without --sensors].")
+@click.option("--sensors", "sensors_file", type=click.Path(exists=True, dir_okay=False,
+              path_type=Path), default=None,
+              help="Sensors file (TOML: radar sites, errors, P_D, periods) for timed plots "
+              "(no scan column): converts range/bearing and lat/lon plots, and adds lat, "
+              "lon and east/north vx, vy to the tracks (docs/file-formats.md) [default: "
+              "sensors.toml beside timed PLOTS, if any].")
+@click.option("--reorder-window", "reorder_window_s", type=click.FloatRange(min=0),
+              default=None, help="Timed plots may be out of time order by at most this "
+              "many seconds [2].")
 @birth_options
 @output_option
 @click.option("--progress/--no-progress", default=True, help="Progress bar on stderr.")
@@ -124,40 +133,22 @@ def track(plots: Path, tracker: str, tracker_pd: float | None, meas_sigma: float
           accel_sigma: float | None, imm_accel_sigma: float | None,
           clutter_density: float | None,
           birth_density: float | None, nscan: int | None, out: Path,
-          scenario_file: Path | None, birth: str, birth_theta: float, fusion: str | None,
-          output: str, progress: bool) -> None:
+          scenario_file: Path | None, sensors_file: Path | None,
+          reorder_window_s: float | None, birth: str, birth_theta: float,
+          fusion: str | None, output: str, progress: bool) -> None:
     """Run a tracker on a PLOTS file and write its tracks."""
     import numpy as np
 
     from mhtrack.build import default_config, default_fusion, make_tracker
     from mhtrack.experiments.pipeline import track as run_tracker
-    from mhtrack.io import read_plots, write_tracks
-    from mhtrack.io.plots import check_scan_times
-    from mhtrack.scenario import load_scenario
+    from mhtrack.io import write_tracks
 
-    if scenario_file is None and (plots.parent / "scenario.toml").is_file():
-        scenario_file = plots.parent / "scenario.toml"
-    sensors = None
-    scenario = None
-    if scenario_file is not None:
-        scenario = load_scenario(scenario_file)
-        sensors = {s.id: s for s in scenario.sensors}
-    table = read_plots(plots, sensors=sensors)
-    if scenario is not None:
-        check_scan_times(plots, table, scenario.scan_indices(), scenario.scan_times(),
-                         f"scenario {scenario_file}")
-        table = dataclasses.replace(
-            table, scan_times=(scenario.scan_indices(), scenario.scan_times())
-        )
-    elif table.range is not None:
-        logging.getLogger("mhtrack").warning(
-            "%s has range/bearing columns (polar plots), but no scenario gives its sensors: "
-            "they are ignored and x, y tracked as Cartesian plots with the tracker's σw; "
-            "pass --scenario with the radar(s) to use the polar measurement model", plots)
-    if fusion is None:
+    table, scenario, sensor_set = _read_input(plots, scenario_file, sensors_file,
+                                              reorder_window_s)
+    if fusion is None:  # frames of timed plots hold one sensor each: nothing to fuse
         n_sensors = (len(scenario.sensors) if scenario is not None
                      else len(np.unique(table.sensor)))
-        fusion = default_fusion(n_sensors)
+        fusion = "none" if table.timed else default_fusion(n_sensors)
     if scenario is not None:
         base = default_config(scenario)
     else:  # no scenario: a robust box around the plots is the surveillance area
@@ -168,13 +159,64 @@ def track(plots: Path, tracker: str, tracker_pd: float | None, meas_sigma: float
     _check_clutter_density(tracker, clutter_density)
     trk = make_tracker(tracker, cfg, clutter_density=clutter_density, birth=birth,
                        theta_deg=birth_theta)
+    extra: dict[str, Any] = {} if sensor_set is None else {"sensors": sensor_set}
     result = run_tracker(trk, table, name=tracker, progress=progress, fusion=fusion,
-                         output=output)
-    write_tracks(result.tracks, out)
+                         output=output, **extra)
+    frame = None
+    if sensor_set is not None and sensor_set.reference is not None:
+        frame = sensor_set.frame()
+    write_tracks(result.tracks, out, frame, plots=table)
     n_ids = len(set(result.tracks.track_id.tolist()))
     caps = f", caps acted: {result.caps}" if result.caps else ""
-    click.echo(f"{tracker}: {len(result.stats)} scans, {n_ids} tracks, "
+    steps = "frames" if table.timed else "scans"
+    click.echo(f"{tracker}: {len(result.stats)} {steps}, {n_ids} tracks, "
                f"{1e3 * result.t_avg:.2f} ms/scan{caps} -> {out}")
+
+
+def _read_input(plots: Path, scenario_file: Path | None, sensors_file: Path | None,
+                reorder_window_s: float | None) -> tuple[Any, Any, Any]:
+    """``(plots table, scenario or None, SensorSet or None)`` of the ``track`` command."""
+    from mhtrack.io import read_plots
+    from mhtrack.io.plots import check_scan_times, is_timed
+    from mhtrack.io.sensors import read_sensors
+    from mhtrack.io.timed_plots import DEFAULT_REORDER_WINDOW_S
+    from mhtrack.scenario import load_scenario
+
+    window = DEFAULT_REORDER_WINDOW_S if reorder_window_s is None else reorder_window_s
+    timed = is_timed(plots)
+    if timed:
+        if scenario_file is not None:
+            raise click.UsageError(f"{plots} holds timed plots (no scan column): give "
+                                   "their sensors with --sensors FILE, not --scenario")
+        if sensors_file is None and (plots.parent / "sensors.toml").is_file():
+            sensors_file = plots.parent / "sensors.toml"
+    elif scenario_file is not None and sensors_file is not None:
+        raise click.UsageError("give --scenario (scans) or --sensors (timed plots), not both")
+    if sensors_file is not None:
+        sensor_set = read_sensors(sensors_file)
+        return read_plots(plots, sensors=sensor_set, reorder_window_s=window), None, sensor_set
+    if scenario_file is None and (plots.parent / "scenario.toml").is_file():
+        scenario_file = plots.parent / "scenario.toml"
+    sensors = None
+    scenario = None
+    if scenario_file is not None and not timed:
+        scenario = load_scenario(scenario_file)
+        sensors = {s.id: s for s in scenario.sensors}
+    table = read_plots(plots, sensors=sensors, reorder_window_s=window)
+    if scenario is not None:
+        check_scan_times(plots, table, scenario.scan_indices(), scenario.scan_times(),
+                         f"scenario {scenario_file}")
+        table = dataclasses.replace(
+            table, scan_times=(scenario.scan_indices(), scenario.scan_times())
+        )
+    elif table.range is not None:
+        option = "--sensors with the radars" if table.timed else "--scenario with the radar(s)"
+        logging.getLogger("mhtrack").warning(
+            "%s has range/bearing columns (polar plots), but no %s gives its sensors: they "
+            "are ignored and x, y tracked as Cartesian plots with the tracker's σw; pass %s "
+            "to use the polar measurement model", plots,
+            "sensors file" if table.timed else "scenario", option)
+    return table, scenario, None
 
 
 @click.command()
@@ -225,9 +267,10 @@ def run(scenario: str, seed: int, clutter: str | None, clutter_rate: float | Non
     out = out if out is not None else Path("out") / f"{sc.name}-{tracker}{suffix}-{seed}"
     out.mkdir(parents=True, exist_ok=True)
     sim = result.simulation
+    frame = _output_frame(sc, sim.plots)
     write_plots(sim.plots, out / "plots.csv")
-    write_truth(sim.truth, out / "truth.csv")
-    write_tracks(result.run.tracks, out / "tracks.csv")
+    write_truth(sim.truth, out / "truth.csv", frame)
+    write_tracks(result.run.tracks, out / "tracks.csv", frame, plots=sim.plots)
     write_scenario_toml({"seed": seed, **sc.to_dict()}, out / "scenario.toml")
     summary = result.summary()
     (out / "metrics.json").write_text(dumps(summary, indent=1))
@@ -247,6 +290,15 @@ def run(scenario: str, seed: int, clutter: str | None, clutter_rate: float | Non
     if result.run.caps:
         click.echo(f"hard caps acted: {result.run.caps}")
     click.echo(f"wrote {out}/ (plots, truth, tracks, metrics.json, scene.png, metrics.png)")
+
+
+def _output_frame(sc: Any, plots: Any) -> Any:
+    """The local frame of a simulation's geodetic radars (timed plots), for the lat/lon
+    columns of its truth and tracks files; ``None`` for synchronous scans."""
+    if not plots.timed:
+        return None
+    sensor_set = sc.sensor_set()
+    return sensor_set.frame() if sensor_set.reference is not None else None
 
 
 def _plots_area(plots: Path, table: Any) -> float:

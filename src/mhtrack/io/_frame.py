@@ -22,8 +22,9 @@ import pyarrow.parquet as pq
 from mhtrack.errors import InputError
 from mhtrack.io._source import PathArg, Source, file_format
 
-#: Column kinds of a schema.
-INT, FLOAT = "int", "float"
+#: Column kinds of a schema: integers, floats, and times (read as they are written —
+#: text in CSV, any type in Parquet — and converted by :mod:`mhtrack.io._times`).
+INT, FLOAT, TIME = "int", "float", "time"
 
 _CONVERSION = re.compile(
     r"In CSV column #(\d+): CSV conversion error to (\w+): invalid value '(.*)'", re.S
@@ -138,20 +139,30 @@ class Frame:
         return np.ascontiguousarray(v, dtype=np.float64)
 
 
+def column_names(path: PathArg) -> list[str]:
+    """The column names of a CSV or Parquet file, in file order (located errors)."""
+    src = Source(path)
+    src.check_readable()
+    return _column_names(src)
+
+
+def _column_names(src: Source) -> list[str]:
+    if src.format == "csv":
+        return _csv_header(src)
+    try:
+        return pq.read_schema(src.path).names
+    except (pa.ArrowException, OSError) as e:
+        raise src.error(f"not a readable Parquet file ({e})") from None
+
+
 def read_frame(
     path: PathArg, kinds: Mapping[str, str], required: Sequence[str], schema: str
 ) -> Frame:
-    """Read the columns of ``kinds`` (name -> INT/FLOAT) that ``path`` has; the ``required``
-    ones must all be there. Columns the schema does not know are ignored."""
+    """Read the columns of ``kinds`` (name -> INT/FLOAT/TIME) that ``path`` has; the
+    ``required`` ones must all be there. Columns the schema does not know are ignored."""
     src = Source(path)
     src.check_readable()
-    if src.format == "csv":
-        names = _csv_header(src)
-    else:
-        try:
-            names = pq.read_schema(src.path).names
-        except (pa.ArrowException, OSError) as e:
-            raise src.error(f"not a readable Parquet file ({e})") from None
+    names = _column_names(src)
     seen: set[str] = set()
     for name in names:
         if name in seen:
@@ -166,8 +177,10 @@ def read_frame(
         )
     present = [c for c in kinds if c in seen]
     if src.format == "csv":
-        types = {c: pa.int64() if kinds[c] == INT else pa.float64() for c in present}
-        opts = pacsv.ConvertOptions(column_types=types, include_columns=present, null_values=[""])
+        arrow = {INT: pa.int64(), FLOAT: pa.float64(), TIME: pa.string()}
+        types = {c: arrow[kinds[c]] for c in present}
+        opts = pacsv.ConvertOptions(column_types=types, include_columns=present,
+                                    null_values=[""], strings_can_be_null=True)
         try:
             table = pacsv.read_csv(src.path, convert_options=opts)
         except pa.ArrowInvalid as e:

@@ -1,7 +1,8 @@
-"""Plots files: ``scan, time, sensor, x, y`` [, ``range, bearing``] [, ``origin``].
+"""Plots files: ``scan, time, sensor, x, y`` [, ``range, bearing``] [, ``origin``] — scans
+— or, without ``scan``, timed plots (:mod:`mhtrack.io.timed_plots`).
 
-One row per plot, in non-decreasing scan order; the row order is the plot numbering that
-tracks files refer to (0-based). See ``docs/file-formats.md``.
+One row per plot; the row order is the plot numbering that tracks files refer to
+(0-based). See ``docs/file-formats.md``.
 """
 
 from __future__ import annotations
@@ -12,10 +13,21 @@ import numpy as np
 import pyarrow as pa
 
 from mhtrack.io._checks import check_scan_order, num
-from mhtrack.io._frame import FLOAT, INT, Frame, float_array, int_array, read_frame, write_frame
+from mhtrack.io._frame import (
+    FLOAT,
+    INT,
+    Frame,
+    column_names,
+    float_array,
+    int_array,
+    read_frame,
+    write_frame,
+)
 from mhtrack.io._source import PathArg, Source
+from mhtrack.io.timed_plots import DEFAULT_REORDER_WINDOW_S, read_timed_plots
+from mhtrack.models.radars import SensorSet
 from mhtrack.models.sensors import CartesianSensor, PolarRadar
-from mhtrack.records import MAX_COORDINATE, PlotTable
+from mhtrack.records import MAX_COORDINATE, NO_PLOT, PlotTable
 
 REQUIRED = ("scan", "time", "sensor", "x", "y")
 COLUMNS = {
@@ -38,8 +50,21 @@ MAX_GAP = 10_000
 MAX_EMPTY_RATIO = 10
 
 
-def read_plots(path: PathArg, sensors: SensorRegistry | None = None) -> PlotTable:
+def is_timed(path: PathArg) -> bool:
+    """The plots file has no ``scan`` column: timed plots (located errors if unreadable)."""
+    return "scan" not in column_names(path)
+
+
+def read_plots(
+    path: PathArg, sensors: SensorSet | SensorRegistry | None = None, *,
+    reorder_window_s: float = DEFAULT_REORDER_WINDOW_S,
+) -> PlotTable:
     """Read and validate a plots file (``.csv`` or ``.parquet``).
+
+    A file without a ``scan`` column holds timed plots and is read by
+    :func:`~mhtrack.io.timed_plots.read_timed_plots` with ``sensors`` (a
+    :class:`~mhtrack.models.radars.SensorSet`, from a sensors file) and
+    ``reorder_window_s``. A file with ``scan`` is read as below (scans).
 
     Parameters
     ----------
@@ -60,6 +85,16 @@ def read_plots(path: PathArg, sensors: SensorRegistry | None = None) -> PlotTabl
     ------
     InputError : on any problem with the file, naming file, line/row and column.
     """
+    names = column_names(path)
+    if "scan" not in names and {"time", "sensor"} <= set(names):
+        if sensors is not None and not isinstance(sensors, SensorSet):
+            raise TypeError("a plots file without 'scan' (timed plots) is read with a "
+                            "SensorSet (a sensors file), not a sensor registry")
+        return read_timed_plots(path, sensors, reorder_window_s=reorder_window_s)
+    if isinstance(sensors, SensorSet):
+        raise Source(path).error(
+            "scans are read with a scenario's sensors (--scenario); a sensors file is for "
+            "timed plots (one time per plot, no 'scan' column)", column="scan")
     f = read_frame(path, COLUMNS, REQUIRED, "plots")
     if f.n == 0:
         f.fail("no rows (a plots file needs at least one plot)")
@@ -245,21 +280,63 @@ def check_scan_times(
         )
 
 
+def file_rows(table: PlotTable) -> np.ndarray | None:
+    """The file row (0-based) of each row of ``table``, as :func:`write_plots` writes it
+    (and as a timed file read it): ``table.file_row``; else, for a timed table, the rank
+    of each row in time order (ties: table order); ``None`` when it is the table order."""
+    if table.file_row is not None:
+        return table.file_row
+    if not table.timed:
+        return None
+    n = len(table)
+    rank = np.empty(n, np.int64)
+    rank[np.lexsort((np.arange(n), table.time))] = np.arange(n)
+    return rank
+
+
+def plots_to_file_rows(plot: np.ndarray, table: PlotTable) -> np.ndarray:
+    """Table rows (``Scan.rows``, a track's ``plot``; ``-1`` kept) as file rows."""
+    rows = file_rows(table)
+    plot = np.asarray(plot, np.int64)
+    if rows is None:
+        return plot
+    return np.where(plot == NO_PLOT, NO_PLOT, rows[np.maximum(plot, 0)])
+
+
+def plots_to_table_rows(plot: np.ndarray, table: PlotTable) -> np.ndarray:
+    """The inverse of :func:`plots_to_file_rows`: file rows (``-1`` kept) as table rows."""
+    rows = file_rows(table)
+    plot = np.asarray(plot, np.int64)
+    if rows is None:
+        return plot
+    inverse = np.empty(len(rows), np.int64)
+    inverse[rows] = np.arange(len(rows))
+    return np.where(plot == NO_PLOT, NO_PLOT, inverse[np.maximum(plot, 0)])
+
+
 def write_plots(table: PlotTable, path: PathArg) -> None:
     """Write ``table`` to a ``.csv`` or ``.parquet`` file (``R`` and ``scan_times`` are not
-    stored; NaN ``range``/``bearing`` are written as empty cells / nulls)."""
+    stored; NaN ``range``/``bearing`` are written as empty cells / nulls).
+
+    A timed table (``table.timed``) is written without ``scan`` — ``time, sensor`` [,
+    ``range, bearing``], ``x, y`` [, ``origin``] — its rows in file order
+    (:func:`file_rows`: as read, or by time), which :func:`read_plots` sorts back into
+    the same table."""
     if (table.range is None) != (table.bearing is None):
         raise ValueError("PlotTable has only one of range/bearing; both or neither are needed")
-    cols: dict[str, pa.Array] = {
-        "scan": int_array(table.scan),
-        "time": float_array(table.time),
-        "sensor": int_array(table.sensor),
-        "x": float_array(table.x),
-        "y": float_array(table.y),
-    }
-    if table.range is not None and table.bearing is not None:
+    rows = file_rows(table)
+    order = slice(None) if rows is None else np.argsort(rows, kind="stable")
+    cols: dict[str, pa.Array] = {} if table.timed else {"scan": int_array(table.scan)}
+    cols["time"] = float_array(table.time[order])
+    cols["sensor"] = int_array(table.sensor[order])
+    if table.timed and table.range is not None and table.bearing is not None:
+        cols["range"] = float_array(table.range[order], nan_as_null=True)
+        cols["bearing"] = float_array(table.bearing[order], nan_as_null=True)
+    cols["x"] = float_array(table.x[order])
+    cols["y"] = float_array(table.y[order])
+    if not table.timed and table.range is not None and table.bearing is not None:
         cols["range"] = float_array(table.range, nan_as_null=True)
         cols["bearing"] = float_array(table.bearing, nan_as_null=True)
     if table.origin is not None:
-        cols["origin"] = int_array(table.origin)
+        cols["origin"] = int_array(table.origin[order])
     write_frame(path, cols)

@@ -2,22 +2,38 @@
 tracker output, one row per reported track and scan, in non-decreasing scan order. ``plot``
 is the 0-based row of the plots file that the track used at that scan, empty (CSV) or null
 (Parquet) on a miss; ``tentative`` is 1 on rows reported after their scan, when the track
-was confirmed later (the history output), else 0. See ``docs/file-formats.md``."""
+was confirmed later (the history output), else 0. Written with a frame, ``lat, lon`` and
+east/north ``vx, vy`` (:mod:`mhtrack.io._geodetic`). See ``docs/file-formats.md``."""
 
 from __future__ import annotations
+
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from mhtrack.errors import InputError
+from mhtrack.io import _geodetic
 from mhtrack.io._checks import check_scan_order, check_unique, num
-from mhtrack.io._frame import FLOAT, INT, float_array, int_array, read_frame, write_frame
+from mhtrack.io._frame import (
+    FLOAT,
+    INT,
+    column_names,
+    float_array,
+    int_array,
+    read_frame,
+    write_frame,
+)
 from mhtrack.io._source import PathArg
+from mhtrack.io.plots import plots_to_file_rows, plots_to_table_rows
 from mhtrack.io.truth import read_truth
-from mhtrack.records import NO_PLOT, TrackTable, TruthTable
+from mhtrack.records import NO_PLOT, PlotTable, TrackTable, TruthTable
+
+if TYPE_CHECKING:
+    from mhtrack.models.geodesy import LocalFrame
 
 REQUIRED = ("scan", "time", "track_id", "x", "y", "vx", "vy", "plot")
 COLUMNS = dict.fromkeys((*REQUIRED, "score"), FLOAT) | {
-    "scan": INT, "track_id": INT, "plot": INT, "tentative": INT}
+    "scan": INT, "track_id": INT, "plot": INT, "tentative": INT} | _geodetic.COLUMNS
 
 
 def tracks_from_truth(truth: TruthTable) -> TrackTable:
@@ -29,7 +45,10 @@ def tracks_from_truth(truth: TruthTable) -> TrackTable:
     )
 
 
-def read_tracks(path: PathArg, *, accept_truth: bool = True) -> TrackTable:
+def read_tracks(
+    path: PathArg, *, accept_truth: bool = True, frame: LocalFrame | None = None,
+    plots: PlotTable | None = None,
+) -> TrackTable:
     """Read and validate a tracks file (``.csv`` or ``.parquet``).
 
     A file with a header and no rows is valid (the tracker reported nothing). Misses
@@ -40,24 +59,31 @@ def read_tracks(path: PathArg, *, accept_truth: bool = True) -> TrackTable:
     perfect tracker's output (:func:`tracks_from_truth`), so that ``evaluate truth truth``
     checks the metrics' zero point.
 
+    A file with ``lat, lon`` has east/north ``vx, vy``: the local state comes from ``x, y,
+    vx_grid, vy_grid``, or from converting with ``frame``
+    (:func:`mhtrack.io._geodetic.read_state`). With ``plots`` (the table read from the
+    plots file the tracks refer to) the ``plot`` column's file rows become that table's
+    rows (:func:`~mhtrack.io.plots.plots_to_table_rows`; a timed file is re-sorted).
+
     Raises
     ------
     InputError : on any problem with the file, naming file, line/row and column.
     """
     try:
-        f = read_frame(path, COLUMNS, REQUIRED, "tracks")
+        names = column_names(path)
+        f = read_frame(path, COLUMNS, _geodetic.required(names, REQUIRED), "tracks")
     except InputError as tracks_error:
         if not accept_truth or tracks_error.line is not None or tracks_error.row is not None:
             raise
         try:
-            truth = read_truth(path)
+            truth = read_truth(path, frame=frame)
         except InputError:
             raise tracks_error from None
         return tracks_from_truth(truth)
     scan = f.ints("scan")
     time = f.floats("time")
     tid = f.ints("track_id")
-    cols = {c: f.floats(c) for c in ("x", "y", "vx", "vy")}
+    cols = _geodetic.read_state(f, frame)
     plot = f.ints("plot", nullable=True, fill=NO_PLOT)
     written = ~f.nulls("plot")
     miss = "leave the cell empty" if f.src.format == "csv" else "use null"
@@ -75,22 +101,30 @@ def read_tracks(path: PathArg, *, accept_truth: bool = True) -> TrackTable:
         tentative = flag == 1
     check_scan_order(f, scan, time)
     check_unique(f, scan, tid, "track_id")
+    if plots is not None:
+        f.check(plot >= len(plots), "plot", lambda r: f"plot {num(plot[r])} is not a row of "
+                f"the plots file ({len(plots)} plots)")
+        plot = plots_to_table_rows(plot, plots)
     return TrackTable(scan=scan, time=time, track_id=tid, plot=plot, score=score,
                       tentative=tentative, **cols)
 
 
-def write_tracks(table: TrackTable, path: PathArg) -> None:
+def write_tracks(
+    table: TrackTable, path: PathArg, frame: LocalFrame | None = None, *,
+    plots: PlotTable | None = None,
+) -> None:
     """Write ``table`` to a ``.csv`` or ``.parquet`` file; ``plot = -1`` (a miss) is
-    written as an empty cell / null, and ``P`` is not stored."""
+    written as an empty cell / null, and ``P`` is not stored. With ``frame``, also
+    ``lat, lon`` and east/north ``vx, vy`` (:func:`mhtrack.io._geodetic.state_columns`);
+    with ``plots`` (the table the tracker ran on), ``plot`` names the row of its file
+    (:func:`~mhtrack.io.plots.plots_to_file_rows`)."""
+    plot = table.plot if plots is None else plots_to_file_rows(table.plot, plots)
     cols = {
         "scan": int_array(table.scan),
         "time": float_array(table.time),
         "track_id": int_array(table.track_id),
-        "x": float_array(table.x),
-        "y": float_array(table.y),
-        "vx": float_array(table.vx),
-        "vy": float_array(table.vy),
-        "plot": int_array(table.plot, missing=table.plot == NO_PLOT),
+        **_geodetic.state_columns(table.x, table.y, table.vx, table.vy, frame),
+        "plot": int_array(plot, missing=plot == NO_PLOT),
     }
     if table.score is not None:
         cols["score"] = float_array(table.score)

@@ -1,0 +1,239 @@
+"""Timed plots files (no ``scan`` column): each plot with its own ``time`` and ``sensor``,
+and its position as ``range, bearing`` (polar radars), ``x, y`` (local frame) or
+``lat, lon`` (WGS-84) — real data from several rotating radars (docs/file-formats.md,
+"Timed plots").
+
+Reading converts every plot into the local frame with :mod:`mhtrack.models.geodesy`
+through the :class:`~mhtrack.models.radars.SensorSet` of a sensors file (its frame and
+sites), checks that the rows are in time order to within a reorder window, cuts them into
+one-sensor frames with :func:`mhtrack.frames.make_frames` and returns a timed
+:class:`~mhtrack.records.PlotTable` whose ``file_row`` maps each row back to the file.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from mhtrack.frames import frame_lengths, make_frames
+from mhtrack.io._checks import num
+from mhtrack.io._frame import FLOAT, INT, TIME, Frame, read_frame
+from mhtrack.io._source import PathArg
+from mhtrack.io._times import seconds
+from mhtrack.models.radars import SensorSet
+from mhtrack.records import MAX_COORDINATE, PlotTable
+
+#: Rows may come out of time order by at most this much (s) by default (network jitter
+#: between radars): a row's time must be ≥ the largest time of the rows above it − window.
+DEFAULT_REORDER_WINDOW_S = 2.0
+#: Largest range accepted (m): 20 000 km, about half a meridian (20 003.9 km) — farther
+#: than any point of the Earth from the site along the ground.
+MAX_RANGE_M = 2e7
+
+REQUIRED = ("time", "sensor")
+COLUMNS = {"time": TIME, "sensor": INT, "range": FLOAT, "bearing": FLOAT, "x": FLOAT,
+           "y": FLOAT, "lat": FLOAT, "lon": FLOAT, "origin": INT}
+#: Position column pairs, in the order a row's position is taken from them.
+PAIRS = (("range", "bearing"), ("x", "y"), ("lat", "lon"))
+_NEEDS_SENSORS = "read them with a sensors file (mhtrack track --sensors FILE)"
+
+
+def read_timed_plots(
+    path: PathArg, sensors: SensorSet | None = None, *,
+    reorder_window_s: float = DEFAULT_REORDER_WINDOW_S,
+) -> PlotTable:
+    """Read a plots file without ``scan`` (docs/file-formats.md, "Timed plots").
+
+    Without ``sensors`` every row needs ``x, y`` (``R`` is then ``None``: the tracker's
+    own σ applies) and ``range``/``bearing`` are only carried along. With ``sensors``:
+    a polar sensor's rows need ``range, bearing`` (``z, R`` by
+    :func:`~mhtrack.models.geodesy.polar_to_local`), a Cartesian sensor's rows ``x, y`` or
+    ``lat, lon`` (``LocalFrame.to_local``) with ``R = σ² I``.
+
+    Returns a ``PlotTable(timed=True)`` sorted by frame, then time; ``file_row[i]`` is the
+    0-based file row of table row ``i``.
+    """
+    if not reorder_window_s >= 0:
+        raise ValueError(f"reorder_window_s must be >= 0, got {reorder_window_s!r}")
+    f = read_frame(path, COLUMNS, REQUIRED, "timed plots")
+    if f.n == 0:
+        f.fail("no rows (a plots file needs at least one plot)")
+    _check_pairs(f)
+    time = seconds(f)
+    _check_order(f, time, reorder_window_s)
+    sensor = f.ints("sensor")
+    origin = None
+    if f.has("origin"):
+        origin = f.ints("origin")
+        f.check(origin < -1, "origin", lambda r: f"origin {num(origin[r])} is invalid (a "
+                "target id >= 0, or -1 for clutter)")
+    rng, bearing = _range_bearing(f)
+    lat, lon = _lat_lon(f)
+    if sensors is None:
+        x, y, R = _without_sensors(f)
+    else:
+        x, y, R = _convert(f, sensor, rng, bearing, lat, lon, sensors)
+    for name, v in (("x", x), ("y", y)):
+        f.check(np.abs(v) > MAX_COORDINATE, name if f.has(name) else None,
+                lambda r, v=v, name=name: f"{name} = {num(v[r])} m is beyond "
+                f"±{MAX_COORDINATE:g} m of the frame's origin (a unit or parsing error?)")
+    periods = {s: sensors.sensor(s).period if sensors is not None else None
+               for s in np.unique(sensor).tolist()}
+    frame, order = make_frames(time, sensor, frame_lengths(periods))
+
+    def take(v: np.ndarray | None) -> np.ndarray | None:
+        return None if v is None else np.ascontiguousarray(v[order])
+
+    return PlotTable(
+        scan=frame[order], time=time[order], sensor=sensor[order], x=take(x), y=take(y),
+        range=take(rng), bearing=take(bearing), origin=take(origin), R=take(R),
+        timed=True, file_row=order.astype(np.int64),
+    )  # type: ignore[arg-type]
+
+
+def _check_pairs(f: Frame) -> None:
+    """Position columns come in pairs, and at least one pair is there."""
+    for a, b in PAIRS:
+        if f.has(a) != f.has(b):
+            have, other = (a, b) if f.has(a) else (b, a)
+            f.fail(f"column {have!r} is present without column {other!r}; give both or "
+                   "neither")
+    if not any(f.has(a) for a, _ in PAIRS):
+        f.fail("no plot positions: a plots file without 'scan' needs columns 'range' and "
+               "'bearing', 'x' and 'y', or 'lat' and 'lon'")
+
+
+def _check_order(f: Frame, time: np.ndarray, window: float) -> None:
+    """Each row's time ≥ (largest time of the rows above it) − ``window``."""
+    if time.size < 2:
+        return
+    before = np.maximum.accumulate(time)[:-1]
+    late = np.concatenate(([False], time[1:] < before - window))
+
+    def text(r: int) -> str:
+        m = before[r - 1]
+        at = int(np.flatnonzero(time[:r] == m)[0])
+        return (f"time {f.text('time', r)} is {m - time[r]:.6g} s before time "
+                f"{f.text('time', at)} on {f.src.where(at)}, beyond the reorder window of "
+                f"{window:g} s; sort the rows by time (or widen reorder_window_s)")
+
+    f.check(late, "time", text)
+
+
+def _floats_or_none(f: Frame, name: str) -> np.ndarray | None:
+    """A position column that may be empty on some rows (NaN there), finite elsewhere."""
+    if not f.has(name):
+        return None
+    v = f.floats(name, nullable=True, finite=False)
+    nulls = f.nulls(name)
+    f.check(~np.isfinite(v) & ~nulls, name, lambda r: f"value {f.text(name, r)!r} is not "
+            "finite")
+    return v
+
+
+def _range_bearing(f: Frame) -> tuple[np.ndarray | None, np.ndarray | None]:
+    """``range`` (≥ 0 m) and ``bearing`` (in [0, 360]°), NaN where empty, or ``None``."""
+    rng, bearing = _floats_or_none(f, "range"), _floats_or_none(f, "bearing")
+    if rng is None or bearing is None:
+        return None, None
+    f.check(rng < 0, "range", lambda r: f"range {num(rng[r])} m is negative")
+    f.check(rng > MAX_RANGE_M, "range", lambda r: f"range {num(rng[r])} m is beyond "
+            f"{MAX_RANGE_M / 1e3:.0f} km, half-way round the Earth (a unit error?)")
+    f.check((bearing < 0) | (bearing > 360), "bearing", lambda r: f"bearing "
+            f"{num(bearing[r])} is outside [0, 360] degrees (clockwise from north)")
+    for name, a, b in (("bearing", rng, bearing), ("range", bearing, rng)):
+        f.check(~np.isnan(a) & np.isnan(b), name, lambda r: "value is missing (range and "
+                "bearing come together)")
+    return rng, bearing
+
+
+def _lat_lon(f: Frame) -> tuple[np.ndarray | None, np.ndarray | None]:
+    """``lat`` in [−90, 90]° and ``lon`` in [−180, 180]° (NaN where empty), or ``None``."""
+    lat, lon = _floats_or_none(f, "lat"), _floats_or_none(f, "lon")
+    if lat is None or lon is None:
+        return None, None
+    f.check(np.abs(lat) > 90, "lat", lambda r: f"latitude {num(lat[r])} is outside "
+            "[-90, 90] degrees")
+    f.check(np.abs(lon) > 180, "lon", lambda r: f"longitude {num(lon[r])} is outside "
+            "[-180, 180] degrees")
+    for name, a, b in (("lon", lat, lon), ("lat", lon, lat)):
+        f.check(~np.isnan(a) & np.isnan(b), name, lambda r: "value is missing (lat and "
+                "lon come together)")
+    return lat, lon
+
+
+def _without_sensors(f: Frame) -> tuple[np.ndarray, np.ndarray, None]:
+    if not f.has("x"):
+        what = "range/bearing" if f.has("range") else "lat/lon"
+        needs = "the radar sites" if f.has("range") else "the local frame's origin"
+        f.fail(f"{what} plots need {needs}: {_NEEDS_SENSORS}")
+    return f.floats("x"), f.floats("y"), None
+
+
+def _convert(
+    f: Frame, sensor: np.ndarray, rng: np.ndarray | None, bearing: np.ndarray | None,
+    lat: np.ndarray | None, lon: np.ndarray | None, sensors: SensorSet,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Positions and covariances of every row in the sensors' local frame."""
+    from mhtrack.models.geodesy import polar_to_local  # pyproj only when converting
+
+    ids = sensors.ids
+    listed = ", ".join(str(i) for i in ids)
+    f.check(~np.isin(sensor, np.asarray(ids, np.int64)), "sensor", lambda r: (
+        f"unknown sensor {num(sensor[r])} (the sensors file lists {listed})"))
+    kinds = {s.id: s for s in sensors.sensors}
+    polar = np.isin(sensor, [s.id for s in sensors.sensors if s.kind == "polar"])
+    has_rb = np.zeros(f.n, bool) if rng is None else ~np.isnan(rng)
+    if polar.any() and rng is None:
+        used = ", ".join(str(i) for i in np.unique(sensor[polar]).tolist())
+        f.fail(f"missing columns 'range', 'bearing', needed by polar sensor(s) {used}")
+    f.check(polar & ~has_rb, "range", lambda r: f"value is missing (sensor "
+            f"{num(sensor[r])} is a polar radar: its plots are range and bearing)")
+
+    def not_polar(r: int) -> str:
+        s = kinds[int(sensor[r])]
+        what = "a cartesian sensor" + ("" if s.has_site else " without a site")
+        return (f"sensor {s.id} is {what}: a range/bearing plot needs a polar sensor with "
+                "its site (lat/lon or position) in the sensors file")
+
+    f.check(~polar & has_rb, "range", not_polar)
+    x, y = np.full(f.n, np.nan), np.full(f.n, np.nan)
+    R = np.zeros((f.n, 2, 2))
+    for s in sensors.sensors:
+        rows = np.flatnonzero(sensor == s.id)
+        if rows.size == 0:
+            continue
+        if s.kind == "polar":
+            z, R[rows] = polar_to_local(sensors.frame(), *sensors.site_latlon(s.id),
+                                        rng[rows], bearing[rows],  # type: ignore[index]
+                                        s.sigma_range, s.sigma_bearing_deg)
+            x[rows], y[rows] = z[:, 0], z[:, 1]
+        else:
+            x[rows], y[rows] = _cartesian(f, sensors, rows, s.id, lat, lon)
+            R[rows] = np.eye(2) * float(s.sigma) ** 2  # type: ignore[arg-type]
+    return x, y, R
+
+
+def _cartesian(f: Frame, sensors: SensorSet, rows: np.ndarray, sensor_id: int,
+               lat: np.ndarray | None, lon: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
+    """A Cartesian sensor's rows: ``x, y`` where written, else ``lat, lon``."""
+    n = rows.size
+    x, y = _floats_or_none(f, "x"), _floats_or_none(f, "y")
+    xr = np.full(n, np.nan) if x is None or y is None else x[rows]
+    yr = np.full(n, np.nan) if x is None or y is None else y[rows]
+    use_xy = ~np.isnan(xr) & ~np.isnan(yr)
+    la = np.full(n, np.nan) if lat is None or lon is None else lat[rows]
+    lo = np.full(n, np.nan) if lat is None or lon is None else lon[rows]
+    use_ll = ~use_xy & ~np.isnan(la)
+    none = np.zeros(f.n, bool)
+    none[rows] = ~use_xy & ~use_ll
+    f.check(none, "x" if x is not None else "lat", lambda r: (
+        f"value is missing (sensor {sensor_id} is cartesian: give x and y, or lat and lon)"))
+    if use_ll.any():
+        try:
+            frame = sensors.frame()
+        except ValueError:
+            f.fail("lat/lon plots need the local frame's origin: give [origin] (or a "
+                   "sensor's lat/lon) in the sensors file", row=int(rows[use_ll][0]),
+                   column="lat")
+        xr[use_ll], yr[use_ll] = frame.to_local(la[use_ll], lo[use_ll])
+    return xr, yr

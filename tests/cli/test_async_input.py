@@ -4,7 +4,6 @@ column, no traceback, each message checked verbatim."""
 
 from __future__ import annotations
 
-import inspect
 from pathlib import Path
 
 import numpy as np
@@ -149,7 +148,7 @@ def test_track_passes_the_sensor_set_and_writes_geodetic_tracks(tmp_path, monkey
     seen: dict = {}
 
     def fake_track(tracker, table: PlotTable, **kw):
-        seen.update(kw, table=table)
+        seen.update(kw, table=table, tracker=tracker)
         k = int(np.flatnonzero(table.time == table.time.max())[0])  # the last polar plot
         tr = TrackTable(np.array([table.scan[k]]), np.array([table.time[k]]), np.array([1]),
                         table.x[k:k + 1], table.y[k:k + 1], np.array([100.0]),
@@ -160,7 +159,11 @@ def test_track_passes_the_sensor_set_and_writes_geodetic_tracks(tmp_path, monkey
     code, stdout, stderr = invoke("track", str(plots), "--sensors", str(sensors),
                                   "--out", str(tmp_path / "t.csv"), "--no-progress")
     assert code == 0, stderr
-    assert seen["sensors"] == read_sensors(sensors) and seen["fusion"] == "none"
+    from mhtrack.mht.coverage import RadarCoverage
+
+    coverage = seen["tracker"].coverage  # the radars' coverage and clutter come from the file
+    assert isinstance(coverage, RadarCoverage) and coverage.sensors == read_sensors(sensors)
+    assert seen["fusion"] == "none"
     table = seen["table"]
     assert table.timed and table.file_row.tolist() == [1, 0, 2, 3]
     out = pacsv.read_csv(tmp_path / "t.csv").to_pydict()
@@ -175,8 +178,6 @@ def test_track_passes_the_sensor_set_and_writes_geodetic_tracks(tmp_path, monkey
     assert back.vx.tolist() == [100.0] and back.x[0] == table.x[3]
 
 
-@pytest.mark.skipif("sensors" not in inspect.signature(pipeline.track).parameters,
-                    reason="pipeline.track(sensors=...) comes with the asynchronous MHT")
 def test_track_runs_end_to_end_on_timed_plots(tmp_path):
     plots, sensors = files(tmp_path, GOOD)
     code, _, stderr = invoke("track", str(plots), "--sensors", str(sensors),

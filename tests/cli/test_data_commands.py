@@ -170,8 +170,16 @@ def test_simulate_rotating_radars_writes_timed_plots_truth_and_sensors(tmp_path)
     assert {"time", "target_id", "lat", "lon", "vx", "vy", "x", "y"} <= set(truth[0])
     sim = simulate(preset("opensky-radars", scans=7), seed=1)
     assert len(plots) == len(sim.plots)
-    np.testing.assert_array_equal([float(r["range"]) for r in plots], sim.plots.range)
+    # the file is in time order; read back with its sensors it is the simulated table
+    from mhtrack.io import read_plots
+
     ss = read_sensors(tmp_path / "sensors.toml")
+    back = read_plots(tmp_path / "plots.csv", sensors=ss)
+    np.testing.assert_array_equal(np.sort([float(r["time"]) for r in plots]),
+                                  np.sort(sim.plots.time))
+    np.testing.assert_array_equal(back.range, sim.plots.range)
+    np.testing.assert_array_equal(back.scan, sim.plots.scan)
+    np.testing.assert_allclose(back.x, sim.plots.x, atol=1e-6)
     assert ss == sim.scenario.sensor_set()
     # lat/lon of the truth are its x, y on the ellipsoid; vx, vy east/north keep the speed
     frame = LocalFrame(*ss.origin)

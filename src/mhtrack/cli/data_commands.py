@@ -45,31 +45,15 @@ def simulate(scenario: str, seed: int, clutter: str | None, clutter_rate: float 
 
 
 def _write_rotating(sim: Any, out: Path, fmt: str) -> None:
-    """The files of a rotating-radar simulation (``mhtrack simulate --help``).
-
-    Stand-in until ``mhtrack.io.write_plots`` writes timed tables without ``scan`` and
-    ``write_truth`` takes the ``frame`` (issue 14, helper io14): these two tables are
-    written here with the io layer's column writer; the lead replaces the two
-    ``write_frame`` calls by ``write_plots`` / ``write_truth(..., frame=frame)``.
-    """
-    from mhtrack.io import write_scenario_toml
-    from mhtrack.io._frame import float_array, int_array, write_frame
+    """The files of a rotating-radar simulation (``mhtrack simulate --help``): timed plots
+    (no scan), truth with lat/lon and east/north velocities, the sensors file."""
+    from mhtrack.io import write_plots, write_scenario_toml, write_truth
     from mhtrack.io.sensors import write_sensors
 
     sc, plots, truth = sim.scenario, sim.plots, sim.truth
     sensor_set = sc.sensor_set()
-    frame = sensor_set.frame()
-    write_frame(out / f"plots.{fmt}", {
-        "time": float_array(plots.time), "sensor": int_array(plots.sensor),
-        "range": float_array(plots.range), "bearing": float_array(plots.bearing),
-        "origin": int_array(plots.origin)})
-    lat, lon = frame.to_geodetic(truth.x, truth.y)
-    ve, vn = frame.velocity_to_geodetic(truth.x, truth.y, truth.vx, truth.vy)
-    write_frame(out / f"truth.{fmt}", {
-        "scan": int_array(truth.scan), "time": float_array(truth.time),
-        "target_id": int_array(truth.target_id), "x": float_array(truth.x),
-        "y": float_array(truth.y), "lat": float_array(lat), "lon": float_array(lon),
-        "vx": float_array(ve), "vy": float_array(vn)})
+    write_plots(plots, out / f"plots.{fmt}")
+    write_truth(truth, out / f"truth.{fmt}", sensor_set.frame())
     write_sensors(sensor_set, out / "sensors.toml")
     write_scenario_toml({"seed": sim.seed, **sc.to_dict()}, out / "scenario.toml")
     n_clutter = int((plots.origin < 0).sum())
@@ -91,21 +75,44 @@ def _write_rotating(sim: Any, out: Path, fmt: str) -> None:
               help="OSPA/GOSPA order p.")
 @click.option("--match-distance", type=click.FloatRange(min=0, min_open=True), default=None,
               help="Track-to-truth matching distance for CLEAR-MOT (m) [default: cut-off].")
+@click.option("--sensors", "sensors_file", type=click.Path(exists=True, dir_okay=False,
+              path_type=Path), default=None,
+              help="Sensors file of timed (asynchronous) data: reads timed PLOTS and files "
+              "that give positions only as lat/lon [default: sensors.toml beside TRUTH, if "
+              "any].")
+@click.option("--at", "at", type=click.Choice(["scans", "truth-times"]), default=None,
+              help="Score at the tracks' scans, or at the truth's times with each track's "
+              "latest state predicted to them [default: truth-times for tracks numbered by "
+              "frame (timed plots), else scans; docs/metrics.md].")
+@click.option("--max-age", "max_age_s", type=click.FloatRange(min=0), default=None,
+              help="At truth times: the oldest track state (s) still predicted [15].")
 @click.option("--json", "as_json", is_flag=True, help="Print one JSON object.")
 def evaluate(tracks: Path, truth: Path, plots: Path | None, cutoff: float, order: float,
-             match_distance: float | None, as_json: bool) -> None:
-    """Score TRACKS against TRUTH: OSPA, GOSPA, cardinality, CLEAR-MOT."""
+             match_distance: float | None, sensors_file: Path | None, at: str | None,
+             max_age_s: float | None, as_json: bool) -> None:
+    """Score TRACKS against TRUTH: OSPA, GOSPA, cardinality, CLEAR-MOT, coverage."""
     from mhtrack.io import read_plots, read_tracks, read_truth
+    from mhtrack.io.sensors import read_sensors
+    from mhtrack.io.tracks import has_frames
     from mhtrack.metrics import evaluate as run_evaluation
+    from mhtrack.metrics.resample import DEFAULT_MAX_AGE_S, alignment
 
-    tr = read_tracks(tracks)
-    gt = read_truth(truth)
-    pl = read_plots(plots) if plots is not None else None
-    _check_same_times(tracks, tr, truth, gt)
-    if pl is not None and plots is not None:
-        _check_same_times(plots, pl, truth, gt)
+    if sensors_file is None and (truth.parent / "sensors.toml").is_file():
+        sensors_file = truth.parent / "sensors.toml"
+    sensor_set = read_sensors(sensors_file) if sensors_file is not None else None
+    frame = sensor_set.frame() if sensor_set is not None else None
+    pl = read_plots(plots, sensors=sensor_set) if plots is not None else None
+    tr = read_tracks(tracks, frame=frame, plots=pl if pl is not None and pl.timed else None)
+    gt = read_truth(truth, frame=frame)
+    if at is None and not has_frames(tracks):
+        at = "scans"  # tracks numbered by scan are scored at their scans, times checked
+    if alignment(tr, gt, pl, at) == "scans":
+        _check_same_times(tracks, tr, truth, gt)
+        if pl is not None and plots is not None:
+            _check_same_times(plots, pl, truth, gt)
     ev = run_evaluation(tr, gt, plots=pl, cutoff=cutoff, order=order,
-                        match_distance=match_distance)
+                        match_distance=match_distance, at=at,
+                        max_age_s=DEFAULT_MAX_AGE_S if max_age_s is None else max_age_s)
     if as_json:
         echo_json(ev.to_dict())
     else:
@@ -136,7 +143,8 @@ def _check_same_times(path_a: Path, a: Any, path_b: Path, b: Any) -> None:
 def plot(directory: Path, output: Path | None, title: str | None) -> None:
     """Draw DIR's truth, plots (clutter grey) and tracks, whichever are present."""
     from mhtrack.io import read_plots, read_toml, read_tracks, read_truth
-    from mhtrack.plotting.scene import plot_scene, save_figure
+    from mhtrack.io.sensors import read_sensors
+    from mhtrack.plotting.scene import plot_scene, save_figure, sensor_sites
 
     paths = {s: table_path(directory, s) for s in ("plots", "truth", "tracks")}
     if not any(paths.values()):
@@ -145,11 +153,18 @@ def plot(directory: Path, output: Path | None, title: str | None) -> None:
         title = directory.name
         if (directory / "scenario.toml").is_file():
             title = str(read_toml(directory / "scenario.toml").get("name", title))
+    sensors = directory / "sensors.toml"  # radars at geodetic sites: drawn, and their frame
+    sensor_set = read_sensors(sensors) if sensors.is_file() else None
+    frame = sensor_set.frame() if sensor_set is not None else None
+    plots = read_plots(paths["plots"], sensors=sensor_set) if paths["plots"] else None
     fig = plot_scene(
-        plots=read_plots(paths["plots"]) if paths["plots"] else None,
-        truth=read_truth(paths["truth"]) if paths["truth"] else None,
-        tracks=read_tracks(paths["tracks"]) if paths["tracks"] else None,
+        plots=plots,
+        truth=read_truth(paths["truth"], frame=frame) if paths["truth"] else None,
+        tracks=read_tracks(paths["tracks"], frame=frame,
+                           plots=plots if plots is not None and plots.timed else None)
+        if paths["tracks"] else None,
         title=title,
+        sites=sensor_sites(sensor_set) if sensor_set is not None else None,
     )
     path = save_figure(fig, output or directory / "scene.png")
     click.echo(f"wrote {path}")

@@ -158,10 +158,9 @@ def track(plots: Path, tracker: str, tracker_pd: float | None, meas_sigma: float
                   imm_accel_sigma)
     _check_clutter_density(tracker, clutter_density)
     trk = make_tracker(tracker, cfg, clutter_density=clutter_density, birth=birth,
-                       theta_deg=birth_theta)
-    extra: dict[str, Any] = {} if sensor_set is None else {"sensors": sensor_set}
+                       theta_deg=birth_theta, sensors=sensor_set)
     result = run_tracker(trk, table, name=tracker, progress=progress, fusion=fusion,
-                         output=output, **extra)
+                         output=output)
     frame = None
     if sensor_set is not None and sensor_set.reference is not None:
         frame = sensor_set.frame()

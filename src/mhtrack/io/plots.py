@@ -319,7 +319,8 @@ def write_plots(table: PlotTable, path: PathArg) -> None:
     stored; NaN ``range``/``bearing`` are written as empty cells / nulls).
 
     A timed table (``table.timed``) is written without ``scan`` — ``time, sensor`` [,
-    ``range, bearing``], ``x, y`` [, ``origin``] — its rows in file order
+    ``range, bearing``], ``x, y`` (left out when every plot is polar: the reader converts
+    range and bearing with the sensors file) [, ``origin``] — its rows in file order
     (:func:`file_rows`: as read, or by time), which :func:`read_plots` sorts back into
     the same table."""
     if (table.range is None) != (table.bearing is None):
@@ -332,8 +333,10 @@ def write_plots(table: PlotTable, path: PathArg) -> None:
     if table.timed and table.range is not None and table.bearing is not None:
         cols["range"] = float_array(table.range[order], nan_as_null=True)
         cols["bearing"] = float_array(table.bearing[order], nan_as_null=True)
-    cols["x"] = float_array(table.x[order])
-    cols["y"] = float_array(table.y[order])
+    polar = table.range is not None and bool(np.isfinite(table.range).all())
+    if not (table.timed and polar):  # timed polar plots: x, y follow from range, bearing
+        cols["x"] = float_array(table.x[order])
+        cols["y"] = float_array(table.y[order])
     if not table.timed and table.range is not None and table.bearing is not None:
         cols["range"] = float_array(table.range, nan_as_null=True)
         cols["bearing"] = float_array(table.bearing, nan_as_null=True)

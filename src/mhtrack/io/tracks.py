@@ -32,8 +32,12 @@ if TYPE_CHECKING:
     from mhtrack.models.geodesy import LocalFrame
 
 REQUIRED = ("scan", "time", "track_id", "x", "y", "vx", "vy", "plot")
+#: Tracks of timed plots (several rotating radars) number their rows by ``frame``
+#: (:mod:`mhtrack.frames`) instead of ``scan``, and each row has its state's own time.
+TIMED_REQUIRED = ("frame", *REQUIRED[1:])
 COLUMNS = dict.fromkeys((*REQUIRED, "score"), FLOAT) | {
-    "scan": INT, "track_id": INT, "plot": INT, "tentative": INT} | _geodetic.COLUMNS
+    "scan": INT, "frame": INT, "track_id": INT, "plot": INT, "tentative": INT
+} | _geodetic.COLUMNS
 
 
 def tracks_from_truth(truth: TruthTable) -> TrackTable:
@@ -43,6 +47,13 @@ def tracks_from_truth(truth: TruthTable) -> TrackTable:
         scan=truth.scan, time=truth.time, track_id=truth.target_id, x=truth.x, y=truth.y,
         vx=truth.vx, vy=truth.vy, plot=np.full(len(truth), NO_PLOT, np.int64),
     )
+
+
+def has_frames(path: PathArg) -> bool:
+    """Whether a tracks file is numbered by ``frame`` (tracks of timed plots, each row at
+    its state's own time) rather than by ``scan``."""
+    names = column_names(path)
+    return "frame" in names and "scan" not in names
 
 
 def read_tracks(
@@ -71,7 +82,9 @@ def read_tracks(
     """
     try:
         names = column_names(path)
-        f = read_frame(path, COLUMNS, _geodetic.required(names, REQUIRED), "tracks")
+        timed = "frame" in names and "scan" not in names
+        f = read_frame(path, COLUMNS, _geodetic.required(
+            names, TIMED_REQUIRED if timed else REQUIRED), "tracks")
     except InputError as tracks_error:
         if not accept_truth or tracks_error.line is not None or tracks_error.row is not None:
             raise
@@ -80,7 +93,7 @@ def read_tracks(
         except InputError:
             raise tracks_error from None
         return tracks_from_truth(truth)
-    scan = f.ints("scan")
+    scan = f.ints("frame" if timed else "scan")
     time = f.floats("time")
     tid = f.ints("track_id")
     cols = _geodetic.read_state(f, frame)
@@ -99,7 +112,12 @@ def read_tracks(
         f.check((flag != 0) & (flag != 1), "tentative",
                 lambda r: f"tentative must be 0 or 1, got {num(flag[r])}")
         tentative = flag == 1
-    check_scan_order(f, scan, time)
+    if timed:  # frames in order; each row at its own time
+        f.check(np.concatenate(([False], scan[1:] < scan[:-1])), "frame",
+                lambda r: f"frame {num(scan[r])} after frame {num(scan[r - 1])}; rows must "
+                "be in non-decreasing frame order")
+    else:
+        check_scan_order(f, scan, time)
     check_unique(f, scan, tid, "track_id")
     if plots is not None:
         f.check(plot >= len(plots), "plot", lambda r: f"plot {num(plot[r])} is not a row of "
@@ -117,10 +135,12 @@ def write_tracks(
     written as an empty cell / null, and ``P`` is not stored. With ``frame``, also
     ``lat, lon`` and east/north ``vx, vy`` (:func:`mhtrack.io._geodetic.state_columns`);
     with ``plots`` (the table the tracker ran on), ``plot`` names the row of its file
-    (:func:`~mhtrack.io.plots.plots_to_file_rows`)."""
+    (:func:`~mhtrack.io.plots.plots_to_file_rows`). Tracks of timed plots are written
+    with ``frame`` in place of ``scan``: their rows have their states' own times."""
     plot = table.plot if plots is None else plots_to_file_rows(table.plot, plots)
+    timed = plots is not None and plots.timed
     cols = {
-        "scan": int_array(table.scan),
+        "frame" if timed else "scan": int_array(table.scan),
         "time": float_array(table.time),
         "track_id": int_array(table.track_id),
         **_geodetic.state_columns(table.x, table.y, table.vx, table.vy, frame),

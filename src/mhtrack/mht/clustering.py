@@ -4,7 +4,11 @@ cluster; the global hypothesis splits into one independent problem per cluster
 
 Two leaves *conflict* when they belong to the same tree or use the same plot at the same
 scan. A plot is identified by ``(window column, plot id)``, so plot ids need only be
-unique within a scan.
+unique within a scan — when every tree steps every scan (P1's scans). With frames of
+several sensors a tree's columns are its *own* looks (``docs/mht.md``, *Asynchronous
+plots*): the same plot may sit in column 1 of one tree and column 0 of another, so there
+(``by_id``) a plot is identified by its id alone, ids unique over the window (a
+:class:`~mhtrack.records.PlotTable`'s rows are).
 """
 
 from __future__ import annotations
@@ -16,22 +20,24 @@ from scipy.sparse.csgraph import connected_components
 from mhtrack.mht.tree import NO_PLOT
 
 
-def plot_keys(window: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def plot_keys(window: np.ndarray, *, by_id: bool = False) -> tuple[np.ndarray, np.ndarray]:
     """Flatten the plots used in ``window`` (L, W) to ``(leaf, key)`` pairs with one
-    integer key per distinct ``(column, plot id)``, misses left out. Keys are dense
-    ``0 … K−1`` in sorted ``(column, plot)`` order."""
+    integer key per distinct ``(column, plot id)`` (``by_id``: per distinct plot id),
+    misses left out. Keys are dense ``0 … K−1`` in sorted ``(column, plot)`` (``plot``)
+    order."""
     leaf, col = np.nonzero(window != NO_PLOT)
     if leaf.size == 0:
         e = np.zeros(0, np.int64)
         return e, e
     plot = window[leaf, col]
     span = int(plot.max()) + 1
-    raw = col.astype(np.int64) * span + plot
+    raw = plot.astype(np.int64) if by_id else col.astype(np.int64) * span + plot
     _, key = np.unique(raw, return_inverse=True)
     return leaf.astype(np.int64), key.reshape(-1).astype(np.int64)
 
 
-def cluster_trees(tree: np.ndarray, window: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def cluster_trees(tree: np.ndarray, window: np.ndarray, *,
+                  by_id: bool = False) -> tuple[np.ndarray, np.ndarray]:
     """Connected components of the graph whose nodes are trees and plots and whose edges
     join a tree to each plot one of its leaves uses.
 
@@ -39,6 +45,7 @@ def cluster_trees(tree: np.ndarray, window: np.ndarray) -> tuple[np.ndarray, np.
     ----------
     tree : (L,) tree id of each leaf.
     window : (L, W) plot ids per scan of each leaf (``-1``: none).
+    by_id : a plot is its id, whatever its column (:func:`plot_keys`).
 
     Returns
     -------
@@ -49,7 +56,7 @@ def cluster_trees(tree: np.ndarray, window: np.ndarray) -> tuple[np.ndarray, np.
     uniq, tree_index = np.unique(tree, return_inverse=True)
     tree_index = tree_index.reshape(-1).astype(np.int64)
     n_trees = uniq.size
-    leaf, key = plot_keys(window)
+    leaf, key = plot_keys(window, by_id=by_id)
     if leaf.size == 0:
         return tree_index, np.arange(n_trees, dtype=np.int64)
     label = _min_label_components(tree_index[leaf], key, n_trees)

@@ -55,8 +55,16 @@ class Coverage(ABC):
 
     Required: :meth:`detection` and :meth:`plot_pd`. Optional hooks: :meth:`arrays` /
     :meth:`set_arrays` for a coverage that keeps state across frames (saved with the
-    tracker; default: none).
+    tracker; default: none); :attr:`per_tree_looks` (default ``False``).
     """
+
+    #: Whether a frame may leave trees unstepped (``False``: every tree steps every scan,
+    #: P1). Then a tree's window columns are its own looks, and two trees may hold one
+    #: plot in different columns: the global hypothesis, the clustering and the hand-over
+    #: identify a plot by its id alone (``by_id`` of
+    #: :func:`~mhtrack.mht.hypothesis.best_hypothesis`; ids unique over the window, as a
+    #: :class:`~mhtrack.records.PlotTable`'s rows are).
+    per_tree_looks: bool = False
 
     @abstractmethod
     def detection(self, scan: Scan, x: np.ndarray, P: np.ndarray,
@@ -125,6 +133,8 @@ class RadarCoverage(Coverage):
     sharp edges 24 of 202 target plots fell on a leaf the coverage had given to the
     neighbouring frame (a duplicate track each time); with the band, none.
     """
+
+    per_tree_looks = True
 
     def __init__(self, sensors: SensorSet, *, max_pd: float = MAX_COVERAGE_PD) -> None:
         self.sensors = sensors

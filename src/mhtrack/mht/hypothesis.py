@@ -73,6 +73,8 @@ def best_hypothesis(
     window: np.ndarray,
     max_cluster_size: int | None = None,
     time_limit: float | None = None,
+    *,
+    by_id: bool = False,
 ) -> GlobalHypothesis:
     """Best global hypothesis over all leaves.
 
@@ -84,6 +86,8 @@ def best_hypothesis(
         same id in the same column conflict.
     max_cluster_size : clusters with more candidate leaves are solved greedily.
     time_limit : seconds ``milp`` may spend on one cluster.
+    by_id : two leaves using the same plot id conflict whatever the columns (frames of
+        several sensors, :func:`~mhtrack.mht.clustering.plot_keys`).
 
     Returns
     -------
@@ -95,7 +99,7 @@ def best_hypothesis(
     if cand.size == 0:
         return _empty()
     s, w = score[cand], np.asarray(window)[cand]
-    tree_index, tree_cluster = cluster_trees(np.asarray(tree)[cand], w)
+    tree_index, tree_cluster = cluster_trees(np.asarray(tree)[cand], w, by_id=by_id)
     leaf_cluster = tree_cluster[tree_index]
     n_clusters = int(tree_cluster.max()) + 1
     sizes = np.bincount(leaf_cluster, minlength=n_clusters)
@@ -103,7 +107,7 @@ def best_hypothesis(
     # best leaf of each tree (highest score, then lowest index)
     order = np.lexsort((-s, tree_index))  # stable: ties keep index order
     best = order[segment_starts(tree_index[order])]
-    bl, bk = plot_keys(w[best])
+    bl, bk = plot_keys(w[best], by_id=by_id)
     clash = np.zeros(n_clusters, bool)
     if bk.size:
         dup = np.bincount(bk)[bk] > 1
@@ -117,11 +121,11 @@ def best_hypothesis(
         for c in hard.tolist():
             members = by_cluster[bounds[c] : bounds[c + 1]]
             if max_cluster_size is not None and members.size > max_cluster_size:
-                pick = solve_greedy(s[members], tree_index[members], w[members])
+                pick = solve_greedy(s[members], tree_index[members], w[members], by_id=by_id)
                 n_greedy += 1
             else:
                 pick, exact = solve_exact(
-                    s[members], tree_index[members], w[members], time_limit
+                    s[members], tree_index[members], w[members], time_limit, by_id=by_id
                 )
                 n_limited += not exact
             chosen.append(members[pick])
@@ -137,9 +141,9 @@ def best_hypothesis(
     )
 
 
-def _conflict_masks(tree: np.ndarray, window: np.ndarray) -> list[int]:
+def _conflict_masks(tree: np.ndarray, window: np.ndarray, by_id: bool) -> list[int]:
     """Per leaf, a Python-int bitset of the plots it uses."""
-    leaf, key = plot_keys(window)
+    leaf, key = plot_keys(window, by_id=by_id)
     masks = [0] * len(tree)
     for i, k in zip(leaf.tolist(), key.tolist(), strict=True):
         masks[i] |= 1 << k
@@ -147,7 +151,8 @@ def _conflict_masks(tree: np.ndarray, window: np.ndarray) -> list[int]:
 
 
 def solve_exact(
-    score: np.ndarray, tree: np.ndarray, window: np.ndarray, time_limit: float | None = None
+    score: np.ndarray, tree: np.ndarray, window: np.ndarray, time_limit: float | None = None,
+    *, by_id: bool = False,
 ) -> tuple[np.ndarray, bool]:
     """Best compatible subset of one cluster: ``(indices ascending, proven optimal)``.
 
@@ -155,22 +160,24 @@ def solve_exact(
     each remaining tree's best score) for small clusters, handing over to
     :func:`solve_milp` when it visits more than :data:`BNB_NODE_LIMIT` nodes or the
     cluster has more than :data:`BNB_MAX_LEAVES` leaves. Only positive scores count.
+    ``by_id``: as :func:`best_hypothesis`.
     """
     if np.count_nonzero(score > 0) <= BNB_MAX_LEAVES:
-        pick = _branch_and_bound(score, tree, window, BNB_NODE_LIMIT)
+        pick = _branch_and_bound(score, tree, window, BNB_NODE_LIMIT, by_id)
         if pick is not None:
             return pick, True
-    return solve_milp(score, tree, window, time_limit)
+    return solve_milp(score, tree, window, time_limit, by_id=by_id)
 
 
 def _branch_and_bound(
-    score: np.ndarray, tree: np.ndarray, window: np.ndarray, node_limit: int
+    score: np.ndarray, tree: np.ndarray, window: np.ndarray, node_limit: int,
+    by_id: bool = False,
 ) -> np.ndarray | None:
     pos = np.flatnonzero(score > 0)
     if pos.size == 0:
         return np.zeros(0, np.int64)
     s = score[pos]
-    masks = _conflict_masks(tree[pos], window[pos])
+    masks = _conflict_masks(tree[pos], window[pos], by_id)
     order = np.lexsort((-s, tree[pos]))
     starts = [*segment_starts(tree[pos][order]).tolist(), pos.size]
     options = []  # per tree: [(score, mask, index)] best first
@@ -212,7 +219,8 @@ def _branch_and_bound(
 
 
 def solve_milp(
-    score: np.ndarray, tree: np.ndarray, window: np.ndarray, time_limit: float | None = None
+    score: np.ndarray, tree: np.ndarray, window: np.ndarray, time_limit: float | None = None,
+    *, by_id: bool = False,
 ) -> tuple[np.ndarray, bool]:
     """Best compatible subset as a 0–1 integer programme (``scipy.optimize.milp``, HiGHS,
     relative gap 0): maximise ``Σ score·x`` with one constraint ``≤ 1`` per tree and per
@@ -228,7 +236,7 @@ def solve_milp(
     s = score[pos]
     _, t = np.unique(tree[pos], return_inverse=True)
     t = t.reshape(-1)
-    leaf, key = plot_keys(window[pos])
+    leaf, key = plot_keys(window[pos], by_id=by_id)
     n_t = int(t.max()) + 1
     rows = np.concatenate((t, n_t + key))
     cols = np.concatenate((np.arange(pos.size), leaf))
@@ -250,20 +258,21 @@ def solve_milp(
     )
     if res.status == 0 and res.x is not None:
         return pos[np.flatnonzero(res.x > 0.5)], True
-    greedy = solve_greedy(score, tree, window)
+    greedy = solve_greedy(score, tree, window, by_id=by_id)
     if res.x is None:
         return greedy, False
     sel = pos[np.flatnonzero(res.x > 0.5)]
     return (sel if score[sel].sum() >= score[greedy].sum() else greedy), False
 
 
-def solve_greedy(score: np.ndarray, tree: np.ndarray, window: np.ndarray) -> np.ndarray:
+def solve_greedy(score: np.ndarray, tree: np.ndarray, window: np.ndarray, *,
+                 by_id: bool = False) -> np.ndarray:
     """Greedy compatible subset: take leaves by decreasing score (ties: lower index)
     while they conflict with nothing taken. Not exact; used for oversize clusters."""
     pos = np.flatnonzero(score > 0)
     if pos.size == 0:
         return np.zeros(0, np.int64)
-    leaf, key = plot_keys(window[pos])
+    leaf, key = plot_keys(window[pos], by_id=by_id)
     by_leaf = np.argsort(leaf, kind="stable")
     kstart = np.searchsorted(leaf[by_leaf], np.arange(pos.size + 1))
     keys = key[by_leaf].tolist()

@@ -27,17 +27,19 @@ class Reported:
     window: np.ndarray
 
     @classmethod
-    def of(cls, leaves: Leaves) -> Reported:
-        """What the leaves of the last scan reported (chosen, confirmed)."""
+    def of(cls, leaves: Leaves, *, by_id: bool = False) -> Reported:
+        """What the leaves of the last scan reported (chosen, confirmed); ``by_id``: the
+        whole windows (a tree's columns are its own looks, not the scans)."""
         rep = leaves.chosen & (leaves.track >= 0)
-        return cls(leaves.track[rep], leaves.window[rep, 1:])
+        return cls(leaves.track[rep], leaves.window[rep] if by_id else leaves.window[rep, 1:])
 
 
-def hand_over(leaves: Leaves, previous: Reported) -> Leaves:
+def hand_over(leaves: Leaves, previous: Reported, *, by_id: bool = False) -> Leaves:
     """A tentative tree whose chosen leaf shares a plot (within the window) with a track
     reported at the previous scan that the best hypothesis no longer carries takes over
     that track's id; the old tree gives it up. Most shared plots first, then lower tree,
-    then lower track id; each tree and each id at most once."""
+    then lower track id; each tree and each id at most once. A plot is shared at the same
+    scan column, or (``by_id``: frames of several sensors) by its id in any column."""
     track = leaves.track
     chosen = np.flatnonzero(leaves.chosen)
     carried = track[chosen]
@@ -47,8 +49,13 @@ def hand_over(leaves: Leaves, previous: Reported) -> Leaves:
         return leaves
     track = track.copy()
     lost_ids, lost_win = previous.track[lost], previous.window[lost]
-    win = leaves.window[cand, :-1]
-    shared = ((win[:, None, :] == lost_win[None, :, :]) & (win[:, None, :] >= 0)).sum(2)
+    if by_id:
+        win = leaves.window[cand]
+        shared = ((win[:, None, :, None] == lost_win[None, :, None, :])
+                  & (win[:, None, :, None] >= 0)).sum((2, 3))
+    else:
+        win = leaves.window[cand, :-1]
+        shared = ((win[:, None, :] == lost_win[None, :, :]) & (win[:, None, :] >= 0)).sum(2)
     ci, li = np.nonzero(shared)
     order = np.lexsort((lost_ids[li], leaves.tree[cand[ci]], -shared[ci, li]))
     taken_c, taken_l = np.zeros(cand.size, bool), np.zeros(lost_ids.size, bool)

@@ -142,7 +142,8 @@ class MHTTracker:
         cfg, ftime = self.config, float(scan.time)
         caps: dict[str, int] = {}
         z, R, rows = validate_scan(scan, self._R, self._last_time, self._last_index)
-        previous = Reported.of(self._leaves)
+        by_id = self.coverage.per_tree_looks
+        previous = Reported.of(self._leaves, by_id=by_id)
         looks = self.coverage.detection(scan, self._leaves.x, self._leaves.P,
                                         self._leaves.time)
         leaves, looks, idle = split_looked(self._leaves, looks)
@@ -164,13 +165,13 @@ class MHTTracker:
         first_node = self.nodes.next
         leaves = merge_by_tree(number_nodes(Leaves.concat(grown, births), self.nodes), idle)
         hyp = best_hypothesis(leaves.score, leaves.tree, leaves.window, cfg.max_cluster_size,
-                              cfg.milp_time_limit)
+                              cfg.milp_time_limit, by_id=by_id)
         solver_caps(hyp, caps)
         leaves = prune_after_solve(leaves, hyp.leaves, cfg.max_trees, caps)
         # the leaves this frame stepped (new node ids); None: all of them
         is_new = None if len(idle) == 0 else leaves.node >= first_node
         first_new = self.tracks.next
-        leaves = hand_over(leaves, previous)
+        leaves = hand_over(leaves, previous, by_id=by_id)
         leaves = confirm(leaves, self.sprt.confirms(leaves), self.tracks)
         self.last_backfill = self._history.backfill(leaves, newly_confirmed(leaves, first_new))
         self._history.record(int(scan.index), ftime,

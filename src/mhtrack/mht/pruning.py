@@ -87,7 +87,8 @@ def cap_trees(
     return keep_tree[seg], int(starts.size - cap)
 
 
-def n_scan_keep(tree: np.ndarray, oldest: np.ndarray, chosen: np.ndarray) -> np.ndarray:
+def n_scan_keep(tree: np.ndarray, oldest: np.ndarray, chosen: np.ndarray,
+                window: np.ndarray | None = None) -> np.ndarray:
     """N-scan pruning (P1 §1.3; Blackman & Popoli 1999 §16.3.4).
 
     ``oldest`` (L,) is each leaf's plot at scan ``k − N`` (window column 0), ``chosen`` the
@@ -98,6 +99,15 @@ def n_scan_keep(tree: np.ndarray, oldest: np.ndarray, chosen: np.ndarray) -> np.
     * its plot at ``k − N`` is used by the best hypothesis in another tree.
 
     Trees not in the best hypothesis keep their other leaves.
+
+    ``window`` (L, W), frames of several sensors (each tree's columns are its own looks):
+    rule 2 holds for the chosen leaves' plots at their own ``k − N`` found in *any*
+    column of another tree's leaf — that tree may have looked fewer times, so the plot
+    sits in a later column; kept, the leaf would turn compatible (a duplicate of the
+    track) once the plot leaves the track's window. And the other way, a leaf's own
+    plot at its ``k − N`` found in any column of a chosen leaf of another tree (the leaf
+    looked more often, and would forget the conflict at its next look). With scans
+    (every tree steps every scan) both reduce to rule 2.
     """
     n = tree.size
     keep = np.ones(n, bool)
@@ -115,10 +125,24 @@ def n_scan_keep(tree: np.ndarray, oldest: np.ndarray, chosen: np.ndarray) -> np.
         up, ut = cplot[used], ctree[used]
         o = np.argsort(up, kind="stable")
         up, ut = up[o], ut[o]
-        j = np.minimum(np.searchsorted(up, oldest), up.size - 1)
-        taken = (up[j] == oldest) & (oldest != NO_PLOT)
-        keep &= ~(taken & (ut[j] != tree))
+        cols = oldest[:, None] if window is None else window
+        keep &= ~_taken(up, ut, cols, tree).any(axis=1)
+    if window is not None:  # rule 2, the other way: the leaf's own k − N anywhere
+        cw = window[chosen]
+        ct = np.broadcast_to(ctree[:, None], cw.shape)
+        used = cw != NO_PLOT
+        if used.any():
+            up, ut = cw[used], ct[used]
+            o = np.argsort(up, kind="stable")
+            keep &= ~_taken(up[o], ut[o], oldest[:, None], tree)[:, 0]
     return keep
+
+
+def _taken(up: np.ndarray, ut: np.ndarray, cols: np.ndarray, tree: np.ndarray) -> np.ndarray:
+    """Mask like ``cols`` (L, C): the plot is one of the sorted ``up`` whose tree ``ut``
+    differs from the leaf's ``tree``."""
+    j = np.minimum(np.searchsorted(up, cols), up.size - 1)
+    return (up[j] == cols) & (cols != NO_PLOT) & (ut[j] != tree[:, None])
 
 
 def prune_children(leaves: Leaves, children: Children, n_births: int, sprt: SPRT,
@@ -145,12 +169,14 @@ def prune_children(leaves: Leaves, children: Children, n_births: int, sprt: SPRT
 
 
 def prune_after_solve(leaves: Leaves, chosen: np.ndarray, max_trees: int,
-                      caps: dict[str, int]) -> Leaves:
+                      caps: dict[str, int], *, by_id: bool = False) -> Leaves:
     """N-scan pruning around the best hypothesis (leaf indices ``chosen``), then the cap
-    on trees; marks the surviving chosen leaves."""
+    on trees; marks the surviving chosen leaves. ``by_id``: trees step on their own looks
+    (:func:`n_scan_keep`'s ``window``)."""
     is_chosen = np.zeros(len(leaves), bool)
     is_chosen[chosen] = True
-    keep = n_scan_keep(leaves.tree, leaves.window[:, 0], chosen)
+    keep = n_scan_keep(leaves.tree, leaves.window[:, 0], chosen,
+                       leaves.window if by_id else None)
     protected = is_chosen | (leaves.track >= 0)
     keep_t, cut = cap_trees(leaves.tree[keep], leaves.score[keep], protected[keep], max_trees)
     if cut:

@@ -167,7 +167,7 @@ class MHTTracker:
         hyp = best_hypothesis(leaves.score, leaves.tree, leaves.window, cfg.max_cluster_size,
                               cfg.milp_time_limit, by_id=by_id)
         solver_caps(hyp, caps)
-        leaves = prune_after_solve(leaves, hyp.leaves, cfg.max_trees, caps)
+        leaves = prune_after_solve(leaves, hyp.leaves, cfg.max_trees, caps, by_id=by_id)
         # the leaves this frame stepped (new node ids); None: all of them
         is_new = None if len(idle) == 0 else leaves.node >= first_node
         first_new = self.tracks.next

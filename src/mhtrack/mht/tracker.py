@@ -51,7 +51,7 @@ from mhtrack.clutter.known import KnownClutter
 from mhtrack.mht.births import Birth, make_birth
 from mhtrack.mht.caps import CapWarnings, solver_caps
 from mhtrack.mht.config import MHTConfig
-from mhtrack.mht.coverage import Coverage, Everywhere
+from mhtrack.mht.coverage import Coverage, Everywhere, Looks
 from mhtrack.mht.extend import grow_children, propose_children
 from mhtrack.mht.gating import Gate, plots_in_confirmed_gates
 from mhtrack.mht.history import TentativeHistory
@@ -132,21 +132,16 @@ class MHTTracker:
         return self.birth
 
     def step(self, scan: Scan) -> TrackTable:
-        """Process one scan; return the confirmed tracks of the best global hypothesis.
-
-        The stages are the module docstring's cycle. Statistics of the step are left in
-        :attr:`last_stats`, the earlier rows of tracks confirmed at this scan in
-        :attr:`last_backfill`; a warning is logged (once) when a hard cap acted.
-        """
+        """Process one scan (or frame) through the module docstring's cycle; return the
+        confirmed tracks of the best global hypothesis. Statistics go to :attr:`last_stats`,
+        the earlier rows of tracks confirmed now to :attr:`last_backfill`."""
         t0 = time.perf_counter()
         cfg, ftime = self.config, float(scan.time)
         caps: dict[str, int] = {}
         z, R, rows = validate_scan(scan, self._R, self._last_time, self._last_index)
         by_id = self.coverage.per_tree_looks
         previous = Reported.of(self._leaves, by_id=by_id)
-        looks = self.coverage.detection(scan, self._leaves.x, self._leaves.P,
-                                        self._leaves.time)
-        leaves, looks, idle = split_looked(self._leaves, looks)
+        leaves, looks, idle = self._look(scan)
         pred = predict_leaves(self.motion, leaves, ftime)
         gated, pair_pred = gate_looked(self.gate, leaves, pred, looks.pd, z, R, scan.t, ftime,
                                        self.motion, caps)
@@ -168,7 +163,6 @@ class MHTTracker:
                               cfg.milp_time_limit, by_id=by_id)
         solver_caps(hyp, caps)
         leaves = prune_after_solve(leaves, hyp.leaves, cfg.max_trees, caps, by_id=by_id)
-        # the leaves this frame stepped (new node ids); None: all of them
         is_new = None if len(idle) == 0 else leaves.node >= first_node
         first_new = self.tracks.next
         leaves = hand_over(leaves, previous, by_id=by_id)
@@ -176,15 +170,26 @@ class MHTTracker:
         self.last_backfill = self._history.backfill(leaves, newly_confirmed(leaves, first_new))
         self._history.record(int(scan.index), ftime,
                              leaves if is_new is None else leaves.take(is_new))
-        used = confirmed_windows(leaves)
-        self.birth.forget_used(used)
-        self.clutter.forget(np.isin(rows, used[:, -1]))
+        self._forget(leaves, rows)
         self._leaves, self._last_time, self._last_index = leaves, ftime, int(scan.index)
         out = report(scan, leaves, is_new)
         self.last_stats = StepStats.of(scan, len(z), leaves, births, hyp, out,
                                        time.perf_counter() - t0, caps)
         self._cap_warnings(int(scan.index), caps)
         return out
+
+    def _look(self, scan: Scan) -> tuple[Leaves, Looks, Leaves]:
+        """Coverage: each leaf's ``P_D`` in this frame; the leaves its sensor did not look
+        at are set aside (``idle``) and carried unchanged."""
+        lv = self._leaves
+        return split_looked(lv, self.coverage.detection(scan, lv.x, lv.P, lv.time))
+
+    def _forget(self, leaves: Leaves, rows: np.ndarray) -> None:
+        """The plots the confirmed tracks used leave the birth process and the clutter
+        estimator (their optional hooks)."""
+        used = confirmed_windows(leaves)
+        self.birth.forget_used(used)
+        self.clutter.forget(np.isin(rows, used[:, -1]))
 
     def run(
         self, scans: Iterable[Scan] | PlotTable, stats: list[StepStats] | None = None,

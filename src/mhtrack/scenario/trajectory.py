@@ -105,3 +105,24 @@ def sample_truth(segs: list[Segment], start: float, end: float, dt: float) -> Tr
     return TruthTable(scan=scan[o], time=times[scan[o]], target_id=tid[o],
                       x=np.ascontiguousarray(p[o, 0]), y=np.ascontiguousarray(p[o, 1]),
                       vx=np.ascontiguousarray(v[o, 0]), vy=np.ascontiguousarray(v[o, 1]))
+
+
+def bridge_gaps(scans: np.ndarray, states: np.ndarray, period: float,
+                max_gap_s: float) -> tuple[np.ndarray, np.ndarray]:
+    """A recorded trajectory with its short gaps filled: at every missing grid scan of a
+    gap of at most ``max_gap_s`` seconds between two rows, the Hermite state of the curve
+    joining them (module docstring). ``scans`` (n,) increasing, ``states`` (n, 4) as
+    ``[x, vx, y, vy]``; longer gaps stay gaps (the target is absent there)."""
+    scans = np.asarray(scans, np.int64)
+    states = np.asarray(states, float)
+    new_scans, new_states = [scans], [states]
+    for i in np.flatnonzero((np.diff(scans) > 1) & (np.diff(scans) * period <= max_gap_s)):
+        t = np.array([scans[i], scans[i + 1]], float) * period
+        seg = Segment(0, t, states[[i, i + 1]][:, [0, 2]], states[[i, i + 1]][:, [1, 3]])
+        fill = np.arange(scans[i] + 1, scans[i + 1])
+        pos, vel = seg.state(fill * period)
+        new_scans.append(fill)
+        new_states.append(np.column_stack((pos[:, 0], vel[:, 0], pos[:, 1], vel[:, 1])))
+    sc = np.concatenate(new_scans)
+    order = np.argsort(sc, kind="stable")
+    return sc[order], np.concatenate(new_states)[order]

@@ -51,6 +51,17 @@ from mhtrack.scenario import Scenario
 #: Default known clutter density of the plain MHT (P1 §3: 1e−9 per m²).
 DEFAULT_CLUTTER_DENSITY = 1e-9
 
+#: Plots a branch must hold before a tree of asynchronous plots is confirmed. A tree
+#: starts from one plot with velocity ``0 ± v_max/2``, so its second plot's
+#: ``ln p(z₂|T)`` only says that the two plots lie within ``v_max·Δt`` of each other —
+#: any pair does, target or clutter — and every pair of plots makes an exact
+#: constant-velocity line. The third plot is the first whose likelihood tests the
+#: motion (Blackman & Popoli 1999 §6.3: a track is confirmed on the scans after the two
+#: that initiate it). Measured on ``opensky-radars`` seeds 1–3 (``docs/mht.md``,
+#: *Asynchronous plots*): all 7 tracks confirmed on clutter and the duplicates of 2
+#: plots had exactly 2 plots. Synchronous scans keep P1's 2 (bit for bit).
+TIMED_CONFIRM_MIN_PLOTS = 3
+
 #: Clutter-estimator name (:data:`mhtrack.names.CLUTTER_ESTIMATORS`) → class.
 CLUTTER_ESTIMATOR_CLASSES: dict[str, type[Any]] = dict(
     zip(names.CLUTTER_ESTIMATORS, (KnownClutter, GMMClutter, AGMMClutter), strict=True))
@@ -108,7 +119,9 @@ def make_tracker(
     frame's radar where its beam swept (:class:`~mhtrack.mht.coverage.RadarCoverage`),
     and estimates clutter per radar, a rotation at a time
     (:class:`~mhtrack.clutter.per_sensor.PerSensorClutter`, the tracker's estimator per
-    radar; ``known``: κ per m² per look)."""
+    radar; ``known``: κ per m² per look), and confirms a tree only once its branch holds
+    at least :data:`TIMED_CONFIRM_MIN_PLOTS` plots (``config.confirm_min_plots`` if
+    larger)."""
     if name not in TRACKER_ESTIMATORS:
         raise ValueError(f"unknown tracker {name!r} "
                          f"(expected one of {', '.join(TRACKER_ESTIMATORS)})")
@@ -117,6 +130,8 @@ def make_tracker(
     estimator = TRACKER_ESTIMATORS[name]
     if sensors is None:
         return MHTTracker(config, make_clutter_estimator(estimator, kappa=kappa))
+    config = config_with(config, confirm_min_plots=max(config.confirm_min_plots,
+                                                       TIMED_CONFIRM_MIN_PLOTS))
     clutter = PerSensorClutter(
         lambda: make_clutter_estimator(estimator, kappa=kappa),
         {s.id: s.period for s in sensors.sensors},

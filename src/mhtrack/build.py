@@ -58,8 +58,8 @@ DEFAULT_CLUTTER_DENSITY = 1e-9
 #: constant-velocity line. The third plot is the first whose likelihood tests the
 #: motion (Blackman & Popoli 1999 §6.3: a track is confirmed on the scans after the two
 #: that initiate it). Measured on ``opensky-radars`` seeds 1–3 (``docs/mht.md``,
-#: *Asynchronous plots*): all 7 tracks confirmed on clutter and the duplicates of 2
-#: plots had exactly 2 plots. Synchronous scans keep P1's 2 (bit for bit).
+#: *Asynchronous plots*): on seed 1 all 7 tracks confirmed on clutter and 2 of the 5
+#: short duplicates held exactly 2 plots. Synchronous scans keep P1's 2 (bit for bit).
 TIMED_CONFIRM_MIN_PLOTS = 3
 
 #: Clutter-estimator name (:data:`mhtrack.names.CLUTTER_ESTIMATORS`) → class.

@@ -44,11 +44,15 @@ class StoneSoupRun:
 
 
 def _table(rows: list[tuple[int, float, int, float, float, float, float]]) -> TrackTable:
+    """Rows ``(frame, time, track, x, y, vx, vy)`` as a TrackTable, one row per frame and
+    track (the latest), as mhtrack reports."""
     if not rows:
         return TrackTable.empty()
     a = np.array(rows)
-    order = np.lexsort((a[:, 2], a[:, 1], a[:, 0]))
-    a = a[order]
+    a = a[np.lexsort((a[:, 1], a[:, 2], a[:, 0]))]  # by frame, track, time
+    last = np.ones(len(a), bool)  # one row per (frame, track): its latest state
+    last[:-1] = (a[1:, 0] != a[:-1, 0]) | (a[1:, 2] != a[:-1, 2])
+    a = a[last]
     return TrackTable(
         scan=a[:, 0].astype(np.int64), time=a[:, 1], track_id=a[:, 2].astype(np.int64),
         x=a[:, 3], y=a[:, 4], vx=a[:, 5], vy=a[:, 6], plot=np.full(len(a), -1, np.int64),
@@ -62,13 +66,17 @@ def _seconds(ts: datetime.datetime) -> float:
 def run_stonesoup_timed(
     plots: PlotTable, *, pd: dict[int, float], clutter_density: dict[int, float],
     kind: str = "jpda", q: float = 1.0, min_points: int = 3, delete_s: float = 40.0,
-    init_delete_s: float = 13.0, sigma_speed: float = 300.0,
+    init_delete_s: float = 13.0, sigma_speed: float = 300.0, grouping: str = "frame",
 ) -> StoneSoupRun:
     """Track the timed ``plots`` with Stone Soup (``kind`` ``"gnn"`` or ``"jpda"``).
 
     ``pd`` and ``clutter_density`` (per m² per look) are per sensor id; ``q`` the CV
     process-noise intensity (m²/s³); ``sigma_speed`` the initiator's prior velocity σ
-    (m/s). The tracker alone is timed (the detections are built before)."""
+    (m/s). ``grouping``: one step per frame (``"frame"``), or per distinct plot time
+    (``"time"``: exact for JPDA's mixture, which merges a track's hypotheses into one
+    state labelled with one time; per frame the missed-detection prediction at the frame's
+    end and updates at the plots' earlier times are merged). The tracker alone is timed
+    (the detections are built before)."""
     from stonesoup.base import Property
     from stonesoup.dataassociator.base import DataAssociator
     from stonesoup.dataassociator.neighbour import GNNWith2DAssignment
@@ -103,6 +111,8 @@ def run_stonesoup_timed(
             sensor = next(iter(detections)).metadata["sensor"]
             return self.by_sensor[sensor].associate(tracks, detections, timestamp, **kwargs)
 
+    if grouping not in ("frame", "time"):
+        raise ValueError(f"grouping must be 'frame' or 'time', got {grouping!r}")
     if kind not in ("gnn", "jpda"):
         raise ValueError(f"kind must be 'gnn' or 'jpda', got {kind!r}")
     transition = CombinedLinearGaussianTransitionModel([ConstantVelocity(q), ConstantVelocity(q)])
@@ -126,16 +136,20 @@ def run_stonesoup_timed(
             DistanceHypothesiser(predictor, updater, Mahalanobis(), missed_distance=3)),
         updater=updater, min_points=min_points,
     )
-    feed = []
-    frames = []
+    feed = []  # (step time, detections)
+    steps = []  # frame index of each step
+    frames = []  # (frame index, frame time)
     for sc in plots.scans():
-        t_frame = EPOCH + datetime.timedelta(seconds=float(sc.time))
-        dets = set()
+        groups: dict[float, set] = {}
         for z, R, ti, s in zip(sc.z, sc.R, sc.plot_times(), sc.sensor, strict=True):
             model = LinearGaussian(ndim_state=4, mapping=(0, 2), noise_covar=np.asarray(R))
-            dets.add(Detection(z.reshape(2, 1), timestamp=EPOCH + datetime.timedelta(
-                seconds=float(ti)), measurement_model=model, metadata={"sensor": int(s)}))
-        feed.append((t_frame, dets))
+            key = float(ti) if grouping == "time" else float(sc.time)
+            groups.setdefault(key, set()).add(Detection(
+                z.reshape(2, 1), timestamp=EPOCH + datetime.timedelta(seconds=float(ti)),
+                measurement_model=model, metadata={"sensor": int(s)}))
+        for t, dets in sorted(groups.items()) or [(float(sc.time), set())]:
+            feed.append((EPOCH + datetime.timedelta(seconds=t), dets))
+            steps.append(sc.index)
         frames.append((sc.index, float(sc.time)))
     tracker_cls = MultiTargetTracker if kind == "gnn" else MultiTargetMixtureTracker
     tracker = tracker_cls(initiator=initiator, deleter=UpdateTimeDeleter(
@@ -146,7 +160,7 @@ def run_stonesoup_timed(
     online: list[tuple[int, float, int, float, float, float, float]] = []
     wall = 0.0
     it = iter(tracker)
-    for index, _t in frames:
+    for index in steps:
         t0 = time.perf_counter()
         _, tracks = next(it)
         wall += time.perf_counter() - t0
@@ -168,4 +182,4 @@ def run_stonesoup_timed(
         for k, st in last.items():
             m = np.asarray(st.state_vector, float).ravel()
             history.append((k, _seconds(st.timestamp), tid, m[0], m[2], m[1], m[3]))
-    return StoneSoupRun(_table(online), _table(history), wall, len(frames))
+    return StoneSoupRun(_table(online), _table(history), wall, len(steps))

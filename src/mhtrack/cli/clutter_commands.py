@@ -44,6 +44,7 @@ def clutter(scenario: str, seed: int, clutter: str | None, clutter_rate: float |
     estimated intensity maps at one scan)."""
     from mhtrack.build import make_clutter_estimator
     from mhtrack.experiments.clutter_study import clutter_accuracy
+    from mhtrack.io.atomic import atomic_write
     from mhtrack.io.jsonsafe import dumps
     from mhtrack.metrics.clutter import uniform_guess
     from mhtrack.plotting.clutter import plot_intensity_maps, save_maps
@@ -67,7 +68,7 @@ def clutter(scenario: str, seed: int, clutter: str | None, clutter_rate: float |
         summary["clutter_density"] = kappa
     out = out if out is not None else Path("out") / f"{sc.name}-clutter-{estimator}-{seed}"
     out.mkdir(parents=True, exist_ok=True)
-    (out / "clutter.json").write_text(dumps(summary, indent=1))
+    atomic_write(out / "clutter.json", dumps(summary, indent=1))
     true, hat = acc.maps[k_map]
     z = sim.plots.z[sim.plots.scan == k_map]
     fig = plot_intensity_maps(

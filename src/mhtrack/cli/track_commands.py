@@ -248,6 +248,7 @@ def run(scenario: str, seed: int, clutter: str | None, clutter_rate: float | Non
     from mhtrack.build import capped_pd, default_config
     from mhtrack.experiments.pipeline import run_scenario
     from mhtrack.io import write_plots, write_scenario_toml, write_tracks, write_truth
+    from mhtrack.io.atomic import atomic_write
     from mhtrack.io.jsonsafe import dumps
     from mhtrack.plotting.metrics import plot_ospa_cardinality
     from mhtrack.plotting.scene import plot_scene, save_figure
@@ -272,7 +273,7 @@ def run(scenario: str, seed: int, clutter: str | None, clutter_rate: float | Non
     write_tracks(result.run.tracks, out / "tracks.csv", frame, plots=sim.plots)
     write_scenario_toml({"seed": seed, **sc.to_dict()}, out / "scenario.toml")
     summary = result.summary()
-    (out / "metrics.json").write_text(dumps(summary, indent=1))
+    atomic_write(out / "metrics.json", dumps(summary, indent=1))
     title = f"{sc.name}, {tracker}, seed {seed}"
     save_figure(plot_scene(sim.plots, sim.truth, result.run.tracks, title=title),
                 out / "scene.png")

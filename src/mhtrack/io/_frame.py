@@ -3,7 +3,7 @@
 :func:`read_frame` parses a file with pyarrow and turns every pyarrow or OS error into a
 located :class:`~mhtrack.errors.InputError`; :class:`Frame` converts its columns to NumPy
 with vectorised checks that report the first offending row; :func:`write_frame` writes
-columns as CSV (shortest round-trip numbers) or Parquet.
+columns as CSV (shortest round-trip numbers) or Parquet, atomically.
 """
 
 from __future__ import annotations
@@ -21,6 +21,7 @@ import pyarrow.parquet as pq
 
 from mhtrack.errors import InputError
 from mhtrack.io._source import PathArg, Source, file_format
+from mhtrack.io.atomic import atomic_path
 
 #: Column kinds of a schema: integers, floats, and times (read as they are written —
 #: text in CSV, any type in Parquet — and converted by :mod:`mhtrack.io._times`).
@@ -238,17 +239,18 @@ def write_frame(path: PathArg, columns: Mapping[str, pa.Array]) -> None:
     """Write ``columns`` (in order) to ``path`` as CSV or Parquet by its extension.
 
     CSV: a plain header line, then one line per row, numbers in shortest round-trip form,
-    nulls as empty cells, nothing quoted."""
+    nulls as empty cells, nothing quoted. Written atomically (:func:`atomic_path`)."""
     fmt = file_format(path)
     table = pa.table(dict(columns))
     try:
-        if fmt == "csv":
-            with open(path, "wb") as fh:
-                fh.write((",".join(table.column_names) + "\n").encode())
-                opts = pacsv.WriteOptions(include_header=False, quoting_style="none")
-                pacsv.write_csv(table, fh, opts)
-        else:
-            pq.write_table(table, str(path))
+        with atomic_path(path, make_parent=False) as tmp:
+            if fmt == "csv":
+                with open(tmp, "wb") as fh:
+                    fh.write((",".join(table.column_names) + "\n").encode())
+                    opts = pacsv.WriteOptions(include_header=False, quoting_style="none")
+                    pacsv.write_csv(table, fh, opts)
+            else:
+                pq.write_table(table, str(tmp))
     except OSError as e:
         raise InputError(f"{path}: cannot write ({e.strerror or e})", file=str(path)) from None
 

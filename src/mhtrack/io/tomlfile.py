@@ -1,7 +1,7 @@
 """TOML files: the one reader (scenarios, configurations) and the scenario writer.
 
 Read with :mod:`tomllib` (UTF-8, with or without a byte-order mark); written with
-``tomli-w``. Floats are written in shortest round-trip form, so a written scenario reads
+``tomli-w``, atomically. Floats are written in shortest round-trip form, so a written scenario reads
 back exactly. Every reading problem is an :class:`~mhtrack.errors.InputError` in the one
 message style of :mod:`mhtrack.errors`, ``<file>[, line L[, column C]]: <problem>``, e.g.
 ``s.toml, line 4, column 6: Expected '=' after a key in a key/value pair`` or
@@ -22,6 +22,7 @@ import tomli_w
 
 from mhtrack.errors import InputError
 from mhtrack.io._source import PathArg
+from mhtrack.io.atomic import atomic_write
 
 _AT = re.compile(r"\s*\(at line (\d+), column (\d+)\)\s*$")
 #: A message that starts with a key path: ``T: …``, ``targets[2].birth: …``.
@@ -110,6 +111,6 @@ def write_scenario_toml(data: Mapping[str, Any], path: PathArg) -> None:
     """
     text = tomli_w.dumps(_plain(data, ""))
     try:
-        Path(path).write_text(text, encoding="utf-8")
+        atomic_write(path, text, make_parent=False)
     except OSError as e:
         raise InputError(f"{path}: cannot write ({e.strerror or e})", file=str(path)) from None

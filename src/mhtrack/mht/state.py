@@ -18,6 +18,7 @@ import numpy as np
 
 from mhtrack.clutter.base import ClutterEstimator
 from mhtrack.clutter.known import KnownClutter
+from mhtrack.io.atomic import atomic_path
 from mhtrack.mht.config import MHTConfig
 
 FORMAT = "mhtrack.mht.MHTTracker/3"
@@ -56,13 +57,13 @@ def decode(obj: Any, arrays: dict[str, np.ndarray]) -> Any:
 def save_state(path: str | PathLike[str], parts: dict[str, dict[str, np.ndarray]],
                clutter: ClutterEstimator, config: MHTConfig, meta: dict[str, Any]) -> None:
     """Write ``parts`` (prefix → arrays, in order), the estimator's state, the
-    configuration and ``meta`` (JSON-able bookkeeping) to ``path``."""
+    configuration and ``meta`` (JSON-able bookkeeping) to ``path``, atomically."""
     arrays = {f"{prefix}__{k}": v for prefix, part in parts.items() for k, v in part.items()}
     clutter_state = encode(clutter.get_state(), arrays)
     meta = {"format": FORMAT, "config": json.loads(config.to_json()),
             "clutter_name": clutter.name, "clutter_state": clutter_state, **meta}
     arrays["meta"] = np.array(json.dumps(meta, sort_keys=True))
-    with open(path, "wb") as f:
+    with atomic_path(path, make_parent=False) as tmp, open(tmp, "wb") as f:
         np.savez(f, **arrays)  # type: ignore[arg-type]
 
 

@@ -23,6 +23,7 @@ from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 from matplotlib.ticker import FuncFormatter
 
+from mhtrack.io.atomic import atomic_path
 from mhtrack.records import PlotTable, TrackTable, TruthTable
 
 if TYPE_CHECKING:
@@ -187,12 +188,12 @@ def plot_scene(
 def save_figure(fig: Figure, path: str | Path, *, dpi: int = 130,
                 tight: bool = True) -> Path:
     """Write ``fig`` to ``path`` (format from the extension; PNG by the Agg canvas, whatever
-    the interactive backend) after a tight layout (``tight``), and release it."""
+    the interactive backend) after a tight layout (``tight``), atomically, and release it."""
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
     if tight:
         fig.tight_layout()
-    fig.savefig(path, dpi=dpi)
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, dpi=dpi)
     close_figure(fig)
     return path
 

@@ -25,8 +25,11 @@ def simulate(scenario: str, seed: int, clutter: str | None, clutter_rate: float 
     origin; no scan), DIR/truth (scan = sample, time, target_id, x, y, lat, lon, vx, vy
     east/north m/s) and DIR/sensors.toml for `mhtrack track --sensors`."""
     from mhtrack.io import write_plots, write_scenario_toml, write_truth
+    from mhtrack.io.paths import check_output_dir
     from mhtrack.scenario import simulate as run_simulation
 
+    scenario_path = Path(scenario) if Path(scenario).is_file() else None
+    check_output_dir(out, inputs=(scenario_path,), what="simulation files")
     sc = load_scenario_arg(scenario, clutter, clutter_rate, pd, scans)
     sim = run_simulation(sc, seed=seed)
     out.mkdir(parents=True, exist_ok=True)
@@ -143,10 +146,14 @@ def _check_same_times(path_a: Path, a: Any, path_b: Path, b: Any) -> None:
 def plot(directory: Path, output: Path | None, title: str | None) -> None:
     """Draw DIR's truth, plots (clutter grey) and tracks, whichever are present."""
     from mhtrack.io import read_plots, read_toml, read_tracks, read_truth
+    from mhtrack.io.paths import check_output_file
     from mhtrack.io.sensors import read_sensors
     from mhtrack.plotting.scene import plot_scene, save_figure, sensor_sites
 
     paths = {s: table_path(directory, s) for s in ("plots", "truth", "tracks")}
+    if output is not None:
+        check_output_file(output, inputs=paths.values(), suffixes=(".png",), what="figure",
+                          option="-o")
     if not any(paths.values()):
         raise click.ClickException(f"{directory} holds no plots, truth or tracks file")
     if title is None:

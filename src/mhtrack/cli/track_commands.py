@@ -142,7 +142,9 @@ def track(plots: Path, tracker: str, tracker_pd: float | None, meas_sigma: float
     from mhtrack.build import default_config, default_fusion, make_tracker
     from mhtrack.experiments.pipeline import track as run_tracker
     from mhtrack.io import write_tracks
+    from mhtrack.io.paths import check_output_file
 
+    check_output_file(out, inputs=(plots, scenario_file, sensors_file), what="tracks file")
     table, scenario, sensor_set = _read_input(plots, scenario_file, sensors_file,
                                               reorder_window_s)
     if fusion is None:  # frames of timed plots hold one sensor each: nothing to fuse
@@ -253,6 +255,11 @@ def run(scenario: str, seed: int, clutter: str | None, clutter_rate: float | Non
     from mhtrack.plotting.metrics import plot_ospa_cardinality
     from mhtrack.plotting.scene import plot_scene, save_figure
 
+    if out is not None:
+        from mhtrack.io.paths import check_output_dir
+
+        check_output_dir(out, inputs=(Path(scenario) if Path(scenario).is_file() else None,),
+                         what="run's files")
     sc = load_scenario_arg(scenario, clutter, clutter_rate, pd, scans)
     if tracker_pd is None and pd is not None:  # the scenario's P_D, as default_config caps it
         tracker_pd = capped_pd(pd)

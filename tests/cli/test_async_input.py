@@ -111,7 +111,7 @@ def test_bad_timed_plots_give_one_located_line(tmp_path, rows, message):
     plots, sensors = files(tmp_path, rows)
     code, _, stderr = invoke("track", str(plots), "--sensors", str(sensors),
                              "--out", str(tmp_path / "t.csv"), "--no-progress")
-    assert code == 1
+    assert code == 2
     assert stderr == f"Error: {plots}, {message}\n"
     assert not (tmp_path / "t.csv").exists()
 
@@ -120,7 +120,7 @@ def test_range_without_bearing_column(tmp_path):
     plots, sensors = files(tmp_path, ["0.5,1,1000"], header="time,sensor,range\n")
     code, _, stderr = invoke("track", str(plots), "--sensors", str(sensors),
                              "--out", str(tmp_path / "t.csv"), "--no-progress")
-    assert code == 1
+    assert code == 2
     assert stderr == (f"Error: {plots}: column 'range' is present without column 'bearing'; "
                       "give both or neither\n")
 
@@ -129,7 +129,7 @@ def test_polar_plots_without_a_sensors_file(tmp_path):
     plots, _ = files(tmp_path, ["0.5,1,1000,10"], header="time,sensor,range,bearing\n")
     code, _, stderr = invoke("track", str(plots), "--out", str(tmp_path / "t.csv"),
                              "--no-progress")
-    assert code == 1
+    assert code == 2
     assert stderr == (f"Error: {plots}: range/bearing plots need the radar sites: read them "
                       "with a sensors file (mhtrack track --sensors FILE)\n")
 

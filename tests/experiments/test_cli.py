@@ -62,7 +62,7 @@ def test_other_parameters_are_refused(study):
     out, _ = study
     code, _, stderr = invoke(*SMALL, "--trackers", "mht", "--workers", "1", "--nscan", "2",
                              "--out", str(out))
-    assert code == 1
+    assert code == 2
     assert "other parameters" in stderr and "config" in stderr
 
 

@@ -10,6 +10,12 @@ from typing import Any
 import click
 
 
+class InputProblem(click.ClickException):
+    """A user's input is wrong: one line on stderr, exit status 2 (as a usage error)."""
+
+    exit_code = 2
+
+
 def scenario_options(f: Callable[..., Any]) -> Callable[..., Any]:
     """``SCENARIO`` (preset name or TOML file) and the common overrides."""
     for opt in reversed(

@@ -7,7 +7,13 @@ from typing import Any
 
 import click
 
-from mhtrack.cli.common import echo_json, load_scenario_arg, scenario_options, table_path
+from mhtrack.cli.common import (
+    InputProblem,
+    echo_json,
+    load_scenario_arg,
+    scenario_options,
+    table_path,
+)
 
 
 @click.command()
@@ -155,7 +161,7 @@ def plot(directory: Path, output: Path | None, title: str | None) -> None:
         check_output_file(output, inputs=paths.values(), suffixes=(".png",), what="figure",
                           option="-o")
     if not any(paths.values()):
-        raise click.ClickException(f"{directory} holds no plots, truth or tracks file")
+        raise InputProblem(f"{directory} holds no plots, truth or tracks file")
     if title is None:
         title = directory.name
         if (directory / "scenario.toml").is_file():

@@ -10,6 +10,7 @@ from typing import Any
 import click
 
 from mhtrack.cli.common import (
+    InputProblem,
     echo_json,
     executor_kwargs,
     executor_options,
@@ -123,7 +124,7 @@ def montecarlo(scenario: str, clutter: str | None, clutter_rate: float | None,
         spec = MonteCarloSpec(sc, trackers, runs, seed, config=config, run_kwargs=kwargs)
         result = run_montecarlo(spec, out, **run_on)
     except (SpecMismatchError, ValueError) as e:
-        raise click.ClickException(str(e)) from None
+        raise InputProblem(str(e)) from None
     write_montecarlo_report(result)
     if as_json:
         echo_json(result.summary())

@@ -1,7 +1,8 @@
 """The ``mhtrack`` command line: parse, call the library, print. Nothing else lives here.
 
 Every command is reachable from Python through the library functions it calls. Bad input
-gives exit status 1 and one line on stderr (set ``MHTRACK_DEBUG=1`` for the traceback).
+gives exit status 2 (as a usage error does) and one line on stderr (set ``MHTRACK_DEBUG=1``
+for the traceback).
 """
 
 from __future__ import annotations
@@ -12,6 +13,7 @@ import os
 import click
 
 from mhtrack import __version__
+from mhtrack.cli.common import InputProblem
 
 #: Errors that are the user's input, not a bug: reported as one line, no traceback.
 USER_ERRORS: tuple[type[BaseException], ...] = (ValueError, OSError, KeyError)
@@ -31,7 +33,7 @@ class Group(click.Group):
             msg = str(exc) or type(exc).__name__
             if isinstance(exc, KeyError):
                 msg = f"missing key {msg}"
-            raise click.ClickException(msg) from None
+            raise InputProblem(msg) from None
 
 
 @click.group(cls=Group, context_settings={"help_option_names": ["-h", "--help"]})

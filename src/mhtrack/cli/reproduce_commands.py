@@ -6,7 +6,7 @@ from pathlib import Path
 
 import click
 
-from mhtrack.cli.common import executor_kwargs, executor_options, exit_if_runs_failed
+from mhtrack.cli.common import InputProblem, executor_kwargs, executor_options, exit_if_runs_failed
 
 
 @click.group()
@@ -40,7 +40,7 @@ def p1(runs: int, out: Path, seed: int, workers: int | None, dask_scheduler: str
     try:
         repro = reproduce_p1(out, runs, seed, **run_on)
     except (SpecMismatchError, ValueError) as e:
-        raise click.ClickException(str(e)) from None
+        raise InputProblem(str(e)) from None
     report = write_p1_report(repro)
     res = repro.result
     click.echo(report.table_md)
@@ -78,7 +78,7 @@ def p2(runs: int, out: Path, seed: int, workers: int | None, dask_scheduler: str
     try:
         repro = reproduce_p2(out, runs, seed, **run_on)
     except ValueError as e:
-        raise click.ClickException(str(e)) from None
+        raise InputProblem(str(e)) from None
     paths = write_p2_report(repro)
     click.echo((repro.out_dir / "tables.md").read_text(encoding="utf-8"))
     click.echo(f"{repro.computed} jobs computed, {repro.skipped} already done "

@@ -71,7 +71,8 @@ def cluster(scenario: str, seed: int, clutter: str | None, clutter_rate: float |
     d = {"scenario": sc.name, "method": method, "runs": runs, "seed": seed,
          "clutter_rate": _rate(sc), "weighting": weighting, **m.to_dict()}
     if figure is not None:
-        from mhtrack.reports.initiation import clustering_figure_for, save_figure
+        from mhtrack.plotting.scene import save_figure
+        from mhtrack.reports.initiation import clustering_figure_for
 
         save_figure(clustering_figure_for(sc, seed), figure)
     if as_json:
@@ -142,7 +143,8 @@ def initiate(scenario: str, seed: int, clutter: str | None, clutter_rate: float 
          "runs": runs, "seed": seed, "clutter_rate": _rate(sc), **m.to_dict(),
          "t_fusion_scan": sum(fs) / len(fs) if fs else float("nan")}
     if figure is not None:
-        from mhtrack.reports.initiation import initiation_figure_for, save_figure
+        from mhtrack.plotting.scene import save_figure
+        from mhtrack.reports.initiation import initiation_figure_for
 
         save_figure(initiation_figure_for(sc, seed, fusion=fusion, theta_deg=theta_deg,
                                           gate_radius=gate_radius, v_min=v_min, v_max=v_max),

@@ -4,13 +4,11 @@ the data from :mod:`mhtrack.experiments.initiation_runs`, drawn by
 
 from __future__ import annotations
 
-from pathlib import Path
 from typing import Any
 
 from matplotlib.figure import Figure
 
 from mhtrack.experiments.initiation_runs import clustering_example, initiation_example
-from mhtrack.reports.figures import save
 from mhtrack.scenario import Scenario
 
 
@@ -36,9 +34,3 @@ def initiation_figure_for(scenario: Scenario, seed: int, *, fusion: str = "adapt
     return initiation_figure(ex.raw, ex.fused, ex.tracks, ex.truth_xy,
                              title=f"{scenario.name}, scans {s[0]}–{s[-1]}, fusion {fusion}, "
                              f"θ = {theta_deg:g}°")
-
-
-def save_figure(fig: Figure, path: str | Path) -> Path:
-    """Write a ``--figure`` file (format from the extension), as ``mhtrack`` always did:
-    tight layout, 130 dpi."""
-    return save(fig, path, dpi=130)

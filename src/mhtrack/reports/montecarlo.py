@@ -8,7 +8,7 @@ from pathlib import Path
 
 from mhtrack.experiments.montecarlo import MonteCarloResult
 from mhtrack.io.atomic import atomic_write
-from mhtrack.reports.figures import save
+from mhtrack.plotting.scene import save_figure
 
 SUMMARY_FILE = "summary.md"
 FIGURE_FILE = "ospa_cardinality.png"
@@ -58,6 +58,6 @@ def write_montecarlo_report(result: MonteCarloResult) -> list[Path]:
         spec = result.spec
         cutoff = spec.run_kwargs.get("cutoff", 500.0)
         title = f"{spec.scenario_name}: mean ± std over {spec.runs} runs"
-        out.append(save(plot_ospa_cardinality(curves, cutoff=cutoff, title=title),
+        out.append(save_figure(plot_ospa_cardinality(curves, cutoff=cutoff, title=title),
                         result.out_dir / FIGURE_FILE, dpi=130))
     return out

@@ -20,7 +20,7 @@ from mhtrack.experiments.p1.constants import (
 )
 from mhtrack.io.atomic import atomic_write
 from mhtrack.io.jsonsafe import to_jsonable
-from mhtrack.reports.figures import save
+from mhtrack.plotting.scene import save_figure
 from mhtrack.reports.montecarlo import write_montecarlo_report
 from mhtrack.reports.p1_text import report_markdown, table3_file
 
@@ -38,7 +38,7 @@ class P1Report:
 
 def _figures(repro: P1Reproduction) -> dict[str, Path]:
     from mhtrack.plotting.p1 import mean_curves_figure, tracks_panels_figure
-    from mhtrack.plotting.scene import plot_scene, save_figure  # Figs. 2–3: pyplot figures
+    from mhtrack.plotting.scene import plot_scene  # Figs. 2–3
 
     spec, sim = repro.result.spec, repro.simulation
     name = spec.scenario_name
@@ -50,19 +50,19 @@ def _figures(repro: P1Reproduction) -> dict[str, Path]:
     tracks = {TRACKER_LABELS.get(t, t): (None if repro.run0.get(t) is None
                                          else repro.run0[t].run.tracks)
               for t in spec.trackers}
-    save(tracks_panels_figure(sim.truth, tracks,
+    save_figure(tracks_panels_figure(sim.truth, tracks,
                               title=f"Fig. 4 — {name}: tracks of the three algorithms"),
          paths["fig4"], dpi=130)
     summ = repro.result.summary()
     curves = {TRACKER_LABELS.get(t, t): summ[t]["per_scan"] for t in spec.trackers
               if summ[t]["per_scan"]["scans"]}
     cutoff = spec.run_kwargs.get("cutoff", 500.0)
-    save(mean_curves_figure(
+    save_figure(mean_curves_figure(
         curves, "ospa", band_alpha=0.12,
         ylabel=f"OSPA (m), c = {cutoff:g}, p = {spec.run_kwargs.get('order', 2.0):g}",
         title=f"Fig. 5 — OSPA distance, mean over {spec.runs} runs (band ± std)"),
         paths["fig5"], dpi=130)
-    save(mean_curves_figure(
+    save_figure(mean_curves_figure(
         curves, "cardinality", band_alpha=0.15, truth_key="cardinality_true",
         ylabel="number of targets / tracks",
         title=f"Fig. 6 — cardinality estimate, mean (band ± std) over {spec.runs} runs"),

@@ -25,7 +25,7 @@ from mhtrack.experiments.p2.constants import (
 )
 from mhtrack.experiments.p2.examples import FIGURE_NUMBERS, fig2_example, fig12_15_example
 from mhtrack.io.atomic import atomic_write
-from mhtrack.reports.figures import save
+from mhtrack.plotting.scene import save_figure
 from mhtrack.reports.p2_text import report_markdown, tables_markdown
 
 
@@ -55,7 +55,7 @@ def _theta_figures(repro: P2Reproduction) -> None:
                 curves[label(s, r)] = [float("nan") if v is None else v for v in c[key]]
         fig = theta_curves_figure(res["thetas_deg"], curves, ylabel=key, title=title,
                                   theta_mark=THETA0, mark_label="θ = 20° (P2's choice)")
-        save(fig, out / FIGURES[name], dpi=110)
+        save_figure(fig, out / FIGURES[name], dpi=110)
 
 
 def _fig2(seed: int, path: Path) -> None:
@@ -64,7 +64,7 @@ def _fig2(seed: int, path: Path) -> None:
     ex = fig2_example(seed)
     fig = clustering_figure(ex.scan, ex.fused, ex.truth_xy,
                             title=f"{ex.scenario}, scan {ex.scan.index}")
-    save(fig, path, dpi=100, tight=False)
+    save_figure(fig, path, dpi=100, tight=False)
 
 
 def _fig12_15(seed: int, path: Path) -> None:
@@ -77,7 +77,7 @@ def _fig12_15(seed: int, path: Path) -> None:
         ex.fused, ex.tracks, ex.truth_xy, titles,
         title=f"multiradar, run 0, scans {s[0]}–{s[-1]}, σr = 20 m, λ = 50, θ = 20°, "
               f"adaptive K-means fusion")
-    save(fig, path, dpi=100)
+    save_figure(fig, path, dpi=100)
 
 
 def write_p2_report(repro: P2Reproduction) -> list[Path]:

@@ -38,6 +38,7 @@ from mhtrack.clutter.base import ClutterEstimator
 from mhtrack.clutter.gmm import GMMClutter
 from mhtrack.clutter.known import KnownClutter
 from mhtrack.clutter.per_sensor import PerSensorClutter
+from mhtrack.clutter.polar import PolarClutter
 from mhtrack.initiation.factory import INITIATOR_CLASSES, make_initiator
 from mhtrack.initiation.fusion import AdaptiveKMeansFusion, KMeansFusion
 from mhtrack.mht import MHTConfig, MHTTracker
@@ -106,6 +107,7 @@ def make_tracker(
     birth: str | None = None,
     theta_deg: float | None = None,
     sensors: SensorSet | None = None,
+    clutter_frame: str = "polar",
 ) -> MHTTracker:
     """A fresh tracker by name (:data:`TRACKER_ESTIMATORS`).
 
@@ -119,7 +121,9 @@ def make_tracker(
     frame's radar where its beam swept (:class:`~mhtrack.mht.coverage.RadarCoverage`),
     and estimates clutter per radar, a rotation at a time
     (:class:`~mhtrack.clutter.per_sensor.PerSensorClutter`, the tracker's estimator per
-    radar; ``known``: κ per m² per look), and confirms a tree only once its branch holds
+    radar; ``known``: κ per m² per look) — in the radar's own range and bearing
+    (``clutter_frame="polar"``, :class:`~mhtrack.clutter.polar.PolarClutter`) or in the
+    local plane (``"plane"``) — and confirms a tree only once its branch holds
     at least :data:`TIMED_CONFIRM_MIN_PLOTS` plots (``config.confirm_min_plots`` if
     larger)."""
     if name not in TRACKER_ESTIMATORS:
@@ -132,10 +136,18 @@ def make_tracker(
         return MHTTracker(config, make_clutter_estimator(estimator, kappa=kappa))
     config = config_with(config, confirm_min_plots=max(config.confirm_min_plots,
                                                        TIMED_CONFIRM_MIN_PLOTS))
+    if clutter_frame not in names.CLUTTER_FRAMES:
+        raise ValueError(f"unknown clutter frame {clutter_frame!r} "
+                         f"(expected one of {', '.join(names.CLUTTER_FRAMES)})")
+    wrap = None
+    if clutter_frame == "polar" and estimator != "known":
+        def wrap(sid: int, inner: ClutterEstimator) -> ClutterEstimator:
+            s = sensors.sensor(sid)
+            return inner if not s.has_site else PolarClutter(inner, sensors.site_xy(sid))
     clutter = PerSensorClutter(
         lambda: make_clutter_estimator(estimator, kappa=kappa),
         {s.id: s.period for s in sensors.sensors},
-        initial=DEFAULT_CLUTTER_DENSITY if kappa is None else kappa)
+        initial=DEFAULT_CLUTTER_DENSITY if kappa is None else kappa, wrap=wrap)
     return MHTTracker(config, clutter, coverage=RadarCoverage(sensors))
 
 

@@ -13,6 +13,9 @@ from __future__ import annotations
 TRACKERS: tuple[str, ...] = ("mht", "mht-agmm", "mht-gmm")
 #: Clutter-intensity estimators (``mhtrack.clutter``).
 CLUTTER_ESTIMATORS: tuple[str, ...] = ("known", "gmm", "agmm")
+#: Coordinates a radar's clutter is estimated in (asynchronous data): the local
+#: east-north plane, or the radar's own range and bearing.
+CLUTTER_FRAMES: tuple[str, ...] = ("plane", "polar")
 #: P2's track initiators and their modified variants (``mhtrack.initiation``).
 INITIATORS: tuple[str, ...] = ("logic", "modified-logic", "hough", "modified-hough")
 #: The MHT's default birth process: every plot may start a tree (P1).

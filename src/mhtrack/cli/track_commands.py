@@ -11,7 +11,7 @@ from typing import Any
 import click
 
 from mhtrack.cli.common import echo_json, load_scenario_arg, scenario_options
-from mhtrack.names import BIRTHS, OUTPUTS, TRACKER_FUSIONS, TRACKERS
+from mhtrack.names import BIRTHS, CLUTTER_FRAMES, OUTPUTS, TRACKER_FUSIONS, TRACKERS
 
 
 def tracker_options(pd_flag: str) -> Callable[[Callable[..., Any]], Callable[..., Any]]:
@@ -126,6 +126,10 @@ def _config(base: Any, tracker_pd: float | None, meas_sigma: float | None,
 @click.option("--reorder-window", "reorder_window_s", type=click.FloatRange(min=0),
               default=None, help="Timed plots may be out of time order by at most this "
               "many seconds [2].")
+@click.option("--clutter-frame", type=click.Choice(CLUTTER_FRAMES), default="polar",
+              show_default=True, help="Timed plots: estimate each radar's clutter in the "
+              "local east-north plane or in the radar's own range and bearing "
+              "(docs/clutter.md).")
 @birth_options
 @output_option
 @click.option("--progress/--no-progress", default=True, help="Progress bar on stderr.")
@@ -134,8 +138,8 @@ def track(plots: Path, tracker: str, tracker_pd: float | None, meas_sigma: float
           clutter_density: float | None,
           birth_density: float | None, nscan: int | None, out: Path,
           scenario_file: Path | None, sensors_file: Path | None,
-          reorder_window_s: float | None, birth: str, birth_theta: float,
-          fusion: str | None, output: str, progress: bool) -> None:
+          reorder_window_s: float | None, clutter_frame: str, birth: str,
+          birth_theta: float, fusion: str | None, output: str, progress: bool) -> None:
     """Run a tracker on a PLOTS file and write its tracks."""
     import numpy as np
 
@@ -160,7 +164,7 @@ def track(plots: Path, tracker: str, tracker_pd: float | None, meas_sigma: float
                   imm_accel_sigma)
     _check_clutter_density(tracker, clutter_density)
     trk = make_tracker(tracker, cfg, clutter_density=clutter_density, birth=birth,
-                       theta_deg=birth_theta, sensors=sensor_set)
+                       theta_deg=birth_theta, sensors=sensor_set, clutter_frame=clutter_frame)
     result = run_tracker(trk, table, name=tracker, progress=progress, fusion=fusion,
                          output=output)
     frame = None

@@ -6,7 +6,9 @@ rate), so one estimator over all radars' plots would give a plot of one radar th
 of another. :class:`PerSensorClutter` keeps one inner estimator (any
 :class:`~mhtrack.clutter.base.ClutterEstimator`) per sensor id. Coordinates: the common
 local east-north plane, in which every radar's clutter is stationary (the sites do not
-move; a translation to a site's own plane would change no fit).
+move), unless ``wrap`` puts each inner estimator in its radar's own range and bearing
+(:class:`~mhtrack.clutter.polar.PolarClutter`, the builder's default: measured in
+docs/clutter.md).
 
 *Per rotation.* A frame of a rotating radar holds one sector; ``κ`` in the score is the
 clutter intensity per m² *per look* (P1 eqs. 5, 15), which for a rotating radar is per
@@ -37,14 +39,20 @@ class PerSensorClutter(ClutterEstimator):
     periods : rotation period (s) per sensor id (``None`` or absent: every frame is a
         scan of its own).
     initial : ``κ`` (per m² per look) of a sensor before its first full rotation.
+    wrap : ``wrap(sensor_id, inner)`` turns a fresh inner estimator into the sensor's
+        estimator (e.g. :class:`~mhtrack.clutter.polar.PolarClutter` about its site);
+        default: the inner estimator itself.
     """
 
     name = "per-sensor"
 
     def __init__(self, make: Callable[[], ClutterEstimator],
                  periods: Mapping[int, float | None] | None = None, *,
-                 initial: float = 1e-9) -> None:
+                 initial: float = 1e-9,
+                 wrap: Callable[[int, ClutterEstimator], ClutterEstimator] | None = None
+                 ) -> None:
         self.make = make
+        self.wrap = wrap
         self.periods = dict(periods or {})
         self.initial = float(initial)
         self._inner: dict[int, ClutterEstimator] = {}
@@ -63,8 +71,14 @@ class PerSensorClutter(ClutterEstimator):
     def estimator(self, sensor_id: int) -> ClutterEstimator:
         """The inner estimator of ``sensor_id`` (made on first use)."""
         if sensor_id not in self._inner:
-            self._inner[sensor_id] = self.make()
+            inner = self.make()
+            self._inner[sensor_id] = (inner if self.wrap is None
+                                      else self.wrap(sensor_id, inner))
         return self._inner[sensor_id]
+
+    def has_estimate(self, sensor_id: int) -> bool:
+        """Whether ``sensor_id``'s estimator has been fed (its first rotation is complete)."""
+        return sensor_id in self._fed
 
     def update(self, scan: Scan, in_track_gates: np.ndarray | None = None) -> None:
         sid = self._current = self._sensor(scan)

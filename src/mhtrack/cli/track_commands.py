@@ -11,6 +11,7 @@ from typing import Any
 import click
 
 from mhtrack.cli.common import echo_json, load_scenario_arg, scenario_options
+from mhtrack.cli.terminal import progress_enabled, progress_option
 from mhtrack.names import BIRTHS, OUTPUTS, TRACKER_FUSIONS, TRACKERS
 
 
@@ -128,14 +129,14 @@ def _config(base: Any, tracker_pd: float | None, meas_sigma: float | None,
               "many seconds [2].")
 @birth_options
 @output_option
-@click.option("--progress/--no-progress", default=True, help="Progress bar on stderr.")
+@progress_option
 def track(plots: Path, tracker: str, tracker_pd: float | None, meas_sigma: float | None,
           accel_sigma: float | None, imm_accel_sigma: float | None,
           clutter_density: float | None,
           birth_density: float | None, nscan: int | None, out: Path,
           scenario_file: Path | None, sensors_file: Path | None,
           reorder_window_s: float | None, birth: str, birth_theta: float,
-          fusion: str | None, output: str, progress: bool) -> None:
+          fusion: str | None, output: str, progress: bool | None) -> None:
     """Run a tracker on a PLOTS file and write its tracks."""
     import numpy as np
 
@@ -161,8 +162,8 @@ def track(plots: Path, tracker: str, tracker_pd: float | None, meas_sigma: float
     _check_clutter_density(tracker, clutter_density)
     trk = make_tracker(tracker, cfg, clutter_density=clutter_density, birth=birth,
                        theta_deg=birth_theta, sensors=sensor_set)
-    result = run_tracker(trk, table, name=tracker, progress=progress, fusion=fusion,
-                         output=output)
+    result = run_tracker(trk, table, name=tracker, progress=progress_enabled(progress),
+                         fusion=fusion, output=output)
     frame = None
     if sensor_set is not None and sensor_set.reference is not None:
         frame = sensor_set.frame()
@@ -234,14 +235,14 @@ def _read_input(plots: Path, scenario_file: Path | None, sensors_file: Path | No
 @click.option("--json", "as_json", is_flag=True, help="Print one JSON object.")
 @birth_options
 @output_option
-@click.option("--progress/--no-progress", default=True, help="Progress bar on stderr.")
+@progress_option
 def run(scenario: str, seed: int, clutter: str | None, clutter_rate: float | None,
         pd: float | None, scans: int | None, tracker: str, tracker_pd: float | None,
         meas_sigma: float | None, accel_sigma: float | None, imm_accel_sigma: float | None,
         clutter_density: float | None,
         birth_density: float | None, nscan: int | None, out: Path | None, cutoff: float,
         order: float, as_json: bool, birth: str, birth_theta: float, fusion: str | None,
-        output: str, progress: bool) -> None:
+        output: str, progress: bool | None) -> None:
     """Simulate SCENARIO, track, evaluate and plot, in one go.
 
     Writes plots, truth, tracks, scenario.toml, metrics.json, scene.png (truth, plots,
@@ -268,8 +269,8 @@ def run(scenario: str, seed: int, clutter: str | None, clutter_rate: float | Non
     _check_clutter_density(tracker, clutter_density)
     _warn_known_kappa(sc, tracker, clutter_density)
     result = run_scenario(sc, seed, tracker, cfg, clutter_density=clutter_density,
-                          cutoff=cutoff, order=order, progress=progress, birth=birth,
-                          theta_deg=birth_theta, fusion=fusion, output=output)
+                          cutoff=cutoff, order=order, progress=progress_enabled(progress),
+                          birth=birth, theta_deg=birth_theta, fusion=fusion, output=output)
     suffix = "" if birth == "every-plot" else f"-{birth}"
     out = out if out is not None else Path("out") / f"{sc.name}-{tracker}{suffix}-{seed}"
     out.mkdir(parents=True, exist_ok=True)

@@ -15,3 +15,12 @@ def test_readme_python_example_runs(tmp_path, monkeypatch, capsys):
     out = capsys.readouterr().out
     assert "OSPA mean" in out and "Rcc" in out
     assert (tmp_path / "state.npz").is_file()
+
+
+def test_readme_lists_every_command():
+    """Each ``mhtrack`` command has a row in the README's command table."""
+    from mhtrack.cli.main import cli
+
+    text = README.read_text()
+    missing = [name for name in cli.commands if f"| `mhtrack {name}" not in text]
+    assert not missing, f"README's command table lacks {missing}"

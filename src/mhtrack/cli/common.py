@@ -28,8 +28,8 @@ def scenario_options(f: Callable[..., Any]) -> Callable[..., Any]:
                          help="Replace the scenario's clutter density."),
             click.option("--clutter-rate", type=click.FloatRange(min=0), default=None,
                          help="Mean clutter plots per scan (per sensor)."),
-            click.option("--pd", type=click.FloatRange(0, 1), default=None,
-                         help="Detection probability of every sensor."),
+            click.option("--pd", type=click.FloatRange(0, 1, min_open=True), default=None,
+                         help="Detection probability of every sensor, in (0, 1]."),
             click.option("--scans", type=click.IntRange(min=1), default=None,
                          help="Number of scans to simulate."),
         ]

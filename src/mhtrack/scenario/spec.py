@@ -131,7 +131,7 @@ class Scenario:
         pd = tuple(pd)  # type: ignore[arg-type]
         if len(pd) != len(sensors):
             raise ValueError(f"pd: expected one per sensor ({len(sensors)}), got {len(pd)}")
-        pd = tuple(ck.probability(p, f"sensors[{i}].pd") for i, p in enumerate(pd))
+        pd = tuple(ck.detection_probability(p, f"sensors[{i}].pd") for i, p in enumerate(pd))
         object.__setattr__(self, "pd", pd)
 
         if not isinstance(

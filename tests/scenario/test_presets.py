@@ -1,4 +1,4 @@
-"""Presets against SPEC §6, and their overrides."""
+"""Presets against P1 §3 / P2 §3 (``docs/scenarios.md``), and their overrides."""
 
 from pathlib import Path
 

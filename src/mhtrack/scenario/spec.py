@@ -246,7 +246,7 @@ class Scenario:
     # ------------------------------------------------------------------ derived values
     @property
     def rotating(self) -> bool:
-        """The sensors are rotating radars (plots timed by the beam, SPEC §8)."""
+        """The sensors are rotating radars (plots timed by the beam, ``docs/scenarios.md``)."""
         return any(isinstance(s, RotatingRadar) for s in self.sensors)
 
     def sensor_set(self) -> SensorSet:

@@ -12,10 +12,14 @@ from __future__ import annotations
 from typing import Any
 
 from matplotlib.axes import Axes
+from matplotlib.transforms import ScaledTranslation
 
 #: ``(line style, marker)`` of curve ``j`` (cycled).
 CURVE_STYLES: tuple[tuple[str, str], ...] = (
     ("-", "o"), ("--", "s"), (":", "^"), ("-.", "D"), ((0, (5, 1, 1, 1)), "v"), ("-", "x"))
+#: How far (inches) under the axes a legend below them starts: below the tick labels and
+#: the x label, whatever the size of the axes.
+BELOW_AXES_IN = 0.5
 #: About this many markers per curve.
 MARKERS_PER_CURVE = 12
 
@@ -46,5 +50,7 @@ def legend_below(ax: Axes, **kwargs: Any) -> None:
     if not handles:
         return
     kwargs.setdefault("fontsize", 8)
-    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.09), borderaxespad=0.0,
-              ncol=min(3, len(handles)), **kwargs)
+    kwargs.setdefault("ncol", min(3, len(handles)))
+    below = ax.transAxes + ScaledTranslation(0.0, -BELOW_AXES_IN, ax.figure.dpi_scale_trans)
+    ax.legend(loc="upper center", bbox_to_anchor=(0.5, 0.0), bbox_transform=below,
+              borderaxespad=0.0, **kwargs)

@@ -130,7 +130,7 @@ def test_overrides():
 @pytest.mark.parametrize(
     ("kw", "message"),
     [
-        ({"pd": 1.5}, r"^pd: must be in \[0, 1\]"),
+        ({"pd": 1.5}, r"^pd: must be in \(0, 1\]"),
         ({"pd": "high"}, r"^pd: expected a number"),
         ({"scans": 0}, r"^scans: must be >= 1"),
         ({"scans": 2.5}, r"^scans: expected an integer"),

@@ -33,7 +33,7 @@ def start(out):
 def wait_for_first_run(proc, out):
     runs = out / "runs" / "mht-agmm"
     for _ in range(POLLS):
-        if runs.is_dir() and any(p.suffix == ".parquet" for p in runs.iterdir()):
+        if runs.is_dir() and list(runs.glob("run-*.parquet")):  # not a temporary file
             return
         assert proc.poll() is None, proc.communicate()
         time.sleep(0.1)

@@ -85,3 +85,14 @@ def test_a_pool_takes_jobs_from_the_plan_a_few_at_a_time(tmp_path):
     with pytest.raises(Stop) as e:
         run_jobs(JobPlan(10**6, counting), double, store, workers=2)
     assert e.value.args[0] <= IN_FLIGHT_PER_WORKER * 2 + 1
+
+
+def test_cli_runs_bound_is_the_spec_bound(tmp_path):
+    from click.testing import CliRunner
+
+    from mhtrack.cli.main import cli
+
+    r = CliRunner().invoke(cli, ["montecarlo", "crossing", "--runs", str(MAX_RUNS + 1),
+                                 "--out", str(tmp_path / "mc")])
+    assert r.exit_code == 2 and "--runs" in r.stderr and "1000000" in r.stderr
+    assert not (tmp_path / "mc").exists()

@@ -15,3 +15,22 @@ def test_readme_python_example_runs(tmp_path, monkeypatch, capsys):
     out = capsys.readouterr().out
     assert "OSPA mean" in out and "Rcc" in out
     assert (tmp_path / "state.npz").is_file()
+
+
+def test_readme_lists_every_command():
+    """Each ``mhtrack`` command has a row in the README's command table."""
+    from mhtrack.cli.main import cli
+
+    text = README.read_text()
+    missing = [name for name in cli.commands if f"| `mhtrack {name}" not in text]
+    assert not missing, f"README's command table lacks {missing}"
+
+
+def test_no_docstring_or_page_cites_the_internal_spec():
+    """Users have the papers and docs/, not the project's SPEC.md: nothing cites it."""
+    root = README.parent
+    files = [README, *(root / "docs").glob("*.md"), *(root / "src").rglob("*.py")]
+    cites = [f"{p.relative_to(root)}:{i}" for p in files
+             for i, line in enumerate(p.read_text(encoding="utf-8").splitlines(), 1)
+             if re.search(r"SPEC(\.md)?\s*§", line)]
+    assert not cites, cites

@@ -1,4 +1,4 @@
-"""Frames: how asynchronous plots are cut into the tracker's steps (SPEC §8).
+"""Frames: how asynchronous plots are cut into the tracker's steps (``docs/mht.md``).
 
 A rotating radar times each plot when its beam crossed it, and several radars interleave.
 The tracker steps once per *frame*: the plots of **one sensor** over at most ``frame_s``

@@ -10,7 +10,7 @@ Conventions (all layers):
 * a state vector is ``[x, vx, y, vy]`` (P1 §1.1);
 * scan indices are integers, times in seconds, non-decreasing with the scan index;
 * synchronous data (the papers): every plot of a scan has the scan's time; asynchronous
-  data (rotating radars, SPEC §8): every plot has its own ``time`` and the "scan" is a
+  data (rotating radars, ``docs/mht.md``): every plot has its own ``time`` and the "scan" is a
   *frame* of one sensor's plots over a short time (:mod:`mhtrack.frames`), flagged by
   ``PlotTable.timed`` and carried to the tracker as ``Scan.t``;
 * ``origin`` of a plot is the id of the target that produced it, or ``-1`` for clutter;

@@ -1,4 +1,4 @@
-"""A self-contained version of the SPEC §6 ``crossing`` scenario with *uniform* Poisson
+"""A self-contained version of P1 §3's ``crossing`` scenario with *uniform* Poisson
 clutter (so the true clutter density is known exactly), and a truth-matching assessment
 for the MHT tests."""
 
@@ -13,7 +13,7 @@ from mhtrack.records import Scan
 REGION = 4000.0  # the region is [-REGION, REGION]²
 AREA = (2 * REGION) ** 2
 
-#: SPEC §6 crossing targets: initial [x, vx, y, vy] at their first scan, first, last scan.
+#: crossing targets (P1 Table 1): initial [x, vx, y, vy] at their first scan, first, last scan.
 CROSSING_TARGETS = (
     ((2000.0, -70.0, 3000.0, -60.0), 1, 80),
     ((-3000.0, 80.0, 2000.0, -100.0), 40, 90),

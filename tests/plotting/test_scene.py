@@ -89,10 +89,12 @@ def test_wide_scenes_are_drawn_in_km_and_small_ones_in_m():
     for loc, text in zip(ax.get_xticks(), xt, strict=True):
         assert float(text.replace("\u2212", "-")) == pytest.approx(loc / 1000)
     assert any(float(t.replace("\u2212", "-")) == 300 for t in xt)
-    small = plot_scene(truth=_wide_truth(15_000.0))
+    small = plot_scene(truth=_wide_truth(8_000.0))  # P1's crossing region: 8 km
     assert small.axes[0].get_xlabel() == "x east (m)"
-    forced = plot_scene(truth=_wide_truth(15_000.0), units="km")
+    forced = plot_scene(truth=_wide_truth(8_000.0), units="km")
     assert forced.axes[0].get_xlabel() == "x east (km)"
+    # multiradar's ≈ 14 km: five-digit metre ticks read worse than km
+    assert plot_scene(truth=_wide_truth(15_000.0)).axes[0].get_xlabel() == "x east (km)"
     assert plot_scene().axes[0].get_xlabel() == "x east (m)"  # nothing drawn: metres
     with pytest.raises(ValueError, match="units"):
         plot_scene(units="mi")
@@ -108,7 +110,7 @@ def test_radar_sites_are_drawn_and_labelled():
     assert marks.get_ydata().tolist() == [10_000.0, -20_000.0]
     assert [t.get_text() for t in ax.texts] == ["radar 1", "radar 2"]
     assert "radar sites" in [t.get_text() for t in ax.get_legend().get_texts()]
-    assert ax.get_xlabel() == "x east (km)"  # the sites widen the scene beyond 20 km
+    assert ax.get_xlabel() == "x east (km)"  # the sites widen the scene beyond 10 km
 
 
 def test_sensor_sites_come_from_the_sensor_set():

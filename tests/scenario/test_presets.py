@@ -1,4 +1,4 @@
-"""Presets against SPEC §6, and their overrides."""
+"""Presets against P1 §3 / P2 §3 (``docs/scenarios.md``), and their overrides."""
 
 from pathlib import Path
 
@@ -130,7 +130,7 @@ def test_overrides():
 @pytest.mark.parametrize(
     ("kw", "message"),
     [
-        ({"pd": 1.5}, r"^pd: must be in \[0, 1\]"),
+        ({"pd": 1.5}, r"^pd: must be in \(0, 1\]"),
         ({"pd": "high"}, r"^pd: expected a number"),
         ({"scans": 0}, r"^scans: must be >= 1"),
         ({"scans": 2.5}, r"^scans: expected an integer"),

@@ -280,7 +280,10 @@ def test_mixed_sensors_have_nan_polar_columns_on_cartesian_rows():
 
 
 def test_empty_scans_are_listed():
-    s = preset("crossing", scans=4, clutter="uniform", clutter_rate=0.0, pd=0.0)
+    import dataclasses
+
+    s = dataclasses.replace(preset("crossing", scans=4, clutter="uniform", clutter_rate=0.0),
+                            targets=())
     p = simulate(s, 0).plots
     assert len(p) == 0 and p.n_scans == 4
     assert [sc.index for sc in p.scans()] == [1, 2, 3, 4]

@@ -99,7 +99,7 @@ def scenarios(draw) -> Scenario:
         T=draw(st.floats(1e-3, 100)),
         scans=(first, last),
         sensors=tuple(sensors),
-        pd=tuple(draw(st.floats(0, 1)) for _ in sensors),
+        pd=tuple(draw(st.floats(0, 1, exclude_min=True)) for _ in sensors),
         clutter=clutter,
         targets=tuple(targets),
         truth_sigma_v=draw(st.floats(0, 20)),
@@ -193,7 +193,7 @@ BAD = [
     (("region", "ymin"), float("inf"), r"^region\.ymin: must be finite"),
     (("sensors", 1, "id"), 0, r"^sensors\[1\]\.id: duplicate id 0"),
     (("sensors", 1, "id"), True, r"^sensors\[1\]\.id: expected an integer, got bool"),
-    (("sensors", 0, "pd"), 1.5, r"^sensors\[0\]\.pd: must be in \[0, 1\]"),
+    (("sensors", 0, "pd"), 1.5, r"^sensors\[0\]\.pd: must be in \(0, 1\]"),
     (
         ("sensors", 1, "kind"),
         "sonar",

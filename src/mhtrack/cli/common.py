@@ -2,12 +2,13 @@
 
 from __future__ import annotations
 
-import sys
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
 import click
+
+from mhtrack.cli.terminal import progress_enabled, progress_option
 
 
 class InputProblem(click.ClickException):
@@ -27,8 +28,8 @@ def scenario_options(f: Callable[..., Any]) -> Callable[..., Any]:
                          help="Replace the scenario's clutter density."),
             click.option("--clutter-rate", type=click.FloatRange(min=0), default=None,
                          help="Mean clutter plots per scan (per sensor)."),
-            click.option("--pd", type=click.FloatRange(0, 1), default=None,
-                         help="Detection probability of every sensor."),
+            click.option("--pd", type=click.FloatRange(0, 1, min_open=True), default=None,
+                         help="Detection probability of every sensor, in (0, 1]."),
             click.option("--scans", type=click.IntRange(min=1), default=None,
                          help="Number of scans to simulate."),
         ]
@@ -86,9 +87,7 @@ def executor_options(f: Callable[..., Any]) -> Callable[..., Any]:
             click.option("--dask-scheduler", default=None, metavar="ADDRESS",
                          help="Run the jobs on this Dask scheduler (e.g. tcp://host:8786) "
                          "instead."),
-            click.option("--progress/--no-progress", default=None,
-                         help="Progress bar over jobs on stderr [when stderr is a "
-                         "terminal]."),
+            progress_option,
         ]
     ):
         f = opt(f)
@@ -105,7 +104,7 @@ def executor_kwargs(workers: int | None, dask_scheduler: str | None,
         "executor": "dask" if dask_scheduler else "local",
         "workers": workers,
         "scheduler": dask_scheduler,
-        "progress": sys.stderr.isatty() if progress is None else progress,
+        "progress": progress_enabled(progress),
     }
 
 

@@ -18,6 +18,7 @@ from mhtrack.cli.common import (
     load_scenario_arg,
     scenario_options,
 )
+from mhtrack.cli.terminal import resume_on_interrupt
 from mhtrack.cli.track_commands import config_changes, output_option, tracker_options
 
 
@@ -68,8 +69,9 @@ def _run_kwargs(ctx: click.Context, param: click.Parameter, value: tuple[str, ..
 @_params_of(scenario_options, drop={"seed"})
 @click.option("--trackers", default="mht,mht-gmm,mht-agmm", show_default=True,
               callback=_trackers, help="Comma-separated trackers to compare.")
-@click.option("--runs", type=click.IntRange(min=1), default=10, show_default=True,
-              help="Runs per tracker.")
+@click.option("--runs", type=click.IntRange(min=1, max=1_000_000), default=10,
+              show_default=True, help="Runs per tracker (at most 10⁶: every run is one file "
+              "that the summary reads back).")
 @click.option("--seed", type=click.IntRange(min=0), default=0, show_default=True,
               help="Base seed; run i simulates with a seed derived from (SEED, i) only, the "
               "same for every tracker.")
@@ -122,7 +124,8 @@ def montecarlo(scenario: str, clutter: str | None, clutter_rate: float | None,
     kwargs.update(run_kwarg)
     try:
         spec = MonteCarloSpec(sc, trackers, runs, seed, config=config, run_kwargs=kwargs)
-        result = run_montecarlo(spec, out, **run_on)
+        with resume_on_interrupt("montecarlo", out):
+            result = run_montecarlo(spec, out, **run_on)
     except (SpecMismatchError, ValueError) as e:
         raise InputProblem(str(e)) from None
     write_montecarlo_report(result)

@@ -7,6 +7,7 @@ from pathlib import Path
 import click
 
 from mhtrack.cli.common import InputProblem, executor_kwargs, executor_options, exit_if_runs_failed
+from mhtrack.cli.terminal import resume_on_interrupt
 
 
 @click.group()
@@ -15,8 +16,8 @@ def reproduce() -> None:
 
 
 @reproduce.command("p1")
-@click.option("--runs", type=click.IntRange(min=1), default=10, show_default=True,
-              help="Monte-Carlo runs per tracker.")
+@click.option("--runs", type=click.IntRange(min=1, max=1_000_000), default=10,
+              show_default=True, help="Monte-Carlo runs per tracker (at most 10⁶).")
 @click.option("--out", type=click.Path(file_okay=False, path_type=Path), required=True,
               help="Output directory (montecarlo/, table3.md, table3.json, report.md, "
               "fig2–fig6 PNG); an existing study with the same parameters is resumed.")
@@ -38,7 +39,8 @@ def p1(runs: int, out: Path, seed: int, workers: int | None, dask_scheduler: str
 
     run_on = executor_kwargs(workers, dask_scheduler, progress)
     try:
-        repro = reproduce_p1(out, runs, seed, **run_on)
+        with resume_on_interrupt("reproduce p1", out):
+            repro = reproduce_p1(out, runs, seed, **run_on)
     except (SpecMismatchError, ValueError) as e:
         raise InputProblem(str(e)) from None
     report = write_p1_report(repro)
@@ -76,7 +78,8 @@ def p2(runs: int, out: Path, seed: int, workers: int | None, dask_scheduler: str
 
     run_on = executor_kwargs(workers, dask_scheduler, progress)
     try:
-        repro = reproduce_p2(out, runs, seed, **run_on)
+        with resume_on_interrupt("reproduce p2", out):
+            repro = reproduce_p2(out, runs, seed, **run_on)
     except ValueError as e:
         raise InputProblem(str(e)) from None
     paths = write_p2_report(repro)

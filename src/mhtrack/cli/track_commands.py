@@ -11,6 +11,7 @@ from typing import Any
 import click
 
 from mhtrack.cli.common import echo_json, load_scenario_arg, scenario_options
+from mhtrack.cli.terminal import progress_enabled, progress_option
 from mhtrack.names import BIRTHS, CLUTTER_FRAMES, OUTPUTS, TRACKER_FUSIONS, TRACKERS
 
 
@@ -39,7 +40,10 @@ def _tracker_options(f: Callable[..., Any], pd_flag: str) -> Callable[..., Any]:
                      default=None, help="Known clutter intensity κ (per m² per scan) for "
                      "--tracker mht [1e-9]."),
         click.option("--birth-density", type=click.FloatRange(min=0, min_open=True),
-                     default=None, help="New-target density λv (per m²) [1e-7]."),
+                     default=None, help="New-target density λv, per m² per scan, used as "
+                     "given (MHTConfig.new_target_density) [P1's 6.4 new targets per scan "
+                     "over the surveillance area: the scenario's region, else the plots' "
+                     "robust bounding box; 1e-7 on P1's 8 km × 8 km region]."),
         click.option("--nscan", type=click.IntRange(min=1), default=None,
                      help="N-scan pruning depth [3]."),
     ]
@@ -132,14 +136,15 @@ def _config(base: Any, tracker_pd: float | None, meas_sigma: float | None,
               "(docs/clutter.md).")
 @birth_options
 @output_option
-@click.option("--progress/--no-progress", default=True, help="Progress bar on stderr.")
+@progress_option
 def track(plots: Path, tracker: str, tracker_pd: float | None, meas_sigma: float | None,
           accel_sigma: float | None, imm_accel_sigma: float | None,
           clutter_density: float | None,
           birth_density: float | None, nscan: int | None, out: Path,
           scenario_file: Path | None, sensors_file: Path | None,
           reorder_window_s: float | None, clutter_frame: str, birth: str,
-          birth_theta: float, fusion: str | None, output: str, progress: bool) -> None:
+          birth_theta: float, fusion: str | None, output: str,
+          progress: bool | None) -> None:
     """Run a tracker on a PLOTS file and write its tracks."""
     import numpy as np
 
@@ -155,18 +160,19 @@ def track(plots: Path, tracker: str, tracker_pd: float | None, meas_sigma: float
         n_sensors = (len(scenario.sensors) if scenario is not None
                      else len(np.unique(table.sensor)))
         fusion = "none" if table.timed else default_fusion(n_sensors)
+    area = None
     if scenario is not None:
         base = default_config(scenario)
     else:  # no scenario: a robust box around the plots is the surveillance area
-        base = default_config(area=_plots_area(plots, table)) if len(table) > 1 \
-            else default_config()
+        area = _plots_area(plots, table) if len(table) > 1 else None
+        base = default_config(area=area.area) if area is not None else default_config()
     cfg = _config(base, tracker_pd, meas_sigma, accel_sigma, birth_density, nscan,
                   imm_accel_sigma)
     _check_clutter_density(tracker, clutter_density)
     trk = make_tracker(tracker, cfg, clutter_density=clutter_density, birth=birth,
                        theta_deg=birth_theta, sensors=sensor_set, clutter_frame=clutter_frame)
-    result = run_tracker(trk, table, name=tracker, progress=progress, fusion=fusion,
-                         output=output)
+    result = run_tracker(trk, table, name=tracker, progress=progress_enabled(progress),
+                         fusion=fusion, output=output)
     frame = None
     if sensor_set is not None and sensor_set.reference is not None:
         frame = sensor_set.frame()
@@ -176,6 +182,12 @@ def track(plots: Path, tracker: str, tracker_pd: float | None, meas_sigma: float
     steps = "frames" if table.timed else "scans"
     click.echo(f"{tracker}: {len(result.stats)} {steps}, {n_ids} tracks, "
                f"{1e3 * result.t_avg:.2f} ms/scan{caps} -> {out}")
+    if birth_density is None:
+        where = ("the scenario's region" if scenario is not None
+                 else f"the plots' {area.width / 1e3:.3g} km × {area.height / 1e3:.3g} km "
+                 "bounding box" if area is not None
+                 else "P1's 8 km × 8 km region")
+        click.echo(birth_density_note(cfg.new_target_density, where))
 
 
 def _read_input(plots: Path, scenario_file: Path | None, sensors_file: Path | None,
@@ -238,14 +250,14 @@ def _read_input(plots: Path, scenario_file: Path | None, sensors_file: Path | No
 @click.option("--json", "as_json", is_flag=True, help="Print one JSON object.")
 @birth_options
 @output_option
-@click.option("--progress/--no-progress", default=True, help="Progress bar on stderr.")
+@progress_option
 def run(scenario: str, seed: int, clutter: str | None, clutter_rate: float | None,
         pd: float | None, scans: int | None, tracker: str, tracker_pd: float | None,
         meas_sigma: float | None, accel_sigma: float | None, imm_accel_sigma: float | None,
         clutter_density: float | None,
         birth_density: float | None, nscan: int | None, out: Path | None, cutoff: float,
         order: float, as_json: bool, birth: str, birth_theta: float, fusion: str | None,
-        output: str, progress: bool) -> None:
+        output: str, progress: bool | None) -> None:
     """Simulate SCENARIO, track, evaluate and plot, in one go.
 
     Writes plots, truth, tracks, scenario.toml, metrics.json, scene.png (truth, plots,
@@ -272,8 +284,8 @@ def run(scenario: str, seed: int, clutter: str | None, clutter_rate: float | Non
     _check_clutter_density(tracker, clutter_density)
     _warn_known_kappa(sc, tracker, clutter_density)
     result = run_scenario(sc, seed, tracker, cfg, clutter_density=clutter_density,
-                          cutoff=cutoff, order=order, progress=progress, birth=birth,
-                          theta_deg=birth_theta, fusion=fusion, output=output)
+                          cutoff=cutoff, order=order, progress=progress_enabled(progress),
+                          birth=birth, theta_deg=birth_theta, fusion=fusion, output=output)
     suffix = "" if birth == "every-plot" else f"-{birth}"
     out = out if out is not None else Path("out") / f"{sc.name}-{tracker}{suffix}-{seed}"
     out.mkdir(parents=True, exist_ok=True)
@@ -298,9 +310,21 @@ def run(scenario: str, seed: int, clutter: str | None, clutter_rate: float | Non
                              "marked tentative)" if output == "history"
                              else "online (what the tracker reported at each scan)"))
     click.echo(f"tracker time: {1e3 * result.run.t_avg:.2f} ms/scan (mean)")
+    if birth_density is None:
+        click.echo(birth_density_note(cfg.new_target_density, "the scenario's region"))
     if result.run.caps:
         click.echo(f"hard caps acted: {result.run.caps}")
     click.echo(f"wrote {out}/ (plots, truth, tracks, metrics.json, scene.png, metrics.png)")
+
+
+def birth_density_note(density: float, where: str) -> str:
+    """The line saying which new-target density a run used when ``--birth-density`` was
+    not given (:func:`~mhtrack.build.default_config`)."""
+    from mhtrack.build import P1_BIRTHS_PER_SCAN
+
+    return (f"new-target density λv = {density:.4g} per m² per scan: P1's "
+            f"{P1_BIRTHS_PER_SCAN:g} new targets per scan over {where} (--birth-density "
+            "sets it)")
 
 
 def _output_frame(sc: Any, plots: Any) -> Any:
@@ -312,9 +336,10 @@ def _output_frame(sc: Any, plots: Any) -> Any:
     return sensor_set.frame() if sensor_set.reference is not None else None
 
 
-def _plots_area(plots: Path, table: Any) -> float:
-    """Surveillance area (m²) of a plots file with no scenario
-    (:func:`~mhtrack.build.plots_area`); warns about plots far outside its box."""
+def _plots_area(plots: Path, table: Any) -> Any:
+    """Surveillance area of a plots file with no scenario, a
+    :class:`~mhtrack.build.PlotsArea` (:func:`~mhtrack.build.plots_area`); warns about
+    plots far outside its box."""
     from mhtrack.build import plots_area
 
     box = plots_area(table.x, table.y)
@@ -324,7 +349,7 @@ def _plots_area(plots: Path, table: Any) -> float:
             "(x %.6g to %.6g m, y %.6g to %.6g m); the surveillance area (%.4g m²) is taken "
             "from that box — check those plots, or pass --scenario with the true region",
             plots, box.n_far, len(table), box.x0, box.x1, box.y0, box.y1, box.area)
-    return box.area
+    return box
 
 
 def _warn_known_kappa(sc: Any, tracker: str, clutter_density: float | None) -> None:

@@ -1,4 +1,4 @@
-"""Metrics of tracking performance (SPEC §5): pure functions, arrays in, small results out.
+"""Tracking performance metrics (``docs/metrics.md``): pure functions, arrays in, small results out.
 
 * :func:`ospa`, :func:`ospa_per_scan` — OSPA (Schuhmacher, Vo & Vo 2008);
 * :func:`gospa`, :func:`gospa_per_scan` — GOSPA with α = 2 (Rahmathullah et al. 2017);

@@ -1,7 +1,7 @@
 """Cardinality per scan: number of reported tracks against number of true targets.
 
 The cardinality error at scan ``k`` is ``|n̂_k − n_k|`` with ``n̂_k`` the number of track
-rows and ``n_k`` the number of truth rows at that scan (SPEC §5).
+rows and ``n_k`` the number of truth rows at that scan (``docs/metrics.md``).
 """
 
 from __future__ import annotations

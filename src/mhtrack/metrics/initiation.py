@@ -1,4 +1,4 @@
-"""Metrics of plot fusion and track initiation (P2 §2.2, §3; SPEC §5).
+"""Metrics of plot fusion and track initiation (P2 §2.2, §3; ``docs/metrics.md``).
 
 Pure functions on arrays; definitions (also in ``docs/initiation.md``):
 

@@ -25,6 +25,8 @@ from matplotlib.figure import Figure
 
 from mhtrack.initiation import FusedScan, InitiatedTracks, Window
 from mhtrack.metrics.initiation import track_targets
+from mhtrack.plotting.scene import KM_ABOVE_M, set_distance_axes
+from mhtrack.plotting.styles import legend_below
 from mhtrack.records import Scan
 
 MARKERS = "o^sDvP*X"
@@ -41,10 +43,11 @@ def zoom_to_truth(ax: Axes, truth_xy: np.ndarray | None, margin: float = 800.0) 
 
 
 def finish_axes(ax: Axes, title: str) -> None:
-    """Equal axes in metres (x east, y north), a light grid and ``title``."""
+    """Equal axes (x east, y north) in metres, or in kilometres when the view spans more
+    than :data:`~mhtrack.plotting.scene.KM_ABOVE_M`; a light grid and ``title``."""
     ax.set_aspect("equal", adjustable="box")
-    ax.set_xlabel("x east (m)")
-    ax.set_ylabel("y north (m)")
+    (x0, x1), (y0, y1) = ax.get_xlim(), ax.get_ylim()
+    set_distance_axes(ax, "km" if max(abs(x1 - x0), abs(y1 - y0)) > KM_ABOVE_M else "m")
     ax.grid(True, lw=0.3, alpha=0.5)
     ax.set_title(title, fontsize=9)
 
@@ -53,8 +56,8 @@ def _tracks_legend(ax: Axes, fontsize: int) -> None:
     """Legend with the true/false track entries only."""
     handles, labels = ax.get_legend_handles_labels()
     keep = [i for i, lab in enumerate(labels) if "tracks" in lab]
-    ax.legend([handles[i] for i in keep], [labels[i] for i in keep], fontsize=fontsize,
-              loc="upper right")
+    legend_below(ax, handles=[handles[i] for i in keep],
+                 labels=[labels[i] for i in keep], fontsize=fontsize, ncol=2)
 
 
 def draw_clusters(ax: Axes, scan: Scan, fused: FusedScan) -> None:
@@ -82,7 +85,7 @@ def clustering_figure(scan: Scan, fused: Mapping[str, FusedScan],
             ax.plot(truth_xy[:, 0], truth_xy[:, 1], "k+", ms=9, label="truth")
         zoom_to_truth(ax, truth_xy)
         finish_axes(ax, f"{name}: k = {f.n_clusters}")
-        ax.legend(fontsize=7, loc="upper right")
+        legend_below(ax, fontsize=7)
     if title:
         fig.suptitle(title)
     return fig
@@ -131,7 +134,7 @@ def initiation_figure(raw: Window, fused: Window, results: Mapping[str, Initiate
     for ax, name in ((flat_axes[0], "plots of the window"), (flat_axes[1], "fused plots")):
         zoom_to_truth(ax, truth_xy)
         finish_axes(ax, name)
-        ax.legend(fontsize=7, loc="upper right", markerscale=1.5)
+        legend_below(ax, fontsize=7, markerscale=1.5)
     for ax, (name, tr) in zip(flat_axes[2:], results.items(), strict=False):
         draw_window(ax, fused)
         draw_tracks(ax, fused, tr)

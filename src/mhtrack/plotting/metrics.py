@@ -9,31 +9,37 @@ from collections.abc import Mapping, Sequence
 
 import numpy as np
 from matplotlib.figure import Figure
+from matplotlib.ticker import MaxNLocator
+
+from mhtrack.plotting.styles import curve_style, legend_outside
 
 
 def plot_ospa_cardinality(
     runs: Mapping[str, Mapping[str, Sequence[float]]], *, cutoff: float | None = None,
     title: str = "",
 ) -> Figure:
-    """OSPA per scan (top) and estimated vs true cardinality (bottom), one line per entry.
+    """OSPA per scan (top) and estimated vs true cardinality (bottom), one line per entry,
+    each with its own line style and markers (:mod:`~mhtrack.plotting.styles`), legends
+    outside the axes.
 
     ``runs`` maps a label (e.g. tracker name) to a mapping with per-scan arrays ``scans``,
     ``ospa``, ``cardinality`` and ``cardinality_true`` — the keys of
     :meth:`mhtrack.metrics.Evaluation.to_dict`. Entries may also hold ``ospa_std`` and
     ``cardinality_std`` (Monte-Carlo spread), drawn as bands.
     """
-    fig = Figure(figsize=(8, 6.5))
+    fig = Figure(figsize=(9.5, 6.5))
     ax1, ax2 = fig.subplots(2, 1, sharex=True)
     true_drawn = False
-    for label, r in runs.items():
+    for j, (label, r) in enumerate(runs.items()):
         k = np.asarray(r["scans"])
         ospa = np.asarray(r["ospa"], float)
-        (line,) = ax1.plot(k, ospa, lw=1.3, label=label)
+        style = curve_style(j, len(k), len(runs))
+        (line,) = ax1.plot(k, ospa, lw=1.3, label=label, **style)
         if "ospa_std" in r:
             s = np.asarray(r["ospa_std"], float)
             ax1.fill_between(k, ospa - s, ospa + s, color=line.get_color(), alpha=0.15, lw=0)
         card = np.asarray(r["cardinality"], float)
-        ax2.plot(k, card, lw=1.3, color=line.get_color(), label=label)
+        ax2.plot(k, card, lw=1.3, color=line.get_color(), label=label, **style)
         if "cardinality_std" in r:
             s = np.asarray(r["cardinality_std"], float)
             ax2.fill_between(k, card - s, card + s, color=line.get_color(), alpha=0.15, lw=0)
@@ -43,10 +49,11 @@ def plot_ospa_cardinality(
             true_drawn = True
     ax1.set_ylabel("OSPA (m)" + (f", c = {cutoff:g}" if cutoff else ""))
     ax2.set_ylabel("number of tracks")
+    ax2.yaxis.set_major_locator(MaxNLocator(integer=True))
     ax2.set_xlabel("scan")
     for ax in (ax1, ax2):
         ax.grid(True, lw=0.3, alpha=0.5)
-        ax.legend(fontsize=8)
+        legend_outside(ax)
     if title:
         ax1.set_title(title)
     return fig

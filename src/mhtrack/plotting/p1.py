@@ -12,10 +12,8 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from mhtrack.plotting.scene import plot_scene
+from mhtrack.plotting.styles import curve_style, legend_outside
 from mhtrack.records import TrackTable, TruthTable
-
-#: Line styles per curve, so that coinciding curves stay visible.
-LINESTYLES = ("-", "--", ":")
 
 
 def tracks_panels_figure(truth: TruthTable, tracks: Mapping[str, TrackTable | None], *,
@@ -40,16 +38,17 @@ def mean_curves_figure(curves: Mapping[str, Mapping[str, Sequence[float]]], key:
                        ylabel: str, title: str, band_alpha: float,
                        truth_key: str | None = None) -> Figure:
     """Per-scan mean of ``key`` with a ± ``key_std`` band, one line per entry of ``curves``
-    (label → per-scan dict with ``scans``, ``key``, ``key_std``), line styles cycling
-    through :data:`LINESTYLES`; ``truth_key``: a black dashed step of the first entry's
+    (label → per-scan dict with ``scans``, ``key``, ``key_std``), each with its own line
+    style and markers (:func:`~mhtrack.plotting.styles.curve_style`, so coinciding curves
+    stay visible), legend outside the axes; ``truth_key``: a black dashed step of the first entry's
     true values (P1 Figs. 5–6)."""
-    fig = Figure(figsize=(8, 4.5))
+    fig = Figure(figsize=(9.5, 4.5))
     ax = fig.subplots()
     true_drawn = truth_key is None
     for j, (label, c) in enumerate(curves.items()):
         k = np.asarray(c["scans"])
         m, sd = np.asarray(c[key], float), np.asarray(c[f"{key}_std"], float)
-        (line,) = ax.plot(k, m, lw=1.4, ls=LINESTYLES[j % 3], label=label)
+        (line,) = ax.plot(k, m, lw=1.4, label=label, **curve_style(j, len(k), len(curves)))
         ax.fill_between(k, m - sd, m + sd, color=line.get_color(), alpha=band_alpha, lw=0)
         if not true_drawn:
             ax.step(k, np.asarray(c[truth_key], float), where="mid", color="black",  # type: ignore[index]
@@ -57,6 +56,5 @@ def mean_curves_figure(curves: Mapping[str, Mapping[str, Sequence[float]]], key:
             true_drawn = True
     ax.set(xlabel="scan", ylabel=ylabel, title=title)
     ax.grid(True, lw=0.3, alpha=0.5)
-    if curves:
-        ax.legend(fontsize=8)
+    legend_outside(ax)
     return fig

@@ -24,6 +24,7 @@ from matplotlib.figure import Figure
 from matplotlib.ticker import FuncFormatter
 
 from mhtrack.io.atomic import atomic_path
+from mhtrack.plotting.styles import legend_below
 from mhtrack.records import PlotTable, TrackTable, TruthTable
 
 if TYPE_CHECKING:
@@ -31,8 +32,9 @@ if TYPE_CHECKING:
 
 TRUTH_STYLE = {"color": "black", "lw": 1.2, "alpha": 0.8}
 
-#: ``units=None`` draws kilometres when the scene's larger side exceeds this (m).
-KM_ABOVE_M = 20_000.0
+#: ``units=None`` draws kilometres when the scene's larger side exceeds this (m): beyond
+#: 10 km, tick labels of five digits and more (``−12000``) read worse than ``−12``.
+KM_ABOVE_M = 10_000.0
 
 #: A radar site to draw: ``(x, y, label)``, local frame (m).
 Site = tuple[float, float, str]
@@ -158,12 +160,13 @@ def plot_scene(
     ``(x, y, label)`` in the local frame, e.g. :func:`sensor_sites`), equal axes.
 
     ``units``: ``"m"``, ``"km"``, or ``None`` — kilometres when the scene spans more than
-    20 km (:func:`scene_units`), metres otherwise. Draws on a new
+    10 km (:func:`scene_units`), metres otherwise. The legend sits under the axes, where
+    it covers no track (:func:`~mhtrack.plotting.styles.legend_below`). Draws on a new
     :class:`~matplotlib.figure.Figure` (or on ``ax``), never on pyplot's state."""
     if units not in (None, "m", "km"):
         raise ValueError(f"units must be 'm', 'km' or None, got {units!r}")
     if ax is None:
-        fig = Figure(figsize=(7.5, 7))
+        fig = Figure(figsize=(7.5, 8))
         ax = fig.add_subplot()
     else:
         fig = ax.figure
@@ -180,8 +183,7 @@ def plot_scene(
     ax.grid(True, lw=0.3, alpha=0.5)
     if title:
         ax.set_title(title)
-    if ax.get_legend_handles_labels()[0]:
-        ax.legend(loc="best", fontsize=8, markerscale=3)
+    legend_below(ax, markerscale=3)
     return fig
 
 

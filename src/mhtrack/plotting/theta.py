@@ -11,18 +11,22 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 from matplotlib.figure import Figure
 
+from mhtrack.plotting.styles import curve_style, legend_outside
+
 
 def theta_curves_figure(thetas_deg: Sequence[float], curves: Mapping[str, Sequence[float]],
                         *, ylabel: str, title: str, theta_mark: float | None = None,
                         mark_label: str = "") -> Figure:
     """One line per entry of ``curves`` (label → value per θ of ``thetas_deg``, NaN where
-    undefined), θ sorted, on a [0, 1] axis; a dotted vertical line at ``theta_mark``."""
+    undefined), θ sorted, on a [0, 1] axis, each with its own line style and marker,
+    legend outside the axes; a dotted vertical line at ``theta_mark``."""
     th = np.asarray(thetas_deg, float)
     o = np.argsort(th)
-    fig = Figure(figsize=(7, 4.6))
+    fig = Figure(figsize=(8.5, 4.6))
     ax = fig.subplots()
-    for label, v in curves.items():
-        ax.plot(th[o], np.asarray(v, float)[o], "o-", ms=3.5, label=label)
+    for j, (label, v) in enumerate(curves.items()):
+        style = {**curve_style(j, len(th), len(curves)), "markevery": None, "ms": 3.5}
+        ax.plot(th[o], np.asarray(v, float)[o], label=label, **style)
     if theta_mark is not None:
         ax.axvline(theta_mark, color="0.6", ls=":", lw=1, label=mark_label or None)
     ax.set_xlabel("angle limit θ (deg)")
@@ -30,6 +34,6 @@ def theta_curves_figure(thetas_deg: Sequence[float], curves: Mapping[str, Sequen
     ax.set_ylim(-0.02, 1.02)
     ax.set_xticks(np.arange(0, 181, 20))
     ax.grid(alpha=0.3)
-    ax.legend(fontsize=8)
+    legend_outside(ax)
     ax.set_title(title, fontsize=10)
     return fig

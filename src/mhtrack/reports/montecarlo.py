@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
+from typing import Any
 
 from mhtrack.experiments.montecarlo import MonteCarloResult
 from mhtrack.io.atomic import atomic_write
@@ -21,8 +22,8 @@ def _fmt(v: float) -> str:
 
 
 def summary_markdown(result: MonteCarloResult) -> str:
-    """``summary.md``: mean ± std per metric (rows) and tracker (columns), then the failed
-    and missing runs."""
+    """``summary.md``: the evaluation's parameters, then mean ± std per metric (rows) and
+    tracker (columns), then the failed and missing runs."""
     s = result.summary()
     spec = result.spec
     lines = [
@@ -31,6 +32,7 @@ def summary_markdown(result: MonteCarloResult) -> str:
         f"{spec.runs} runs per tracker, base seed {spec.seed}; mean ± std over the "
         "successful runs (population std, NaN ignored).",
         "",
+        *_parameters_lines(s, spec.trackers),
         "| metric | " + " | ".join(spec.trackers) + " |",
         "|---|" + "---|" * len(spec.trackers),
     ]
@@ -45,6 +47,28 @@ def summary_markdown(result: MonteCarloResult) -> str:
         lines += [f"* {t} run {i}: see `runs/{t}/run-{i}.error.txt`" for t, i in failed]
         lines += [f"* {t} run {i}: not run" for t, i in result.missing]
     return "\n".join(lines) + "\n"
+
+
+#: How :func:`summary_markdown` names the evaluation's parameters, with their units.
+PARAMETER_TEXT = {"cutoff": ("OSPA/GOSPA cut-off c", " m"), "order": ("order p", ""),
+                  "match_distance": ("CLEAR-MOT matching distance", " m")}
+
+
+def _parameters_lines(s: dict[str, Any], trackers: tuple[str, ...]) -> list[str]:
+    """One line giving the evaluation's parameters (per tracker if they differ)."""
+    per = {t: s[t]["parameters"] for t in trackers if s[t]["parameters"]}
+    if not per:
+        return []
+
+    def text(params: dict[str, Any]) -> str:
+        return ", ".join(f"{PARAMETER_TEXT[k][0]} = {v:g}{PARAMETER_TEXT[k][1]}"
+                         if not isinstance(v, list) else f"{PARAMETER_TEXT[k][0]} = {v}"
+                         for k, v in params.items())
+
+    distinct = {text(p) for p in per.values()}
+    if len(distinct) == 1:
+        return [f"Parameters: {distinct.pop()}.", ""]
+    return ["Parameters:", "", *(f"* {t}: {text(p)}" for t, p in per.items()), ""]
 
 
 def write_montecarlo_report(result: MonteCarloResult) -> list[Path]:

@@ -8,7 +8,7 @@
   rotating radars :func:`simulate_rotating` (``sweep``: plots timed by the beam, on the
   WGS-84 ellipsoid; ``trajectory``: continuous-time truth; ``radardict``: their TOML
   form; ``radarset``: :meth:`Scenario.sensor_set`);
-* :func:`preset`, :data:`PRESETS` (``presets``) — the reference scenarios of SPEC §6 and
+* :func:`preset`, :data:`PRESETS` (``presets``) — the papers' scenarios (``docs/scenarios.md``) and
   the OpenSky scenario; :func:`apply_overrides` (``overrides``) — the CLI's common
   overrides (clutter kind and rate, P_D, number of scans, …) for any scenario;
 * :func:`load_opensky`, :func:`aircraft_ids` (``opensky``), :func:`geodetic_to_enu`

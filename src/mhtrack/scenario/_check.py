@@ -108,6 +108,16 @@ def probability(v: object, path: str) -> float:
     return x
 
 
+def detection_probability(v: object, path: str) -> float:
+    """A sensor's ``P_D`` in (0, 1] — the one rule of scenario files, sensors files,
+    overrides and the CLI's ``--pd``: a sensor that never detects gives nothing to track."""
+    x = number(v, path)
+    if not 0.0 < x <= 1.0:
+        raise ValueError(f"{path}: must be in (0, 1], got {x} (detection probability; a "
+                         "sensor with P_D = 0 never detects, so nothing could be tracked)")
+    return x
+
+
 def integer(v: object, path: str, *, lo: int | None = None) -> int:
     """An integer (bools and floats rejected), optionally ``>= lo``."""
     if isinstance(v, bool) or not isinstance(v, int | np.integer):

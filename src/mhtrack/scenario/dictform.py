@@ -235,7 +235,7 @@ def _sensor_from(v: object, path: str) -> tuple[Sensor, float]:
             unit="degrees",
         )
         sensor = PolarRadar(sid, (float(pos[0]), float(pos[1])), sr, sb)
-    return sensor, ck.probability(d["pd"], f"{path}.pd")
+    return sensor, ck.detection_probability(d["pd"], f"{path}.pd")
 
 
 def _target_from(v: object, path: str, first: int, last: int) -> AnyTarget:

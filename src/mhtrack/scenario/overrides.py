@@ -113,7 +113,7 @@ def apply_overrides(scenario: Scenario, **overrides: Any) -> Scenario:
         clutter = _with_rate(clutter, ck.number(ov["clutter_rate"], "clutter_rate", lo=0.0))
     changes["clutter"] = clutter
     if "pd" in ov:
-        changes["pd"] = ck.probability(ov["pd"], "pd")
+        changes["pd"] = ck.detection_probability(ov["pd"], "pd")
     if "scans" in ov:
         n = ck.integer(ov["scans"], "scans", lo=1)
         if n > MAX_SCANS:

@@ -1,4 +1,4 @@
-"""Reference scenarios of SPEC §6 and the OpenSky scenario, by name.
+"""Reference scenarios (``docs/scenarios.md``: P1 §3, P2 §3) and the OpenSky scenario, by name.
 
 ``preset(name, **overrides)`` builds one; :data:`PRESETS` lists the names. Values marked
 *(ours)* are not in the papers: they are our documented choices (``docs/scenarios.md``).

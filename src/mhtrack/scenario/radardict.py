@@ -95,4 +95,4 @@ def rotating_from(d: Mapping[str, Any], path: str) -> tuple[RotatingRadar, float
             rate=ck.number(t["rate"], f"{pp}.rate", lo=0.0)))
     with ck.at(path):
         radar = RotatingRadar(id=sid, clutter_patches=tuple(patches), **kw)
-    return radar, ck.probability(d["pd"], f"{path}.pd")
+    return radar, ck.detection_probability(d["pd"], f"{path}.pd")

@@ -131,7 +131,7 @@ class Scenario:
         pd = tuple(pd)  # type: ignore[arg-type]
         if len(pd) != len(sensors):
             raise ValueError(f"pd: expected one per sensor ({len(sensors)}), got {len(pd)}")
-        pd = tuple(ck.probability(p, f"sensors[{i}].pd") for i, p in enumerate(pd))
+        pd = tuple(ck.detection_probability(p, f"sensors[{i}].pd") for i, p in enumerate(pd))
         object.__setattr__(self, "pd", pd)
 
         if not isinstance(
@@ -246,7 +246,7 @@ class Scenario:
     # ------------------------------------------------------------------ derived values
     @property
     def rotating(self) -> bool:
-        """The sensors are rotating radars (plots timed by the beam, SPEC §8)."""
+        """The sensors are rotating radars (plots timed by the beam, ``docs/scenarios.md``)."""
         return any(isinstance(s, RotatingRadar) for s in self.sensors)
 
     def sensor_set(self) -> SensorSet:

@@ -7,7 +7,7 @@ Two kinds of target:
   (inclusive). Without process noise its state at scan ``k`` is ``F(T)^(k−birth) x0``
   (exact straight line); with truth process noise ``σv > 0`` it follows
   ``x_{k+1} = F x_k + w_k``, ``w_k ~ N(0, Q(T)·σv²)`` (P1 §1.1; the noise on the truth is
-  an option, SPEC §6).
+  an option, ``docs/scenarios.md``).
 * :class:`RecordedTarget` — an explicit per-scan trajectory (recorded truth such as the
   OpenSky aircraft): the target exists at a scan iff the trajectory has a row for it;
   process noise is never added.

@@ -18,8 +18,11 @@ from mhtrack.experiments.jobs import JobStore
 from mhtrack.experiments.montecarlo.job import RECORDS
 from mhtrack.experiments.montecarlo.spec import RUNS_DIR, SPEC_FILE, MonteCarloSpec
 
-#: Scalar columns that are bookkeeping, not metrics.
-NOT_METRICS = frozenset({"run", "seed", "base_seed"})
+#: Scalar columns that are the evaluation's parameters (the same in every run), reported
+#: under ``parameters``, not averaged among the metrics.
+PARAMETERS: tuple[str, ...] = ("cutoff", "order", "match_distance")
+#: Scalar columns that are bookkeeping or parameters, not metrics.
+NOT_METRICS = frozenset({"run", "seed", "base_seed", *PARAMETERS})
 
 
 def run_store(out_dir: str | os.PathLike[str]) -> JobStore:
@@ -61,11 +64,24 @@ class MonteCarloResult:
                         keys.setdefault(k)
         return list(keys)
 
+    def parameters(self, tracker: str) -> dict[str, Any]:
+        """The evaluation's :data:`PARAMETERS` of ``tracker``'s runs (OSPA/GOSPA cut-off
+        ``c`` and order ``p``, CLEAR-MOT matching distance): one value when every run has
+        the same, else the sorted list of values."""
+        out: dict[str, Any] = {}
+        for k in PARAMETERS:
+            vals = sorted({r[k] for r in self.records.get(tracker, []) if r.get(k) is not None})
+            if vals:
+                out[k] = vals[0] if len(vals) == 1 else vals
+        return out
+
     def summary(self) -> dict[str, dict[str, Any]]:
         """``{tracker: {metric: mean, …, "std": {metric: std}, "n_runs", "failed",
-        "per_scan": {scans, ospa, ospa_std, cardinality, cardinality_std,
-        cardinality_true, gospa, gospa_std}}}`` — means under the ``evaluate`` keys plus
-        ``t_avg``; NaN where no run has a value."""
+        "parameters": {cutoff, order, match_distance}, "per_scan": {scans, ospa, ospa_std,
+        cardinality, cardinality_std, cardinality_true, gospa, gospa_std}}}`` — means
+        under the ``evaluate`` keys plus ``t_avg``; NaN where no run has a value. The
+        evaluation's parameters are under ``parameters`` (:meth:`parameters`), not among
+        the metrics."""
         keys = self.metric_keys()
         out: dict[str, dict[str, Any]] = {}
         for t in self.spec.trackers:
@@ -78,6 +94,7 @@ class MonteCarloResult:
             entry["std"] = std
             entry["n_runs"] = len(recs)
             entry["failed"] = sorted(self.failures.get(t, {}))
+            entry["parameters"] = self.parameters(t)
             entry["per_scan"] = per_scan(recs)
             out[t] = entry
         return out

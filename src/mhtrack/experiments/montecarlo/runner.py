@@ -4,12 +4,13 @@ from __future__ import annotations
 
 import json
 import os
-from collections.abc import Callable, Mapping
+import re
+from collections.abc import Callable, Iterator, Mapping
 from pathlib import Path
 from typing import Any
 
-from mhtrack.experiments.jobs import check_executor, run_jobs
-from mhtrack.experiments.montecarlo.job import run_job
+from mhtrack.experiments.jobs import Job, JobStore, check_executor, run_jobs
+from mhtrack.experiments.montecarlo.job import RECORDS, run_job
 from mhtrack.experiments.montecarlo.result import MonteCarloResult, load_results, run_store
 from mhtrack.experiments.montecarlo.spec import (
     SPEC_FILE,
@@ -18,6 +19,9 @@ from mhtrack.experiments.montecarlo.spec import (
     check_study,
 )
 from mhtrack.io.atomic import atomic_write
+
+#: A run's record file: ``run-<i>`` and the record suffix.
+_RUN_FILE = re.compile(r"run-(0|[1-9][0-9]*)" + re.escape(RECORDS.suffix))
 
 
 def run_montecarlo(
@@ -53,8 +57,7 @@ def run_montecarlo(
     out_dir.mkdir(parents=True, exist_ok=True)
     check_study(spec, out_dir)
     store = run_store(out_dir)
-    jobs = list(spec.jobs())
-    for job in jobs:
+    for job in _stored_jobs(spec, store):
         h = store.stored_hash(job)
         if h is not None and h != job.hash:
             raise SpecMismatchError(
@@ -62,9 +65,23 @@ def run_montecarlo(
                 f"{h[:12]}…, expected {job.hash[:12]}…); use another --out directory or "
                 "delete it")
     atomic_write(out_dir / SPEC_FILE, json.dumps(spec.to_dict(), indent=1) + "\n")
-    done = run_jobs(jobs, job_function or run_job, store, executor=executor, workers=workers,
-                    scheduler=scheduler, progress=progress, desc="montecarlo", unit="run")
+    done = run_jobs(spec.plan(), job_function or run_job, store, executor=executor,
+                    workers=workers, scheduler=scheduler, progress=progress,
+                    desc="montecarlo", unit="run")
     result = load_results(out_dir)
     result.computed = done.computed
     result.skipped = done.skipped
     return result
+
+
+def _stored_jobs(spec: MonteCarloSpec, store: JobStore) -> Iterator[Job]:
+    """The jobs of ``spec`` that have a record file in ``store`` (found by listing the
+    tracker folders, not by making every job of the study)."""
+    for tracker in spec.trackers:
+        folder = store.root / tracker
+        if not folder.is_dir():
+            continue
+        found = (_RUN_FILE.fullmatch(entry.name) for entry in os.scandir(folder))
+        for run in sorted(int(m.group(1)) for m in found if m is not None):
+            if run < spec.runs:
+                yield spec.job(tracker, run)

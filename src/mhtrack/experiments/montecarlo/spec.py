@@ -13,7 +13,7 @@ from typing import Any
 
 import numpy as np
 
-from mhtrack.experiments.jobs import COMPACT, Job, run_seed
+from mhtrack.experiments.jobs import COMPACT, Job, JobPlan, run_seed
 from mhtrack.io.jsonsafe import to_jsonable
 
 #: Bumped when the meaning of a job (and so its hash) changes.
@@ -24,6 +24,9 @@ RUNS_DIR = "runs"
 DEFAULT_TRACKERS: tuple[str, ...] = ("mht", "mht-gmm", "mht-agmm")
 #: Spec fields that must match for a directory to be resumed.
 STUDY_FIELDS = ("scenario", "seed", "config", "run_kwargs")
+#: Most runs per tracker of one study: its plan is lazy (:meth:`MonteCarloSpec.plan`), but
+#: the summary reads every record back, one file each.
+MAX_RUNS = 1_000_000
 #: ``run_scenario`` arguments the runner sets itself.
 RESERVED_KWARGS = frozenset({"scenario", "seed", "tracker", "config", "progress"})
 
@@ -55,7 +58,7 @@ class MonteCarloSpec:
     ----------
     scenario : Scenario or its dict form (:meth:`Scenario.to_dict`); stored as the dict.
     trackers : tracker names (:data:`mhtrack.names.TRACKERS`).
-    runs : number of runs per tracker.
+    runs : number of runs per tracker, 1 to :data:`MAX_RUNS`.
     seed : base seed; run ``i`` simulates with ``run_seed(seed, i)`` (stream ``"spawn"``
         of :mod:`mhtrack.experiments.jobs.seeds`), the same for every tracker.
     config : :class:`~mhtrack.mht.MHTConfig` fields to change from their defaults.
@@ -92,6 +95,9 @@ class MonteCarloSpec:
         for name, v, lo in (("runs", self.runs, 1), ("seed", self.seed, 0)):
             if isinstance(v, bool) or not isinstance(v, int | np.integer) or v < lo:
                 raise ValueError(f"{name}: expected an integer >= {lo}, got {v!r}")
+        if self.runs > MAX_RUNS:
+            raise ValueError(f"runs: expected at most {MAX_RUNS:,} runs per tracker, got "
+                             f"{self.runs:,}")
         fields = {f.name for f in dataclasses.fields(MHTConfig)}
         bad = sorted(set(self.config) - fields)
         if bad:
@@ -158,9 +164,14 @@ class MonteCarloSpec:
 
     def jobs(self) -> Iterator[Job]:
         """All jobs, run-major (run 0 of every tracker, then run 1, …)."""
-        for i in range(self.runs):
-            for t in self.trackers:
-                yield self.job(t, i)
+        return iter(self.plan())
+
+    def plan(self) -> JobPlan:
+        """All jobs as a lazy :class:`~mhtrack.experiments.jobs.JobPlan`, run-major: job
+        ``k`` is run ``k // T`` of tracker ``k % T`` (``T`` trackers), made when asked
+        for, so a study of :data:`MAX_RUNS` runs costs no memory before its first job."""
+        n = len(self.trackers)
+        return JobPlan(self.runs * n, lambda k: self.job(self.trackers[k % n], k // n))
 
 
 def check_study(spec: MonteCarloSpec, out_dir: Path) -> None:

@@ -15,7 +15,7 @@ TRACKER_LABELS = {"mht": "MHT", "mht-gmm": "MHT-GMM", "mht-agmm": "MHT-AGMM"}
 #: Where :data:`PAPER_TABLE3` comes from.
 PAPER_SOURCE = (
     "P1 (MHT-AGMM: MHT with adaptive-GMM clutter estimation), §3, Table 3 "
-    "(\"Performance metrics of three algorithms\"), as copied in SPEC.md §7; "
+    "(\"Performance metrics of three algorithms\"), as printed in the paper; "
     "their machine, their code"
 )
 #: P1 Table 3, as printed (Tavg, L* in s). P1 gives no OSPA mean (only Fig. 5).

@@ -17,7 +17,7 @@ CHUNK = 50
 #: Initiator settings (those of ``mhtrack initiate``; P2's r = 300 m, Nθ = Nρ = 90, 4 votes).
 LOGIC_PARAMS: dict[str, float] = {"gate_radius": 300.0, "v_min": 50.0, "v_max": 400.0}
 
-#: P2's printed numbers (SPEC §7; P2 Tables 1–2), their machine, their code.
+#: P2's printed numbers (P2 §3, Tables 1–2), their machine, their code.
 PAPER_T_CLUSTER = {"random": 0.045, "adaptive": 0.034}
 PAPER_T_INIT = {"logic": 0.17, "modified-logic": 0.18, "hough": 114.5,
                 "modified-hough": 7.29}

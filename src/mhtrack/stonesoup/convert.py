@@ -126,21 +126,18 @@ def detections_to_plots(
     truth_ids: dict[Any, int] | None = None,
 ) -> PlotTable:
     """A Stone Soup detector's output — ``(time, detections)`` steps — as a
-    :class:`PlotTable`, one scan per step (scan ``k`` at ``seconds(time, epoch)``), plots
-    in the order of :func:`sort_detections`, positions and ``R`` by
-    :func:`detections_to_xy`. The steps must be synchronous (every detection at its step's
-    time). ``origin``: with ``truth_ids`` (ground-truth path → target id, from
+    :class:`PlotTable`: one scan per distinct detection time of each step
+    (:func:`split_by_time`, as :class:`~mhtrack.stonesoup.MHTrackTracker` reads them; scan
+    ``k`` at ``seconds(t, epoch)``), positions and ``R`` by :func:`detections_to_xy`.
+    ``origin``: with ``truth_ids`` (ground-truth path → target id, from
     :func:`ground_truth_to_table`) each ``TrueDetection`` gets its path's id and each
     ``Clutter`` ``−1``; detections of other types make the column absent."""
     scans: list[Scan] = []
     row = 0
     has_origin = truth_ids is not None
-    for k, (time, dets) in enumerate(feed):
+    steps = ((t, d) for time, dets in feed for t, d in split_by_time(time, dets))
+    for k, (time, d) in enumerate(steps):
         epoch = time if epoch is None else epoch
-        d = sort_detections(dets)
-        if any(x.timestamp not in (None, time) for x in d):
-            raise ValueError(f"step {k} ({time}): a detection has another timestamp; "
-                             "detections_to_plots reads synchronous steps only")
         z, R = detections_to_xy(d, position_mapping=position_mapping,
                                 measurement_model=measurement_model)
         origin = _origins(d, truth_ids) if has_origin else None
@@ -163,6 +160,19 @@ def _origins(dets: Sequence[Any], truth_ids: dict[Any, int] | None) -> np.ndarra
         elif not isinstance(d, Clutter):
             return None
     return out
+
+
+def split_by_time(time: datetime.datetime, detections: Iterable[Any]
+                  ) -> list[tuple[datetime.datetime, list[Any]]]:
+    """One detector step as mhtrack scans: one ``(timestamp, detections)`` per distinct
+    detection timestamp (a detection without one takes the step's ``time``), in time
+    order, each sorted by :func:`sort_detections`; ``[(time, [])]`` for an empty step."""
+    groups: dict[datetime.datetime, list[Any]] = {}
+    for d in detections:
+        groups.setdefault(time if d.timestamp is None else d.timestamp, []).append(d)
+    if not groups:
+        return [(time, [])]
+    return [(t, sort_detections(groups[t])) for t in sorted(groups)]
 
 
 def sort_detections(detections: Iterable[Any]) -> list[Any]:

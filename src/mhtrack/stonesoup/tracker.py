@@ -31,19 +31,19 @@ from mhtrack.stonesoup.convert import (
     POSITION_MAPPING,
     detections_to_xy,
     seconds,
-    sort_detections,
+    split_by_time,
 )
 
 
 class MHTrackTracker(Tracker):
     """mhtrack's track-oriented MHT behind Stone Soup's ``Tracker`` interface.
 
-    Each detector step ``(time, detections)`` is one scan of the MHT. When every detection
-    has the step's ``time`` the scan is synchronous; otherwise (several sensors' own
-    timestamps in one step) it is a timed frame whose plots keep their own times
-    (:mod:`mhtrack.frames`), the frame's time being the latest of them and ``time``. Either
-    way a step is taken as **one look** at every target (at most one plot per target): feed
-    several sensors one step each (e.g. Stone Soup's time-ordered feeders), or fuse them.
+    Each detector step ``(time, detections)`` is one scan of the MHT per distinct
+    detection timestamp (:func:`~mhtrack.stonesoup.convert.split_by_time`; one scan when
+    every detection has the step's time), in time order: several sensors' detections with
+    their own timestamps are scans of their own. Each scan is taken as **one look** at
+    every target (at most one plot per target, ``P_D`` of the config): detections of two
+    sensors with one timestamp should be fused first.
 
     Output: the confirmed tracks of the best global hypothesis at this step (``tracks``),
     each a persistent Stone Soup ``Track`` (one per mhtrack track id, ``id``
@@ -81,6 +81,7 @@ class MHTrackTracker(Tracker):
         # detections of the last steps by row id, for the states of the tentative past
         self._dets: dict[int, Any] = {}
         self._steps: deque[tuple[int, int]] = deque()
+        self._stamps: dict[float, datetime.datetime] = {}  # scan times (s) → datetime
         self._parts: list[TrackTable] = []
 
     @property
@@ -116,25 +117,21 @@ class MHTrackTracker(Tracker):
         """One step: ``detections`` at ``time`` through the MHT; the tracks after it."""
         if self.epoch is None:
             self.epoch = time
-        dets = sort_detections(detections)
-        out = self.engine.step(self._scan(time, dets))
-        backfill = self.engine.last_backfill
-        self._parts += [out, backfill]
-        stamps = {seconds(time, self.epoch): time}
-        stamps.update((seconds(d.timestamp, self.epoch), d.timestamp) for d in dets
-                      if d.timestamp is not None)
-        self._live = set()
-        for table, is_now in ((backfill, False), (out, True)):
-            for r in range(len(table)):
-                trk = self._record(table, r, stamps)
-                if is_now:
-                    self._live.add(trk)
+        for t, dets in split_by_time(time, detections):
+            out = self.engine.step(self._scan(t, dets))
+            backfill = self.engine.last_backfill
+            self._parts += [out, backfill]
+            self._stamps[seconds(t, self.epoch)] = t
+            for r in range(len(backfill)):
+                self._record(backfill, r)
+            self._live = {self._record(out, r) for r in range(len(out))}
         return time, self.tracks
 
     def _scan(self, time: datetime.datetime, dets: list[Any]) -> Scan:
         z, R = detections_to_xy(dets, position_mapping=self.position_mapping,
                                 measurement_model=self.measurement_model)
         n = len(dets)
+        assert self.epoch is not None
         rows = np.arange(self._row, self._row + n, dtype=np.int64)
         self._dets.update(zip(rows.tolist(), dets, strict=True))
         self._steps.append((self._row, n))
@@ -143,22 +140,14 @@ class MHTrackTracker(Tracker):
             for i in range(first, first + m):
                 self._dets.pop(i, None)
         self._row += n
-        assert self.epoch is not None
-        t_step = seconds(time, self.epoch)
-        t = np.array([t_step if d.timestamp is None else seconds(d.timestamp, self.epoch)
-                      for d in dets])
-        timed = bool(n) and bool(np.any(t != t_step))
-        scan = Scan(self._k, max(t_step, float(t.max())) if timed else t_step, z,
-                    np.zeros(n, np.int64), rows, R, t=t if timed else None)
         self._k += 1
-        return scan
+        return Scan(self._k - 1, seconds(time, self.epoch), z, np.zeros(n, np.int64), rows, R)
 
-    def _record(self, table: TrackTable, r: int, stamps: dict[float, datetime.datetime]
-                ) -> Track:
+    def _record(self, table: TrackTable, r: int) -> Track:
         """Row ``r`` of ``table`` as a state of its persistent Track (created when new)."""
         assert self.epoch is not None and table.P is not None
         tsec = float(table.time[r])
-        ts = stamps.get(tsec) or self.epoch + datetime.timedelta(seconds=tsec)
+        ts = self._stamps.get(tsec) or self.epoch + datetime.timedelta(seconds=tsec)
         mean = np.array([[table.x[r]], [table.vx[r]], [table.y[r]], [table.vy[r]]])
         det = self._dets.get(int(table.plot[r]))
         if det is not None:

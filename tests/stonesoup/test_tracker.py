@@ -168,3 +168,25 @@ def test_bearing_range_sensors_with_their_own_timestamps():
 def test_iterating_without_detector_is_an_error():
     with pytest.raises(AttributeError, match="detector"):
         iter(MHTrackTracker())
+
+
+def test_siap_and_plotter_work_unchanged(scene):
+    import matplotlib.pyplot as plt
+    from stonesoup.dataassociator.tracktotrack import TrackToTruth
+    from stonesoup.metricgenerator.tracktotruthmetrics import SIAPMetrics
+    from stonesoup.plotter import Plotter
+
+    feed, paths = scene
+    trk, _ = _run(feed)
+    siap = SIAPMetrics(position_measure=Euclidean((0, 2)), velocity_measure=Euclidean((1, 3)))
+    manager = MultiManager([siap], associator=TrackToTruth(association_threshold=100))
+    manager.add_data({"tracks": trk.all_tracks, "groundtruth_paths": paths})
+    m = manager.generate_metrics()["siap_generator"]
+    # every target tracked most of the time, by about one track, within σ-ish of the truth
+    assert m["SIAP Completeness"].value > 0.8
+    assert 1.0 <= m["SIAP Ambiguity"].value < 1.2
+    assert m["SIAP Position Accuracy"].value < 40.0
+    plotter = Plotter()
+    plotter.plot_tracks(trk.all_tracks, [0, 2], uncertainty=True)
+    assert len(plotter.ax.lines) >= len(trk.all_tracks)
+    plt.close(plotter.fig)

@@ -154,3 +154,31 @@ def test_in_evaluate(random_run):
         (r.hota, r.deta, r.assa, r.loca, 300.0))
     assert evaluate(tracks, truth, hota_distance=100.0).hota.hota == pytest.approx(
         hota(tracks, truth, 100.0).hota)
+
+
+def test_cli_evaluate_json_shows_hota_and_ospa2(tmp_path):
+    # the truth of a simulated run scored as tracks: perfect, HOTA = DetA = AssA = LocA = 1
+    import csv
+    import json
+
+    from click.testing import CliRunner
+
+    from mhtrack.cli.main import cli
+
+    r = CliRunner().invoke(cli, ["simulate", "crossing", "--seed", "1", "--scans", "20",
+                                 "--out", str(tmp_path)])
+    assert r.exit_code == 0, r.stderr
+    tracks = tmp_path / "tracks.csv"
+    with (tmp_path / "truth.csv").open() as f, tracks.open("w", newline="") as g:
+        w = csv.writer(g)
+        w.writerow(["scan", "time", "track_id", "x", "y", "vx", "vy", "plot"])
+        for row in csv.DictReader(f):
+            w.writerow([row[k] for k in ("scan", "time", "target_id", "x", "y", "vx", "vy")]
+                       + [""])
+    r = CliRunner().invoke(cli, ["evaluate", str(tracks), str(tmp_path / "truth.csv"),
+                                 "--json"])
+    assert r.exit_code == 0, r.stderr
+    d = json.loads(r.stdout)
+    assert (d["hota"], d["deta"], d["assa"], d["loca"]) == (1.0, 1.0, 1.0, 1.0)
+    assert d["hota_distance"] == d["cutoff"] and d["ospa2_window"] == 10
+    assert d["ospa2_mean"] == 0.0 and d["ospa2"] == [0.0] * d["n_scans"]

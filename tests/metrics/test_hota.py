@@ -7,12 +7,17 @@ import pytest
 from mhtrack.metrics.hota import ALPHAS, hota, similarity
 
 
-def _trackeval_hota():
-    """trackeval's HOTA metric object; numpy aliases that old trackeval releases use are
-    restored here (test only), never in the library."""
+@pytest.fixture(autouse=True)
+def _numpy_aliases_for_trackeval(monkeypatch):
+    """The numpy aliases (np.float, np.int, np.bool) that older trackeval code uses, for
+    the duration of each test here only (never in the library; 1.3.0 does not need them)."""
     for name, alias in (("float", float), ("int", int), ("bool", bool)):
         if not hasattr(np, name):
-            setattr(np, name, alias)
+            monkeypatch.setattr(np, name, alias, raising=False)
+
+
+def _trackeval_hota():
+    """trackeval's HOTA metric object."""
     metrics = pytest.importorskip("trackeval.metrics",
                                   reason="trackeval not installed (pip install -e '.[reference]')")
     return metrics.HOTA()

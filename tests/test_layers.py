@@ -17,7 +17,7 @@ LAYER = {
     "scenario": 4, "mht": 4,
     "build": 5, "metrics": 5,
     "experiments": 6,
-    "plotting": 7,
+    "plotting": 7, "stonesoup": 7,
     "reports": 8,
     "cli": 9,
 }

@@ -8,6 +8,8 @@
 * :func:`association_metrics` — P1 Table 3's Rcc, Rmc, Rfg and track life Lmin/Lavg/Lmax;
 * :func:`tracks_at_times` — asynchronous tracks at the truth's times (latest state no
   older than ``max_age_s``, predicted with constant velocity);
+* :func:`ospa2_per_scan` — OSPA(2) over a sliding window of scans (Beard, Vo & Vo 2017);
+* :func:`hota` — HOTA, DetA, AssA, LocA for point targets (Luiten et al. 2021);
 * :func:`evaluate` — all of the above for one run (asynchronous tracks scored at the
   truth's times).
 
@@ -24,7 +26,9 @@ from mhtrack.metrics.clearmot import (
 )
 from mhtrack.metrics.evaluate import Evaluation, evaluate
 from mhtrack.metrics.gospa import GOSPAPerScan, GOSPAResult, gospa, gospa_per_scan
+from mhtrack.metrics.hota import HOTAResult, hota
 from mhtrack.metrics.ospa import OSPAPerScan, OSPAResult, ospa, ospa_per_scan
+from mhtrack.metrics.ospa2 import OSPA2PerScan, ospa2_per_scan
 from mhtrack.metrics.resample import DEFAULT_MAX_AGE_S, tracks_at_times
 
 __all__ = [
@@ -36,7 +40,9 @@ __all__ = [
     "Evaluation",
     "GOSPAPerScan",
     "GOSPAResult",
+    "HOTAResult",
     "MOTMatching",
+    "OSPA2PerScan",
     "OSPAPerScan",
     "OSPAResult",
     "association_metrics",
@@ -45,7 +51,9 @@ __all__ = [
     "evaluate",
     "gospa",
     "gospa_per_scan",
+    "hota",
     "ospa",
+    "ospa2_per_scan",
     "ospa_per_scan",
     "tracks_at_times",
 ]

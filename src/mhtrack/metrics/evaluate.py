@@ -2,9 +2,9 @@
 
 :func:`evaluate` aligns tracks and truth — on scan indices when they share their scans, or
 at the truth's times (:func:`~mhtrack.metrics.resample.tracks_at_times`) when the tracks
-are asynchronous — and runs OSPA, GOSPA, cardinality, CLEAR-MOT and P1 Table 3's
-association metrics; :class:`Evaluation` holds the results and renders them as a JSON-able
-dict or a plain-text table.
+are asynchronous — and runs OSPA, GOSPA, cardinality, CLEAR-MOT, P1 Table 3's association
+metrics, OSPA(2) and HOTA; :class:`Evaluation` holds the results and renders them as a
+JSON-able dict or a plain-text table.
 """
 
 from __future__ import annotations
@@ -31,7 +31,9 @@ from mhtrack.metrics.association import AssociationResult, association_indexed
 from mhtrack.metrics.cardinality import CardinalityPerScan, cardinality_indexed
 from mhtrack.metrics.clearmot import CLEARMOTResult, clear_mot_indexed
 from mhtrack.metrics.gospa import GOSPAPerScan, gospa_indexed
+from mhtrack.metrics.hota import HOTA_KEYS, HOTAResult, hota_indexed
 from mhtrack.metrics.ospa import OSPAPerScan, ospa_indexed
+from mhtrack.metrics.ospa2 import DEFAULT_OSPA2_WINDOW, OSPA2PerScan, check_window, ospa2_indexed
 from mhtrack.metrics.resample import (
     DEFAULT_MAX_AGE_S,
     Alignment,
@@ -67,6 +69,8 @@ class Evaluation:
         How the tracks were aligned with the truth (see :func:`evaluate`).
     max_age_s : float or None
         Largest age of a track state used at a truth time (s); ``None`` with ``"scans"``.
+    ospa2, hota : OSPA2PerScan, HOTAResult or None
+        OSPA(2) on ``scans`` (``cutoff``, ``order``, ``ospa2.window`` scans); HOTA.
     """
 
     cutoff: float
@@ -82,6 +86,8 @@ class Evaluation:
     association: AssociationResult | None = None
     at: Alignment = "scans"
     max_age_s: float | None = None
+    ospa2: OSPA2PerScan | None = None
+    hota: HOTAResult | None = None
 
     @property
     def n_track_ids(self) -> int:
@@ -100,6 +106,11 @@ class Evaluation:
     def ospa_mean(self) -> float:
         """Mean OSPA over the evaluated scans (m); NaN when there is no scan."""
         return _mean(self.ospa.distance)
+
+    @property
+    def ospa2_mean(self) -> float:
+        """Mean OSPA(2) over the evaluated scans (m); NaN when there is none."""
+        return float("nan") if self.ospa2 is None else _mean(self.ospa2.distance)
 
     @property
     def gospa_mean(self) -> float:
@@ -124,7 +135,9 @@ class Evaluation:
         target id, ``None`` for a target never confirmed). Per-scan lists (aligned
         with ``scans``): ``scans, ospa, gospa, cardinality`` (number of tracks),
         ``cardinality_true``. Issue 14's keys: ``at``, ``coverage``, ``n_track_ids`` and,
-        with ``at = "truth-times"`` only, ``max_age_s``.
+        with ``at = "truth-times"`` only, ``max_age_s``. Issue 19's: ``ospa2_mean,
+        ospa2_window``, the per-scan list ``ospa2``, and ``hota, deta, assa, loca,
+        hota_distance`` (means over α; ``None`` / empty when not computed).
         """
         m = self.clear_mot
         return {
@@ -152,12 +165,20 @@ class Evaluation:
             **({} if self.max_age_s is None else {"max_age_s": _num(self.max_age_s)}),
             "coverage": _num(self.coverage),
             "n_track_ids": self.n_track_ids,
+            **self._issue19_dict(),
             "scans": [int(s) for s in self.scans],
             "ospa": [float(v) for v in self.ospa.distance],
             "gospa": [float(v) for v in self.gospa.distance],
             "cardinality": [int(v) for v in self.cardinality.n_tracks],
             "cardinality_true": [int(v) for v in self.cardinality.n_true],
+            "ospa2": [] if self.ospa2 is None else [float(v) for v in self.ospa2.distance],
         }
+
+    def _issue19_dict(self) -> dict[str, Any]:
+        h = {} if self.hota is None else self.hota.summary()
+        return {"ospa2_mean": _num(self.ospa2_mean),
+                "ospa2_window": None if self.ospa2 is None else self.ospa2.window,
+                **{k: _num(h[k]) if h else None for k in HOTA_KEYS}}
 
     def _association_dict(self) -> dict[str, Any]:
         a = self.association
@@ -172,6 +193,13 @@ class Evaluation:
             return []
         return [("aligned at", f"truth times, states <= {_fmt(self.max_age_s or 0.0)} s old "
                  "predicted (CV)")]
+
+    def _issue19_rows(self) -> list[tuple[str, str]]:
+        o, h = self.ospa2, self.hota
+        return ([] if o is None else [(f"OSPA(2) mean (window {o.window} scans)",
+                                       _fmt(self.ospa2_mean, " m"))]) + ([] if h is None else [
+            (f"HOTA (d_max={_fmt(h.d_max)} m)", _fmt(h.hota)),
+            ("  DetA / AssA / LocA", f"{_fmt(h.deta)} / {_fmt(h.assa)} / {_fmt(h.loca)}")])
 
     def to_table(self, *, per_scan: bool = False) -> str:
         """Plain-text (ASCII) table of the summary metrics, for a terminal.
@@ -191,6 +219,7 @@ class Evaluation:
             ("  cardinality part", _fmt(_mean(self.ospa.cardinality), " m")),
             (f"GOSPA mean (alpha=2, c={c} m, p={p})", _fmt(self.gospa_mean, " m")),
             ("cardinality error mean |n_est - n|", _fmt(self.cardinality_error_mean)),
+            *self._issue19_rows(),
             (f"MOTA (match distance {_fmt(self.match_distance)} m)", _fmt(m.mota)),
             ("MOTP (mean matched distance)", _fmt(m.motp, " m")),
             ("coverage (matched truth states)", _fmt(self.coverage)),
@@ -242,9 +271,13 @@ def evaluate(
     scans: npt.ArrayLike | None = None,
     at: str | None = None,
     max_age_s: float = DEFAULT_MAX_AGE_S,
+    ospa2_window: int = DEFAULT_OSPA2_WINDOW,
+    hota_distance: float | None = None,
 ) -> Evaluation:
     """Score ``tracks`` against ``truth``: OSPA, GOSPA (α = 2), cardinality, CLEAR-MOT and
-    P1 Table 3's Rcc, Rmc, Rfg, Lmin/Lavg/Lmax (:func:`association_metrics`).
+    P1 Table 3's Rcc, Rmc, Rfg, Lmin/Lavg/Lmax (:func:`association_metrics`), OSPA(2)
+    (:func:`~mhtrack.metrics.ospa2.ospa2_per_scan`, same ``c`` and ``p``) and HOTA
+    (:func:`~mhtrack.metrics.hota.hota`).
 
     **Alignment** (``at``). ``"scans"``: tracks and truth are compared scan by scan; the
     scans evaluated are the sorted union of the truth's scans, the tracks' scans, every
@@ -281,6 +314,11 @@ def evaluate(
     max_age_s : float, default 15.0
         Largest age (s) of a track state used at a truth time, ``>= 0``
         (``"truth-times"`` only).
+    ospa2_window : int, default 10
+        OSPA(2) window length in scans, ``>= 1``.
+    hota_distance : float, optional
+        HOTA's ``d_max`` (m): the similarity ``max(0, 1 − d/d_max)`` of a truth–track
+        pair falls to 0 at this distance; defaults to ``cutoff``.
 
     Returns
     -------
@@ -295,6 +333,8 @@ def evaluate(
     extra = check_scans(scans)
     p_scans = plot_scans(plots)  # also type-checks plots
     age = check_max_age(max_age_s)
+    window = check_window(ospa2_window, "ospa2_window")
+    d_max = c if hota_distance is None else check_cutoff(hota_distance, "hota_distance")
     how = alignment(tracks, truth, plots, at)
     n_tracks = len(np.unique(tracks.track_id))
     if how == "scans":
@@ -323,6 +363,8 @@ def evaluate(
         association=association_indexed(data, plots, mot.matching, d_match),
         at=how,
         max_age_s=None if how == "scans" else age,
+        ospa2=ospa2_indexed(data, c, p, window),
+        hota=hota_indexed(data, d_max),
     )
 
 

@@ -51,7 +51,9 @@ def summary_markdown(result: MonteCarloResult) -> str:
 
 #: How :func:`summary_markdown` names the evaluation's parameters, with their units.
 PARAMETER_TEXT = {"cutoff": ("OSPA/GOSPA cut-off c", " m"), "order": ("order p", ""),
-                  "match_distance": ("CLEAR-MOT matching distance", " m")}
+                  "match_distance": ("CLEAR-MOT matching distance", " m"),
+                  "ospa2_window": ("OSPA(2) window", " scans"),
+                  "hota_distance": ("HOTA zero-similarity distance", " m")}
 
 
 def _parameters_lines(s: dict[str, Any], trackers: tuple[str, ...]) -> list[str]:

@@ -20,7 +20,8 @@ from mhtrack.experiments.montecarlo.spec import RUNS_DIR, SPEC_FILE, MonteCarloS
 
 #: Scalar columns that are the evaluation's parameters (the same in every run), reported
 #: under ``parameters``, not averaged among the metrics.
-PARAMETERS: tuple[str, ...] = ("cutoff", "order", "match_distance")
+PARAMETERS: tuple[str, ...] = ("cutoff", "order", "match_distance", "ospa2_window",
+                                "hota_distance")
 #: Scalar columns that are bookkeeping or parameters, not metrics.
 NOT_METRICS = frozenset({"run", "seed", "base_seed", *PARAMETERS})
 

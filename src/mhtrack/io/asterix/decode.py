@@ -18,6 +18,7 @@ import numpy as np
 
 import mhtrack.io.asterix._lib as _lib
 from mhtrack.io.asterix.container import blocks, container, payloads
+from mhtrack.io.asterix.fast import reader034, reader048
 from mhtrack.io.asterix.problems import Problems
 
 #: Seconds in a day: I048/140 and I034/030 are times of day (UTC), modulo this.
@@ -65,10 +66,12 @@ class Recording:
         return out
 
 
-def read_recording(path: str | Path) -> Recording:
+def read_recording(path: str | Path, *, fast: bool = True) -> Recording:
     """Decode the CAT048 plots and CAT034 sweep marks of a pcap, pcapng or raw ASTERIX
     file (recognised by content). Malformed parts are counted in ``problems`` (the caller
-    warns); a file that is no recording raises :class:`~mhtrack.errors.InputError`."""
+    warns); a file that is no recording raises :class:`~mhtrack.errors.InputError`.
+    ``fast=False`` decodes every record with libasterix alone (the reference path of
+    :mod:`~mhtrack.io.asterix.fast`)."""
     name = str(path)
     data = Path(path).read_bytes()
     base, _ = _lib.modules()
@@ -81,10 +84,22 @@ def read_recording(path: str | Path) -> Recording:
     marks: list[tuple[Any, ...]] = []
     order: list[tuple[int, int]] = []  # (0 plot / 1 mark, index) in file order
     bits = base.Bits.from_bytes
+    readers = {48: reader048(plot_row), 34: reader034(mark_row)} if fast else {}
     for offset, payload in payloads(data, kind, name, problems):
         for at, cat, raw in blocks(payload, offset, problems):
             if cat not in (48, 34):
                 problems.add("unknown_category", at, detail=f"category {cat}")
+                continue
+            if cat in readers:
+                found = readers[cat].block(raw, at, problems)
+                if found is None:
+                    problems.add("undecodable", at, detail=f"category {cat}: records do "
+                                 "not fill the block")
+                    continue
+                into = rows if cat == 48 else marks
+                for row in found:
+                    order.append((0 if cat == 48 else 1, len(into)))
+                    into.append(row)
                 continue
             spec = c48 if cat == 48 else c34
             records = spec.cv_uap.parse(bits(raw))
@@ -93,12 +108,12 @@ def read_recording(path: str | Path) -> Recording:
                 continue
             for rec in records:
                 if cat == 48:
-                    row = _plot(rec, at, problems)
+                    row = plot_row(rec, at, problems)
                     if row is not None:
                         order.append((0, len(rows)))
                         rows.append(row)
                 else:
-                    mark = _mark(rec)
+                    mark = mark_row(rec)
                     if mark is not None:
                         order.append((1, len(marks)))
                         marks.append(mark)
@@ -114,7 +129,7 @@ def _sub(item: Any, name: str) -> Any:
     return item.variation.get_item(name)
 
 
-def _plot(rec: Any, at: int, problems: Problems) -> tuple[Any, ...] | None:
+def plot_row(rec: Any, at: int, problems: Problems) -> tuple[Any, ...] | None:
     """One plot row from a CAT048 record, or ``None`` (counted) without 040/140/010."""
     i040 = rec.get_item("040")
     if i040 is None:
@@ -143,7 +158,7 @@ def _plot(rec: Any, at: int, problems: Problems) -> tuple[Any, ...] | None:
             callsign, tn, typ)
 
 
-def _mark(rec: Any) -> tuple[Any, ...] | None:
+def mark_row(rec: Any) -> tuple[Any, ...] | None:
     """``(time of day, sensor, kind, azimuth, period)`` of a CAT034 north marker or
     sector crossing, or ``None`` for other messages or without I034/010, 030."""
     i000, i010, i030 = rec.get_item("000"), rec.get_item("010"), rec.get_item("030")

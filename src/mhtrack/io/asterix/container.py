@@ -45,8 +45,8 @@ def container(data: bytes, name: str, known_categories: set[int]) -> str:
         cat, length = data[0], int.from_bytes(data[1:3], "big")
         if cat in known_categories and 3 <= length <= len(data):
             return "raw"
-    shown = data[:8].hex(" ") if data else "an empty file"
-    raise InputError(f"{name}: byte 0: not an ASTERIX recording (starts with {shown}; "
+    shown = f"starts with {data[:8].hex(' ')}" if data else "the file is empty"
+    raise InputError(f"{name}: byte 0: not an ASTERIX recording ({shown}; "
                      "expected a pcap or pcapng header, or an ASTERIX data block: a "
                      "category, then a length of 3 octets or more that fits in the file)",
                      file=name)

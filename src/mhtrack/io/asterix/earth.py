@@ -16,11 +16,12 @@ With ``γ`` the angle at the earth's centre, the triangle centre–antenna–tar
 
 solved for ``s`` (:func:`ground_range`) or ``ρ`` (:func:`slant_range`) in the form above,
 which keeps full precision at short range. The 4/3 effective radius models the bending
-of the ray for *elevation angles and horizons*; the range a radar measures is the
-(refracted) path length, which exceeds the straight chord by a few centimetres at 300 km,
-so the straight line is the right geometry here. The test places targets at known
-geodetic positions and heights and compares with the straight-line distance between
-their ECEF points (pyproj, WGS-84): within 2 m up to 300 km and FL 450.
+of the ray for *elevation angles and horizons*; the bent ray (curvature ``κ = 1/4R``) is
+longer than the straight chord by only ``L³κ²/24`` ≈ 1.7 m at 300 km (a quarter of an
+LSB of RHO), so the straight line is the right geometry for ranges. The test places
+targets at known geodetic positions and heights and compares with the straight-line
+distance between their ECEF points (pyproj, WGS-84): within 0.5 m (worst measured
+0.08 m) up to 300 km and FL 450.
 """
 
 from __future__ import annotations

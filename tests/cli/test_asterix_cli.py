@@ -114,3 +114,22 @@ def test_missing_libasterix(monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> 
     r = _run("convert", path, tmp_path / "p.csv")
     assert r.exit_code == 1
     assert r.output.strip() == "Error: " + _lib.INSTALL_HINT  # type: ignore[attr-defined]
+
+
+def test_export_tracks_as_cat062(sim: Path, tmp_path: Path) -> None:
+    from mhtrack.io.asterix.cat062 import read_system_tracks
+
+    tracks = tmp_path / "tracks.csv"
+    tracks.write_text("frame,time,track_id,lat,lon,vx,vy,plot,tentative\n"
+                      "1,10.0,5,52.1,-1.2,200,10,3,1\n2,14.0,5,52.11,-1.19,201,9,,0\n")
+    out = tmp_path / "system.pcap"
+    r = _run("export", tracks, "--out", out, "--category", "062", "--sac", 25, "--sic", 200)
+    assert r.exit_code == 0, r.output  # type: ignore[attr-defined]
+    assert "2 track updates in" in r.output  # type: ignore[attr-defined]
+    back, _ = read_system_tracks(out)
+    assert back["track_number"].tolist() == [5, 5]
+    assert back["tentative"].tolist() == [1, 0] and back["coasting"].tolist() == [0, 1]
+    assert back["sic"].tolist() == [200, 200]
+    r = _run("export", sim / "plots.csv", "--out", tmp_path / "p.ast")
+    assert r.exit_code == 2
+    assert "needs --sensors FILE" in r.output  # type: ignore[attr-defined]

@@ -70,22 +70,41 @@ def convert(recording: Path, output: Path, sensors_file: Path | None) -> None:
 
 @click.command()
 @click.argument("plots", type=_EXISTING)
-@click.option("--sensors", "sensors_file", type=_EXISTING, required=True,
+@click.option("--sensors", "sensors_file", type=_EXISTING, default=None,
               help="Sensors file (TOML): sites (lat, lon, alt) for the slant range, and "
-              "periods for the CAT034 north markers.")
+              "periods for the CAT034 north markers [required for 048; for 062 only for "
+              "tracks without lat/lon].")
 @click.option("--out", type=click.Path(dir_okay=False, path_type=Path), required=True,
               help="Recording to write: .pcap (UDP datagrams) or .ast (raw data blocks).")
+@click.option("--category", type=click.Choice(["048", "062"]), default="048",
+              show_default=True, help="048: PLOTS are timed plots, written as CAT048 target "
+              "reports with CAT034 sweeps; 062: PLOTS is a tracks file, written as CAT062 "
+              "system tracks.")
+@click.option("--sac", type=click.IntRange(0, 255), default=0, show_default=True,
+              help="CAT062: the tracker's system area code (I062/010).")
+@click.option("--sic", type=click.IntRange(0, 255), default=1, show_default=True,
+              help="CAT062: the tracker's system identification code (I062/010).")
 @_needs_libasterix
-def export(plots: Path, sensors_file: Path, out: Path) -> None:
+def export(plots: Path, sensors_file: Path | None, out: Path, category: str, sac: int,
+           sic: int) -> None:
     """Encode timed PLOTS (time, sensor, range or slant_range, bearing) as ASTERIX
-    CAT048 target reports with CAT034 north markers and sector crossings."""
+    CAT048 target reports with CAT034 north markers and sector crossings; or, with
+    --category 062, a TRACKS file as CAT062 system tracks."""
     from mhtrack.io.asterix import export as run_export
+    from mhtrack.io.asterix.cat062 import export_tracks
     from mhtrack.io.paths import check_output_file
     from mhtrack.io.sensors import read_sensors
 
     check_output_file(out, inputs=(plots, sensors_file), suffixes=(".pcap", ".ast"),
                       what="recording")
-    n, blocks = run_export(plots, read_sensors(sensors_file), out)
+    sensors = read_sensors(sensors_file) if sensors_file is not None else None
+    if category == "062":
+        n, blocks = export_tracks(plots, sensors, out, sac=sac, sic=sic)
+        click.echo(f"{n} track updates in {blocks} data blocks (CAT062) -> {out}")
+        return
+    if sensors is None:
+        raise click.UsageError("export of plots (CAT048) needs --sensors FILE")
+    n, blocks = run_export(plots, sensors, out)
     click.echo(f"{n} plots in {blocks} data blocks (CAT048, CAT034) -> {out}")
 
 

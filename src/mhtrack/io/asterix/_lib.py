@@ -46,6 +46,11 @@ def cat034() -> Any:
     return modules()[1].Cat_034_1_29
 
 
+def cat062() -> Any:
+    """libasterix's CAT062 edition 1.18 (the edition most system trackers send)."""
+    return modules()[1].Cat_062_1_18
+
+
 def version() -> str:
     """The installed libasterix version."""
     from importlib.metadata import PackageNotFoundError

@@ -48,7 +48,7 @@ def lsb() -> dict[str, float]:
 @dataclass(frozen=True)
 class Message:
     """One message to encode: ``time`` (s, the output's time scale), ``sensor``,
-    ``category`` (48 or 34) and its items (libasterix ``create`` arguments)."""
+    ``category`` (48, 34 or 62) and its items (libasterix ``create`` arguments)."""
 
     time: float
     sensor: int
@@ -165,7 +165,7 @@ def sweep_messages(time: np.ndarray, sensor: np.ndarray, bearing: np.ndarray,
 def encode_blocks(messages: list[Message]) -> Iterator[tuple[float, int, bytes]]:
     """``(time, sensor, data block bytes)`` of the messages in time order (stable: at
     equal times a sweep mark before the plots), runs of one radar and category per block."""
-    spec = {48: _lib.cat048(), 34: _lib.cat034()}
+    spec = {48: _lib.cat048(), 34: _lib.cat034(), 62: _lib.cat062()}
     order = sorted(range(len(messages)),
                    key=lambda i: (messages[i].time, messages[i].category != 34, i))
     run: list[Message] = []

@@ -15,7 +15,7 @@ KINDS = {
     "bad_length": "{n} data block(s) whose length field is below 3 octets: the rest of "
                   "their datagram skipped",
     "undecodable": "{n} data block(s) whose records do not decode to their length skipped",
-    "unknown_category": "{n} data block(s) of categories other than 48 and 34 skipped",
+    "unknown_category": "{n} data block(s) of categories not read here skipped",
     "no_position": "{n} CAT048 report(s) without a measured position (I048/040) skipped",
     "no_time": "{n} CAT048 report(s) without time of day (I048/140) or data source "
                "(I048/010) skipped",

@@ -4,6 +4,7 @@ fetched at test time, and simulated opensky-radars plots."""
 from __future__ import annotations
 
 import hashlib
+import os
 import subprocess
 import sys
 import tarfile
@@ -20,6 +21,8 @@ pytest.importorskip("asterix.generated", reason="libasterix not installed "
 SDIST = "asterix_decoder==0.7.11"
 MEMBER = "asterix_decoder-0.7.11/asterix/sample_data/cat_034_048.pcap"
 PCAP_SHA256 = "7f4e9a37641bfa27022ee95ba52f178e68260c1b7e83d6a0e4720a96b3a2cc3d"
+#: sha256 of the sdist itself (PyPI files never change).
+SDIST_SHA256 = "3eb28379c576ad09c813f6ed482d1f5e397667814d3baaf8ff13dceec2146426"
 
 
 def _sha256(path: Path) -> str:
@@ -40,13 +43,16 @@ def conformance_pcap(pytestconfig: pytest.Config) -> Path:
         if done.returncode != 0 or not sdists:
             pytest.skip(f"cannot fetch the conformance recording ({SDIST} sdist; offline?): "
                         f"{(done.stderr or done.stdout).strip().splitlines()[-1:]}")
+        assert _sha256(sdists[0]) == SDIST_SHA256, f"{sdists[0].name}: unexpected sha256"
         with tarfile.open(sdists[0]) as tar:
             member = tar.extractfile(MEMBER)
             assert member is not None, f"{MEMBER} not in the sdist"
             data = member.read()
     digest = hashlib.sha256(data).hexdigest()
     assert digest == PCAP_SHA256, f"cat_034_048.pcap sha256 {digest} != {PCAP_SHA256}"
-    cached.write_bytes(data)
+    part = cached.with_name(f"{cached.name}.{os.getpid()}")  # xdist workers race: rename
+    part.write_bytes(data)
+    os.replace(part, cached)
     return cached
 
 

@@ -85,3 +85,16 @@ def test_empty_file_refused(tmp_path: Path) -> None:
     with pytest.raises(InputError, match=r"byte 0: not an ASTERIX recording \(the file is "
                        "empty"):
         read_recording(path)
+
+
+def test_is_recording_by_content(tmp_path: Path) -> None:
+    from mhtrack.io.asterix import is_recording
+
+    raw = tmp_path / "feed.dat"
+    raw.write_bytes(b"".join(_blocks()))
+    text = tmp_path / "notes.txt"
+    text.write_text("time,sensor\n" + "0.5,1\n" * 20000)  # 120 kB of text
+    table = tmp_path / "plots.csv"
+    table.write_bytes(b"".join(_blocks()))  # a table by its name, whatever it holds
+    assert is_recording(raw)
+    assert not is_recording(text) and not is_recording(table)

@@ -28,14 +28,37 @@ _TEXT = ("mode_3a", "address", "callsign")
 
 def is_recording(path: str | Path) -> bool:
     """Whether ``path`` is to be read as an ASTERIX recording: not a ``.csv``/``.parquet``
-    table, and starting like a pcap, a pcapng or an ASTERIX data block."""
+    table, and starting like a pcap, a pcapng or an ASTERIX data block (a category, then a
+    length of 3 octets or more that fits in the file, see :func:`_blocks_chain`) — or
+    named like a recording
+    (``.ast``, ``.pcap``, ...), so that a damaged one gets the decoder's message."""
     p = Path(path)
     if p.suffix.lower() in FORMATS or not p.is_file():
         return False
     with p.open("rb") as fh:
-        head = fh.read(4)
-    return head in PCAP_MAGICS or head == PCAPNG_MAGIC or p.suffix.lower() in (
-        ".ast", ".asterix", ".pcap", ".pcapng", ".raw", ".bin", ".ff")
+        head = fh.read(1 << 16)
+    if head[:4] in PCAP_MAGICS or head[:4] == PCAPNG_MAGIC or _blocks_chain(head,
+                                                                            p.stat().st_size):
+        return True
+    return p.suffix.lower() in (".ast", ".asterix", ".pcap", ".pcapng", ".raw", ".ff")
+
+
+def _blocks_chain(head: bytes, size: int) -> bool:
+    """The file starts with a data block of a category mhtrack reads (34, 48, 62), whose
+    length fits in the file and whose records libasterix decodes to exactly that length
+    (without libasterix: the header alone)."""
+    if len(head) < 3 or head[0] not in (34, 48, 62):
+        return False
+    length = int.from_bytes(head[1:3], "big")
+    if not 3 <= length <= min(size, len(head)):
+        return False
+    try:
+        base, _ = _lib.modules()
+    except _lib.MissingExtra:
+        return True
+    spec = {34: _lib.cat034, 48: _lib.cat048, 62: _lib.cat062}[head[0]]()
+    return not isinstance(spec.cv_uap.parse(base.Bits.from_bytes(head[3:length])),
+                          ValueError)
 
 
 def add_ground_range(rec: Recording, sensors: SensorSet) -> np.ndarray:

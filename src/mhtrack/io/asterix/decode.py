@@ -74,11 +74,9 @@ def read_recording(path: str | Path, *, fast: bool = True) -> Recording:
     :mod:`~mhtrack.io.asterix.fast`)."""
     name = str(path)
     data = Path(path).read_bytes()
-    base, _ = _lib.modules()
+    base, gen = _lib.modules()
     c48, c34 = _lib.cat048(), _lib.cat034()
-    known = set(_lib.modules()[1].manifest["CATS"]) if hasattr(
-        _lib.modules()[1], "manifest") else {34, 48}
-    kind = container(data, name, {int(c) for c in known} | {34, 48})
+    kind = container(data, name, {int(c) for c in gen.manifest["CATS"]} | {34, 48})
     problems = Problems()
     rows: list[tuple[Any, ...]] = []
     marks: list[tuple[Any, ...]] = []

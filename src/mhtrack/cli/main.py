@@ -48,6 +48,7 @@ def cli(verbose: int) -> None:
 
 def _register() -> None:
     from mhtrack.cli import (
+        asterix_commands,
         clutter_commands,
         data_commands,
         experiment_commands,
@@ -57,7 +58,7 @@ def _register() -> None:
     )
 
     modules = (data_commands, track_commands, clutter_commands, initiation_commands,
-               experiment_commands, reproduce_commands)
+               experiment_commands, reproduce_commands, asterix_commands)
     for module in modules:
         for command in module.COMMANDS:
             cli.add_command(command)

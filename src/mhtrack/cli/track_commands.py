@@ -10,6 +10,7 @@ from typing import Any
 
 import click
 
+from mhtrack.cli.asterix_commands import recording_hook
 from mhtrack.cli.common import echo_json, load_scenario_arg, scenario_options
 from mhtrack.cli.terminal import progress_enabled, progress_option
 from mhtrack.names import BIRTHS, CLUTTER_FRAMES, OUTPUTS, TRACKER_FUSIONS, TRACKERS
@@ -154,6 +155,7 @@ def track(plots: Path, tracker: str, tracker_pd: float | None, meas_sigma: float
     from mhtrack.io.paths import check_output_file
 
     check_output_file(out, inputs=(plots, scenario_file, sensors_file), what="tracks file")
+    plots, sensors_file = recording_hook(plots, sensors_file)  # ASTERIX: a plots file
     table, scenario, sensor_set = _read_input(plots, scenario_file, sensors_file,
                                               reorder_window_s)
     if fusion is None:  # frames of timed plots hold one sensor each: nothing to fuse

@@ -1,0 +1,188 @@
+"""Convert and export: an ASTERIX recording to a plots table, and a plots table (with its
+sensors file) to an ASTERIX recording (docs/file-formats.md, "ASTERIX recordings")."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+from pathlib import Path
+
+import numpy as np
+import pyarrow as pa
+
+import mhtrack.io.asterix._lib as _lib
+from mhtrack.errors import InputError
+from mhtrack.io._frame import FLOAT, INT, TIME, float_array, int_array, read_frame, write_frame
+from mhtrack.io._source import FORMATS
+from mhtrack.io._times import seconds
+from mhtrack.io.asterix.container import PCAP_MAGICS, PCAPNG_MAGIC
+from mhtrack.io.asterix.decode import FL_M, PLOT_COLUMNS, Recording, read_recording
+from mhtrack.io.asterix.earth import ground_range, slant_range
+from mhtrack.io.asterix.encode import encode_blocks, plot_messages, sweep_messages
+from mhtrack.io.asterix.writer import write_blocks
+from mhtrack.models.radars import SensorSet
+
+#: Largest sensor id an ASTERIX data source holds (SAC·256 + SIC).
+MAX_SENSOR_ID = 0xFFFF
+_TEXT = ("mode_3a", "address", "callsign")
+
+
+def is_recording(path: str | Path) -> bool:
+    """Whether ``path`` is to be read as an ASTERIX recording: not a ``.csv``/``.parquet``
+    table, and starting like a pcap, a pcapng or an ASTERIX data block (a category, then a
+    length of 3 octets or more that fits in the file, see :func:`_blocks_chain`) — or
+    named like a recording
+    (``.ast``, ``.pcap``, ...), so that a damaged one gets the decoder's message."""
+    p = Path(path)
+    if p.suffix.lower() in FORMATS or not p.is_file():
+        return False
+    with p.open("rb") as fh:
+        head = fh.read(1 << 16)
+    if head[:4] in PCAP_MAGICS or head[:4] == PCAPNG_MAGIC or _blocks_chain(head,
+                                                                            p.stat().st_size):
+        return True
+    return p.suffix.lower() in (".ast", ".asterix", ".pcap", ".pcapng", ".raw", ".ff")
+
+
+def _blocks_chain(head: bytes, size: int) -> bool:
+    """The file starts with a data block of a category mhtrack reads (34, 48, 62), whose
+    length fits in the file and whose records libasterix decodes to exactly that length
+    (without libasterix: the header alone)."""
+    if len(head) < 3 or head[0] not in (34, 48, 62):
+        return False
+    length = int.from_bytes(head[1:3], "big")
+    if not 3 <= length <= min(size, len(head)):
+        return False
+    try:
+        base, _ = _lib.modules()
+    except _lib.MissingExtra:
+        return True
+    spec = {34: _lib.cat034, 48: _lib.cat048, 62: _lib.cat062}[head[0]]()
+    return not isinstance(spec.cv_uap.parse(base.Bits.from_bytes(head[3:length])),
+                          ValueError)
+
+
+def add_ground_range(rec: Recording, sensors: SensorSet) -> np.ndarray:
+    """The ``range`` column (m) of a recording's plots: ground range from slant range,
+    flight level and the site's ``alt`` (:mod:`~mhtrack.io.asterix.earth`; ``alt``
+    absent = 0 m, flight level absent = the site's height); NaN for a sensor the file
+    does not list or that has no geodetic site."""
+    p = rec.plots
+    out = np.full(len(rec), np.nan)
+    for sid in np.unique(p["sensor"]).tolist():
+        if sid not in sensors.ids or sensors.sensor(sid).lat is None:
+            continue
+        s = sensors.sensor(sid)
+        rows = p["sensor"] == sid
+        alt = float(s.alt or 0.0)
+        h = np.where(np.isnan(p["flight_level"][rows]), alt, p["flight_level"][rows] * FL_M)
+        out[rows] = ground_range(p["slant_range"][rows], p["bearing"][rows], h,
+                                 float(s.lat), alt)  # type: ignore[arg-type]
+    return out
+
+
+def plot_columns(rec: Recording, sensors: SensorSet | None = None) -> dict[str, pa.Array]:
+    """The plots table of a recording, columns in output order (``range`` last, with
+    ``sensors``); empty text and ``-1`` ints become empty cells."""
+    p = rec.plots
+    cols: dict[str, pa.Array] = {}
+    for name in PLOT_COLUMNS:
+        v = p[name]
+        if name in _TEXT:
+            cols[name] = pa.array(v.tolist(), type=pa.string(), mask=v == "")
+        elif v.dtype.kind == "i":
+            cols[name] = int_array(v, v < 0 if name in ("track_number", "typ") else None)
+        else:
+            cols[name] = float_array(v, nan_as_null=True)
+    if sensors is not None:
+        cols["range"] = float_array(add_ground_range(rec, sensors), nan_as_null=True)
+    return cols
+
+
+@dataclass(frozen=True)
+class Converted:
+    """What :func:`convert` did: plots written, the recording (its problems, periods)."""
+
+    n_plots: int
+    recording: Recording
+
+
+def convert(source: str | Path, out: str | Path, sensors: SensorSet | None = None, *,
+            recording: Recording | None = None) -> Converted:
+    """Decode ``source`` and write its plots to ``out`` (CSV or Parquet)."""
+    rec = recording if recording is not None else read_recording(source)
+    if len(rec) == 0:
+        raise InputError(f"{source}: no CAT048 plot with a measured position (I048/040) "
+                         f"in this {rec.container} recording", file=str(source))
+    write_frame(out, plot_columns(rec, sensors))
+    return Converted(len(rec), rec)
+
+
+def sensors_with_periods(sensors: SensorSet, rec: Recording) -> SensorSet:
+    """``sensors`` with the rotation periods the recording's CAT034 messages give filled
+    in where the file has none (they set the length of the tracker's frames)."""
+    found = rec.periods()
+    radars = tuple(replace(s, period=found[s.id]) if s.period is None and s.id in found
+                   else s for s in sensors.sensors)
+    return replace(sensors, sensors=radars)
+
+
+# --- export -----------------------------------------------------------------------------
+
+_EXPORT = {"time": TIME, "sensor": INT, "range": FLOAT, "slant_range": FLOAT,
+           "bearing": FLOAT, "flight_level": FLOAT, "typ": INT, "track_number": INT,
+           "mode_3a": TIME, "address": TIME, "callsign": TIME}  # TIME: read as text
+
+
+def export(plots: str | Path, sensors: SensorSet, out: str | Path) -> tuple[int, int]:
+    """Encode a timed plots file (``time, sensor, bearing`` and ``slant_range`` or
+    ``range``) as CAT048 with CAT034 sweep marks of the radars with a ``period``;
+    ``out`` ``.pcap`` or raw. Returns ``(plots, data blocks)`` written."""
+    _lib.modules()
+    f = read_frame(plots, _EXPORT, ("time", "sensor", "bearing"), "timed plots")
+    if f.n == 0:
+        f.fail("no rows (nothing to export)")
+    if not (f.has("range") or f.has("slant_range")):
+        f.fail("missing column 'range' or 'slant_range' (export writes polar plots)")
+    time = seconds(f)
+    f.check(time < 0, "time", lambda r: f"time {time[r]:g} s is negative (ASTERIX times "
+            "are times of day)")
+    sensor = f.ints("sensor")
+    f.check((sensor < 0) | (sensor > MAX_SENSOR_ID), "sensor", lambda r: f"sensor "
+            f"{sensor[r]} is not a data source id SAC·256 + SIC in [0, 65535]")
+    f.check(~np.isin(sensor, np.asarray(sensors.ids, np.int64)), "sensor", lambda r: (
+        f"unknown sensor {sensor[r]} (the sensors file lists "
+        f"{', '.join(map(str, sensors.ids))})"))
+    bearing = f.floats("bearing")
+    extra: dict[str, np.ndarray] = {}
+    if f.has("flight_level"):
+        extra["flight_level"] = f.floats("flight_level", nullable=True)
+    for name in ("typ", "track_number"):
+        if f.has(name):
+            extra[name] = f.ints(name, nullable=True)
+    for name in _TEXT:
+        if f.has(name):
+            extra[name] = np.array(f.table.column(name).to_pylist(), dtype=object)
+    if f.has("slant_range"):
+        slant = f.floats("slant_range")
+    else:
+        ground = f.floats("range")
+        slant = np.empty(f.n)
+        fl = extra.get("flight_level", np.full(f.n, np.nan))
+        for sid in np.unique(sensor).tolist():
+            s = sensors.sensor(sid)
+            rows = sensor == sid
+            if s.lat is None:
+                f.fail(f"sensor {sid} has no lat/lon site in the sensors file (needed to "
+                       "turn ground range into slant range)", row=int(np.argmax(rows)),
+                       column="sensor")
+            alt = float(s.alt or 0.0)
+            h = np.where(np.isnan(fl[rows]), alt, fl[rows] * FL_M)
+            slant[rows] = slant_range(ground[rows], bearing[rows], h, float(s.lat), alt)
+    try:
+        messages = plot_messages(time, sensor, slant, bearing, extra)
+    except ValueError as e:
+        raise InputError(f"{plots}: {e}", file=str(plots)) from None
+    periods = {s.id: float(s.period) for s in sensors.sensors if s.period is not None}
+    messages += sweep_messages(time, sensor, bearing, periods)
+    n = write_blocks(out, encode_blocks(messages))
+    return f.n, n

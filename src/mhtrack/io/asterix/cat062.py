@@ -1,0 +1,153 @@
+"""System tracks as ASTERIX CAT062 (issue 19, item 4): a tracks file encoded as I062/010
+(the tracker's data source), 040 track number, 070 time of track information, 105
+WGS-84 position, 185 Cartesian velocity (east, north) and 080 track status (CNF
+tentative, CST coasting), by libasterix (edition 1.18); and read back
+(:func:`read_system_tracks`) by the same library (docs/file-formats.md, "ASTERIX
+recordings").
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+import mhtrack.io.asterix._lib as _lib
+from mhtrack.errors import InputError
+from mhtrack.io._frame import FLOAT, INT, TIME, read_frame
+from mhtrack.io._times import seconds
+from mhtrack.io.asterix.container import blocks, container, payloads
+from mhtrack.io.asterix.decode import unwrap_days
+from mhtrack.io.asterix.encode import Message, encode_blocks, raw_tod
+from mhtrack.io.asterix.problems import Problems
+from mhtrack.io.asterix.writer import write_blocks
+from mhtrack.models.radars import SensorSet
+
+_TRACKS = {"time": TIME, "track_id": INT, "lat": FLOAT, "lon": FLOAT, "x": FLOAT,
+           "y": FLOAT, "vx": FLOAT, "vy": FLOAT, "plot": INT, "tentative": INT}
+#: Columns of :func:`read_system_tracks`.
+TRACK_COLUMNS = ("time", "sac", "sic", "track_number", "lat", "lon", "vx", "vy",
+                 "tentative", "coasting")
+
+
+def lsb062() -> dict[str, float]:
+    """LSBs of the CAT062 items written, from libasterix (raw 1 read back)."""
+    rec = _lib.cat062().cv_record
+    pos = rec.spec("105").create((("LAT", 1), ("LON", 1))).variation
+    vel = rec.spec("185").create((("VX", 1), ("VY", 1))).variation
+    return {"tod_s": float(rec.spec("070").create(1).variation.content.as_quantity("s")),
+            "deg": float(pos.get_item("LAT").variation.content.as_quantity("°")),
+            "mps": float(vel.get_item("VX").variation.content.as_quantity("m/s"))}
+
+
+def _status(tentative: int, coasting: int) -> tuple[Any, ...]:
+    """I062/080 with its first four extents: CNF (1 = tentative) and CST (1 = coasting);
+    libasterix takes each extent as its items plus a placeholder for the FX bit."""
+    return ((0, 0, 0, 0, ("CNF", tentative), None), (0, 0, 0, 0, 0, 0, 0, None),
+            (0, 0, 0, 0, 0, None), (("CST", coasting), 0, 0, 0, 0, 0, 0, None))
+
+
+def export_tracks(tracks: str | Path, sensors: SensorSet | None, out: str | Path, *,
+                  sac: int = 0, sic: int = 1) -> tuple[int, int]:
+    """Encode a tracks file as CAT062 system tracks from data source ``sac``/``sic``;
+    positions from ``lat, lon`` (else ``x, y`` through the sensors file's frame),
+    velocities east/north. Returns ``(track rows, data blocks)``."""
+    _lib.modules()
+    f = read_frame(tracks, _TRACKS, ("time", "track_id"), "tracks")
+    if f.n == 0:
+        f.fail("no rows (nothing to export)")
+    time = seconds(f)
+    f.check(time < 0, "time", lambda r: f"time {time[r]:g} s is negative (ASTERIX times "
+            "are times of day)")
+    tn = f.ints("track_id")
+    f.check((tn < 0) | (tn > 0xFFFF), "track_id", lambda r: f"track_id {tn[r]} does not "
+            "fit I062/040 (0 to 65535)")
+    if f.has("lat") and f.has("lon"):
+        lat, lon = f.floats("lat"), f.floats("lon")
+        ve = f.floats("vx") if f.has("vx") else np.zeros(f.n)
+        vn = f.floats("vy") if f.has("vy") else np.zeros(f.n)
+    else:
+        if sensors is None or sensors.reference is None:
+            f.fail("no lat/lon columns: give the sensors file whose frame the x, y are in")
+        frame = sensors.frame()  # type: ignore[union-attr]
+        x, y = f.floats("x"), f.floats("y")
+        lat, lon = frame.to_geodetic(x, y)
+        vx = f.floats("vx") if f.has("vx") else np.zeros(f.n)
+        vy = f.floats("vy") if f.has("vy") else np.zeros(f.n)
+        ve, vn = frame.velocity_to_geodetic(x, y, vx, vy)
+    L = lsb062()
+    raw = {k: np.round(v / L["mps"]).astype(np.int64) for k, v in (("vx", ve), ("vy", vn))}
+    for k, v in raw.items():
+        f.check(np.abs(v) > 0x7FFF, "vx" if k == "vx" else "vy", lambda r, k=k: (
+            f"velocity {k} beyond I062/185's ±8192 m/s"))
+    lat_raw = np.round(lat / L["deg"]).astype(np.int64)
+    lon_raw = np.round(((lon + 180.0) % 360.0 - 180.0) / L["deg"]).astype(np.int64)
+    coasting = (f.ints("plot", nullable=True) < 0).astype(int) if f.has("plot") \
+        else np.zeros(f.n, int)
+    tentative = (f.ints("tentative", nullable=True, fill=0) != 0).astype(int) \
+        if f.has("tentative") else np.zeros(f.n, int)
+    tod = raw_tod(time)
+    sid = (sac << 8) | sic
+    messages = [Message(float(time[i]), sid, 62, {
+        "010": (("SAC", sac), ("SIC", sic)), "070": int(tod[i]),
+        "105": (("LAT", int(lat_raw[i])), ("LON", int(lon_raw[i]))),
+        "185": (("VX", int(raw["vx"][i])), ("VY", int(raw["vy"][i]))),
+        "040": int(tn[i]), "080": _status(int(tentative[i]), int(coasting[i])),
+    }) for i in range(f.n)]
+    n = write_blocks(out, encode_blocks(messages))
+    return f.n, n
+
+
+def read_system_tracks(path: str | Path) -> tuple[dict[str, np.ndarray], Problems]:
+    """CAT062 records of a recording (pcap, pcapng or raw) as columns
+    :data:`TRACK_COLUMNS`, with the parts skipped; times continued across midnight."""
+    base, gen = _lib.modules()
+    spec = _lib.cat062()
+    name = str(path)
+    data = Path(path).read_bytes()
+    kind = container(data, name, {int(c) for c in gen.manifest["CATS"]} | {62})
+    problems = Problems()
+    rows: list[tuple[Any, ...]] = []
+    for offset, payload in payloads(data, kind, name, problems):
+        for at, cat, raw in blocks(payload, offset, problems):
+            if cat != 62:
+                problems.add("unknown_category", at, detail=f"category {cat}")
+                continue
+            records = spec.cv_uap.parse(base.Bits.from_bytes(raw))
+            if isinstance(records, ValueError):
+                problems.add("undecodable", at, detail=f"category 62: {records}")
+                continue
+            rows += [r for r in map(_track_row, records) if r is not None]
+    if not rows:
+        raise InputError(f"{name}: no CAT062 track with I062/010, 040, 070 and 105",
+                         file=name)
+    cols = {k: np.array(v) for k, v in zip(TRACK_COLUMNS, zip(*rows, strict=True),
+                                             strict=True)}
+    cols["time"] = unwrap_days(cols["time"].astype(float))
+    return cols, problems
+
+
+def _track_row(rec: Any) -> tuple[Any, ...] | None:
+    items = {k: rec.get_item(k) for k in ("010", "040", "070", "105", "185", "080")}
+    if any(items[k] is None for k in ("010", "040", "070", "105")):
+        return None
+
+    def sub(k: str, s: str) -> Any:
+        return items[k].variation.get_item(s).variation.content  # type: ignore[union-attr]
+
+    vel = items["185"]
+    vx = float(sub("185", "VX").as_quantity("m/s")) if vel is not None else np.nan
+    vy = float(sub("185", "VY").as_quantity("m/s")) if vel is not None else np.nan
+    status = items["080"]
+    cnf = cst = -1
+    if status is not None:
+        c = status.variation.get_item("CNF")
+        s = status.variation.get_item("CST")
+        cnf = -1 if c is None else int(c.variation.content.as_uint())
+        cst = -1 if s is None else int(s.variation.content.as_uint())
+    return (float(items["070"].variation.content.as_quantity("s")),  # type: ignore[union-attr]
+            int(sub("010", "SAC").as_uint()), int(sub("010", "SIC").as_uint()),
+            int(items["040"].variation.content.as_uint()),  # type: ignore[union-attr]
+            float(sub("105", "LAT").as_quantity("°")),
+            float(sub("105", "LON").as_quantity("°")), vx, vy, cnf, cst)

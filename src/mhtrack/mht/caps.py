@@ -17,10 +17,10 @@ cap                      limit at a scan (``MHTConfig`` value = the floor)
 The coefficients are the default floors' own ratios to the default births (5 000 trees,
 20 000 leaves, 300 000 pairs for 2 000 births) rounded, plus room for the confirmed
 tracks' trees; ``max_leaves_per_tree``, ``max_cluster_size`` and ``milp_time_limit`` do
-not depend on the scene's size and stay as configured. Up to ~1 000 plots per scan
-(every preset) the limits *are* the configured values, so nothing changes there. A scan
-of more than ``BURST_PLOTS`` plots (a clutter burst) gets the limits of
-``BURST_PLOTS``: its work stays bounded, and the caps say what they cut.
+not depend on the scene's size and stay as configured. Up to 900 plots and 100
+confirmed tracks per scan (every preset) the limits *are* the configured values, so
+nothing changes there. A scan of more than ``BURST_PLOTS`` plots (a clutter burst) gets
+the limits of ``BURST_PLOTS``: its work stays bounded, and the caps say what they cut.
 ``MHTConfig(scale_caps=False)`` keeps the configured values at every scan.
 
 **Counting.** Every stage that applies a cap (``max_gated_pairs``,

@@ -81,7 +81,7 @@ class MHTConfig:
     scale_caps : the caps ``max_births_per_scan``, ``max_trees``, ``max_leaves`` and
         ``max_gated_pairs`` grow with the scan's plots and confirmed tracks, the values
         below being their floors (:func:`mhtrack.mht.caps.scaled_limits`; unchanged up to
-        ~1 000 plots per scan, bounded in a burst of over 20 000). Default True; False:
+        900 plots and 100 tracks per scan, bounded in a burst of over 20 000). Default True; False:
         the values below at every scan.
     max_leaves_per_tree : hard cap on the leaves of one tree (best scores kept).
         Default 300 (above the largest trees, ~290 leaves, of the crossing scenario with

@@ -11,10 +11,10 @@ draw (``numpy`` seed fixed):
 
 Each scene runs in its own subprocess so that its peak RSS (``ru_maxrss``) is its own.
 Every run prints the caps that acted (``StepStats.caps``: scans and counts) beside the
-limits the scene's size gave (:func:`mhtrack.mht.caps.scaled_caps`).
+limits the scene's size gave (:func:`mhtrack.mht.caps.scaled_limits`).
 
-Run: ``python benchmarks/bench_scale.py [--scans 10] [--scene big|agmm]``. Timings are
-noisy on a shared machine; the figures in ``docs/performance.md`` say when they were taken.
+Run: ``python benchmarks/bench_scale.py [--scans 10] [--scene big|agmm] [--fixed-caps]``.
+Timings are noisy on a shared machine; ``docs/performance.md`` says when they were taken.
 """
 
 from __future__ import annotations
@@ -54,7 +54,7 @@ def scene(n_targets: int, clutter_rate: float, n_scans: int) -> object:
                                clutter=UniformClutter(region, clutter_rate))
 
 
-def run_one(name: str, n_scans: int, seed: int) -> dict:
+def run_one(name: str, n_scans: int, seed: int, fixed: bool = False) -> dict:
     """One scene in this process: the figures as a dict."""
     import logging
 
@@ -66,7 +66,7 @@ def run_one(name: str, n_scans: int, seed: int) -> dict:
     n_targets, rate, tracker = SCENES[name]
     sc = scene(n_targets, rate, n_scans)
     sim = simulate(sc, seed=seed)
-    cfg = default_config(sc)
+    cfg = dataclasses.replace(default_config(sc), scale_caps=not fixed)
     kappa = rate / sc.region.area
     trk = make_tracker(tracker, cfg, clutter_density=kappa if tracker == "mht" else None)
     t0 = time.perf_counter()
@@ -79,17 +79,18 @@ def run_one(name: str, n_scans: int, seed: int) -> dict:
     if len(tr) and len(tt):
         from scipy.spatial import cKDTree
 
-        d, _ = cKDTree(tr.positions()).query(sim.truth.positions()[tt])
+        d, _ = cKDTree(tr.positions).query(sim.truth.positions[tt])
         found = int(np.count_nonzero(d <= 300.0))
     per_scan = run.seconds_per_scan
-    return {"scene": name, "tracker": tracker, "targets": n_targets, "clutter": rate,
+    return {"scene": name, "tracker": tracker, "caps_rule": "fixed" if fixed else "scaled",
+            "targets": n_targets, "clutter": rate,
             "scans": n_scans, "plots_per_scan": len(sim.plots) / n_scans,
             "s_per_scan_median": float(np.median(per_scan)),
             "s_per_scan_mean": float(per_scan.mean()), "wall_s": wall,
             "coverage": found / max(len(tt), 1),
             "peak_rss_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024,
-            "caps": run.caps, "cap_scans": getattr(run, "cap_scans", {}),
-            "limits_last_scan": getattr(run.stats[-1], "limits", {}) if run.stats else {}}
+            "caps": run.caps, "cap_scans": run.cap_scans,
+            "limits_last_scan": run.stats[-1].limits if run.stats else {}}
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -98,16 +99,20 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--scene", choices=sorted(SCENES), default=None,
                     help="one scene in this process (default: each in a subprocess)")
+    ap.add_argument("--fixed-caps", action="store_true",
+                    help="MHTConfig(scale_caps=False): the caps of before, for comparison")
     a = ap.parse_args(argv)
     if a.scene is not None:
-        print(json.dumps(run_one(a.scene, a.scans, a.seed)))
+        print(json.dumps(run_one(a.scene, a.scans, a.seed, a.fixed_caps)))
         return 0
     for name in ("big", "agmm"):
         out = subprocess.run([sys.executable, __file__, "--scene", name, "--scans",
-                              str(a.scans), "--seed", str(a.seed)],
+                              str(a.scans), "--seed", str(a.seed)]
+                             + (["--fixed-caps"] if a.fixed_caps else []),
                              capture_output=True, text=True, check=True)
         r = json.loads(out.stdout.strip().splitlines()[-1])
         print(f"{r['targets']} targets x {r['clutter']:g} clutter/scan, {r['tracker']}, "
+              f"{r['caps_rule']} caps, "
               f"{r['scans']} scans ({r['plots_per_scan']:.0f} plots/scan): "
               f"median {r['s_per_scan_median']:.3f} s/scan (mean {r['s_per_scan_mean']:.3f}), "
               f"coverage {r['coverage']:.3f}, peak RSS {r['peak_rss_mb']:.0f} MB")

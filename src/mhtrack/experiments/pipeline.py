@@ -17,7 +17,6 @@ order), so it stays a valid plot-table row.
 from __future__ import annotations
 
 import dataclasses
-import logging
 from collections.abc import Iterable
 from dataclasses import dataclass
 from typing import Any
@@ -35,14 +34,10 @@ from mhtrack.build import (
 from mhtrack.initiation.fusion import AdaptiveKMeansFusion
 from mhtrack.metrics import Evaluation, evaluate
 from mhtrack.mht import MHTConfig, MHTTracker, StepStats
-from mhtrack.mht.caps import describe
 from mhtrack.models.radars import SensorSet
 from mhtrack.names import OUTPUTS, TRACKER_FUSIONS
 from mhtrack.records import PlotTable, Scan, TrackTable
 from mhtrack.scenario import Scenario, Simulation, simulate
-
-#: Warnings of the run (the fusion's caps in a burst).
-logger = logging.getLogger("mhtrack.experiments.pipeline")
 
 
 def fuse_scan(scan: Scan, fuser: AdaptiveKMeansFusion | None = None) -> Scan:
@@ -61,8 +56,8 @@ def fuse_scan(scan: Scan, fuser: AdaptiveKMeansFusion | None = None) -> Scan:
 def fused(scans: Iterable[Scan], fusion: str,
           caps: dict[int, dict[str, int]] | None = None) -> Iterable[Scan]:
     """``scans`` unchanged (``"none"``) or each fused (``"adaptive-kmeans"``). The caps
-    the fusion applied in a burst (``Fuser.caps_``) go to ``caps[scan index]`` and to one
-    warning line."""
+    the fusion applied in a burst (``Fuser.caps_``, logged by ``Fuser.fuse``) go to
+    ``caps[scan index]``."""
     if fusion not in TRACKER_FUSIONS:
         raise ValueError(f"unknown fusion {fusion!r} (expected {', '.join(TRACKER_FUSIONS)})")
     factory = TRACKER_FUSERS[fusion]
@@ -71,13 +66,10 @@ def fused(scans: Iterable[Scan], fusion: str,
     fuser = factory()
 
     def each(s: Scan) -> Scan:
-        out = fuse_scan(s, fuser)
+        out = fuse_scan(s, fuser)  # logs the caps that acted (Fuser.fuse)
         acted = dict(getattr(fuser, "caps_", None) or {}) if len(s) else {}
-        if acted:
-            logger.warning("scan %d (%d plots fused into %d): fusion caps acted: %s",
-                           s.index, len(s), len(out), describe(acted))
-            if caps is not None:
-                caps[int(s.index)] = acted
+        if acted and caps is not None:
+            caps[int(s.index)] = acted
         return out
 
     return (each(s) for s in scans)

@@ -149,7 +149,8 @@ def test_load_checks_the_clutter_estimator(crossing10, tmp_path):
 
 
 def test_burst_of_ten_thousand_plots_is_bounded(crossing40, caplog):
-    trk = MHTTracker(MHTConfig(), KnownClutter(crossing40.clutter_density))
+    """Fixed caps (``scale_caps=False``); the scaled ones: tests/mht/test_caps.py."""
+    trk = MHTTracker(MHTConfig(scale_caps=False), KnownClutter(crossing40.clutter_density))
     trk.run(crossing40.scans[:30])
     rng = np.random.default_rng(0)
     burst = Scan.from_positions(31, 31.0, rng.uniform(-4000, 4000, (10_000, 2)))
@@ -180,7 +181,7 @@ def test_caps_are_counted_and_logged(crossing40, caplog):
     """Every scan where a cap acts is logged (DEBUG); a WARNING the first time each cap
     acts, so a long run in a clutter storm does not flood the log."""
     cfg = MHTConfig(max_leaves_per_tree=2, max_trees=50, max_births_per_scan=30,
-                    max_leaves=400, max_cluster_size=3)
+                    max_leaves=400, max_cluster_size=3, scale_caps=False)
     stats: list[StepStats] = []
     with caplog.at_level(logging.DEBUG, logger="mhtrack.mht.tracker"):
         _run(simulate(clutter_rate=40.0, n_scans=15, seed=3), cfg, stats)

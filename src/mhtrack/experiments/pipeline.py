@@ -53,15 +53,26 @@ def fuse_scan(scan: Scan, fuser: AdaptiveKMeansFusion | None = None) -> Scan:
     return dataclasses.replace(f.scan, rows=np.asarray(scan.rows, np.int64)[first])
 
 
-def fused(scans: Iterable[Scan], fusion: str) -> Iterable[Scan]:
-    """``scans`` unchanged (``"none"``) or each fused (``"adaptive-kmeans"``)."""
+def fused(scans: Iterable[Scan], fusion: str,
+          caps: dict[int, dict[str, int]] | None = None) -> Iterable[Scan]:
+    """``scans`` unchanged (``"none"``) or each fused (``"adaptive-kmeans"``). The caps
+    the fusion applied in a burst (``Fuser.caps_``, logged by ``Fuser.fuse``) go to
+    ``caps[scan index]``."""
     if fusion not in TRACKER_FUSIONS:
         raise ValueError(f"unknown fusion {fusion!r} (expected {', '.join(TRACKER_FUSIONS)})")
     factory = TRACKER_FUSERS[fusion]
     if factory is None:
         return scans
     fuser = factory()
-    return (fuse_scan(s, fuser) for s in scans)
+
+    def each(s: Scan) -> Scan:
+        out = fuse_scan(s, fuser)  # logs the caps that acted (Fuser.fuse)
+        acted = dict(getattr(fuser, "caps_", None) or {}) if len(s) else {}
+        if acted and caps is not None:
+            caps[int(s.index)] = acted
+        return out
+
+    return (each(s) for s in scans)
 
 
 @dataclass(frozen=True)
@@ -92,6 +103,16 @@ class TrackingRun:
                 total[k] = total.get(k, 0) + v
         return total
 
+    @property
+    def cap_scans(self) -> dict[str, list[int]]:
+        """The scans at which each hard cap acted (``StepStats.caps``; with the fusion's
+        caps, ``fusion_*``, of each scan)."""
+        out: dict[str, list[int]] = {}
+        for s in self.stats:
+            for k in sorted(s.caps):
+                out.setdefault(k, []).append(s.scan)
+        return out
+
 
 def track(
     tracker: MHTTracker | str, scans: PlotTable | Iterable[Scan], *, name: str = "mht",
@@ -118,9 +139,12 @@ def track(
         total = scans.n_scans
         scans = scans.scans()
     stats: list[StepStats] = []
-    bar = tqdm(fused(scans, fusion), total=total, desc=name, unit="scan",
+    fusion_caps: dict[int, dict[str, int]] = {}
+    bar = tqdm(fused(scans, fusion, fusion_caps), total=total, desc=name, unit="scan",
                disable=not progress, leave=False)
     tracks = tracker.run(bar, stats, history=output == "history")
+    for st in stats:  # the fusion's caps join the scan's own
+        st.caps.update(fusion_caps.get(st.scan, {}))
     return TrackingRun(name, tracks, tuple(stats), output)
 
 
@@ -133,14 +157,17 @@ class ScenarioRun:
     evaluation: Evaluation
 
     def summary(self) -> dict[str, Any]:
-        """The ``evaluate`` JSON object plus ``t_avg`` (s/scan), ``tracker``, ``caps`` and
-        ``output`` (the output mode, :data:`OUTPUTS`)."""
+        """The ``evaluate`` JSON object plus ``t_avg`` (s/scan), ``tracker``, ``caps`` (the
+        total each hard cap cut), ``output`` (the output mode, :data:`OUTPUTS`) and, when a
+        cap acted, ``cap_scans`` (the scans at which each did)."""
         return {
             **self.evaluation.to_dict(),
             "t_avg": self.run.t_avg,
             "tracker": self.run.tracker,
             "caps": self.run.caps,
             "output": self.run.output,
+            # when a cap acted: at which scans (absent otherwise, as on every preset)
+            **({"cap_scans": self.run.cap_scans} if self.run.caps else {}),
         }
 
 

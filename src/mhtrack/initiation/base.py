@@ -22,6 +22,7 @@ over a base class, ``sklearn/mixture/_base.py``):
 from __future__ import annotations
 
 import abc
+import logging
 from collections.abc import Sequence
 
 import numpy as np
@@ -35,6 +36,9 @@ from mhtrack.initiation.window import (
     remove_dominated,
 )
 from mhtrack.records import Scan
+
+#: Warnings of the fusers (caps that acted in a burst).
+logger = logging.getLogger("mhtrack.initiation")
 
 
 class Fuser(abc.ABC):
@@ -58,9 +62,16 @@ class Fuser(abc.ABC):
         covariances ``R`` (n, 2, 2) (optional); set ``labels_``; return ``self``."""
 
     def fuse(self, scan: Scan) -> FusedScan:
-        """Cluster ``scan``'s plots (:meth:`fit`) and return the fused scan."""
+        """Cluster ``scan``'s plots (:meth:`fit`) and return the fused scan. When caps of
+        the clustering acted (a burst; ``caps_``, name → count), one warning line says so."""
         self.fit(scan.z, scan.sensor, scan.R)
-        return fused_scan(scan, self.labels_, self.threshold_, weighting=self.weighting)
+        out = fused_scan(scan, self.labels_, self.threshold_, weighting=self.weighting)
+        caps = getattr(self, "caps_", None)
+        if caps:
+            logger.warning("scan %d (%d plots fused into %d): fusion caps acted: %s",
+                           scan.index, len(scan), out.n_clusters,
+                           ", ".join(f"{k} {caps[k]}" for k in sorted(caps)))
+        return out
 
     @staticmethod
     def check_plots(z: object, sensor: object) -> tuple[np.ndarray, np.ndarray]:

@@ -33,8 +33,8 @@ from mhtrack.initiation.kmeans import (
     enforce_one_plot_per_sensor,
     kmeans_lloyd,
     merge_compatible_clusters,
-    sorted_distances,
 )
+from mhtrack.initiation.neighbours import SortedDistances
 from mhtrack.models.linalg2 import lmax2
 
 
@@ -66,8 +66,20 @@ def split_inconsistent(
     W = np.linalg.inv(R)
     limit = chi2.ppf(probability, 2 * np.arange(int(n.max())))  # by n − 1
     nxt = k
-    for c in np.flatnonzero(n >= 2):
-        idx = np.flatnonzero(labels == c)
+    by_label = np.argsort(labels, kind="stable")  # each cluster's plots, ascending
+    start = np.cumsum(n) - n
+    # first test of all clusters of one size at once (same arithmetic as the loop below)
+    consistent = np.zeros(k, bool)
+    for size in np.unique(n[n >= 2]).tolist():
+        cs = np.flatnonzero(n == size)
+        idx = by_label[start[cs][:, None] + np.arange(size)]
+        Wi, zi = W[idx], z[idx]
+        zh = np.linalg.solve(Wi.sum(1), np.einsum("cnij,cnj->ci", Wi, zi)[..., None])[..., 0]
+        d = zi - zh[:, None]
+        term = np.einsum("cni,cnij,cnj->cn", d, Wi, d)
+        consistent[cs] = term.sum(1) <= limit[size - 1]
+    for c in np.flatnonzero((n >= 2) & ~consistent):
+        idx = by_label[start[c]:start[c] + n[c]]
         while len(idx) >= 2:
             Wsum = W[idx].sum(0)
             zh = np.linalg.solve(Wsum, np.einsum("nij,nj->i", W[idx], z[idx]))
@@ -89,6 +101,9 @@ class _KMeansFuser(Fuser):
     max_iter: int
     cluster_centers_: np.ndarray
     n_iter_: int
+    #: Caps of the sparse assignment that acted in the last :meth:`fit` (a burst;
+    #: :func:`~mhtrack.initiation.assignment.sparse_gated_assignment`): name → count.
+    caps_: dict[str, int]
 
     def _check(self, z: object, sensor: object) -> tuple[np.ndarray, np.ndarray]:
         if self.weighting not in WEIGHTINGS:
@@ -101,7 +116,7 @@ class _KMeansFuser(Fuser):
                 n_iter: int, adaptive: bool, R: np.ndarray | None = None,
                 gamma: float | None = None) -> None:
         if len(z):
-            labels = enforce_one_plot_per_sensor(z, sensor, labels, eps, R, gamma)
+            labels = enforce_one_plot_per_sensor(z, sensor, labels, eps, R, gamma, self.caps_)
             if adaptive:
                 labels = merge_compatible_clusters(z, sensor, labels, eps, R, gamma)
         k = int(labels.max()) + 1 if len(labels) else 0
@@ -167,7 +182,9 @@ class AdaptiveKMeansFusion(_KMeansFuser):
         elif cap is not None and not (isinstance(cap, int | float) and cap > 0):
             raise ValueError(f"max_threshold must be > 0, 'auto' or None, got {cap!r}")
         self.threshold_cap_ = cap
-        c0, _, eps = adaptive_initial_centres(za, s, R=Ra, gamma=gamma, max_threshold=cap)
+        self.caps_ = {}
+        c0, _, eps = adaptive_initial_centres(za, s, R=Ra, gamma=gamma, max_threshold=cap,
+                                              caps=self.caps_)
         self.initial_centers_ = c0
         q = self.consistency
         if q is not None and not (isinstance(q, float) and 0.0 < q < 1.0):
@@ -204,11 +221,14 @@ class KMeansFusion(_KMeansFuser):
         za, s = self._check(z, sensor)
         if not (isinstance(self.n_clusters, int | np.integer) and self.n_clusters >= 1):
             raise ValueError(f"n_clusters must be an integer >= 1, got {self.n_clusters!r}")
+        self.caps_ = {}
         rng = np.random.default_rng(self.random_state)
         k = min(int(self.n_clusters), len(za))
         c0 = za[rng.choice(len(za), size=k, replace=False)] if k else np.zeros((0, 2))
         self.initial_centers_ = c0
         c, labels, it = kmeans_lloyd(za, c0, max_iter=self.max_iter)
-        eps = dissimilarity_threshold(sorted_distances(za), len(c), len(np.unique(s)))
+        ns = len(np.unique(s))
+        D = SortedDistances(za, len(c) * (ns * (ns - 1) // 2))  # read at k·C(N_s,2) − 1
+        eps = dissimilarity_threshold(D, len(c), ns)
         self._finish(za, s, labels, eps, it, adaptive=False)
         return self

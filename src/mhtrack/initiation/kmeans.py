@@ -14,7 +14,8 @@ stop changing.
 Adaptive K-means (P2 §1.2, steps 1–6; :func:`adaptive_initial_centres`), as implemented
 here:
 
-1. ``D`` = all ``C(n, 2)`` pairwise plot distances sorted ascending (``pdist``).
+1. ``D`` = all ``C(n, 2)`` pairwise plot distances sorted ascending; only the part that
+   ``ε(k)`` can read is computed (:class:`~mhtrack.initiation.neighbours.SortedDistances`).
 2. Dissimilarity threshold for ``k`` clusters: ``ε(k) = D[k·C(N_s, 2)]`` read **1-based**
    as P2 prints it (``D(1)`` the smallest), i.e. ``D[k·C(N_s,2) − 1]`` 0-based, clipped to
    ``[0, len(D) − 1]``. Why: ``k`` clusters of ``N_s`` plots hold ``k·C(N_s, 2)``
@@ -65,27 +66,34 @@ those clusters and to clusters holding no plot of that radar; a plot with no all
 centre left opens its own cluster (a split). One pass suffices; the labels that did not
 break the rule are kept (:func:`enforce_one_plot_per_sensor`).
 
+Memory is O(n · neighbours), never O(n²): the distances and the assignments come from k-d
+trees (:mod:`mhtrack.initiation.neighbours`, :mod:`mhtrack.initiation.assignment`; the same
+numbers as the dense formulas on normal scans, caps counted in a burst).
 The fused output and the estimators live in :mod:`mhtrack.initiation.fusion`, which
 imports this module (never the other way round). 2×2 algebra: :mod:`mhtrack.models.linalg2`.
 """
 
 from __future__ import annotations
 
+from functools import partial
+
 import numpy as np
-from scipy.optimize import linear_sum_assignment
 from scipy.spatial import cKDTree
 from scipy.spatial.distance import pdist
 
+from mhtrack.initiation.assignment import gated_assignment as _gated_assignment
+from mhtrack.initiation.neighbours import SortedDistances, close_pairs
 from mhtrack.models.linalg2 import lmax2, mahalanobis2
 
 
 # ---------------------------------------------------------------------- building blocks
 def sorted_distances(z: np.ndarray) -> np.ndarray:
-    """All pairwise distances ``‖z_i − z_j‖``, ``i < j``, sorted ascending (P2 §1.2 step 2)."""
+    """All pairwise distances ``‖z_i − z_j‖``, ``i < j``, sorted ascending (P2 §1.2 step 2).
+    O(n²) memory: for many plots use :class:`~mhtrack.initiation.neighbours.SortedDistances`."""
     return np.sort(pdist(np.asarray(z, float).reshape(-1, 2)))
 
 
-def dissimilarity_threshold(D: np.ndarray, k: int, n_sensors: int) -> float:
+def dissimilarity_threshold(D: np.ndarray | SortedDistances, k: int, n_sensors: int) -> float:
     """``ε(k) = D(k·C(N_s, 2))`` of P2 §1.2 step 3, ``D`` sorted ascending and indexed
     1-based as printed (0-based index ``k·C(N_s,2) − 1``), clipped to ``D``'s range.
 
@@ -122,59 +130,9 @@ def _cluster_cov(R: np.ndarray, labels: np.ndarray, k: int) -> np.ndarray:
         return Rc / (n**2)[:, None, None]
 
 
-def _gated_assignment(
-    z: np.ndarray,
-    centres: np.ndarray,
-    eps: float,
-    R: np.ndarray | None = None,
-    Rc: np.ndarray | None = None,
-    gamma: float | None = None,
-) -> np.ndarray:
-    """One-to-one assignment of plots ``z`` to ``centres`` (P2 §1.2 step 4 with the
-    one-plot-per-radar rule). Returns the centre index per plot, or ``−1`` for a plot
-    that opens a new cluster.
-
-    A pair is *allowed* when ``‖z − c‖ ≤ eps`` (P2) or, with plot covariances ``R``,
-    centre covariances ``Rc`` and a gate ``gamma``, when ``(z − c)ᵀ (R + R̄c)⁻¹ (z − c) ≤ γ``
-    (ours). Among allowed pairs the assignment minimises the total cost
-    (``linear_sum_assignment``), leaving a plot unassigned costing ``stay``: without
-    covariances cost ``‖z − c‖²`` and ``stay = eps²``; with them cost ``min(d², γ⁻)`` and
-    ``stay = γ`` (``γ⁻`` just below ``γ``: a pair allowed by ``ε`` alone joins only when
-    it takes no better pair's centre). A plot joins when an allowed centre is left for it.
-    """
-    m = len(z)
-    out = np.full(m, -1, np.int64)
-    if m == 0 or len(centres) == 0:
-        return out
-    stat = R is not None and Rc is not None and gamma is not None
-    radius = eps
-    if stat:
-        radius = max(eps, float(np.sqrt(gamma * (lmax2(R).max() + lmax2(Rc).max()))))
-    near = cKDTree(centres).query_ball_point(z, radius * (1 + 1e-12) + 1e-9)
-    cols = np.unique(np.fromiter((j for h in near for j in h), np.int64))
-    if cols.size == 0:
-        return out
-    delta = z[:, None, :] - centres[None, cols, :]
-    d2 = (delta**2).sum(-1)
-    allowed = d2 <= eps * eps
-    if stat:
-        dm, _ = mahalanobis2(delta, R[:, None] + Rc[None, cols])  # type: ignore[index]
-        allowed |= dm <= gamma
-        stay = float(gamma)  # type: ignore[arg-type]
-        cost = np.minimum(dm, stay * (1 - 1e-9))  # allowed by ε only: just below "stay"
-    else:
-        cost = d2
-        stay = eps * eps
-    if not allowed.any():
-        return out
-    big = 2.0 * stay + 1.0
-    full = np.full((m, len(cols) + m), big)
-    full[:, : len(cols)] = np.where(allowed, cost, big)
-    full[np.arange(m), len(cols) + np.arange(m)] = stay  # "open a new cluster"
-    r, c = linear_sum_assignment(full)
-    hit = (c < len(cols)) & (full[r, c] < big)
-    out[r[hit]] = cols[c[hit]]
-    return out
+def _no_common_radar(has: np.ndarray, pairs: np.ndarray) -> np.ndarray:
+    """Pairs of clusters (rows of ``has``: radars present) with no radar in common."""
+    return ~(has[pairs[:, 0]] & has[pairs[:, 1]]).any(axis=1)
 
 
 def _sensor_order(sensor: np.ndarray) -> np.ndarray:
@@ -190,6 +148,7 @@ def adaptive_initial_centres(
     R: np.ndarray | None = None,
     gamma: float | None = None,
     max_threshold: float | None = None,
+    caps: dict[str, int] | None = None,
 ) -> tuple[np.ndarray, np.ndarray, float]:
     """P2 §1.2 steps 1–6: the number of clusters and their initial centres.
 
@@ -206,8 +165,9 @@ def adaptive_initial_centres(
     if n == 0:
         return np.zeros((0, 2)), labels, 0.0
     order = _sensor_order(sensor)
-    D = sorted_distances(z)
     ns = len(order)
+    # k ≤ n clusters: ε(k) reads D at most at index n·C(N_s, 2) − 1
+    D = SortedDistances(z, n * (ns * (ns - 1) // 2), max_threshold)
 
     def eps(k: int) -> float:
         e = dissimilarity_threshold(D, k, ns)
@@ -220,7 +180,8 @@ def adaptive_initial_centres(
     Rc = None if R is None else R[first].copy()
     for s in order[1:]:
         idx = np.flatnonzero(sensor == s)
-        a = _gated_assignment(z[idx], centres, eps(k), None if R is None else R[idx], Rc, gamma)
+        a = _gated_assignment(z[idx], centres, eps(k), None if R is None else R[idx], Rc, gamma,
+                              caps)
         new = a < 0
         a[new] = k + np.arange(int(new.sum()))
         labels[idx] = a
@@ -272,6 +233,7 @@ def enforce_one_plot_per_sensor(
     eps: float,
     R: np.ndarray | None = None,
     gamma: float | None = None,
+    caps: dict[str, int] | None = None,
 ) -> np.ndarray:
     """Labels in which no cluster holds two plots of one radar (P2 §1.2, §3.1).
 
@@ -300,7 +262,7 @@ def enforce_one_plot_per_sensor(
         targets = np.flatnonzero(bad | (per == 0))
         a = _gated_assignment(
             z[idx], centres[targets], eps,
-            None if R is None else R[idx], None if Rc is None else Rc[targets], gamma,
+            None if R is None else R[idx], None if Rc is None else Rc[targets], gamma, caps,
         )
         new = a < 0
         lab = np.where(new, -1, targets[np.maximum(a, 0)])
@@ -335,7 +297,8 @@ def merge_compatible_clusters(
 
     Each round merges the pairs that are each other's nearest (in that test's distance)
     compatible partner — reciprocal nearest neighbours, candidates from a k-d tree — and
-    rounds repeat until none is left. Returns compact labels.
+    rounds repeat until none is left. In a burst the candidates are searched chunk by chunk
+    (:func:`~mhtrack.initiation.neighbours.close_pairs`). Returns compact labels.
     """
     z = np.asarray(z, float).reshape(-1, 2)
     labels = np.asarray(labels, np.int64).copy()
@@ -351,15 +314,15 @@ def merge_compatible_clusters(
         centres, _ = _means(z, labels, k)
         has = np.zeros((k, len(ids)), bool)
         has[labels, s_idx] = True
+        own = None
         if maha:
             Rc = _cluster_cov(R, labels, k)  # type: ignore[arg-type]
-            # d² ≤ γ needs ‖Δ‖² ≤ γ·λmax(R̄a + R̄b) ≤ γ·2·max λmax(R̄)
-            radius = float(np.sqrt(gamma * 2.0 * lmax2(Rc).max()))  # type: ignore[operator]
+            lam = lmax2(Rc)  # d² ≤ γ needs ‖Δ‖² ≤ γ·λmax(R̄a + R̄b) ≤ γ·(λmax R̄a + max λmax R̄)
+            radius = float(np.sqrt(gamma * 2.0 * lam.max()))  # type: ignore[operator]
+            own = np.sqrt(gamma * (lam + lam.max())) * (1 + 1e-12)  # type: ignore[operator]
         else:
             radius = eps
-        pairs = cKDTree(centres).query_pairs(radius, output_type="ndarray")
-        if len(pairs):
-            pairs = pairs[~(has[pairs[:, 0]] & has[pairs[:, 1]]).any(axis=1)]
+        pairs = close_pairs(centres, radius, own, partial(_no_common_radar, has))
         if len(pairs):
             delta = centres[pairs[:, 0]] - centres[pairs[:, 1]]
             if maha:

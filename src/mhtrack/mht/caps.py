@@ -1,19 +1,78 @@
-"""Hard caps: counting what they cut at each scan and telling the user.
+"""Hard caps: limits that scale with the scene, counting what they cut at each scan, and
+telling the user.
 
-Every stage that applies a cap (``max_gated_pairs``, ``max_births_per_scan``,
-``max_leaves_per_tree``, ``max_leaves``, ``max_trees``, the solver's ``max_cluster_size``
-and ``milp_time_limit``) adds to the scan's ``caps`` dict how many leaves, plots, trees or
-clusters it cut; :class:`CapWarnings` logs them.
+**Scaled limits** (:func:`scaled_limits`, issue 18). The work of a scan grows with its
+plots ``n`` (every plot may start a tree, each tree's leaves gate the next plots) and
+with the confirmed tracks ``t`` carried into it. With ``n' = min(n, BURST_PLOTS)``:
+
+======================== =====================================================
+cap                      limit at a scan (``MHTConfig`` value = the floor)
+======================== =====================================================
+``max_births_per_scan``  ``max(floor, n')``                     — every plot may start a tree
+``max_trees``            ``max(floor, 5·n' + t)``               — ~N + 2 scans of new trees
+``max_leaves``           ``max(floor, 16·n' + 50·t)``
+``max_gated_pairs``      ``max(floor, 150·n' + 50·t)``
+======================== =====================================================
+
+The coefficients are the default floors' own ratios to the default births (5 000 trees,
+20 000 leaves, 300 000 pairs for 2 000 births) rounded, plus room for the confirmed
+tracks' trees; ``max_leaves_per_tree``, ``max_cluster_size`` and ``milp_time_limit`` do
+not depend on the scene's size and stay as configured. Up to 900 plots and 100
+confirmed tracks per scan (every preset) the limits *are* the configured values, so
+nothing changes there. A scan of more than ``BURST_PLOTS`` plots (a clutter burst) gets
+the limits of ``BURST_PLOTS``: its work stays bounded, and the caps say what they cut.
+``MHTConfig(scale_caps=False)`` keeps the configured values at every scan.
+
+**Counting.** Every stage that applies a cap (``max_gated_pairs``,
+``max_births_per_scan``, ``max_leaves_per_tree``, ``max_leaves``, ``max_trees``, the
+solver's ``max_cluster_size`` and ``milp_time_limit``) adds to the scan's ``caps`` dict how
+many leaves, plots, trees or clusters it cut; :class:`CapWarnings` logs them with the
+scan's plot count and the limits that acted.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 
+from mhtrack.mht.config import MHTConfig
 from mhtrack.mht.hypothesis import GlobalHypothesis
 
 #: The tracker's logger (the name users and the Monte-Carlo runner filter on).
 logger = logging.getLogger("mhtrack.mht.tracker")
+
+#: Plots per scan beyond which the limits stop growing (a clutter burst).
+BURST_PLOTS = 20_000
+#: Coefficients of :func:`scaled_limits` (per plot ``n'``, per confirmed track ``t``).
+TREES_PER_PLOT, LEAVES_PER_PLOT, PAIRS_PER_PLOT = 5, 16, 150
+LEAVES_PER_TRACK = PAIRS_PER_TRACK = 50
+#: The caps :func:`scaled_limits` scales.
+SCALED = ("max_births_per_scan", "max_trees", "max_leaves", "max_gated_pairs")
+
+
+def scaled_limits(cfg: MHTConfig, n_plots: int, n_tracks: int) -> dict[str, int]:
+    """The limits of a scan of ``n_plots`` plots entered with ``n_tracks`` confirmed
+    tracks (module docstring); the configured values when ``cfg.scale_caps`` is off."""
+    floors = {k: int(getattr(cfg, k)) for k in SCALED}
+    if not cfg.scale_caps:
+        return floors
+    n, t = min(int(n_plots), BURST_PLOTS), int(n_tracks)
+    return {
+        "max_births_per_scan": max(floors["max_births_per_scan"], n),
+        "max_trees": max(floors["max_trees"], TREES_PER_PLOT * n + t),
+        "max_leaves": max(floors["max_leaves"], LEAVES_PER_PLOT * n + LEAVES_PER_TRACK * t),
+        "max_gated_pairs": max(floors["max_gated_pairs"],
+                               PAIRS_PER_PLOT * n + PAIRS_PER_TRACK * t),
+    }
+
+
+def scan_config(cfg: MHTConfig, n_plots: int, n_tracks: int) -> MHTConfig:
+    """``cfg`` with :func:`scaled_limits` for this scan (``cfg`` itself when they are its
+    own values)."""
+    lim = scaled_limits(cfg, n_plots, n_tracks)
+    if all(lim[k] == getattr(cfg, k) for k in SCALED):
+        return cfg
+    return dataclasses.replace(cfg, **lim)
 
 
 def solver_caps(hyp: GlobalHypothesis, caps: dict[str, int]) -> None:
@@ -24,20 +83,35 @@ def solver_caps(hyp: GlobalHypothesis, caps: dict[str, int]) -> None:
         caps["milp_time_limit"] = hyp.n_time_limited
 
 
+def describe(caps: dict[str, int], limits: dict[str, int] | None = None) -> str:
+    """``"max_births_per_scan 50256 (limit 20000), ..."``: the caps that acted, each with
+    its count (what it cut, or for ``fusion_greedy`` the plots it assigned greedily) and,
+    when known, the limit it had at that scan."""
+    parts = []
+    for k in sorted(caps):
+        lim = None if limits is None else limits.get(k)
+        parts.append(f"{k} {caps[k]}" + ("" if lim is None else f" (limit {lim})"))
+    return ", ".join(parts)
+
+
 class CapWarnings:
-    """A warning the first time each cap acts; every scan's counts at DEBUG."""
+    """A warning the first time each cap acts; every scan's counts at DEBUG. One line:
+    ``MHT scan 2 (70256 plots): hard caps acted: max_births_per_scan 50256 (limit 20000)
+    (first time for max_births_per_scan; ...)``."""
 
     def __init__(self) -> None:
         self.warned: set[str] = set()
 
-    def __call__(self, scan_index: int, caps: dict[str, int]) -> None:
+    def __call__(self, scan_index: int, caps: dict[str, int], n_plots: int | None = None,
+                 limits: dict[str, int] | None = None) -> None:
         if not caps:
             return
+        where = f"MHT scan {scan_index}" + ("" if n_plots is None else f" ({n_plots} plots)")
         new = sorted(set(caps) - self.warned)
         if new:
             self.warned.update(new)
             logger.warning(
-                "MHT scan %d: hard caps acted: %s (first time for %s; per-scan counts are "
-                "in StepStats.caps)", scan_index, caps, ", ".join(new))
+                "%s: hard caps acted: %s (first time for %s; per-scan counts are in "
+                "StepStats.caps)", where, describe(caps, limits), ", ".join(new))
         else:
-            logger.debug("MHT scan %d: hard caps acted: %s", scan_index, caps)
+            logger.debug("%s: hard caps acted: %s", where, describe(caps, limits))

@@ -78,18 +78,24 @@ class MHTConfig:
         ``confirm_hits > 0``.
     prune_drop : a leaf more than this below its tree's best leaf is pruned before the
         global hypothesis is solved. Default 12 (a likelihood ratio of e¹² ≈ 1.6·10⁵).
+    scale_caps : the caps ``max_births_per_scan``, ``max_trees``, ``max_leaves`` and
+        ``max_gated_pairs`` grow with the scan's plots and confirmed tracks, the values
+        below being their floors (:func:`mhtrack.mht.caps.scaled_limits`; unchanged up to
+        900 plots and 100 tracks per scan, bounded in a burst of over 20 000). Default True; False:
+        the values below at every scan.
     max_leaves_per_tree : hard cap on the leaves of one tree (best scores kept).
         Default 300 (above the largest trees, ~290 leaves, of the crossing scenario with
         40 uniform clutter plots per scan and the true κ).
     max_leaves : hard cap on all leaves (confirmed trees' leaves first, then best scores).
-        Default 20 000 (≈ 7× the leaves of the crossing scenario).
+        Default 20 000 (≈ 7× the leaves of the crossing scenario); scaled (``scale_caps``).
     max_trees : hard cap on trees (trees in the best hypothesis and confirmed trees first,
-        then highest best-leaf score). Default 5 000.
+        then highest best-leaf score). Default 5 000; scaled (``scale_caps``).
     max_gated_pairs : at most this many leaf–plot pairs are tested in the gates per scan;
         beyond it, leaves of confirmed trees and then the best-scoring leaves are gated
-        first and the rest only get a miss child. Default 300 000.
+        first and the rest only get a miss child. Default 300 000; scaled (``scale_caps``).
     max_births_per_scan : at most this many plots of a scan start trees (plots outside
-        confirmed tracks' gates first, then highest birth score). Default 2 000.
+        confirmed tracks' gates first, then highest birth score). Default 2 000; scaled
+        (``scale_caps``).
     max_cluster_size : clusters with more candidate (positive-score) leaves than this are
         solved greedily instead of exactly. Default 2 000.
     milp_time_limit : seconds HiGHS may spend on one cluster's integer programme; then
@@ -127,6 +133,7 @@ class MHTConfig:
     confirm_hits: int = 0
     confirm_min_score: float = 0.0
     prune_drop: float = 12.0
+    scale_caps: bool = True
     max_leaves_per_tree: int = 300
     max_leaves: int = 20_000
     max_trees: int = 5_000
@@ -164,8 +171,8 @@ class MHTConfig:
             and self.imm_sigma_v >= 0,
             "finite >= 0",
         )
-        check("miss_uses_gate_probability", isinstance(self.miss_uses_gate_probability, bool),
-              "a bool")
+        for name in ("miss_uses_gate_probability", "scale_caps"):
+            check(name, isinstance(getattr(self, name), bool), "a bool")
         check("n_scan", _is_int(self.n_scan) and 1 <= self.n_scan <= MAX_N_SCAN,
               f"an integer in [1, {MAX_N_SCAN}]")
         check("confirm_min_plots", _is_int(self.confirm_min_plots)

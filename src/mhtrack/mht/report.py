@@ -19,7 +19,8 @@ class StepStats:
     ``caps`` maps each hard cap that acted to how many leaves (``max_leaves_per_tree``,
     ``max_leaves``), trees (``max_trees``), plots or initiated tracks
     (``max_births_per_scan``) or clusters (``max_cluster_size``) it cut; empty when none
-    acted. ``n_births`` counts the trees started at this scan.
+    acted. ``n_births`` counts the trees started at this scan. ``limits``: the caps that
+    scale with the scene and their values at this scan (:func:`mhtrack.mht.caps.scaled_limits`).
     """
 
     scan: int
@@ -32,15 +33,17 @@ class StepStats:
     time_s: float
     caps: dict[str, int] = field(default_factory=dict)
     n_births: int = 0
+    limits: dict[str, int] = field(default_factory=dict)
 
     @classmethod
     def of(cls, scan: Scan, n_plots: int, leaves: Leaves, births: Leaves,
            hyp: GlobalHypothesis, out: TrackTable, time_s: float,
-           caps: dict[str, int]) -> StepStats:
+           caps: dict[str, int], limits: dict[str, int] | None = None) -> StepStats:
         return cls(scan=int(scan.index), n_plots=n_plots, n_leaves=len(leaves),
                    n_trees=leaves.n_trees, n_clusters=hyp.n_clusters,
                    largest_cluster=hyp.largest_cluster, n_confirmed=len(out), time_s=time_s,
-                   caps=caps, n_births=int(np.unique(births.tree).size))
+                   caps=caps, n_births=int(np.unique(births.tree).size),
+                   limits={} if limits is None else limits)
 
 
 def confirmed_windows(leaves: Leaves) -> np.ndarray:

@@ -27,7 +27,8 @@ The tracking cycle, one stage per line of :meth:`MHTTracker.step`::
     forget           Birth.forget_used,              the confirmed tracks' plots leave the
                      ClutterEstimator.forget           birth window and the estimator's
     report           report.report, StepStats        confirmed tracks of the best hypothesis
-    caps             caps.CapWarnings                log the hard caps that acted
+    caps             caps.scan_config, CapWarnings   limits scaled to the scan's plots and
+                                                     tracks; log the hard caps that acted
 
 The motion model (:class:`~mhtrack.models.motion.MotionModel`: CV or IMM), the clutter
 estimator (:class:`~mhtrack.clutter.base.ClutterEstimator`), the birth process
@@ -49,7 +50,7 @@ import numpy as np
 from mhtrack.clutter.base import ClutterEstimator
 from mhtrack.clutter.known import KnownClutter
 from mhtrack.mht.births import Birth, make_birth
-from mhtrack.mht.caps import CapWarnings, solver_caps
+from mhtrack.mht.caps import SCALED, CapWarnings, scan_config, solver_caps
 from mhtrack.mht.config import MHTConfig
 from mhtrack.mht.coverage import Coverage, Everywhere, Looks
 from mhtrack.mht.extend import grow_children, propose_children
@@ -139,6 +140,10 @@ class MHTTracker:
         cfg, ftime = self.config, float(scan.time)
         caps: dict[str, int] = {}
         z, R, rows = validate_scan(scan, self._R, self._last_time, self._last_index)
+        lim = scan_config(cfg, len(z), int(np.count_nonzero(
+            self._leaves.chosen & (self._leaves.track >= 0))))  # caps scaled to the scan
+        self.gate.max_pairs = lim.max_gated_pairs
+        self.birth.limit(lim.max_births_per_scan)
         by_id = self.coverage.per_tree_looks
         previous = Reported.of(self._leaves, by_id=by_id)
         leaves, looks, idle = self._look(scan)
@@ -152,7 +157,7 @@ class MHTTracker:
         children = propose_children(leaves, gated, miss_increments(looks.miss_pd, self._miss_pg),
                                     update_dl)
         cand = self.birth.propose(scan, z, R, rows, kappa, in_gates, caps)
-        children = prune_children(leaves, children, len(cand) + len(idle), self.sprt, cfg,
+        children = prune_children(leaves, children, len(cand) + len(idle), self.sprt, lim,
                                   caps)
         grown = grow_children(leaves, pred, children, z, R, rows, self.motion, ftime,
                               pair_pred, scan.t)
@@ -162,7 +167,7 @@ class MHTTracker:
         hyp = best_hypothesis(leaves.score, leaves.tree, leaves.window, cfg.max_cluster_size,
                               cfg.milp_time_limit, by_id=by_id)
         solver_caps(hyp, caps)
-        leaves = prune_after_solve(leaves, hyp.leaves, cfg.max_trees, caps, by_id=by_id)
+        leaves = prune_after_solve(leaves, hyp.leaves, lim.max_trees, caps, by_id=by_id)
         is_new = None if len(idle) == 0 else leaves.node >= first_node
         first_new = self.tracks.next
         leaves = hand_over(leaves, previous, by_id=by_id)
@@ -173,9 +178,10 @@ class MHTTracker:
         self._forget(leaves, rows)
         self._leaves, self._last_time, self._last_index = leaves, ftime, int(scan.index)
         out = report(scan, leaves, is_new)
+        limits = {k: getattr(lim, k) for k in SCALED}
         self.last_stats = StepStats.of(scan, len(z), leaves, births, hyp, out,
-                                       time.perf_counter() - t0, caps)
-        self._cap_warnings(int(scan.index), caps)
+                                       time.perf_counter() - t0, caps, limits)
+        self._cap_warnings(int(scan.index), caps, len(z), limits)
         return out
 
     def _look(self, scan: Scan) -> tuple[Leaves, Looks, Leaves]:

@@ -11,6 +11,9 @@ estimator. Every scan the tracker calls
 3. :meth:`Birth.forget_used` after the best global hypothesis, with the plots of the
    confirmed tracks (optional hook, a no-op by default).
 
+Before :meth:`Birth.propose` the tracker passes the scan's limit on new trees to
+:meth:`Birth.limit` (optional hook).
+
 A process that keeps state across scans saves it through :meth:`Birth.arrays` and
 :meth:`Birth.set_arrays` (optional hooks; by default it has none).
 """
@@ -88,6 +91,11 @@ class Birth(ABC):
         time = np.full(len(cand), float(scan.time)) if cand.time is None else cand.time
         return new_trees(self.motion.new_states(cand.x, cand.P), cand.score, cand.peak,
                          first + group, int(scan.index), cand.n_updates, cand.window, time)
+
+    def limit(self, max_per_scan: int) -> None:  # noqa: B027 (optional hook)
+        """Optional hook: the most new trees this scan may start (the scan's
+        ``max_births_per_scan``, scaled with the scene by :mod:`mhtrack.mht.caps`).
+        Default: nothing (the shipped processes set their ``max_per_scan``)."""
 
     def forget_used(self, window: np.ndarray) -> None:  # noqa: B027 (optional hook)
         """Optional hook: the leaf windows (m, width) of the confirmed tracks' chosen leaves

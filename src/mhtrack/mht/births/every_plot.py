@@ -47,6 +47,9 @@ class EveryPlotBirth(Birth):
         self.max_per_scan = max_per_scan
         self.plot_pd = plot_pd
 
+    def limit(self, max_per_scan: int) -> None:
+        self.max_per_scan = int(max_per_scan)
+
     def propose(self, scan: Scan, z: np.ndarray, R: np.ndarray, rows: np.ndarray,
                 kappa: np.ndarray, in_gates: np.ndarray | None,
                 caps: dict[str, int]) -> BirthCandidates:

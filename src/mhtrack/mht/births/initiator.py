@@ -165,6 +165,9 @@ class InitiatorBirth(Birth):
         self.rows, self.kappa = self.rows[keep], self.kappa[keep]
 
     # ------------------------------------------------------------------ births
+    def limit(self, max_per_scan: int) -> None:
+        self.max_per_scan = int(max_per_scan)
+
     def propose(self, scan: Scan, z: np.ndarray, R: np.ndarray, rows: np.ndarray,
                 kappa: np.ndarray, in_gates: np.ndarray | None,
                 caps: dict[str, int]) -> BirthCandidates:

@@ -2,7 +2,7 @@
 
 Every stage that applies a cap (``max_gated_pairs``, ``max_births_per_scan``,
 ``max_leaves_per_tree``, ``max_leaves``, ``max_trees``, the solver's ``max_cluster_size``
-and ``milp_time_limit``) adds to the scan's ``caps`` dict how many leaves, plots, trees or
+and ``milp_node_limit``) adds to the scan's ``caps`` dict how many leaves, plots, trees or
 clusters it cut; :class:`CapWarnings` logs them.
 """
 
@@ -17,11 +17,11 @@ logger = logging.getLogger("mhtrack.mht.tracker")
 
 
 def solver_caps(hyp: GlobalHypothesis, caps: dict[str, int]) -> None:
-    """Record the clusters solved greedily (too large) or stopped by the MILP time limit."""
+    """Record the clusters solved greedily (too large) or stopped by the MILP node limit."""
     if hyp.n_greedy:
         caps["max_cluster_size"] = hyp.n_greedy
-    if hyp.n_time_limited:
-        caps["milp_time_limit"] = hyp.n_time_limited
+    if hyp.n_node_limited:
+        caps["milp_node_limit"] = hyp.n_node_limited
 
 
 class CapWarnings:

@@ -35,8 +35,9 @@ import numpy as np
 from mhtrack.mht.clustering import plot_keys
 from mhtrack.mht.tree import segment_starts
 
-#: Branch-and-bound nodes one part's search may visit before the enumeration stops.
-NODE_LIMIT = 20_000
+#: Branch-and-bound nodes all the parts' searches of one cluster may visit together
+#: before the enumeration stops (a count, so the result does not depend on the machine).
+NODE_LIMIT = 50_000
 #: Slack (relative to the scores' scale) under which the search keeps exploring a branch
 #: that could tie the incumbent: rounding in the running sums must not cut a tie.
 TIE_SLACK = 1e-9
@@ -56,7 +57,7 @@ def conflict_masks(window: np.ndarray, by_id: bool = False) -> list[int]:
 
 
 class _Limit(Exception):
-    """A part's search passed :data:`NODE_LIMIT`."""
+    """The searches passed :data:`NODE_LIMIT`."""
 
 
 class _Problem:
@@ -76,6 +77,7 @@ class _Problem:
         self.score = {int(p): float(v) for p, v in zip(pos, s, strict=True)}
         self.slack = TIE_SLACK * (1.0 + float(s.sum()) if s.size else 1.0)
         self.node_limit = node_limit
+        self.nodes = 0  # visited by all searches so far
 
     def key(self, leaves: tuple[int, ...]) -> tuple[float, tuple[int, ...]]:
         """Rank key: smaller is better."""
@@ -112,12 +114,11 @@ class _Problem:
         best_key: tuple[float, tuple[int, ...]] | None = None
         best_sel: tuple[int, ...] = ()
         best_val = -math.inf
-        nodes = 0
         stack: list[tuple[int, int, float, tuple[int, ...]]] = [(0, used, base_val, ())]
         while stack:
             j, u, val, sel = stack.pop()
-            nodes += 1
-            if nodes > self.node_limit:
+            self.nodes += 1
+            if self.nodes > self.node_limit:
                 raise _Limit
             if val + bound[j] < best_val - self.slack:
                 continue
@@ -161,13 +162,13 @@ def n_best_hypotheses(
     score, tree, window : the leaves, as :func:`~mhtrack.mht.hypothesis.best_hypothesis`.
     n : how many (fewer when the cluster has fewer hypotheses).
     by_id : plots identified by id alone (frames of several sensors).
-    node_limit : nodes one part's search may visit.
+    node_limit : nodes all the parts' searches may visit together.
 
     Returns
     -------
-    ``([(leaf indices ascending, total), …], complete)``; ``complete`` is false when a
-    part's search passed ``node_limit`` — the list then holds the hypotheses ranked
-    before it (correct, but perhaps fewer than ``n``; empty if the best was not found).
+    ``([(leaf indices ascending, total), …], complete)``; ``complete`` is false when the
+    searches passed ``node_limit`` — the list then holds the hypotheses ranked before
+    that (correct, but perhaps fewer than ``n``; empty if the best was not found).
     """
     prob = _Problem(np.asarray(score, float), np.asarray(tree), np.asarray(window),
                     by_id, node_limit)

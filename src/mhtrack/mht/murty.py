@@ -75,6 +75,8 @@ class _Problem:
             for a, b in itertools.pairwise(starts)
         ]
         self.score = {int(p): float(v) for p, v in zip(pos, s, strict=True)}
+        self.tree_of = {i: t for t, opts in enumerate(self.options) for _, _, i in opts}
+        self.mask_of = {i: m for opts in self.options for _, m, i in opts}
         self.slack = TIE_SLACK * (1.0 + float(s.sum()) if s.size else 1.0)
         self.node_limit = node_limit
         self.nodes = 0  # visited by all searches so far
@@ -90,7 +92,7 @@ class _Problem:
         used = 0
         for leaf in fixed.values():
             if leaf is not None:
-                m = next(m for _, m, i in self.options_of(leaf) if i == leaf)
+                m = self.mask_of[leaf]
                 if m & used:
                     return None
                 used |= m
@@ -140,15 +142,6 @@ class _Problem:
         for i in best_sel:
             choice[self.tree_of[i]] = i
         return choice
-
-    @property
-    def tree_of(self) -> dict[int, int]:
-        if not hasattr(self, "_tree_of"):
-            self._tree_of = {i: t for t, opts in enumerate(self.options) for _, _, i in opts}
-        return self._tree_of
-
-    def options_of(self, leaf: int) -> list[tuple[float, int, int]]:
-        return self.options[self.tree_of[leaf]]
 
 
 def n_best_hypotheses(

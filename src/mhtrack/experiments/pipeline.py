@@ -96,11 +96,14 @@ class TrackingRun:
 
     @property
     def caps(self) -> dict[str, int]:
-        """Total of every hard cap that acted, over the run."""
+        """Total of every hard cap that acted, over the run, and under ``"scans"`` the
+        number of scans (frames) on which any acted; empty when none acted."""
         total: dict[str, int] = {}
         for s in self.stats:
             for k, v in s.caps.items():
                 total[k] = total.get(k, 0) + v
+        if total:
+            total["scans"] = sum(1 for s in self.stats if s.caps)
         return total
 
     @property

@@ -5,30 +5,7 @@ telling the user.
 plots ``n`` (every plot may start a tree, each tree's leaves gate the next plots) and
 with the confirmed tracks ``t`` carried into it. With ``n' = min(n, BURST_PLOTS)``:
 
-======================== =====================================================
-cap                      limit at a scan (``MHTConfig`` value = the floor)
-======================== =====================================================
-``max_births_per_scan``  ``max(floor, n')``                     — every plot may start a tree
-``max_trees``            ``max(floor, 5·n' + t)``               — ~N + 2 scans of new trees
-``max_leaves``           ``max(floor, 16·n' + 50·t)``
-``max_gated_pairs``      ``max(floor, 150·n' + 50·t)``
-======================== =====================================================
-
-The coefficients are the default floors' own ratios to the default births (5 000 trees,
-20 000 leaves, 300 000 pairs for 2 000 births) rounded, plus room for the confirmed
-tracks' trees; ``max_leaves_per_tree``, ``max_cluster_size`` and ``milp_time_limit`` do
-not depend on the scene's size and stay as configured. Up to 900 plots and 100
-confirmed tracks per scan (every preset) the limits *are* the configured values, so
-nothing changes there. A scan of more than ``BURST_PLOTS`` plots (a clutter burst) gets
-the limits of ``BURST_PLOTS``: its work stays bounded, and the caps say what they cut.
-``MHTConfig(scale_caps=False)`` keeps the configured values at every scan.
-
-**Counting.** Every stage that applies a cap (``max_gated_pairs``,
-``max_births_per_scan``, ``max_leaves_per_tree``, ``max_leaves``, ``max_trees``, the
-solver's ``max_cluster_size`` and ``milp_time_limit``) adds to the scan's ``caps`` dict how
-many leaves, plots, trees or clusters it cut; :class:`CapWarnings` logs them with the
-scan's plot count and the limits that acted.
-"""
+======================== =============================================="""
 
 from __future__ import annotations
 
@@ -76,11 +53,11 @@ def scan_config(cfg: MHTConfig, n_plots: int, n_tracks: int) -> MHTConfig:
 
 
 def solver_caps(hyp: GlobalHypothesis, caps: dict[str, int]) -> None:
-    """Record the clusters solved greedily (too large) or stopped by the MILP time limit."""
+    """Record the clusters solved greedily (too large) or stopped by the MILP node limit."""
     if hyp.n_greedy:
         caps["max_cluster_size"] = hyp.n_greedy
-    if hyp.n_time_limited:
-        caps["milp_time_limit"] = hyp.n_time_limited
+    if hyp.n_node_limited:
+        caps["milp_node_limit"] = hyp.n_node_limited
 
 
 def describe(caps: dict[str, int], limits: dict[str, int] | None = None) -> str:

@@ -20,6 +20,11 @@ from mhtrack.names import BIRTHS
 MAX_N_SCAN = 20
 #: Largest tentative history kept (scans).
 MAX_HISTORY_SCANS = 1000
+#: Largest number of best global hypotheses enumerated per cluster.
+MAX_N_BEST = 1000
+#: Fields of older versions ignored when read back (``milp_time_limit``: a wall-clock limit,
+#: replaced by the deterministic ``milp_node_limit``).
+REMOVED_FIELDS = ("milp_time_limit",)
 
 
 @dataclass(frozen=True)
@@ -98,8 +103,11 @@ class MHTConfig:
         (``scale_caps``).
     max_cluster_size : clusters with more candidate (positive-score) leaves than this are
         solved greedily instead of exactly. Default 2 000.
-    milp_time_limit : seconds HiGHS may spend on one cluster's integer programme; then
-        its best answer so far (or greedy's, if better) is used. Default 0.5.
+    milp_node_limit : branch-and-bound nodes HiGHS may explore on one cluster's integer
+        programme; then its best answer so far (or greedy's, if better) is used, counted
+        as ``milp_node_limit`` in ``StepStats.caps``. A count, not a time: the same input
+        gives the same answer on any machine and under any load. Default 1000 (our
+        choice: the crossing clusters that reach the MILP are proven at its root node).
     birth : which plots start new trees (:mod:`mhtrack.mht.births`; one of
         :data:`mhtrack.names.BIRTHS`). ``"every-plot"`` (default,
         P1 Fig. 1): every plot, one-point initialisation. ``"logic"``, ``"modified-logic"``,
@@ -115,6 +123,17 @@ class MHTConfig:
     min_clutter_density : floor on the estimator's ``κ̂(z)`` (per m²), so that a density
         estimate that underflows to 0 far from its components cannot give an infinite
         score. Default 1e−12 (our choice: 1000× below P1's plain-MHT κ = 1e−9).
+    n_best : how many best global hypotheses of each cluster are enumerated (Murty's
+        partitioning, :mod:`mhtrack.mht.murty`) for the track probabilities
+        (:mod:`mhtrack.mht.track_probability`); the best one is still the one reported.
+        Default 1 (only the best: every chosen leaf has probability 1).
+    prune_probability : after the solve, leaves with a positive score whose probability
+        over the ``n_best`` hypotheses is below this are removed (the chosen ones never).
+        Default 0 = off. Only useful with ``n_best > 1``.
+    merge_frames : merge duplicate branches: leaves whose plots (and misses) over their
+        last ``merge_frames`` window columns are the same, at least one a plot, keep only
+        the first by (chosen, confirmed, score, index) (:func:`mhtrack.mht.merging.merge_keep`).
+        Default 0 = off; at most ``n_scan + 1``.
     """
 
     p_detection: float = 0.9
@@ -140,11 +159,14 @@ class MHTConfig:
     max_gated_pairs: int = 300_000
     max_births_per_scan: int = 2_000
     max_cluster_size: int = 2_000
-    milp_time_limit: float = 0.5
+    milp_node_limit: int = 1000
     min_clutter_density: float = 1e-12
     birth: str = "every-plot"
     birth_theta_deg: float = 20.0
     history_scans: int = 30
+    n_best: int = 1
+    prune_probability: float = 0.0
+    merge_frames: int = 0
 
     def __post_init__(self) -> None:
         def check(name: str, ok: bool, what: str) -> None:
@@ -156,7 +178,7 @@ class MHTConfig:
             check(name, isinstance(v, int | float) and 0.0 < v < 1.0, "in (0, 1)")
         check("alpha", self.alpha + self.beta < 1.0, "such that alpha + beta < 1")
         for name in ("new_target_density", "sigma_w", "v_max", "prune_drop",
-                     "milp_time_limit", "min_clutter_density", "imm_mode_time"):
+                     "min_clutter_density", "imm_mode_time"):
             v = getattr(self, name)
             check(name, isinstance(v, int | float) and math.isfinite(v) and v > 0, "finite > 0")
         check(
@@ -182,7 +204,7 @@ class MHTConfig:
         check("confirm_min_score", isinstance(self.confirm_min_score, int | float)
               and math.isfinite(self.confirm_min_score), "finite")
         for name in ("max_leaves_per_tree", "max_leaves", "max_trees", "max_gated_pairs",
-                     "max_births_per_scan", "max_cluster_size"):
+                     "max_births_per_scan", "max_cluster_size", "milp_node_limit"):
             v = getattr(self, name)
             check(name, _is_int(v) and v >= 1, "an integer >= 1")
         check("history_scans", _is_int(self.history_scans)
@@ -193,6 +215,12 @@ class MHTConfig:
               and 0 <= self.birth_theta_deg <= 180, "in [0, 180]")
         check("max_leaves", self.max_leaves > self.max_births_per_scan,
               "larger than max_births_per_scan")
+        check("n_best", _is_int(self.n_best) and 1 <= self.n_best <= MAX_N_BEST,
+              f"an integer in [1, {MAX_N_BEST}]")
+        check("prune_probability", isinstance(self.prune_probability, int | float)
+              and 0 <= self.prune_probability < 1, "in [0, 1)")
+        check("merge_frames", _is_int(self.merge_frames)
+              and 0 <= self.merge_frames <= self.n_scan + 1, "an integer in [0, n_scan + 1]")
 
     @property
     def models(self) -> CVModelSet | None:
@@ -215,6 +243,8 @@ class MHTConfig:
     @classmethod
     def from_json(cls, text: str) -> MHTConfig:
         data: dict[str, Any] = json.loads(text)
+        for name in REMOVED_FIELDS:  # saved by an older version; no longer has a meaning
+            data.pop(name, None)
         known = {f.name for f in fields(cls)}
         unknown = sorted(set(data) - known)
         if unknown:

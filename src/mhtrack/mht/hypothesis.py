@@ -15,8 +15,14 @@ independent clusters (:mod:`mhtrack.mht.clustering`). Per cluster:
   programme above with ``scipy.optimize.milp`` (HiGHS, gap 0) when the search grows;
 * greedily (best score first) when the cluster has more than ``max_cluster_size``
   candidate leaves — counted in :attr:`GlobalHypothesis.n_greedy`;
-* ``milp`` stops at ``time_limit`` seconds with its best feasible answer (at least as
-  good as greedy) — counted in :attr:`GlobalHypothesis.n_time_limited`.
+* ``milp`` stops after ``node_limit`` branch-and-bound nodes with its best feasible
+  answer (at least as good as greedy) — counted in :attr:`GlobalHypothesis.n_node_limited`.
+  Never a time limit: the same input gives the same answer on any machine, under any load.
+
+With ``n_best > 1`` the N best hypotheses of each cluster are also enumerated
+(:mod:`mhtrack.mht.murty`) and each leaf gets its probability over them
+(:mod:`mhtrack.mht.track_probability`); the reported best hypothesis is the same as with
+``n_best = 1``.
 
 All functions are pure: arrays in, a small result out.
 """
@@ -24,13 +30,15 @@ All functions are pure: arrays in, a small result out.
 from __future__ import annotations
 
 import itertools
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from scipy.optimize import Bounds, LinearConstraint, linprog, milp
 from scipy.sparse import csr_matrix
 
 from mhtrack.mht.clustering import cluster_trees, plot_keys
+from mhtrack.mht.murty import conflict_masks, n_best_hypotheses
+from mhtrack.mht.track_probability import leaf_probabilities
 from mhtrack.mht.tree import segment_starts
 
 #: Nodes the branch-and-bound may visit before the cluster is handed to ``milp``.
@@ -51,7 +59,13 @@ class GlobalHypothesis:
     largest_cluster : candidate leaves in the largest cluster.
     n_searched : clusters whose trees' best leaves conflicted (solved by search or milp).
     n_greedy : clusters over ``max_cluster_size`` solved greedily (not exact).
-    n_time_limited : clusters whose ``milp`` hit the time limit (best found, not proven).
+    n_node_limited : clusters whose ``milp`` hit the node limit (best found, not proven).
+    probability : (L,) each input leaf's probability over the N best hypotheses of its
+        cluster (:func:`~mhtrack.mht.track_probability.leaf_probabilities`); with
+        ``n_best = 1`` 1 for the chosen leaves, 0 elsewhere; leaves with score ≤ 0 get 0.
+    n_best_cut : clusters whose N best were not enumerated in full (larger than
+        ``max_cluster_size``, or the search of one of them passed its node limit); their
+        probabilities come from the hypotheses found (at least the best).
     """
 
     leaves: np.ndarray
@@ -60,11 +74,13 @@ class GlobalHypothesis:
     largest_cluster: int = 0
     n_searched: int = 0
     n_greedy: int = 0
-    n_time_limited: int = 0
+    n_node_limited: int = 0
+    probability: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    n_best_cut: int = 0
 
 
-def _empty() -> GlobalHypothesis:
-    return GlobalHypothesis(np.zeros(0, np.int64), 0.0)
+def _empty(n: int) -> GlobalHypothesis:
+    return GlobalHypothesis(np.zeros(0, np.int64), 0.0, probability=np.zeros(n))
 
 
 def best_hypothesis(
@@ -72,9 +88,10 @@ def best_hypothesis(
     tree: np.ndarray,
     window: np.ndarray,
     max_cluster_size: int | None = None,
-    time_limit: float | None = None,
+    node_limit: int | None = None,
     *,
     by_id: bool = False,
+    n_best: int = 1,
 ) -> GlobalHypothesis:
     """Best global hypothesis over all leaves.
 
@@ -85,19 +102,20 @@ def best_hypothesis(
     window : (L, W) plot id used per scan column (``-1``: none); two leaves using the
         same id in the same column conflict.
     max_cluster_size : clusters with more candidate leaves are solved greedily.
-    time_limit : seconds ``milp`` may spend on one cluster.
+    node_limit : branch-and-bound nodes ``milp`` may explore on one cluster.
     by_id : two leaves using the same plot id conflict whatever the columns (frames of
         several sensors, :func:`~mhtrack.mht.clustering.plot_keys`).
+    n_best : hypotheses per cluster the leaf probabilities are taken over.
 
     Returns
     -------
-    GlobalHypothesis; the choice is exact unless ``n_greedy`` or ``n_time_limited``.
+    GlobalHypothesis; the choice is exact unless ``n_greedy`` or ``n_node_limited``.
     Ties are broken deterministically (same input, same output).
     """
     score = np.asarray(score, float)
     cand = np.flatnonzero(score > 0)
     if cand.size == 0:
-        return _empty()
+        return _empty(score.size)
     s, w = score[cand], np.asarray(window)[cand]
     tree_index, tree_cluster = cluster_trees(np.asarray(tree)[cand], w, by_id=by_id)
     leaf_cluster = tree_cluster[tree_index]
@@ -125,11 +143,20 @@ def best_hypothesis(
                 n_greedy += 1
             else:
                 pick, exact = solve_exact(
-                    s[members], tree_index[members], w[members], time_limit, by_id=by_id
+                    s[members], tree_index[members], w[members], node_limit, by_id=by_id
                 )
                 n_limited += not exact
             chosen.append(members[pick])
-    sel = np.sort(np.concatenate(chosen))
+    is_sel = np.zeros(cand.size, bool)
+    is_sel[np.concatenate(chosen)] = True
+    probability = np.zeros(score.size)
+    n_cut = 0
+    if n_best > 1:
+        n_cut = _n_best(s, tree_index, w, leaf_cluster, sizes, n_best, max_cluster_size,
+                        by_id, is_sel, probability, cand)
+    sel = np.flatnonzero(is_sel)
+    if n_best == 1:
+        probability[cand[sel]] = 1.0
     return GlobalHypothesis(
         leaves=cand[sel],
         total=float(s[sel].sum()),
@@ -137,21 +164,45 @@ def best_hypothesis(
         largest_cluster=int(sizes.max()),
         n_searched=int(hard.size),
         n_greedy=n_greedy,
-        n_time_limited=n_limited,
+        n_node_limited=n_limited,
+        probability=probability,
+        n_best_cut=n_cut,
     )
 
 
-def _conflict_masks(tree: np.ndarray, window: np.ndarray, by_id: bool) -> list[int]:
-    """Per leaf, a Python-int bitset of the plots it uses."""
-    leaf, key = plot_keys(window, by_id=by_id)
-    masks = [0] * len(tree)
-    for i, k in zip(leaf.tolist(), key.tolist(), strict=True):
-        masks[i] |= 1 << k
-    return masks
+def _n_best(
+    s: np.ndarray, tree_index: np.ndarray, w: np.ndarray, leaf_cluster: np.ndarray,
+    sizes: np.ndarray, n_best: int, max_cluster_size: int | None, by_id: bool,
+    is_sel: np.ndarray, probability: np.ndarray, cand: np.ndarray,
+) -> int:
+    """Per cluster, the N best hypotheses (:func:`~mhtrack.mht.murty.n_best_hypotheses`):
+    the first becomes the cluster's choice in ``is_sel`` (over candidates; it differs from
+    the solvers' only between hypotheses of exactly equal score) and ``probability`` (over
+    all leaves) gets the leaf probabilities. A cluster over ``max_cluster_size``, or whose
+    best is not found within the search's node limit, keeps the solvers' choice with
+    probability 1. Returns the clusters not enumerated in full."""
+    by_cluster = np.argsort(leaf_cluster, kind="stable")
+    bounds = np.r_[0, np.cumsum(sizes)]
+    n_cut = 0
+    for c in range(sizes.size):
+        members = by_cluster[bounds[c] : bounds[c + 1]]
+        ranked: list = []
+        complete = False
+        if max_cluster_size is None or members.size <= max_cluster_size:
+            ranked, complete = n_best_hypotheses(s[members], tree_index[members],
+                                                 w[members], n_best, by_id=by_id)
+        n_cut += not complete
+        if ranked:
+            is_sel[members] = False
+            is_sel[members[list(ranked[0][0])]] = True
+            probability[cand[members]] = leaf_probabilities(ranked, members.size)
+        else:
+            probability[cand[members[is_sel[members]]]] = 1.0
+    return n_cut
 
 
 def solve_exact(
-    score: np.ndarray, tree: np.ndarray, window: np.ndarray, time_limit: float | None = None,
+    score: np.ndarray, tree: np.ndarray, window: np.ndarray, node_limit: int | None = None,
     *, by_id: bool = False,
 ) -> tuple[np.ndarray, bool]:
     """Best compatible subset of one cluster: ``(indices ascending, proven optimal)``.
@@ -166,7 +217,7 @@ def solve_exact(
         pick = _branch_and_bound(score, tree, window, BNB_NODE_LIMIT, by_id)
         if pick is not None:
             return pick, True
-    return solve_milp(score, tree, window, time_limit, by_id=by_id)
+    return solve_milp(score, tree, window, node_limit, by_id=by_id)
 
 
 def _branch_and_bound(
@@ -177,7 +228,7 @@ def _branch_and_bound(
     if pos.size == 0:
         return np.zeros(0, np.int64)
     s = score[pos]
-    masks = _conflict_masks(tree[pos], window[pos], by_id)
+    masks = conflict_masks(window[pos], by_id)
     order = np.lexsort((-s, tree[pos]))
     starts = [*segment_starts(tree[pos][order]).tolist(), pos.size]
     options = []  # per tree: [(score, mask, index)] best first
@@ -219,13 +270,15 @@ def _branch_and_bound(
 
 
 def solve_milp(
-    score: np.ndarray, tree: np.ndarray, window: np.ndarray, time_limit: float | None = None,
+    score: np.ndarray, tree: np.ndarray, window: np.ndarray, node_limit: int | None = None,
     *, by_id: bool = False,
 ) -> tuple[np.ndarray, bool]:
     """Best compatible subset as a 0–1 integer programme (``scipy.optimize.milp``, HiGHS,
     relative gap 0): maximise ``Σ score·x`` with one constraint ``≤ 1`` per tree and per
-    plot. Returns ``(indices ascending, proven optimal)``; after ``time_limit`` seconds
-    the better of HiGHS's incumbent and :func:`solve_greedy` is returned, not proven.
+    plot. Returns ``(indices ascending, proven optimal)``; after ``node_limit``
+    branch-and-bound nodes the better of HiGHS's incumbent and :func:`solve_greedy` is
+    returned, not proven. HiGHS is deterministic for a given input and option set (its
+    work is counted, not timed), so the answer does not depend on the machine's speed.
 
     The LP relaxation is solved first (``linprog``, HiGHS): when its optimum is integral
     it is the integer optimum (about 60 % of large MHT clusters, at a third of the cost).
@@ -242,13 +295,12 @@ def solve_milp(
     cols = np.concatenate((np.arange(pos.size), leaf))
     n_rows = n_t + (int(key.max()) + 1 if key.size else 0)
     A = csr_matrix((np.ones(rows.size), (rows, cols)), shape=(n_rows, pos.size))
-    lp = linprog(-s, A_ub=A, b_ub=np.ones(n_rows), bounds=(0, 1), method="highs",
-                 options={} if time_limit is None else {"time_limit": float(time_limit)})
+    lp = linprog(-s, A_ub=A, b_ub=np.ones(n_rows), bounds=(0, 1), method="highs")
     if lp.status == 0 and np.all(np.minimum(lp.x, 1 - lp.x) < 1e-9):
         return pos[np.flatnonzero(lp.x > 0.5)], True
     options: dict[str, float] = {"mip_rel_gap": 0.0}
-    if time_limit is not None:
-        options["time_limit"] = float(time_limit)
+    if node_limit is not None:
+        options["node_limit"] = int(node_limit)
     res = milp(
         -s,
         integrality=np.ones(pos.size),

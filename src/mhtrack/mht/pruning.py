@@ -14,6 +14,8 @@ import numpy as np
 
 from mhtrack.mht.config import MHTConfig
 from mhtrack.mht.extend import Children
+from mhtrack.mht.hypothesis import GlobalHypothesis
+from mhtrack.mht.merging import merge_keep
 from mhtrack.mht.sprt import SPRT
 from mhtrack.mht.tree import (
     NO_PLOT,
@@ -168,15 +170,42 @@ def prune_children(leaves: Leaves, children: Children, n_births: int, sprt: SPRT
     return children
 
 
+def removed_after_solve(leaves: Leaves, hyp: GlobalHypothesis,
+                        cfg: MHTConfig) -> np.ndarray | None:
+    """Leaves the optional rules remove after the solve (``None``: both off).
+
+    * probability pruning (``cfg.prune_probability > 0``): leaves with a positive score
+      whose probability over the N best hypotheses (``hyp.probability``) is below it;
+    * merging (``cfg.merge_frames > 0``): all but one of each group of duplicate branches
+      (:func:`~mhtrack.mht.merging.merge_keep`).
+
+    Leaves of the best hypothesis are never removed."""
+    if cfg.prune_probability <= 0 and cfg.merge_frames <= 0:
+        return None
+    chosen = np.zeros(len(leaves), bool)
+    chosen[hyp.leaves] = True
+    remove = np.zeros(len(leaves), bool)
+    if cfg.prune_probability > 0:
+        remove |= (leaves.score > 0) & (hyp.probability < cfg.prune_probability)
+    if cfg.merge_frames > 0:
+        remove |= ~merge_keep(leaves.window, chosen, leaves.track >= 0, leaves.score,
+                              cfg.merge_frames)
+    return remove & ~chosen
+
+
 def prune_after_solve(leaves: Leaves, chosen: np.ndarray, max_trees: int,
-                      caps: dict[str, int], *, by_id: bool = False) -> Leaves:
+                      caps: dict[str, int], *, by_id: bool = False,
+                      remove: np.ndarray | None = None) -> Leaves:
     """N-scan pruning around the best hypothesis (leaf indices ``chosen``), then the cap
     on trees; marks the surviving chosen leaves. ``by_id``: trees step on their own looks
-    (:func:`n_scan_keep`'s ``window``)."""
+    (:func:`n_scan_keep`'s ``window``). ``remove``: a mask of further leaves to drop
+    (:func:`removed_after_solve`)."""
     is_chosen = np.zeros(len(leaves), bool)
     is_chosen[chosen] = True
     keep = n_scan_keep(leaves.tree, leaves.window[:, 0], chosen,
                        leaves.window if by_id else None)
+    if remove is not None:
+        keep &= ~remove
     protected = is_chosen | (leaves.track >= 0)
     keep_t, cut = cap_trees(leaves.tree[keep], leaves.score[keep], protected[keep], max_trees)
     if cut:

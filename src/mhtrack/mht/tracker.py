@@ -61,7 +61,7 @@ from mhtrack.mht.identity import Reported, confirm, hand_over, newly_confirmed
 from mhtrack.mht.intensity import clutter_intensity
 from mhtrack.mht.numbering import Counter, number_nodes
 from mhtrack.mht.predict import predict_leaves
-from mhtrack.mht.pruning import prune_after_solve, prune_children
+from mhtrack.mht.pruning import prune_after_solve, prune_children, removed_after_solve
 from mhtrack.mht.report import StepStats, confirmed_windows, report
 from mhtrack.mht.scoring import miss_increments, update_increment
 from mhtrack.mht.sprt import SPRT
@@ -165,9 +165,10 @@ class MHTTracker:
         first_node = self.nodes.next
         leaves = merge_by_tree(number_nodes(Leaves.concat(grown, births), self.nodes), idle)
         hyp = best_hypothesis(leaves.score, leaves.tree, leaves.window, cfg.max_cluster_size,
-                              cfg.milp_time_limit, by_id=by_id)
+                              cfg.milp_node_limit, by_id=by_id, n_best=cfg.n_best)
         solver_caps(hyp, caps)
-        leaves = prune_after_solve(leaves, hyp.leaves, lim.max_trees, caps, by_id=by_id)
+        leaves = prune_after_solve(leaves, hyp.leaves, lim.max_trees, caps, by_id=by_id,
+                                   remove=removed_after_solve(leaves, hyp, cfg))
         is_new = None if len(idle) == 0 else leaves.node >= first_node
         first_new = self.tracks.next
         leaves = hand_over(leaves, previous, by_id=by_id)

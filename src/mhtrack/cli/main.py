@@ -53,12 +53,14 @@ def _register() -> None:
         data_commands,
         experiment_commands,
         initiation_commands,
+        report_commands,
         reproduce_commands,
         track_commands,
     )
 
     modules = (data_commands, track_commands, clutter_commands, initiation_commands,
-               experiment_commands, reproduce_commands, asterix_commands)
+               experiment_commands, reproduce_commands, asterix_commands,
+               report_commands)
     for module in modules:
         for command in module.COMMANDS:
             cli.add_command(command)

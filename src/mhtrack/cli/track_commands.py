@@ -250,6 +250,9 @@ def _read_input(plots: Path, scenario_file: Path | None, sensors_file: Path | No
 @click.option("--order", type=click.FloatRange(min=1), default=2.0, show_default=True,
               help="OSPA/GOSPA order p.")
 @click.option("--json", "as_json", is_flag=True, help="Print one JSON object.")
+@click.option("--report", "html_report", is_flag=True,
+              help="Also write report.html: one self-contained page (scene, metrics, "
+              "parameters; needs mhtrack[report]).")
 @birth_options
 @output_option
 @progress_option
@@ -258,8 +261,8 @@ def run(scenario: str, seed: int, clutter: str | None, clutter_rate: float | Non
         meas_sigma: float | None, accel_sigma: float | None, imm_accel_sigma: float | None,
         clutter_density: float | None,
         birth_density: float | None, nscan: int | None, out: Path | None, cutoff: float,
-        order: float, as_json: bool, birth: str, birth_theta: float, fusion: str | None,
-        output: str, progress: bool | None) -> None:
+        order: float, as_json: bool, html_report: bool, birth: str, birth_theta: float,
+        fusion: str | None, output: str, progress: bool | None) -> None:
     """Simulate SCENARIO, track, evaluate and plot, in one go.
 
     Writes plots, truth, tracks, scenario.toml, metrics.json, scene.png (truth, plots,
@@ -304,8 +307,15 @@ def run(scenario: str, seed: int, clutter: str | None, clutter_rate: float | Non
                 out / "scene.png")
     save_figure(plot_ospa_cardinality({tracker: summary}, cutoff=cutoff, title=title),
                 out / "metrics.png")
+    page = None
+    if html_report:
+        from mhtrack.cli.report_commands import write_report_or_fail
+
+        page = write_report_or_fail(out)
     if as_json:
         echo_json(summary)
+        if page is not None:
+            click.echo(f"wrote {page}", err=True)
         return
     click.echo(result.evaluation.to_table())
     click.echo("output: " + ("history (each track also before its confirmation, rows "
@@ -317,6 +327,8 @@ def run(scenario: str, seed: int, clutter: str | None, clutter_rate: float | Non
     if result.run.caps:
         click.echo(f"hard caps acted: {result.run.caps}")
     click.echo(f"wrote {out}/ (plots, truth, tracks, metrics.json, scene.png, metrics.png)")
+    if page is not None:
+        click.echo(f"wrote {page}")
 
 
 def birth_density_note(density: float, where: str) -> str:

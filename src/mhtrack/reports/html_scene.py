@@ -1,0 +1,263 @@
+"""The scene of an HTML report as a Plotly figure: plots (clutter grey), truth, tracks,
+radar sites and, for geographic scenes, a map-free latitude/longitude grid.
+
+The same picture as :func:`mhtrack.plotting.scene.plot_scene` (P1 Figs. 2–4: truth with
+``o`` at birth and ``x`` at death, tracks one colour per id), but interactive: zoom and pan
+(mouse wheel, drag), hover for the id, scan and time of a point, click a legend entry to
+hide it. Equal axes, in kilometres beyond :data:`~mhtrack.plotting.scene.KM_ABOVE_M`.
+
+Every trace is an SVG ``scatter`` (no WebGL: the page renders in any browser, headless
+ones included); a scene of more than :data:`MAX_PLOTS` plots is thinned deterministically
+and its legend entry says so.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from mhtrack.plotting.scene import KM_ABOVE_M, Site
+from mhtrack.records import PlotTable, TrackTable, TruthTable
+
+if TYPE_CHECKING:
+    import plotly.graph_objects as go
+
+    from mhtrack.models.geodesy import LocalFrame
+
+#: Most plots drawn (SVG markers); more are thinned to every k-th plot.
+MAX_PLOTS = 30_000
+#: Most tracks drawn as one trace each (hover, own colour); more share one trace.
+MAX_TRACK_TRACES = 250
+#: Plotly's default qualitative colours (the ``D3`` palette, as matplotlib's ``tab10``).
+PALETTE = ("#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2",
+           "#7f7f7f", "#bcbd22", "#17becf")
+#: Grid steps tried (degrees), the first giving at most :data:`GRID_LINES` lines per axis.
+GRID_STEPS = (0.01, 0.02, 0.05, 0.1, 0.2, 0.25, 0.5, 1.0, 2.0, 5.0, 10.0, 15.0, 30.0)
+GRID_LINES = 8
+
+
+def _gapped(xs: Sequence[np.ndarray]) -> np.ndarray:
+    """Concatenate polylines with a NaN between them (Plotly breaks a line at a gap)."""
+    parts: list[np.ndarray] = []
+    for x in xs:
+        parts += [np.asarray(x, float), np.array([np.nan])]
+    return np.concatenate(parts) if parts else np.empty(0)
+
+
+def _segments(ids: np.ndarray, order_key: np.ndarray) -> list[np.ndarray]:
+    """Row indices of each id, in ``order_key`` order within the id."""
+    order = np.lexsort((order_key, ids))
+    cuts = np.flatnonzero(np.diff(ids[order])) + 1
+    return np.split(order, cuts) if len(order) else []
+
+
+def _thin(n: int, most: int) -> np.ndarray:
+    """Indices of at most ``most`` of ``n`` rows, evenly spread (deterministic)."""
+    if n <= most:
+        return np.arange(n)
+    return np.unique(np.linspace(0, n - 1, most).astype(np.int64))
+
+
+def plot_traces(plots: PlotTable, scale: float) -> list[dict[str, Any]]:
+    """Plots as markers: clutter grey and target plots blue when ``origin`` is known;
+    each kind thinned to at most :data:`MAX_PLOTS` (its legend entry then says so)."""
+    hover = ("scan %{customdata[0]}, t = %{customdata[1]:.1f} s, sensor %{customdata[2]}"
+             "<extra></extra>")
+    kinds = ([("plots", np.arange(len(plots)), {"size": 3, "color": "#8c8c8c"})]
+             if plots.origin is None else
+             [("clutter", np.flatnonzero(plots.origin < 0), {"size": 3, "color": "#b3b3b3"}),
+              ("target plots", np.flatnonzero(plots.origin >= 0),
+               {"size": 4, "color": "#1f77b4", "opacity": 0.6})])
+    out = []
+    for name, rows, marker in kinds:
+        keep = rows[_thin(len(rows), MAX_PLOTS)]
+        note = "" if len(keep) == len(rows) else f" ({len(keep)} of {len(rows)} drawn)"
+        out.append({"type": "scatter", "mode": "markers", "name": name + note,
+                    "x": plots.x[keep] / scale, "y": plots.y[keep] / scale,
+                    "customdata": np.column_stack([plots.scan[keep], plots.time[keep],
+                                                   plots.sensor[keep]]),
+                    "hovertemplate": hover, "marker": marker})
+    return out
+
+
+def truth_traces(truth: TruthTable, scale: float) -> list[dict[str, Any]]:
+    """Truth lines (one trace, gaps between targets), ``o`` at births and ``x`` at deaths."""
+    segs = _segments(truth.target_id, truth.time)
+    ids = _gapped([truth.target_id[r] for r in segs])
+    line = {"type": "scatter", "mode": "lines", "name": "truth", "legendgroup": "truth",
+            "x": _gapped([truth.x[r] / scale for r in segs]),
+            "y": _gapped([truth.y[r] / scale for r in segs]),
+            "customdata": ids, "line": {"color": "black", "width": 1.5},
+            "hovertemplate": "target %{customdata}<extra></extra>"}
+    ends = []
+    for name, pick, symbol in (("births", 0, "circle-open"), ("deaths", -1, "x-thin-open")):
+        rows = np.array([r[pick] for r in segs], dtype=np.int64)
+        ends.append({"type": "scatter", "mode": "markers", "name": f"truth {name}",
+                     "legendgroup": "truth", "showlegend": False,
+                     "x": truth.x[rows] / scale, "y": truth.y[rows] / scale,
+                     "customdata": truth.target_id[rows],
+                     "hovertemplate": f"target %{{customdata}} ({name[:-1]})<extra></extra>",
+                     "marker": {"symbol": symbol, "size": 8, "color": "black",
+                                "line": {"width": 1.5, "color": "black"}}})
+    return [line, *ends]
+
+
+def track_traces(tracks: TrackTable, scale: float) -> list[dict[str, Any]]:
+    """Tracks: one trace per id (its own colour, labelled at its end) up to
+    :data:`MAX_TRACK_TRACES` ids, else one trace for all; rows reported before the track
+    was confirmed (``tentative``, the history output) in one dotted trace."""
+    tent = (np.zeros(len(tracks), bool) if tracks.tentative is None
+            else np.asarray(tracks.tentative, bool))
+    segs = _segments(tracks.track_id, tracks.time)
+    hover = ("track %{customdata[0]}, scan %{customdata[1]}, t = %{customdata[2]:.1f} s"
+             "<extra></extra>")
+
+    def trace(rows_list: list[np.ndarray], **kw: Any) -> dict[str, Any]:
+        data = [np.column_stack([tracks.track_id[r], tracks.scan[r], tracks.time[r]])
+                for r in rows_list]
+        gaps = np.full((1, 3), np.nan)
+        custom = np.concatenate([p for d in data for p in (d, gaps)]) if data else gaps
+        return {"type": "scatter", "mode": "lines", "legendgroup": "tracks",
+                "x": _gapped([tracks.x[r] / scale for r in rows_list]),
+                "y": _gapped([tracks.y[r] / scale for r in rows_list]),
+                "customdata": custom, "hovertemplate": hover, **kw}
+
+    out: list[dict[str, Any]] = []
+    if tent.any():  # dotted up to the first confirmed row after the tentative ones
+        dotted = [r[: np.flatnonzero(tent[r])[-1] + 2] for r in segs if tent[r].any()]
+        out.append(trace(dotted, name="tracks before confirmation", legendgroup="tentative",
+                         line={"color": "#7f7f7f", "width": 1.2, "dash": "dot"}))
+    solid = [r[~tent[r]] for r in segs]
+    solid = [r for r in solid if len(r)]
+    if len(solid) > MAX_TRACK_TRACES:
+        out.append(trace(solid, name=f"tracks ({len(solid)})",
+                         line={"color": "#1f77b4", "width": 1.4}))
+        return out
+    for j, r in enumerate(solid):
+        tid = int(tracks.track_id[r[0]])
+        t = trace([r], name="tracks", showlegend=j == 0, mode="lines+text",
+                  line={"color": PALETTE[tid % len(PALETTE)], "width": 1.8})
+        t["text"] = [""] * (len(r) - 1) + [str(tid), ""]
+        t["textposition"] = "top right"
+        t["textfont"] = {"color": PALETTE[tid % len(PALETTE)], "size": 10}
+        out.append(t)
+    return out
+
+
+def site_traces(sites: Sequence[Site], scale: float) -> list[dict[str, Any]]:
+    """Radar sites: red triangles, labelled."""
+    if not sites:
+        return []
+    return [{"type": "scatter", "mode": "markers+text", "name": "radar sites",
+             "x": [s[0] / scale for s in sites], "y": [s[1] / scale for s in sites],
+             "text": [str(s[2]) for s in sites], "textposition": "bottom right",
+             "hovertemplate": "%{text}<extra></extra>",
+             "marker": {"symbol": "triangle-up", "size": 12, "color": "#d62728",
+                        "line": {"color": "black", "width": 1}}}]
+
+
+def grid_step(span_deg: float) -> float:
+    """The first of :data:`GRID_STEPS` giving at most :data:`GRID_LINES` lines over
+    ``span_deg`` degrees."""
+    for step in GRID_STEPS:
+        if span_deg / step <= GRID_LINES:
+            return step
+    return GRID_STEPS[-1]
+
+
+def latlon_grid(frame: LocalFrame, box: tuple[float, float, float, float],
+                scale: float) -> list[dict[str, Any]]:
+    """Lines of constant latitude and longitude over ``box = (x0, x1, y0, y1)`` (local
+    frame, m), projected by ``frame`` (WGS-84, azimuthal equidistant): one trace of lines
+    and one of their labels. No map tiles: nothing is fetched."""
+    x0, x1, y0, y1 = box
+    gx, gy = np.meshgrid(np.linspace(x0, x1, 9), np.linspace(y0, y1, 9))
+    lat, lon = frame.to_geodetic(gx.ravel(), gy.ravel())
+    lat_lo, lat_hi = float(np.min(lat)), float(np.max(lat))
+    lon_lo, lon_hi = float(np.min(lon)), float(np.max(lon))
+    step = grid_step(max(lat_hi - lat_lo, lon_hi - lon_lo))
+    lats = np.arange(math.ceil(lat_lo / step), math.floor(lat_hi / step) + 1) * step
+    lons = np.arange(math.ceil(lon_lo / step), math.floor(lon_hi / step) + 1) * step
+    fine_lon, fine_lat = np.linspace(lon_lo, lon_hi, 60), np.linspace(lat_lo, lat_hi, 60)
+    xs: list[np.ndarray] = []
+    ys: list[np.ndarray] = []
+    lx: list[float] = []
+    ly: list[float] = []
+    labels: list[str] = []
+    for la in lats:
+        x, y = frame.to_local(np.full_like(fine_lon, la), fine_lon)
+        xs.append(x / scale)
+        ys.append(y / scale)
+        lx.append(float(x[0] / scale))
+        ly.append(float(y[0] / scale))
+        labels.append(f"{la:.{_decimals(step)}f}°{'N' if la >= 0 else 'S'}")
+    for lo in lons:
+        x, y = frame.to_local(fine_lat, np.full_like(fine_lat, lo))
+        xs.append(x / scale)
+        ys.append(y / scale)
+        lx.append(float(x[0] / scale))
+        ly.append(float(y[0] / scale))
+        labels.append(f"{abs(lo):.{_decimals(step)}f}°{'E' if lo >= 0 else 'W'}")
+    style = {"color": "#9aa9c4", "width": 0.8, "dash": "dash"}
+    return [
+        {"type": "scatter", "mode": "lines", "name": f"lat/lon grid ({step:g}°)",
+         "legendgroup": "grid", "x": _gapped(xs), "y": _gapped(ys), "line": style,
+         "hoverinfo": "skip"},
+        {"type": "scatter", "mode": "text", "name": "lat/lon labels", "legendgroup": "grid",
+         "showlegend": False, "x": lx, "y": ly, "text": labels, "hoverinfo": "skip",
+         "textposition": "top right", "textfont": {"color": "#5a6f96", "size": 10}},
+    ]
+
+
+def _decimals(step: float) -> int:
+    return max(0, -math.floor(math.log10(step) + 1e-9)) if step < 1 else 0
+
+
+def _box(tables: Sequence[Any], sites: Sequence[Site]) -> tuple[float, float, float, float]:
+    xs = [np.asarray(t.x, float) for t in tables if t is not None and len(t)]
+    ys = [np.asarray(t.y, float) for t in tables if t is not None and len(t)]
+    xs += [np.array([s[0] for s in sites], float)] if sites else []
+    ys += [np.array([s[1] for s in sites], float)] if sites else []
+    if not xs:
+        return (-1.0, 1.0, -1.0, 1.0)
+    x, y = np.concatenate(xs), np.concatenate(ys)
+    x, y = x[np.isfinite(x)], y[np.isfinite(y)]
+    return float(x.min()), float(x.max()), float(y.min()), float(y.max())
+
+
+def scene_figure(plots: PlotTable | None = None, truth: TruthTable | None = None,
+                 tracks: TrackTable | None = None, *, sites: Sequence[Site] = (),
+                 frame: LocalFrame | None = None, title: str = "") -> go.Figure:
+    """The scene as a :class:`plotly.graph_objects.Figure`: plots, truth, tracks, radar
+    ``sites`` and, when ``frame`` is given (a geographic scene), the lat/lon grid.
+    Equal axes, kilometres when the scene spans more than 10 km."""
+    import plotly.graph_objects as go
+
+    box = _box((plots, truth, tracks), sites)
+    span = max(box[1] - box[0], box[3] - box[2])
+    km = math.isfinite(span) and span > KM_ABOVE_M
+    scale, unit = (1000.0, "km") if km else (1.0, "m")
+    traces: list[dict[str, Any]] = []
+    if frame is not None:
+        traces += latlon_grid(frame, box, scale)
+    if plots is not None and len(plots):
+        traces += plot_traces(plots, scale)
+    if truth is not None and len(truth):
+        traces += truth_traces(truth, scale)
+    if tracks is not None and len(tracks):
+        traces += track_traces(tracks, scale)
+    traces += site_traces(sites, scale)
+    fig = go.Figure(data=traces)
+    fig.update_layout(
+        title={"text": title}, height=760, template="plotly_white", dragmode="pan",
+        legend={"orientation": "h", "y": -0.08, "x": 0, "yanchor": "top"},
+        margin={"l": 60, "r": 20, "t": 50, "b": 60}, hovermode="closest",
+        xaxis={"title": {"text": f"x east ({unit})"}, "zeroline": False,
+               "constrain": "domain"},
+        yaxis={"title": {"text": f"y north ({unit})"}, "scaleanchor": "x", "scaleratio": 1,
+               "zeroline": False, "constrain": "domain"},
+    )
+    return fig

@@ -1,0 +1,279 @@
+"""A headless Chromium driven over the Chrome DevTools protocol (CDP) through
+``--remote-debugging-pipe`` (fd 3 commands in, fd 4 replies out, one JSON message per
+NUL-terminated chunk): no websocket library and no open port needed.
+
+``browser`` (fixture) opens a page from disk and returns what the report tests check:
+each Plotly figure's traces (given and drawn as SVG), the console's errors and uncaught
+exceptions, every request that left the machine, and a PNG screenshot of the whole page.
+The fixture skips, with the reason, where no Chromium is installed.
+"""
+
+from __future__ import annotations
+
+import base64
+import fcntl
+import json
+import os
+import select
+import shutil
+import signal
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+#: Names of the Chromium executable, tried in order (Debian's package: ``chromium``).
+CHROMIUM_NAMES = ("chromium", "chromium-browser", "google-chrome", "chrome")
+FLAGS = ("--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
+         "--disable-background-networking", "--disable-component-update", "--disable-sync",
+         "--disable-default-apps", "--disable-extensions", "--mute-audio",
+         "--remote-debugging-pipe")
+#: Per figure: its div id, traces given to Plotly, scatter traces drawn in SVG, SVGs.
+FIGURES_JS = """JSON.stringify(Array.from(document.querySelectorAll('div.plotly-graph-div'))
+  .map(d => ({id: d.id, given: (d.data || []).length,
+              drawn: d.querySelectorAll('g.scatterlayer g.trace').length,
+              svg: d.querySelectorAll('svg.main-svg').length,
+              points: d.querySelectorAll('g.scatterlayer path.point').length})))"""
+#: Local schemes: anything else requested by the page went to the network.
+LOCAL = ("file:", "data:", "about:", "blob:", "chrome:", "devtools:")
+
+
+def chromium_path() -> str | None:
+    """The first Chromium on ``PATH`` (``$MHTRACK_CHROMIUM`` first, when set)."""
+    for name in (os.environ.get("MHTRACK_CHROMIUM"), *CHROMIUM_NAMES):
+        if name and (path := shutil.which(name)):
+            return path
+    return None
+
+
+@dataclass
+class PageCheck:
+    """What the browser saw: ``figures`` (see :data:`FIGURES_JS`), ``errors`` (console
+    errors, uncaught exceptions, failed loads), ``requests`` (URLs outside
+    :data:`LOCAL`), ``screenshot`` path."""
+
+    figures: list[dict[str, Any]]
+    errors: list[str] = field(default_factory=list)
+    requests: list[str] = field(default_factory=list)
+    screenshot: Path | None = None
+
+
+class Chromium:
+    """One headless Chromium process and one page of it, over the CDP pipe."""
+
+    def __init__(self, exe: str, profile: Path) -> None:
+        cmd_r, cmd_w = os.pipe()
+        out_r, out_w = os.pipe()
+        hi = [fcntl.fcntl(fd, fcntl.F_DUPFD_CLOEXEC, 10) for fd in (cmd_r, out_w)]
+        for fd in (cmd_r, out_w):
+            os.close(fd)
+        self.log = open(profile.parent / "chromium.log", "wb")  # noqa: SIM115
+        actions = [(os.POSIX_SPAWN_DUP2, hi[0], 3), (os.POSIX_SPAWN_DUP2, hi[1], 4),
+                   (os.POSIX_SPAWN_DUP2, self.log.fileno(), 1),
+                   (os.POSIX_SPAWN_DUP2, self.log.fileno(), 2)]
+        argv = [exe, *FLAGS, f"--user-data-dir={profile}", "about:blank"]
+        self.pid = os.posix_spawn(exe, argv, os.environ, file_actions=actions,
+                                  setpgroup=0)
+        for fd in hi:
+            os.close(fd)
+        self.w, self.r = cmd_w, out_r
+        self.buf = b""
+        self.next_id = 0
+        self.events: list[dict[str, Any]] = []
+        self.session: str | None = None
+
+    def send(self, method: str, params: dict[str, Any] | None = None, *,
+             timeout: float = 60.0) -> dict[str, Any]:
+        """Send one command (to the page's session once attached); its result."""
+        self.next_id += 1
+        msg: dict[str, Any] = {"id": self.next_id, "method": method, "params": params or {}}
+        if self.session is not None:
+            msg["sessionId"] = self.session
+        os.write(self.w, json.dumps(msg).encode() + b"\0")
+        while True:
+            reply = self._receive(timeout)
+            if reply.get("id") == self.next_id:
+                if "error" in reply:
+                    raise RuntimeError(f"CDP {method}: {reply['error']}")
+                return reply.get("result", {})
+            self.events.append(reply)
+
+    def _receive(self, timeout: float) -> dict[str, Any]:
+        deadline = time.monotonic() + timeout
+        while b"\0" not in self.buf:
+            left = deadline - time.monotonic()
+            if left <= 0 or not select.select([self.r], [], [], left)[0]:
+                raise TimeoutError("no reply from Chromium")
+            chunk = os.read(self.r, 1 << 20)
+            if not chunk:
+                raise ConnectionError("Chromium closed the pipe")
+            self.buf += chunk
+        msg, self.buf = self.buf.split(b"\0", 1)
+        return json.loads(msg)
+
+    def wait_event(self, method: str, timeout: float = 60.0) -> dict[str, Any]:
+        """The first event ``method`` (already received or coming)."""
+        for e in self.events:
+            if e.get("method") == method:
+                return e
+        deadline = time.monotonic() + timeout
+        while True:
+            e = self._receive(max(0.0, deadline - time.monotonic()))
+            self.events.append(e)
+            if e.get("method") == method:
+                return e
+
+    def open(self, url: str, width: int) -> None:
+        """Attach to a new page of ``width`` CSS pixels and load ``url``."""
+        target = self.send("Target.createTarget", {"url": "about:blank"})["targetId"]
+        self.session = self.send("Target.attachToTarget",
+                                 {"targetId": target, "flatten": True})["sessionId"]
+        for domain in ("Runtime", "Log", "Page", "Network"):
+            self.send(f"{domain}.enable")
+        self.send("Emulation.setDeviceMetricsOverride",
+                  {"width": width, "height": 1000, "deviceScaleFactor": 1, "mobile": False})
+        self.send("Page.navigate", {"url": url})
+        self.wait_event("Page.loadEventFired", timeout=120)
+
+    def evaluate(self, expression: str) -> Any:
+        r = self.send("Runtime.evaluate", {"expression": expression, "returnByValue": True})
+        return r["result"].get("value")
+
+    def screenshot(self, path: Path, width: int, most_height: int = 12000) -> Path:
+        """The whole page (up to ``most_height`` pixels) as PNG."""
+        height = self.send("Page.getLayoutMetrics")["cssContentSize"]["height"]
+        shot = self.send("Page.captureScreenshot", {
+            "format": "png", "captureBeyondViewport": True,
+            "clip": {"x": 0, "y": 0, "width": width, "height": min(height, most_height),
+                     "scale": 1}}, timeout=120)
+        path.write_bytes(base64.b64decode(shot["data"]))
+        return path
+
+    def problems(self) -> tuple[list[str], list[str]]:
+        """(errors, network requests) among the events received so far."""
+        errors, requests = [], []
+        for e in self.events:
+            m, p = e.get("method"), e.get("params", {})
+            if m == "Runtime.exceptionThrown":
+                d = p["exceptionDetails"]
+                errors.append(d.get("exception", {}).get("description") or d.get("text", ""))
+            elif m == "Runtime.consoleAPICalled" and p.get("type") in ("error", "assert"):
+                errors.append(" ".join(str(a.get("value", a.get("description", "")))
+                                       for a in p.get("args", [])))
+            elif m == "Log.entryAdded" and p["entry"].get("level") == "error":
+                errors.append(p["entry"].get("text", ""))
+            elif m == "Network.requestWillBeSent":
+                url = p["request"]["url"]
+                if not url.startswith(LOCAL):
+                    requests.append(url)
+        return errors, requests
+
+    def close(self) -> None:
+        try:
+            self.session = None
+            self.send("Browser.close", timeout=10)
+        except (OSError, RuntimeError, TimeoutError, ConnectionError):
+            pass
+        for _ in range(100):
+            if os.waitpid(self.pid, os.WNOHANG)[0]:
+                break
+            time.sleep(0.05)
+        else:
+            os.killpg(self.pid, signal.SIGKILL)
+            os.waitpid(self.pid, 0)
+        for fd in (self.w, self.r):
+            os.close(fd)
+        self.log.close()
+
+
+def check_page(exe: str, page: Path, work: Path, *, width: int = 1400,
+               settle_s: float = 0.5, draw_s: float = 60.0) -> PageCheck:
+    """Open ``page`` in headless Chromium, wait (at most ``draw_s``) until Plotly has drawn
+    every figure, and report (see :class:`PageCheck`); the screenshot goes to
+    ``work/<page stem>.png``."""
+    work.mkdir(parents=True, exist_ok=True)
+    b = Chromium(exe, work / "profile")
+    try:
+        b.open(page.resolve().as_uri(), width)
+        figures: list[dict[str, Any]] = []
+        deadline = time.monotonic() + draw_s
+        while time.monotonic() < deadline:  # until every figure has drawn its traces
+            figures = json.loads(b.evaluate(FIGURES_JS))
+            if all(f["svg"] and f["drawn"] >= f["given"] for f in figures):
+                break
+            time.sleep(0.2)
+        time.sleep(settle_s)
+        shot = b.screenshot(work / f"{page.stem}.png", width)
+        errors, requests = b.problems()
+        return PageCheck(figures, errors, requests, shot)
+    finally:
+        b.close()
+
+
+@pytest.fixture(scope="session")
+def chromium() -> str:
+    """Chromium's path; the test is skipped, with the reason, where there is none."""
+    exe = chromium_path()
+    if exe is None:
+        pytest.skip("no Chromium on PATH (apt-get install chromium, or set "
+                    "MHTRACK_CHROMIUM): the HTML report is not checked in a browser")
+    return exe
+
+
+# --- directories to report on, made once per session through the CLI ---------------------
+
+def invoke(*args: str) -> tuple[int, str, str]:
+    """``mhtrack ARGS`` in this process: exit code, stdout, stderr."""
+    from click.testing import CliRunner
+
+    from mhtrack.cli.main import cli
+
+    r = CliRunner().invoke(cli, list(args))
+    return r.exit_code, r.stdout, r.stderr
+
+
+@pytest.fixture(scope="session")
+def run_dir(tmp_path_factory) -> Path:
+    """``run crossing --seed 1 --scans 30 --report``: a run with its report.html."""
+    out = tmp_path_factory.mktemp("html-run") / "c"
+    code, _, err = invoke("run", "crossing", "--seed", "1", "--scans", "30", "--out",
+                          str(out), "--report", "--no-progress")
+    assert code == 0, err
+    return out
+
+
+@pytest.fixture(scope="session")
+def geo_dir(tmp_path_factory) -> Path:
+    """``simulate opensky-radars`` (4 scans) and ``track``: timed plots of three radars
+    at WGS-84 sites, a sensors file, no metrics.json."""
+    out = tmp_path_factory.mktemp("html-geo")
+    code, _, err = invoke("simulate", "opensky-radars", "--seed", "1", "--scans", "4",
+                          "--out", str(out))
+    assert code == 0, err
+    code, _, err = invoke("track", str(out / "plots.csv"), "--out", str(out / "tracks.csv"),
+                          "--no-progress")
+    assert code == 0, err
+    return out
+
+
+@pytest.fixture(scope="session")
+def study_dir(tmp_path_factory) -> Path:
+    """``montecarlo crossing``: two trackers, 3 runs of 20 scans, in this process."""
+    out = tmp_path_factory.mktemp("html-study") / "mc"
+    code, _, err = invoke("montecarlo", "crossing", "--trackers", "mht-gmm,mht-agmm",
+                          "--runs", "3", "--scans", "20", "--workers", "1", "--out",
+                          str(out), "--no-progress")
+    assert code == 0, err
+    return out
+
+
+@pytest.fixture
+def open_in_browser(chromium, tmp_path):
+    """``open_in_browser(page) -> PageCheck``, screenshots under the test's tmp folder."""
+
+    def run(page: Path, **kw: Any) -> PageCheck:
+        return check_page(chromium, page, tmp_path / "browser", **kw)
+
+    return run

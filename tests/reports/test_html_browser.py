@@ -1,0 +1,104 @@
+"""The HTML report in a real browser: headless Chromium (Debian's ``chromium`` package,
+installed by .ci/run) opens the page from disk over the DevTools protocol (conftest.py),
+every figure draws all its traces as SVG, the console shows no error, nothing is fetched
+from the network, and a screenshot of the whole page is saved in the test's tmp folder.
+Skipped, with the reason, where no Chromium is installed."""
+
+from __future__ import annotations
+
+import csv
+import json
+import shutil
+import struct
+
+import pytest
+
+pytest.importorskip("plotly", reason="the HTML report needs the optional extra [report]")
+
+from mhtrack.reports import montecarlo
+from mhtrack.reports.html_report import REPORT_FILE, write_html_report
+
+
+def _png_size(path):
+    data = path.read_bytes()
+    assert data[:8] == b"\x89PNG\r\n\x1a\n", "not a PNG"
+    return struct.unpack(">II", data[16:24])
+
+
+def _track_traces(path):
+    """Scene traces of a tracks file: one per id with a confirmed row, one for all rows
+    before confirmation."""
+    confirmed, tentative = set(), False
+    with open(path, newline="") as fh:
+        for row in csv.DictReader(fh):
+            if row.get("tentative") == "1":
+                tentative = True
+            else:
+                confirmed.add(row["track_id"])
+    return len(confirmed) + tentative
+
+
+def _clean(check):
+    assert check.errors == [], check.errors
+    assert check.requests == [], check.requests
+    for f in check.figures:
+        assert f["svg"] > 0, f
+        assert f["drawn"] == f["given"], f
+    width, height = _png_size(check.screenshot)
+    assert width == 1400 and height > 1000
+
+
+def test_run_report_renders(run_dir, open_in_browser):
+    check = open_in_browser(run_dir / REPORT_FILE)
+    _clean(check)
+    got = {f["id"]: f["drawn"] for f in check.figures}
+    # scene: clutter, target plots, truth line, births, deaths, the tracks; curves: OSPA,
+    # cardinality, the true number of targets (no OSPA(2) in this evaluation)
+    scene = 2 + 3 + _track_traces(run_dir / "tracks.csv")
+    m = json.loads((run_dir / "metrics.json").read_text())
+    curves = 3 + bool([v for v in m.get("ospa2") or [] if v is not None])
+    assert got == {"fig-scene": scene, "fig-curves": curves}
+    points = {f["id"]: f["points"] for f in check.figures}
+    with open(run_dir / "plots.csv", newline="") as fh:
+        n_plots = sum(1 for _ in csv.DictReader(fh))
+    with open(run_dir / "truth.csv", newline="") as fh:
+        n_targets = len({r["target_id"] for r in csv.DictReader(fh)})
+    assert points["fig-scene"] == n_plots + 2 * n_targets  # markers: plots, births, deaths
+
+
+def test_geographic_report_renders(geo_dir, open_in_browser, tmp_path):
+    page = write_html_report(geo_dir, tmp_path / "geo.html")
+    check = open_in_browser(page)
+    _clean(check)
+    # scene: lat/lon grid and its labels, clutter, target plots, truth (3), tracks, sites
+    scene = 2 + 2 + 3 + _track_traces(geo_dir / "tracks.csv") + 1
+    assert {f["id"]: f["drawn"] for f in check.figures}["fig-scene"] == scene
+
+
+def test_study_report_renders(study_dir, open_in_browser, tmp_path, monkeypatch):
+    monkeypatch.delattr(montecarlo, "paired_comparisons", raising=False)
+    d = tmp_path / "mc"
+    shutil.copytree(study_dir, d)
+    paired = [{"metric": m, "a": "mht-agmm", "b": "mht-gmm", "higher_better": hb, "n": 3,
+               "mean_diff": 1.0, "ci_low": 0.5, "ci_high": 1.5, "verdict": "worse"}
+              for m, hb in (("ospa_mean", False), ("rcc", True))]
+    (d / "results.json").write_text(json.dumps({"paired": paired}))
+    check = open_in_browser(write_html_report(d))
+    _clean(check)
+    # curves: per tracker and panel a band and a mean (2 × 2 × 2), the true cardinality;
+    # paired: one trace per metric
+    assert {f["id"]: f["drawn"] for f in check.figures} == {"fig-curves": 9, "fig-paired": 2}
+
+
+def test_the_check_sees_errors_and_network(open_in_browser, tmp_path):
+    """The browser check can fail: a page that throws and fetches from another host."""
+    page = tmp_path / "bad.html"
+    page.write_text('<!DOCTYPE html><html><body><div class="plotly-graph-div"></div>'
+                    '<img src="http://127.0.0.1:9/x.png">'
+                    "<script>console.error('broken'); undefinedFunction();</script>"
+                    "</body></html>")
+    check = open_in_browser(page, draw_s=1.0)
+    assert any("undefinedFunction" in e for e in check.errors), check.errors
+    assert any("broken" in e for e in check.errors), check.errors
+    assert check.requests == ["http://127.0.0.1:9/x.png"]
+    assert check.figures == [{"id": "", "given": 0, "drawn": 0, "svg": 0, "points": 0}]

@@ -48,3 +48,19 @@ def test_real_aircraft_are_tracked_with_the_defaults(caplog):
     assert s["mota"] > 0.85
     assert s["rcc"] > 0.9
     assert s["id_switches"] < 40
+
+
+def test_run_scenario_tracks_rotating_radars_as_track_sensors_does():
+    # A scenario of rotating radars: run_scenario must track its timed plots frame by
+    # frame with the radars' coverage, exactly as `mhtrack track --sensors` does.
+    from mhtrack.mht.coverage import RadarCoverage
+
+    sc = preset("opensky-radars", scans=4)
+    run = run_scenario(sc, 1, "mht-agmm")
+    assert run.simulation.plots.timed
+    trk = make_tracker("mht-agmm", default_config(sc), sensors=sc.sensor_set())
+    assert isinstance(trk.coverage, RadarCoverage)
+    direct = track(trk, run.simulation.plots, name="mht-agmm")
+    assert len(run.run.tracks) > 0
+    assert run.run.tracks.track_id.tolist() == direct.tracks.track_id.tolist()
+    assert run.run.tracks.x.tolist() == direct.tracks.x.tolist()

@@ -106,6 +106,7 @@ def make_tracker(
     birth: str | None = None,
     theta_deg: float | None = None,
     sensors: SensorSet | None = None,
+    clutter_params: dict[str, Any] | None = None,
 ) -> MHTTracker:
     """A fresh tracker by name (:data:`TRACKER_ESTIMATORS`).
 
@@ -121,19 +122,23 @@ def make_tracker(
     (:class:`~mhtrack.clutter.per_sensor.PerSensorClutter`, the tracker's estimator per
     radar; ``known``: κ per m² per look), and confirms a tree only once its branch holds
     at least :data:`TIMED_CONFIRM_MIN_PLOTS` plots (``config.confirm_min_plots`` if
-    larger)."""
+    larger).
+
+    ``clutter_params``: keywords of the tracker's clutter estimator
+    (:func:`make_clutter_estimator`; e.g. ``{"bic": False}``); ``known`` ignores them."""
     if name not in TRACKER_ESTIMATORS:
         raise ValueError(f"unknown tracker {name!r} "
                          f"(expected one of {', '.join(TRACKER_ESTIMATORS)})")
     config = config_with(config, birth=birth, birth_theta_deg=theta_deg)
     kappa = clutter_density if takes_clutter_density(name) else None
     estimator = TRACKER_ESTIMATORS[name]
+    params = {} if clutter_params is None or estimator == "known" else dict(clutter_params)
     if sensors is None:
-        return MHTTracker(config, make_clutter_estimator(estimator, kappa=kappa))
+        return MHTTracker(config, make_clutter_estimator(estimator, kappa=kappa, **params))
     config = config_with(config, confirm_min_plots=max(config.confirm_min_plots,
                                                        TIMED_CONFIRM_MIN_PLOTS))
     clutter = PerSensorClutter(
-        lambda: make_clutter_estimator(estimator, kappa=kappa),
+        lambda: make_clutter_estimator(estimator, kappa=kappa, **params),
         {s.id: s.period for s in sensors.sensors},
         initial=DEFAULT_CLUTTER_DENSITY if kappa is None else kappa)
     return MHTTracker(config, clutter, coverage=RadarCoverage(sensors))

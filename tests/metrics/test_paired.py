@@ -63,7 +63,7 @@ def test_clear_improvement_lower_is_better() -> None:
     assert c.verdict == BETTER
     assert c.ci_high < 0
     assert c.n_a_better == 40 and c.n_b_better == 0
-    assert c.sentence.startswith("ospa (lower is better): AGMM is better than GMM")
+    assert c.sentence.startswith("AGMM vs GMM, ospa (lower is better): AGMM is better than GMM")
     assert c.wilcoxon_p < 1e-6 and c.sign_p < 1e-6
 
 

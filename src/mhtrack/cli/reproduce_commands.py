@@ -22,15 +22,23 @@ def reproduce() -> None:
               "fig2–fig6 PNG); an existing study with the same parameters is resumed.")
 @click.option("--seed", type=click.IntRange(min=0), default=0, show_default=True,
               help="Base seed; run i simulates with a seed derived from (SEED, i) only.")
+@click.option("--tracker-settings", "tracker_settings", type=click.Choice(["paper", "best"]),
+              default="best", show_default=True,
+              help="paper: P1's tracker (one constant-velocity model, online output, "
+              "P1's clutter-estimator steps only); best: ours (two-model IMM, history "
+              "output, our estimator additions).")
 @executor_options
-def p1(runs: int, out: Path, seed: int, workers: int | None, dask_scheduler: str | None,
-       progress: bool | None) -> None:
+def p1(runs: int, out: Path, seed: int, tracker_settings: str, workers: int | None,
+       dask_scheduler: str | None, progress: bool | None) -> None:
     """P1 §3: Monte-Carlo study of `crossing` with mht, mht-gmm and mht-agmm.
 
     Writes OUT/montecarlo/ (the runs; rerunning resumes), OUT/table3.md (our Table 3,
-    mean ± std over RUNS runs, beside P1's numbers), OUT/report.md (settings, comparison,
-    figures) and P1's Figs. 2–6 as OUT/fig2_truth.png … OUT/fig6_cardinality.png. Prints
-    the table. Exit status 1 if any run failed (after everything was written).
+    mean ± std over RUNS runs, beside P1's numbers, and the paired comparisons),
+    OUT/table3.json, OUT/report.md (settings, comparison, figures) and P1's Figs. 2–6 as
+    OUT/fig2_truth.png … OUT/fig6_cardinality.png. With --tracker-settings paper the
+    files are OUT/montecarlo-paper/, OUT/table3-paper.md, OUT/report-paper.md, … and a
+    study of the other settings in OUT is shown beside it. Prints the table. Exit status
+    1 if any run failed (after everything was written).
     """
     from mhtrack.experiments.montecarlo import SpecMismatchError
     from mhtrack.experiments.p1 import reproduce_p1
@@ -38,7 +46,7 @@ def p1(runs: int, out: Path, seed: int, workers: int | None, dask_scheduler: str
 
     run_on = executor_kwargs(workers, dask_scheduler, progress)
     try:
-        repro = reproduce_p1(out, runs, seed, **run_on)
+        repro = reproduce_p1(out, runs, seed, settings=tracker_settings, **run_on)
     except (SpecMismatchError, ValueError) as e:
         raise InputProblem(str(e)) from None
     report = write_p1_report(repro)

@@ -120,13 +120,13 @@ def verdict_sentence(c: PairedComparison, digits: int = 3, unit: str = "",
         return (f"{c.a} vs {c.b}, {what} ({side}): {NO_DIFFERENCE} at n = {c.n} — "
                 f"identical in all {c.n} runs.")
     head = (f"{c.a} is {c.verdict} than {c.b}" if c.verdict != NO_DIFFERENCE
-            else f"{c.a} vs {c.b}: {NO_DIFFERENCE} at n = {c.n}")
+            else f"{NO_DIFFERENCE} at n = {c.n}")
     ci = (f"95 % CI [{_fmt(c.ci_low, digits)}, {_fmt(c.ci_high, digits)}]{unit}"
           if math.isfinite(c.ci_low) else "no interval from one run")
-    return (f"{what} ({side}): {head} — mean difference {_fmt(c.mean_diff, digits)}{unit}, "
-            f"{ci}, n = {c.n} paired runs, {c.n_identical} identical; {c.a} better in "
-            f"{c.n_a_better}, worse in {c.n_b_better}; sign test p {_p(c.sign_p)}, "
-            f"Wilcoxon p {_p(c.wilcoxon_p)}.")
+    return (f"{c.a} vs {c.b}, {what} ({side}): {head} — mean difference "
+            f"{_fmt(c.mean_diff, digits)}{unit}, {ci}, n = {c.n} paired runs, "
+            f"{c.n_identical} identical; {c.a} better in {c.n_a_better}, worse in "
+            f"{c.n_b_better}; sign test p {_p(c.sign_p)}, Wilcoxon p {_p(c.wilcoxon_p)}.")
 
 
 def compare_paired(a: npt.ArrayLike, b: npt.ArrayLike, *, metric: str, name_a: str,

@@ -120,3 +120,11 @@ def test_paired_by_run_matches_runs() -> None:
     a, b, runs = paired_by_run(ra, rb, "x")
     assert runs == [1, 2]
     assert np.isnan(a[0]) and a[1] == 3.0 and b.tolist() == [20.0, 30.0]
+
+
+def test_small_n_verdict_says_wilcoxon_does_not_confirm() -> None:
+    c = compare_paired([1.0, 2.0, 3.0], [2.0, 3.1, 4.0], metric="m", name_a="A", name_b="B",
+                       higher_better=True)
+    assert c.verdict == WORSE  # the t interval excludes 0
+    assert c.wilcoxon_p >= 0.05  # n = 3: the smallest two-sided p is 0.25
+    assert "does not confirm it" in c.sentence

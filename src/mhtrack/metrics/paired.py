@@ -19,7 +19,10 @@ variation of the scenario. From the ``n`` runs where both have a finite value:
 ``better`` when the whole interval lies on ``a``'s better side of 0 (below 0 when lower is
 better, above when higher is better), ``worse`` when it lies on the other side, otherwise
 ``no detectable difference at n = …``. With one run (no interval) or no runs, no
-difference is detectable. The tests' p-values are printed beside it, not used by it.
+difference is detectable. The tests' p-values are printed beside it, not used by it; when
+the interval gives a verdict that the Wilcoxon test does not confirm at the 0.05 level
+(few runs: with ``n ≤ 5`` it cannot; or differences far from normal), the sentence says
+so.
 """
 
 from __future__ import annotations
@@ -126,7 +129,11 @@ def verdict_sentence(c: PairedComparison, digits: int = 3, unit: str = "",
     return (f"{c.a} vs {c.b}, {what} ({side}): {head} — mean difference "
             f"{_fmt(c.mean_diff, digits)}{unit}, {ci}, n = {c.n} paired runs, "
             f"{c.n_identical} identical; {c.a} better in {c.n_a_better}, worse in "
-            f"{c.n_b_better}; sign test p {_p(c.sign_p)}, Wilcoxon p {_p(c.wilcoxon_p)}.")
+            f"{c.n_b_better}; sign test p {_p(c.sign_p)}, Wilcoxon p {_p(c.wilcoxon_p)}"
+            + (f" (the Wilcoxon test does not confirm it at the {1 - CONFIDENCE:.2f} level: "
+               "few runs or non-normal differences)"
+               if c.verdict != NO_DIFFERENCE and not c.wilcoxon_p < 1 - CONFIDENCE else "")
+            + ".")
 
 
 def compare_paired(a: npt.ArrayLike, b: npt.ArrayLike, *, metric: str, name_a: str,

@@ -92,3 +92,22 @@ def test_cli(tmp_path, monkeypatch):
 def test_cli_rejects_bad_runs(tmp_path):
     r = CliRunner().invoke(reproduce, ["clutter-shift", "--runs", "0", "--out", str(tmp_path)])
     assert r.exit_code == 2
+
+
+def test_ablation_cached_and_explained(tmp_path):
+    from mhtrack.experiments.clutter_shift_ablation import VARIANTS, cached_ablation
+    from mhtrack.reports.clutter_shift import analysis_text
+
+    sc = preset("crossing-changing", scans=5)
+    ab = cached_ablation(tmp_path, sc, runs=2, resolution=30)
+    assert set(ab.iae) == set(VARIANTS) and all(len(v) == 2 for v in ab.iae.values())
+    # the same study read back, not recomputed
+    again = cached_ablation(tmp_path, sc, runs=2, resolution=30)
+    assert [c.to_dict() for c in again.paired] == [c.to_dict() for c in ab.paired]
+    # each comparison is the variant against the GMM, paired on the same runs
+    for c in ab.paired:
+        assert c.b == "gmm" and c.n == 2
+        assert c.mean_diff == pytest.approx(np.mean(ab.iae[c.a]) - np.mean(ab.iae["gmm"]))
+    text = analysis_text(ab)
+    for c in ab.paired:
+        assert c.sentence in text

@@ -110,8 +110,12 @@ def p2(runs: int, out: Path, seed: int, workers: int | None, dask_scheduler: str
               "finished jobs in OUT/jobs are skipped.")
 @click.option("--seed", type=click.IntRange(min=0), default=0, show_default=True,
               help="Base seed; run i simulates with a seed derived from (SEED, i) only.")
+@click.option("--ablation-runs", type=click.IntRange(min=0), default=0, show_default=True,
+              help="Also run each clutter estimator alone, one design choice switched at a "
+              "time, on the first N runs, and explain the AGMM–GMM verdict from it in the "
+              "report (kept in OUT/ablation.json).")
 @executor_options
-def clutter_shift(runs: int, out: Path, seed: int, workers: int | None,
+def clutter_shift(runs: int, out: Path, seed: int, ablation_runs: int, workers: int | None,
                   dask_scheduler: str | None, progress: bool | None) -> None:
     """Known κ, uniform κ̂, GMM and AGMM on `crossing-changing`, a clutter that changes.
 
@@ -129,7 +133,12 @@ def clutter_shift(runs: int, out: Path, seed: int, workers: int | None,
         study = cs.clutter_shift(out, runs, seed, scenario=scenario, **run_on)
     except ValueError as e:
         raise InputProblem(str(e)) from None
-    rep = write_clutter_shift_report(study, scenario)
+    ablation = None
+    if ablation_runs:
+        from mhtrack.experiments.clutter_shift_ablation import cached_ablation
+
+        ablation = cached_ablation(out, scenario, ablation_runs, seed)
+    rep = write_clutter_shift_report(study, scenario, ablation)
     for c in study.paired:
         if c.a == "agmm" and c.b == "gmm":
             click.echo(f"* {c.sentence}")

@@ -184,7 +184,8 @@ def settings_text(spec: MonteCarloSpec, settings: TrackerSettings | None = None)
     sc = Scenario.from_dict(spec.scenario)
     d = spec.scenario
     cfg = config_with(default_config(sc), **spec.config)
-    motion = ("one constant-velocity model" if cfg.models is None else
+    motion = (f"one constant-velocity model (σv = {cfg.sigma_v:g} m/s²)" if cfg.models is None
+              else
               f"an IMM of two constant-velocity models (σv = {cfg.imm_sigma_v:g} and "
               f"{cfg.sigma_v:g} m/s²)")
     lines = ([] if settings is None else [

@@ -108,6 +108,7 @@ def make_tracker(
     theta_deg: float | None = None,
     sensors: SensorSet | None = None,
     clutter_frame: str = "polar",
+    clutter_params: dict[str, Any] | None = None,
 ) -> MHTTracker:
     """A fresh tracker by name (:data:`TRACKER_ESTIMATORS`).
 
@@ -125,15 +126,19 @@ def make_tracker(
     (``clutter_frame="polar"``, :class:`~mhtrack.clutter.polar.PolarClutter`) or in the
     local plane (``"plane"``) — and confirms a tree only once its branch holds
     at least :data:`TIMED_CONFIRM_MIN_PLOTS` plots (``config.confirm_min_plots`` if
-    larger)."""
+    larger).
+
+    ``clutter_params``: keywords of the tracker's clutter estimator
+    (:func:`make_clutter_estimator`; e.g. ``{"bic": False}``); ``known`` ignores them."""
     if name not in TRACKER_ESTIMATORS:
         raise ValueError(f"unknown tracker {name!r} "
                          f"(expected one of {', '.join(TRACKER_ESTIMATORS)})")
     config = config_with(config, birth=birth, birth_theta_deg=theta_deg)
     kappa = clutter_density if takes_clutter_density(name) else None
     estimator = TRACKER_ESTIMATORS[name]
+    params = {} if clutter_params is None or estimator == "known" else dict(clutter_params)
     if sensors is None:
-        return MHTTracker(config, make_clutter_estimator(estimator, kappa=kappa))
+        return MHTTracker(config, make_clutter_estimator(estimator, kappa=kappa, **params))
     config = config_with(config, confirm_min_plots=max(config.confirm_min_plots,
                                                        TIMED_CONFIRM_MIN_PLOTS))
     if clutter_frame not in names.CLUTTER_FRAMES:
@@ -145,7 +150,7 @@ def make_tracker(
             s = sensors.sensor(sid)
             return inner if not s.has_site else PolarClutter(inner, sensors.site_xy(sid))
     clutter = PerSensorClutter(
-        lambda: make_clutter_estimator(estimator, kappa=kappa),
+        lambda: make_clutter_estimator(estimator, kappa=kappa, **params),
         {s.id: s.period for s in sensors.sensors},
         initial=DEFAULT_CLUTTER_DENSITY if kappa is None else kappa, wrap=wrap)
     return MHTTracker(config, clutter, coverage=RadarCoverage(sensors))

@@ -13,7 +13,7 @@ from mhtrack.experiments.p1 import constants as rp
 from mhtrack.experiments.p1 import reproduce_p1
 from mhtrack.experiments.p1 import study as p1_study
 from mhtrack.reports.p1 import write_p1_report
-from mhtrack.reports.p1_text import compare_text, fmt
+from mhtrack.reports.p1_text import fmt
 from mhtrack.scenario import preset
 
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
@@ -74,9 +74,10 @@ def test_table_holds_paper_and_ours(repro):
     s = repro.result.summary()
     for t in rp.P1_TRACKERS:
         label = rp.TRACKER_LABELS[t]
-        paper_row = next(line for line in md.splitlines() if line.startswith(f"| {label} | P1 |"))
+        paper_row = next(line for line in md.splitlines()
+                         if line.startswith(f"| {label} | P1 (as printed) |"))
         ours_row = next(line for line in md.splitlines()
-                        if line.startswith(f"| {label} | ours (2 runs) |"))
+                        if line.startswith(f"| {label} | ours, best settings (2 runs) |"))
         paper_cells = [c.strip() for c in paper_row.strip("|").split("|")][2:]
         ours_cells = [c.strip() for c in ours_row.strip("|").split("|")][2:]
         assert len(paper_cells) == len(ours_cells) == len(rp.TABLE3_METRICS)
@@ -137,19 +138,72 @@ def test_resume_computes_nothing(repro, report):
     assert again_report.table_md == report.table_md  # Tavg too is read back from the files
 
 
-def test_compare_text_ranks_ties():
-    row = {m.key: {"mean": 1.0, "std": 0.0, "paper": math.nan} for m in rp.TABLE3_METRICS}
-    table = {"mht": row, "mht-gmm": dict(row), "mht-agmm": dict(row)}
-    text = compare_text(table)
-    assert "MHT = MHT-GMM = MHT-AGMM" in text
-    assert "Identical accuracy" in text
+def test_paired_comparisons_in_json_match_their_intervals(repro):
+    js = json.loads((repro.out_dir / "table3.json").read_text())
+    assert js["tracker_settings"] == "best"
+    pairs = js["paired"]
+    # three tracker pairs × seven metrics (Tavg is not compared)
+    assert len(pairs) == 3 * 7
+    assert {(p["a"], p["b"]) for p in pairs} == {
+        ("MHT-AGMM", "MHT-GMM"), ("MHT-AGMM", "MHT"), ("MHT-GMM", "MHT")}
+    for p in pairs:
+        lo, hi = p["ci_low"], p["ci_high"]
+        if lo is None or not (lo > 0 or hi < 0):
+            assert p["verdict"] == "no detectable difference", p
+        else:
+            assert p["verdict"] == ("better" if (lo > 0) == p["higher_better"] else "worse")
+        # the per-run values of the run files give the same mean difference
+        ta = next(t for t, lab in rp.TRACKER_LABELS.items() if lab == p["a"])
+        tb = next(t for t, lab in rp.TRACKER_LABELS.items() if lab == p["b"])
+        d = [ra[p["metric"]] - rb[p["metric"]] for ra, rb in
+             zip(repro.result.records[ta], repro.result.records[tb], strict=True)]
+        assert p["mean_diff"] == pytest.approx(sum(d) / len(d), abs=1e-12)
+
+
+def test_report_has_no_unsupported_claim(repro, report):
+    text = report.report_path.read_text()
+    assert "best on" not in text and "best (or tied best)" not in text
+    assert "## Paired comparisons" in text
+    for c in repro.paired:
+        assert c.sentence in text
+
+
+def test_paper_settings_side_by_side(tmp_path):
+    repro, _ = run_p1(tmp_path)  # its own directory: the module's stays best-only
+    paper = reproduce_p1(repro.out_dir, runs=2, seed=3, scenario=preset("crossing", scans=15),
+                         workers=1, settings="paper")
+    rep = write_p1_report(paper)
+    assert paper.result.out_dir == repro.out_dir / "montecarlo-paper"
+    assert paper.result.spec.config == {"imm_sigma_v": 0.0}
+    assert paper.result.spec.run_kwargs["output"] == "online"
+    assert rep.table_path.name == "table3-paper.md"
+    md = rep.table_path.read_text()
+    for t in rp.P1_TRACKERS:
+        label = rp.TRACKER_LABELS[t]
+        for src in ("P1 (as printed)", "ours, P1's settings (2 runs)",
+                    "ours, best settings (2 runs)"):
+            assert f"| {label} | {src} |" in md
+    # each tracker also against itself under the best settings
+    cross = [c for c in paper.paired if "settings)" in c.a]
+    assert len(cross) == 3 * 7
+    js = json.loads((repro.out_dir / "table3-paper.json").read_text())
+    assert set(js["other_settings"]) == {"best"}
+    assert (repro.out_dir / "report-paper.md").is_file()
+    # the best study, rerun (nothing to compute), now shows the paper rows too
+    best = reproduce_p1(repro.out_dir, runs=2, seed=3, scenario=preset("crossing", scans=15),
+                        workers=1)
+    assert best.result.computed == 0
+    md = write_p1_report(best).table_md
+    assert md == (repro.out_dir / "table3.md").read_text()
+    assert "| MHT-AGMM | ours, P1's settings (2 runs) |" in md
 
 
 def test_cli_help():
     assert [reproduce] == COMMANDS
     r = CliRunner().invoke(reproduce, ["p1", "--help"])
     assert r.exit_code == 0
-    for opt in ("--runs", "--out", "--seed", "--workers", "--dask-scheduler", "--no-progress"):
+    for opt in ("--runs", "--out", "--seed", "--workers", "--dask-scheduler", "--no-progress",
+                "--tracker-settings"):
         assert opt in r.output
 
 
@@ -158,7 +212,8 @@ def test_cli_runs(tmp_path, monkeypatch):
     r = CliRunner().invoke(reproduce, ["p1", "--runs", "1", "--workers", "1", "--out",
                                        str(tmp_path), "--no-progress"])
     assert r.exit_code == 0, r.output
-    assert "| MHT-AGMM | P1 |" in r.stdout and "| MHT-AGMM | ours (1 run) |" in r.stdout
+    assert "| MHT-AGMM | P1 (as printed) |" in r.stdout
+    assert "| MHT-AGMM | ours, best settings (1 run) |" in r.stdout
     assert str(tmp_path / "report.md") in r.stdout
     for name in FILES:
         assert (tmp_path / name).is_file()

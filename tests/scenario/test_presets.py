@@ -21,7 +21,8 @@ EXAMPLE = Path(__file__).resolve().parents[2] / "docs" / "examples" / "drifting-
 
 
 def test_names():
-    assert PRESETS == ("crossing", "crossing-wide", "multiradar", "opensky", "opensky-radars")
+    assert PRESETS == ("crossing", "crossing-wide", "multiradar", "opensky", "opensky-radars",
+                       "crossing-changing")
     with pytest.raises(ValueError, match=r"unknown preset 'cross' \(expected crossing, "):
         preset("cross")
 

@@ -188,19 +188,22 @@ def run_scenario(
     theta_deg: float | None = None,
     fusion: str | None = None,
     output: str = "history",
+    clutter_params: dict[str, Any] | None = None,
 ) -> ScenarioRun:
     """Simulate ``scenario`` with ``seed``, run tracker ``tracker`` on it and evaluate.
 
     ``birth`` / ``theta_deg``: see :func:`make_tracker`; ``fusion``: ``"none"`` or
     ``"adaptive-kmeans"``, default :func:`default_fusion` of the scenario's sensors;
-    ``output``: see :func:`track`. A scenario of rotating radars (plots with their own
+    ``output``: see :func:`track`; ``clutter_params``: keywords of the clutter estimator
+    (:func:`make_tracker`). A scenario of rotating radars (plots with their own
     times) is tracked as ``mhtrack track --sensors`` tracks it: frame by frame, unfused,
     with the radars' coverage and per-radar clutter."""
     sim = simulate(scenario, seed=seed)
     config = default_config(scenario) if config is None else config
     timed = sim.plots.timed
     trk = make_tracker(tracker, config, clutter_density=clutter_density, birth=birth,
-                       theta_deg=theta_deg, sensors=scenario.sensor_set() if timed else None)
+                       theta_deg=theta_deg, clutter_params=clutter_params,
+                       sensors=scenario.sensor_set() if timed else None)
     if fusion is None:
         fusion = "none" if timed else default_fusion(len(scenario.sensors))
     run = track(trk, sim.plots, name=tracker, progress=progress, fusion=fusion, output=output)

@@ -1,5 +1,6 @@
-"""The report of a Monte-Carlo study: ``summary.md`` (mean ± std per metric and tracker)
-and ``ospa_cardinality.png`` (per-scan OSPA and cardinality, mean ± std over runs)."""
+"""The report of a Monte-Carlo study: ``summary.md`` (mean ± std per metric and tracker,
+then the paired comparisons of the trackers, :mod:`mhtrack.metrics.paired`) and
+``ospa_cardinality.png`` (per-scan OSPA and cardinality, mean ± std over runs)."""
 
 from __future__ import annotations
 
@@ -13,6 +14,29 @@ from mhtrack.plotting.scene import save_figure
 
 SUMMARY_FILE = "summary.md"
 FIGURE_FILE = "ospa_cardinality.png"
+#: Metrics of the paired comparisons between trackers: key → (higher is better, decimals).
+PAIRED_METRICS: dict[str, tuple[bool, int]] = {
+    "ospa_mean": (False, 1), "gospa_mean": (False, 1), "rcc": (True, 4),
+    "coverage": (True, 4), "mota": (True, 4), "l_avg": (True, 2)}
+
+
+def paired_comparisons(result: MonteCarloResult) -> list[Any]:
+    """Each tracker against each tracker listed before it in the study (candidate A the
+    later one), on :data:`PAIRED_METRICS`, paired by run."""
+    from mhtrack.metrics.paired import compare_paired, paired_by_run
+
+    trackers = [t for t in result.spec.trackers if result.records.get(t)]
+    keys = set(result.metric_keys())
+    out = []
+    for j, a in enumerate(trackers):
+        for b in trackers[:j]:
+            for k, (hb, digits) in PAIRED_METRICS.items():
+                if k not in keys:
+                    continue
+                va, vb, _ = paired_by_run(result.records[a], result.records[b], k)
+                out.append(compare_paired(va, vb, metric=k, name_a=a, name_b=b,
+                                          higher_better=hb, digits=digits))
+    return out
 
 
 def _fmt(v: float) -> str:
@@ -46,6 +70,16 @@ def summary_markdown(result: MonteCarloResult) -> str:
         lines += ["", "## Failed runs", ""]
         lines += [f"* {t} run {i}: see `runs/{t}/run-{i}.error.txt`" for t, i in failed]
         lines += [f"* {t} run {i}: not run" for t, i in result.missing]
+    pairs = paired_comparisons(result)
+    if pairs:
+        from mhtrack.reports.paired_text import paired_table, verdict_list
+
+        lines += ["", "## Paired comparisons", "",
+                  "Run i of every tracker simulates the same plots: A − B per run, its mean "
+                  "with the 95 % t interval, identical runs, sign and Wilcoxon tests; the "
+                  "verdict is read from the interval (↑ higher is better, ↓ lower).", "",
+                  paired_table(pairs, {k: d for k, (_, d) in PAIRED_METRICS.items()}),
+                  verdict_list(pairs).rstrip("\n")]
     return "\n".join(lines) + "\n"
 
 

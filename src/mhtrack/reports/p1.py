@@ -17,6 +17,8 @@ from mhtrack.experiments.p1.constants import (
     TABLE_FILE,
     TABLE_JSON,
     TRACKER_LABELS,
+    TRACKER_SETTINGS,
+    settings_file,
 )
 from mhtrack.io.atomic import atomic_write
 from mhtrack.io.jsonsafe import to_jsonable
@@ -42,7 +44,7 @@ def _figures(repro: P1Reproduction) -> dict[str, Path]:
 
     spec, sim = repro.result.spec, repro.simulation
     name = spec.scenario_name
-    paths = {k: repro.out_dir / v for k, v in FIGURES.items()}
+    paths = {k: repro.out_dir / settings_file(v, repro.settings) for k, v in FIGURES.items()}
     save_figure(plot_scene(truth=sim.truth, title=f"Fig. 2 — {name}: target trajectories"),
                 paths["fig2"])
     save_figure(plot_scene(plots=sim.plots, title=f"Fig. 3 — {name}: plots with clutter "
@@ -72,17 +74,24 @@ def _figures(repro: P1Reproduction) -> dict[str, Path]:
 
 def write_p1_report(repro: P1Reproduction) -> P1Report:
     """Write every output of the study ``repro`` (module docstring)."""
-    out_dir, spec = repro.out_dir, repro.result.spec
+    out_dir, spec, st = repro.out_dir, repro.result.spec, repro.settings
     write_montecarlo_report(repro.result)
     summary = repro.result.summary()
     n_ok = {t: summary[t]["n_runs"] for t in spec.trackers}
-    table_md = table3_file(repro.table, spec.runs, n_ok)
-    table_path = atomic_write(out_dir / TABLE_FILE, table_md)
+    table_md = table3_file(repro)
+    table_path = atomic_write(out_dir / settings_file(TABLE_FILE, st), table_md)
     js = {"source": PAPER_SOURCE, "runs": spec.runs, "seed": spec.seed,
-          "n_runs_ok": n_ok, "table": repro.table}  # NaN (no value) written as null
-    atomic_write(out_dir / TABLE_JSON, json.dumps(to_jsonable(js), indent=1) + "\n")
+          "tracker_settings": st.name, "settings_description": st.description,
+          "config": dict(spec.config), "run_kwargs": dict(spec.run_kwargs),
+          "n_runs_ok": n_ok, "table": repro.table,
+          "other_settings": {k: {"description": TRACKER_SETTINGS[k].description,
+                                 "runs": r.spec.runs, "table": repro.other_tables[k]}
+                             for k, r in repro.others.items()},
+          "paired": [c.to_dict() for c in repro.paired]}  # NaN (no value) written as null
+    json_path = atomic_write(out_dir / settings_file(TABLE_JSON, st),
+                             json.dumps(to_jsonable(js), indent=1) + "\n")
     figures = _figures(repro)
-    report_path = atomic_write(out_dir / REPORT_FILE, report_markdown(repro, figures))
-    paths = [table_path, out_dir / TABLE_JSON, report_path, *figures.values(),
-             repro.result.out_dir]
+    report_path = atomic_write(out_dir / settings_file(REPORT_FILE, st),
+                               report_markdown(repro, figures))
+    paths = [table_path, json_path, report_path, *figures.values(), repro.result.out_dir]
     return P1Report(table_md, table_path, report_path, figures, paths)

@@ -21,8 +21,12 @@ from mhtrack.experiments.p1.constants import (
     TABLE_FILE,
     TABLE_JSON,
     TRACKER_LABELS,
+    TRACKER_SETTINGS,
     Metric,
+    TrackerSettings,
+    settings_file,
 )
+from mhtrack.reports.paired_text import paired_table, tally, verdict_list
 from mhtrack.scenario import Scenario
 
 KNOWN_REASONS = """\
@@ -40,12 +44,13 @@ Known reasons for differences (our choices and what P1 does not give):
   tracks on clutter, and its hypothesis trees grow until the hard caps act. This weighs
   on its OSPA and cardinality far more than P1's Figs. 5–6 suggest for their MHT, whose
   clutter level is unknown.
-* **Output mode.** The tracks are scored in the history output (`docs/mht.md`): each
-  confirmed track also at the scans between its first plot and its confirmation, rows
-  that a live display would only show later. P1 does not say which it scores. Our
-  online output (`mhtrack montecarlo crossing --output online`) scores lower on Rcc and
-  OSPA, since a target is then uncovered for its confirmation delay (`delay_mean` in
-  `montecarlo/summary.md`, in scans, is the same in both).
+* **Tracker settings.** `--tracker-settings paper` runs P1's tracker: one
+  constant-velocity model, the online output (the tracks as known at each scan), the
+  clutter estimators with P1's steps only. `--tracker-settings best` (the default) runs
+  ours: a two-model IMM, the history output (each confirmed track also at the scans
+  between its first plot and its confirmation, `docs/mht.md`) and the estimators with our
+  additions. P1 does not say which output it scores. `docs/reproduction.md` lists every
+  parameter of both.
 * **Metric definitions.** P1 does not define Rcc, Rmc, Rfg or L*; ours are in
   `docs/metrics.md`. In particular Rfg is the number of track breaks per target, counted
   per run over the 4 targets and averaged over runs — P1's values (0.02–0.04) suggest
@@ -64,158 +69,128 @@ def _mean_pm_std(key: str, mean: float, std: float) -> str:
     return fmt(key, mean) + (f" ± {fmt(key, std)}" if math.isfinite(std) else "")
 
 
-def table3_markdown(table: Mapping[str, Mapping[str, Mapping[str, float]]], runs: int) -> str:
-    """Table 3 rows: for each tracker P1's row then ours (mean ± std over ``runs`` runs)."""
+def _runs(n: int) -> str:
+    return f"{n} run{'s' if n != 1 else ''}"
+
+
+def table3_markdown(table: Mapping[str, Mapping[str, Mapping[str, float]]], runs: int,
+                    row_label: str = "ours",
+                    others: Sequence[tuple[str, Mapping[str, Any], int]] = ()) -> str:
+    """Table 3 rows: for each tracker P1's row, ours (``row_label``, mean ± std over
+    ``runs`` runs) and each of ``others`` (row label, its table, its runs)."""
     head = "| algorithm | source | " + " | ".join(m.label for m in TABLE3_METRICS) + " |"
     lines = [head, "|---|---|" + "---|" * len(TABLE3_METRICS)]
     for t, row in table.items():
         label = TRACKER_LABELS.get(t, t)
         paper = [fmt(m.key, row[m.key]["paper"]) for m in TABLE3_METRICS]
-        ours = [
-            _mean_pm_std(m.key, row[m.key]["mean"], row[m.key]["std"])
-            for m in TABLE3_METRICS
-        ]
-        lines.append(f"| {label} | P1 | " + " | ".join(paper) + " |")
-        lines.append(f"| {label} | ours ({runs} run{'s' if runs != 1 else ''}) | "
-                     + " | ".join(ours) + " |")
+        lines.append(f"| {label} | P1 (as printed) | " + " | ".join(paper) + " |")
+        for lab, tab, n in ((row_label, table, runs), *others):
+            if t not in tab:
+                continue
+            cells = [_mean_pm_std(m.key, tab[t][m.key]["mean"], tab[t][m.key]["std"])
+                     for m in TABLE3_METRICS]
+            lines.append(f"| {label} | {lab} ({_runs(n)}) | " + " | ".join(cells) + " |")
     return "\n".join(lines) + "\n"
 
 
-def table3_file(table: Mapping[str, Any], runs: int, n_ok: Mapping[str, int]) -> str:
-    ok = ", ".join(f"{TRACKER_LABELS.get(t, t)} {n}" for t, n in n_ok.items())
+def _others(repro: P1Reproduction) -> list[tuple[str, Mapping[str, Any], int]]:
+    return [(TRACKER_SETTINGS[k].row_label, repro.other_tables[k], r.spec.runs)
+            for k, r in repro.others.items()]
+
+
+def table3_file(repro: P1Reproduction) -> str:
+    """``table3.md``: Table 3 (P1's rows and ours) and the paired comparisons."""
+    spec, st = repro.result.spec, repro.settings
+    summary = repro.result.summary()
+    ok = ", ".join(f"{TRACKER_LABELS.get(t, t)} {summary[t]['n_runs']}" for t in spec.trackers)
     return (
-        "# Table 3: performance metrics of the three algorithms (`crossing`)\n\n"
+        f"# Table 3: performance metrics of the three algorithms (`{spec.scenario_name}`)\n\n"
         f"P1: {PAPER_SOURCE}. P1 gives no OSPA mean (–).\n\n"
-        f"Ours: mean ± population std over the successful runs ({ok} of {runs}); "
-        "Tavg is the tracker's wall-clock time per scan on this machine; OSPA with "
-        f"c = {RUN_KWARGS['cutoff']:g} m, p = {RUN_KWARGS['order']:g}.\n\n"
-        + table3_markdown(table, runs)
+        f"{st.row_label[0].upper()}{st.row_label[1:]} (`--tracker-settings {st.name}`): "
+        f"{st.description}. Mean ± population std over the successful runs ({ok} of "
+        f"{spec.runs}); Tavg is the tracker's wall-clock time per scan on this machine; OSPA "
+        f"with c = {RUN_KWARGS['cutoff']:g} m, p = {RUN_KWARGS['order']:g}."
+        + ("".join(f" Rows '{TRACKER_SETTINGS[k].row_label}': the study of "
+                   f"`--tracker-settings {k}` in the same directory "
+                   f"({TRACKER_SETTINGS[k].description})." for k in repro.others))
+        + "\n\n" + table3_markdown(repro.table, spec.runs, st.row_label, _others(repro))
+        + "\n## Paired comparisons\n\n" + PAIRED_NOTE + "\n\n"
+        + paired_table(repro.paired, DIGITS, LABELS)
     )
 
 
+PAIRED_NOTE = (
+    "Run i of every tracker (and of both settings) simulates the same plots, so each row "
+    "compares A and B run by run: the mean of the per-run differences A − B with its 95 % "
+    "Student-t interval, the runs where both gave the same value, the runs where A is "
+    "better / worse, a two-sided sign test and Wilcoxon signed-rank test. ↑: higher is "
+    "better, ↓: lower is better. The verdict is read from the interval alone: `better` or "
+    "`worse` when it excludes 0, else `no detectable difference` (`docs/reproduction.md`). "
+    "Tavg is a wall-clock time and is not compared.")
+DIGITS = {m.key: m.digits for m in TABLE3_METRICS}
+LABELS = {m.key: m.label for m in TABLE3_METRICS}
+
+
 # ---------------------------------------------------------------------------- comparison
-def _rel(ours: float, paper: float) -> str:
-    if paper == 0:
-        return ""
-    return f", {abs(ours - paper) / abs(paper) * 100:.0f} %"
+def _against_paper(m: Metric, row: Mapping[str, float]) -> str:
+    """Our mean with its 95 % interval, and where P1's value lies against it."""
+    ours, paper, lo, hi = row["mean"], row["paper"], row.get("ci_low", math.nan), row.get(
+        "ci_high", math.nan)
+    if not math.isfinite(ours):
+        return f"* {m.label}: no value of ours (no successful run); P1 {fmt(m.key, paper)}."
+    text = f"* {m.label}: ours {fmt(m.key, ours)}{m.unit}"
+    if m.key == "t_avg":
+        return (text + f"; P1 {fmt(m.key, paper)}{m.unit} — another machine and code, not "
+                "compared.")
+    if not (math.isfinite(lo) and math.isfinite(hi)):
+        return text + f"; P1 {fmt(m.key, paper)}{m.unit} (no interval: fewer than 2 runs)."
+    text += f" (95 % CI of the mean [{fmt(m.key, lo)}, {fmt(m.key, hi)}])"
+    if lo <= paper <= hi:
+        where = "inside it: consistent with P1"
+    else:
+        above = paper > hi
+        ours_better = (not above) == m.higher_better
+        where = (f"{'above' if above else 'below'} it: ours is "
+                 f"{'better' if ours_better else 'worse'} than P1's")
+    return text + f"; P1's {fmt(m.key, paper)}{m.unit} is {where}."
 
 
-def compare_text(table: Mapping[str, Mapping[str, Mapping[str, float]]]) -> str:
-    """Markdown comparison generated from the measured numbers: per tracker and metric, our
-    mean against P1's (better / worse, by how much), then the ranking of the trackers per
-    metric in P1 and in ours."""
+def compare_text(repro: P1Reproduction) -> str:
+    """Markdown generated from the measured numbers: per tracker, each metric's mean and
+    95 % interval against P1's value; then P1's claims between the trackers, each as the
+    paired verdicts of :mod:`mhtrack.metrics.paired`."""
     lines: list[str] = []
-    for t, row in table.items():
-        lines.append(f"**{TRACKER_LABELS.get(t, t)}**")
-        lines.append("")
-        n_better = n_worse = 0
+    for t, row in repro.table.items():
+        lines += [f"**{TRACKER_LABELS.get(t, t)}** ({repro.settings.row_label})", ""]
         for m in TABLE3_METRICS:
-            ours, paper = row[m.key]["mean"], row[m.key]["paper"]
-            if not math.isfinite(paper):
-                continue
-            if not math.isfinite(ours):
-                lines.append(f"* {m.label}: no value of ours (no successful run); P1 "
-                             f"{fmt(m.key, paper)}.")
-                continue
-            diff = ours - paper
-            if fmt(m.key, ours) == fmt(m.key, paper):
-                verdict = "equal to P1 at the printed precision"
-            else:
-                better = (diff > 0) == m.higher_better
-                n_better += better
-                n_worse += not better
-                word = "higher" if diff > 0 else "lower"
-                verdict = (f"{word} than P1's {fmt(m.key, paper)} by "
-                           f"{fmt(m.key, abs(diff))}{m.unit}{_rel(ours, paper)} — "
-                           f"{'better' if better else 'worse'}")
-                if m.key == "t_avg":
-                    verdict += " (different machine and code)"
-            lines.append(f"* {m.label}: ours {fmt(m.key, ours)}{m.unit}, {verdict}.")
-        lines.append(f"* Overall: better than P1 on {n_better}, worse on {n_worse} of the "
-                     "metrics P1 reports.")
+            if math.isfinite(row[m.key]["paper"]):
+                lines.append(_against_paper(m, row[m.key]))
         lines.append("")
-    # rankings
-    trackers = list(table)
-    if len(trackers) > 1:
-        lines.append("**Ranking of the trackers (best first)**")
+    lines += ["**P1's claims between the trackers, paired over our runs**", ""]
+    by_pair: dict[tuple[str, str], list[Any]] = {}
+    for c in repro.paired:
+        by_pair.setdefault((c.a, c.b), []).append(c)
+    for (a, b), cs in by_pair.items():
+        lines.append(f"*{a} against {b}*: {tally(cs)}.")
         lines.append("")
-        lines.append("| metric | P1 | ours | same best? |")
-        lines.append("|---|---|---|---|")
-        for m in TABLE3_METRICS:
-            rp, ro = _ranking(table, m, "paper"), _ranking(table, m, "mean")
-            same = "–" if not rp or not ro else ("yes" if set(rp[0]) & set(ro[0]) else "no")
-            lines.append(f"| {m.label} | {_show_ranking(rp)} | {_show_ranking(ro)} | {same} |")
-        lines.append("")
-        agmm = "mht-agmm"
-        if agmm in table:
-            wins = [m.label for m in TABLE3_METRICS if m.key != "t_avg" and _is_best(
-                table, agmm, m)]
-            lines.append(
-                "P1 finds MHT-AGMM best on association and continuity. In our runs "
-                f"MHT-AGMM is best (or tied best) on {len(wins)} of "
-                f"{len(TABLE3_METRICS) - 1} accuracy metrics"
-                + (f" ({', '.join(wins)})." if wins else "."))
-            lines.append("")
-        note = _identical_note(table)
-        if note:
-            lines += [note, ""]
+        lines.append(verdict_list(cs))
     return "\n".join(lines)
 
 
-def _ranking(table: Mapping[str, Mapping[str, Mapping[str, float]]], m: Metric, src: str
-             ) -> list[list[str]]:
-    """Trackers best first, grouped where equal at the printed precision."""
-    vals = [(table[t][m.key][src], t) for t in table if math.isfinite(table[t][m.key][src])]
-    vals.sort(key=lambda p: -p[0] if m.higher_better else p[0])
-    groups: list[list[str]] = []
-    last = None
-    for v, t in vals:
-        if last is not None and fmt(m.key, v) == last:
-            groups[-1].append(t)
-        else:
-            groups.append([t])
-        last = fmt(m.key, v)
-    return groups
-
-
-def _show_ranking(groups: Sequence[Sequence[str]]) -> str:
-    return " > ".join(" = ".join(TRACKER_LABELS.get(t, t) for t in g) for g in groups) or "–"
-
-
-def _identical_note(table: Mapping[str, Mapping[str, Mapping[str, float]]]) -> str:
-    """A sentence naming trackers whose accuracy metrics are all equal (printed precision)."""
-    ts = list(table)
-    pairs = []
-    for i, a in enumerate(ts):
-        for b in ts[i + 1:]:
-            if all(fmt(m.key, table[a][m.key]["mean"]) == fmt(m.key, table[b][m.key]["mean"])
-                   for m in TABLE3_METRICS if m.key != "t_avg"):
-                pairs.append(f"{TRACKER_LABELS.get(a, a)} and {TRACKER_LABELS.get(b, b)}")
-    if not pairs:
-        return ""
-    return ("Identical accuracy (every metric but Tavg equal at the printed precision): "
-            + "; ".join(pairs) + ". Their tracks score the same on this study, so the "
-            "difference P1 reports between them is not reproduced here.")
-
-
-def _is_best(table: Mapping[str, Mapping[str, Mapping[str, float]]], t: str, m: Metric) -> bool:
-    v = table[t][m.key]["mean"]
-    if not math.isfinite(v):
-        return False
-    others = [table[o][m.key]["mean"] for o in table if o != t]
-    others = [o for o in others if math.isfinite(o)]
-    dv = 10.0 ** -m.digits / 2
-    return all((v >= o - dv) if m.higher_better else (v <= o + dv) for o in others)
-
-
 # ---------------------------------------------------------------------------- report
-def settings_text(spec: MonteCarloSpec) -> str:
-    from mhtrack.build import DEFAULT_CLUTTER_DENSITY, config_with
+def settings_text(spec: MonteCarloSpec, settings: TrackerSettings | None = None) -> str:
+    from mhtrack.build import DEFAULT_CLUTTER_DENSITY, config_with, default_config
 
     sc = Scenario.from_dict(spec.scenario)
     d = spec.scenario
-    cfg = config_with(**spec.config)
-    lines = [
+    cfg = config_with(default_config(sc), **spec.config)
+    motion = (f"one constant-velocity model (σv = {cfg.sigma_v:g} m/s²)" if cfg.models is None
+              else
+              f"an IMM of two constant-velocity models (σv = {cfg.imm_sigma_v:g} and "
+              f"{cfg.sigma_v:g} m/s²)")
+    lines = ([] if settings is None else [
+        f"* Tracker settings `{settings.name}` (`--tracker-settings {settings.name}`): "
+        f"{settings.description}."]) + [
         f"* Scenario `{sc.name}`: {sc.description}",
         f"* Region x ∈ [{sc.region.as_tuple()[0]:g}, {sc.region.as_tuple()[1]:g}] m, "
         f"y ∈ [{sc.region.as_tuple()[2]:g}, {sc.region.as_tuple()[3]:g}] m; T = {sc.T:g} s; "
@@ -227,7 +202,7 @@ def settings_text(spec: MonteCarloSpec) -> str:
         f"λ = {sc.clutter_rate(sc.first):g} per scan.",
         f"* Trackers: {', '.join(spec.trackers)}; track-oriented MHT with "
         f"P_D = {cfg.p_detection:g}, new-target density {cfg.new_target_density:g} /m², "
-        f"σw = {cfg.sigma_w:g} m, σv = {cfg.sigma_v:g} m/s², N-scan pruning depth "
+        f"σw = {cfg.sigma_w:g} m, {motion}, N-scan pruning depth "
         f"{cfg.n_scan}, gate probability {cfg.gate_probability:g}; `mht` with the known "
         f"clutter density κ = {spec.run_kwargs.get('clutter_density', DEFAULT_CLUTTER_DENSITY):g} "
         "/m², `mht-gmm` / `mht-agmm` estimate it online (GMM with a fixed deletion threshold "
@@ -258,6 +233,7 @@ def report_markdown(repro: P1Reproduction, figures: Mapping[str, Path]) -> str:
     the differences and the figures (``figures``: key of :data:`FIGURES` → path)."""
     res = repro.result
     spec = res.spec
+    st = repro.settings
     s = res.summary()
     failed = [(t, i) for t in spec.trackers for i in s[t]["failed"]]
     fig = figures
@@ -271,23 +247,32 @@ def report_markdown(repro: P1Reproduction, figures: Mapping[str, Path]) -> str:
             run0_check.append(f"{TRACKER_LABELS.get(t, t)} "
                               f"{'matches' if same else 'DIFFERS FROM'} its stored run 0")
     parts = [
-        "# Reproduction of P1 §3 (Table 3, Figs. 2–6)",
+        f"# Reproduction of P1 §3 (Table 3, Figs. 2–6) — {st.row_label}",
         "",
-        "Generated by `mhtrack reproduce p1`. Every number below is measured; the text "
-        "comparing them is generated from them.",
+        f"Generated by `mhtrack reproduce p1 --tracker-settings {st.name}`. Every number "
+        "below is measured; every sentence comparing them is generated from them.",
         "",
         "## Settings",
         "",
-        settings_text(spec),
+        settings_text(spec, st),
         "",
         "## Table 3",
         "",
-        f"P1's rows: {PAPER_SOURCE}. Ours: mean ± population std over "
+        f"P1's rows: {PAPER_SOURCE}. Rows '{st.row_label}': mean ± population std over "
         + ", ".join(f"{s[t]['n_runs']}" for t in spec.trackers)
-        + f" successful runs of {', '.join(spec.trackers)} ({TABLE_FILE}, {TABLE_JSON}; "
-        f"per-run files in `{MC_DIR}/runs/`).",
+        + f" successful runs of {', '.join(spec.trackers)} ({settings_file(TABLE_FILE, st)}, "
+        f"{settings_file(TABLE_JSON, st)}; per-run files in "
+        f"`{settings_file(MC_DIR, st)}/runs/`)"
+        + "".join(f"; rows '{TRACKER_SETTINGS[k].row_label}': the study of "
+                  f"`--tracker-settings {k}` found in the same directory" for k in repro.others)
+        + ".",
         "",
-        table3_markdown(repro.table, spec.runs),
+        table3_markdown(repro.table, spec.runs, st.row_label, _others(repro)),
+        "## Paired comparisons",
+        "",
+        PAIRED_NOTE,
+        "",
+        paired_table(repro.paired, DIGITS, LABELS),
     ]
     if failed or res.missing:
         parts += ["**Failed runs**: " + ", ".join(f"{t} run {i}" for t, i in failed)
@@ -296,7 +281,7 @@ def report_markdown(repro: P1Reproduction, figures: Mapping[str, Path]) -> str:
     parts += [
         "## Where our numbers differ from P1's",
         "",
-        compare_text(repro.table),
+        compare_text(repro),
         KNOWN_REASONS,
         "## Figures",
         "",

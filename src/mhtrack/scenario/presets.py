@@ -8,6 +8,9 @@
   birth scan); clutter an equal-weight mixture of four Gaussians with the printed
   covariances read as m² (σ ≈ 28–32 m); ``λ = 40`` per scan *(ours)*.
 * ``crossing-wide``: the same, covariances read as standard deviations (σ = 800, 1000 m).
+* ``crossing-changing``: the crossing targets and sensor in a clutter field whose
+  components appear, vanish, split, merge and drift, ``λ = 40`` per scan *(all ours;*
+  :mod:`mhtrack.scenario.changing`).
 * ``multiradar`` (P2 §2.2, §3): ten targets from the printed initial positions at 200 m/s,
   headings drawn once from ``default_rng(2013)`` *(ours)*; three polar radars ``σr = 20 m``,
   ``σθ = 0.3°`` 10 km from the centre of the targets' area at bearings 30°, 150°, 270°
@@ -54,7 +57,7 @@ from mhtrack.scenario.trajectory import bridge_gaps
 
 #: Names accepted by :func:`preset`.
 PRESETS: tuple[str, ...] = ("crossing", "crossing-wide", "multiradar", "opensky",
-                            "opensky-radars")
+                            "opensky-radars", "crossing-changing")
 #: Keyword overrides accepted by :func:`preset`.
 PRESET_OVERRIDES: tuple[str, ...] = (*OVERRIDES, "heading_seed")
 
@@ -101,6 +104,21 @@ def _crossing(wide: bool, n_scans: int | None) -> Scenario:
         pd=0.9,
         clutter=clutter,
     )
+
+
+def _crossing_changing(n_scans: int | None) -> Scenario:
+    import dataclasses
+
+    from mhtrack.scenario.changing import changing_clutter
+
+    base = _crossing(False, n_scans)
+    return dataclasses.replace(
+        base, name="crossing-changing",
+        description=(
+            "P1 §3's four crossing targets and sensor (σw² = 1e4 m², P_D = 0.9) in clutter "
+            "whose seven Gaussian components appear, vanish, split, merge and drift over "
+            "the run (λ = 40 per scan); the clutter is our choice."),
+        clutter=changing_clutter(base.region))
 
 
 # ------------------------------------------------------------------ multiradar (P2)
@@ -312,6 +330,8 @@ def preset(name: str, **overrides: Any) -> Scenario:
         raise ValueError("heading_seed: only the multiradar preset has headings to draw")
     if name in ("crossing", "crossing-wide"):
         s = _crossing(name == "crossing-wide", n_scans)
+    elif name == "crossing-changing":
+        s = _crossing_changing(n_scans)
     elif name == "multiradar":
         seed = ck.integer(ov.pop("heading_seed", MULTIRADAR_HEADING_SEED), "heading_seed", lo=0)
         s = _multiradar(n_scans, seed)

@@ -57,6 +57,55 @@ METRIC_BY_KEY = {m.key: m for m in TABLE3_METRICS}
 #: job hashes agree with ``mhtrack montecarlo crossing``).
 RUN_KWARGS: dict[str, Any] = {"cutoff": 500.0, "order": 2.0, "output": "history"}
 
+
+@dataclass(frozen=True)
+class TrackerSettings:
+    """One fidelity level of the study: the MHTConfig changes, the run_scenario keywords,
+    the file-name suffix of its outputs and what its rows are called."""
+
+    name: str
+    config: dict[str, Any]
+    run_kwargs: dict[str, Any]
+    suffix: str       #: "" (best: the files of earlier versions) or "-paper"
+    row_label: str    #: what a table row of these settings says it is
+    description: str
+
+
+#: ``--tracker-settings paper``: P1's tracker as P1 §1.3, §2, §3 describe it. One
+#: constant-velocity model (σv² = 100, ``imm_sigma_v = 0``), P1's P_D, λ_v, κ, σw² and
+#: pruning depth (the defaults of :class:`~mhtrack.mht.MHTConfig` on ``crossing``), the
+#: online output (the tracks as known at each scan), and the clutter estimators with
+#: P1's steps only (P1 §2): one fit per scan on that scan's plots (``window = 1``; the
+#: pooling of 5 scans is ours), EM from fresh k-means++ seeds every scan
+#: (``warm_start``, ours), no uniform background component (``background``, ours), no
+#: contrast test (``min_contrast``, ours), no BIC test of the number of components
+#: (``bic``, ours). ``docs/reproduction.md`` lists each and what stays ours.
+PAPER_CLUTTER_PARAMS: dict[str, Any] = {"window": 1, "warm_start": False, "background": False,
+                                        "min_contrast": 0.0, "bic": False}
+TRACKER_SETTINGS: dict[str, TrackerSettings] = {
+    "best": TrackerSettings(
+        "best", {}, dict(RUN_KWARGS), "", "ours, best settings",
+        "our best configuration: two-model IMM (σv = 1 and 10 m/s²), history output, "
+        "clutter estimators with our additions (uniform background component, contrast "
+        "test; BIC test of the number of components in the AGMM)"),
+    "paper": TrackerSettings(
+        "paper", {"imm_sigma_v": 0.0},
+        {**RUN_KWARGS, "output": "online", "clutter_params": PAPER_CLUTTER_PARAMS},
+        "-paper", "ours, P1's settings",
+        "P1's tracker: one constant-velocity model (σv² = 100), online output, clutter "
+        "estimators with P1's steps only (one fit per scan from fresh seeds, no background "
+        "component, no contrast test, no BIC test)"),
+}
+DEFAULT_SETTINGS = "best"
+
+
+def settings_file(name: str, settings: TrackerSettings) -> str:
+    """``name`` (e.g. ``table3.md``) with the settings' suffix before its extension."""
+    if not settings.suffix:
+        return name
+    stem, dot, ext = name.rpartition(".")
+    return f"{stem}{settings.suffix}{dot}{ext}" if dot else f"{name}{settings.suffix}"
+
 MC_DIR = "montecarlo"
 TABLE_FILE = "table3.md"
 TABLE_JSON = "table3.json"

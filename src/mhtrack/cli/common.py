@@ -50,8 +50,11 @@ def load_scenario_arg(
         return preset(scenario, **overrides)
     path = Path(scenario)
     if path.suffix.lower() == ".toml" or path.exists():
-        if not path.is_file():
+        from mhtrack.io.paths import check_input_file
+
+        if not path.exists():
             raise click.BadParameter(f"no such scenario file: {path}", param_hint="SCENARIO")
+        check_input_file(path)
         return apply_overrides(load_scenario(path), **overrides)
     names = ", ".join(sorted(PRESETS))
     raise click.BadParameter(

@@ -124,7 +124,7 @@ def load_results(out_dir: str | os.PathLike[str]) -> MonteCarloResult:
     path = out_dir / SPEC_FILE
     if not path.is_file():
         raise FileNotFoundError(f"{out_dir}: no {SPEC_FILE}; not a Monte-Carlo directory")
-    spec = MonteCarloSpec.from_dict(json.loads(path.read_text()))
+    spec = MonteCarloSpec.from_file(path)
     store = run_store(out_dir)
     records: dict[str, list[dict[str, Any]]] = {t: [] for t in spec.trackers}
     failures: dict[str, dict[int, str]] = {t: {} for t in spec.trackers}

@@ -14,6 +14,7 @@ and text. Bounds: :data:`mhtrack.bounds.MAX_STATE_MEMBER_BYTES`,
 from __future__ import annotations
 
 import zipfile
+import zlib
 from os import PathLike
 
 import numpy as np
@@ -24,6 +25,10 @@ from mhtrack.io.paths import check_input_file
 
 #: dtype kinds a member may hold: bool, signed and unsigned integers, floats, text.
 KINDS = "biufU"
+#: What a damaged archive raises while a member is read (bad CRC or header, corrupt
+#: deflate stream, unsupported compression or encryption, truncated data).
+_DAMAGED = (zipfile.BadZipFile, zlib.error, NotImplementedError, RuntimeError, EOFError,
+            OSError, ValueError)
 
 
 def member_error(path: str | PathLike[str], member: str | None, problem: str) -> InputError:
@@ -36,7 +41,11 @@ def _header(zf: zipfile.ZipFile, info: zipfile.ZipInfo, path: str | PathLike[str
             name: str) -> None:
     """Check the ``.npy`` header of ``info`` against its size, without reading the data."""
     fmt = np.lib.format
-    with zf.open(info) as fh:
+    try:
+        fh = zf.open(info)
+    except _DAMAGED as e:
+        raise member_error(path, name, f"damaged ({clip(str(e), 120)})") from None
+    with fh:
         try:
             version = fmt.read_magic(fh)
             if version == (1, 0):
@@ -46,7 +55,7 @@ def _header(zf: zipfile.ZipFile, info: zipfile.ZipInfo, path: str | PathLike[str
             else:
                 raise ValueError(f"unknown .npy version {version}")
             offset = fh.tell()
-        except (ValueError, OSError, EOFError, SyntaxError) as e:
+        except (*_DAMAGED, SyntaxError) as e:
             raise member_error(path, name, f"not a NumPy array ({clip(str(e), 120)})") from None
     if dtype.hasobject or dtype.kind not in KINDS or dtype.fields is not None:
         raise member_error(path, name, f"dtype {dtype} is not allowed (expected booleans, "
@@ -71,7 +80,7 @@ def read_npz(path: str | PathLike[str], *, max_member: int = MAX_STATE_MEMBER_BY
     check_input_file(path)
     try:
         zf = zipfile.ZipFile(path)
-    except (zipfile.BadZipFile, OSError, ValueError) as e:
+    except _DAMAGED as e:
         raise member_error(path, None, f"not a .npz archive ({clip(str(e), 120)})") from None
     with zf:
         total = 0
@@ -94,6 +103,6 @@ def read_npz(path: str | PathLike[str], *, max_member: int = MAX_STATE_MEMBER_BY
             try:
                 with zf.open(info) as fh:
                     out[name] = np.lib.format.read_array(fh, allow_pickle=False)
-            except (ValueError, OSError, EOFError, zipfile.BadZipFile) as e:
+            except _DAMAGED as e:
                 raise member_error(path, name, f"cannot be read ({clip(str(e), 120)})") from None
     return out

@@ -65,8 +65,8 @@ class _Checker:
             bad = ~np.isfinite(a)
             if bad.any():
                 i = np.argwhere(bad)[0]
-                raise self.fail(member, f"value {a[tuple(i)]!r} at index {tuple(i.tolist())} "
-                                "is not finite")
+                raise self.fail(member, f"value {a[tuple(i)].item()!r} at index "
+                                f"{tuple(i.tolist())} is not finite")
         if a.dtype.kind in "iu" and a.size and (np.abs(a.astype(np.float64)) > MAX_INDEX).any():
             raise self.fail(member, f"holds integers beyond ±2^53 (max {a.max()})")
         return a

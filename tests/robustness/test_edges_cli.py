@@ -108,7 +108,7 @@ def test_cutoff_at_its_bound_gives_finite_json(files: Path) -> None:
 @pytest.mark.parametrize(("text", "where"), [
     ("T = " + "[" * 3000 + "]" * 3000, "nested more than 64 levels deep"),
     ("T = {a = 1}", "T: expected a number, got table {'a': 1}"),
-])
+], ids=["deep", "table-for-number"])
 def test_scenario_toml(files: Path, text: str, where: str) -> None:
     import tomli_w
 

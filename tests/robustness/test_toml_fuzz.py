@@ -129,7 +129,8 @@ def test_one_value_replaced_loads_or_raises_input_error(folder: Path, kind: str,
 
 
 @pytest.mark.parametrize("kind", sorted(READERS))
-@pytest.mark.parametrize("nested", ["[" * 2000 + "]" * 2000, "{a=" * 300 + "1" + "}" * 300])
+@pytest.mark.parametrize("nested", ["[" * 2000 + "]" * 2000, "{a=" * 300 + "1" + "}" * 300],
+                         ids=["arrays", "tables"])
 def test_deep_nesting_is_one_line(tmp_path: Path, kind: str, nested: str) -> None:
     path = tmp_path / "deep.toml"
     path.write_text(f"x = {nested}\n")

@@ -253,3 +253,25 @@ def test_p2_job_record_of_the_wrong_shape_names_the_file_and_field(tmp_path: Pat
     p.write_text(json.dumps(d))
     with pytest.raises(InputError, match=r"key 'result': expected an object, got list"):
         store.load(job)
+
+
+def test_run_file_with_bad_content_is_named(tmp_path: Path) -> None:
+    """A Monte-Carlo run file that holds its job's hash but not a run's record (one row,
+    the per-scan lists as long as ``scans``) is named, with the field."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    out = tmp_path / "mc"
+    args = ["montecarlo", "crossing", "--runs", "1", "--scans", "3", "--trackers",
+            "mht-agmm", "--workers", "1", "--out", str(out)]
+    assert CliRunner().invoke(cli, args).exit_code == 0
+    run = out / "runs" / "mht-agmm" / "run-0.parquet"
+    t = pq.read_table(run)
+    i = t.schema.get_field_index("scans")
+    bad = t.set_column(i, "scans", pa.array([[1]], pa.list_(pa.int64())))
+    pq.write_table(bad.replace_schema_metadata(t.schema.metadata), run)
+    line = refused(args, run)
+    assert line == (f"Error: {run}, key 'result.ospa': expected a list of 1 values (one per "
+                    "scan), got a list of 3")
+    pq.write_table(pa.concat_tables([t, t]).replace_schema_metadata(t.schema.metadata), run)
+    assert refused(args, run) == (f"Error: {run}: a job record holds one row, this one 2")

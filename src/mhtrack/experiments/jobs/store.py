@@ -122,11 +122,19 @@ class ParquetRecords(RecordFormat):
             pq.write_table(table, tmp)
 
     def read(self, path: Path) -> dict[str, Any]:
+        import pyarrow as pa
         import pyarrow.parquet as pq
 
-        row = pq.read_table(path).to_pylist()[0]
+        try:
+            rows = pq.read_table(path).to_pylist()
+        except (OSError, pa.ArrowException) as e:
+            raise InputError(f"{path}: not a readable job record ({str(e)[:120]})",
+                             file=str(path)) from None
+        if len(rows) != 1:
+            raise InputError(f"{path}: a job record holds one row, this one {len(rows)}",
+                             file=str(path))
         return {k: (math.nan if v is None and k not in self.keep_none else v)
-                for k, v in row.items()}
+                for k, v in rows[0].items()}
 
     def stored_hash(self, path: Path) -> str | None:
         import pyarrow as pa

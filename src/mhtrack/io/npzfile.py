@@ -55,7 +55,8 @@ def _header(zf: zipfile.ZipFile, info: zipfile.ZipInfo, path: str | PathLike[str
             else:
                 raise ValueError(f"unknown .npy version {version}")
             offset = fh.tell()
-        except (*_DAMAGED, SyntaxError) as e:
+        except Exception as e:  # a hostile header can make NumPy's parser
+            # (ast, tokenize) raise anything; every such failure is the same user error
             raise member_error(path, name, f"not a NumPy array ({clip(str(e), 120)})") from None
     if dtype.hasobject or dtype.kind not in KINDS or dtype.fields is not None:
         raise member_error(path, name, f"dtype {dtype} is not allowed (expected booleans, "

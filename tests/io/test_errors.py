@@ -142,6 +142,9 @@ CSV_CASES = [
     ("scan-beyond-int64", read_plots, None, P + f"{10**20},0,0,1,2\n",
      "{f}, line 2, column 'scan': value 100000000000000000000 is out of range (expected an "
      "integer in [-2^53, 2^53])"),
+    ("scan-int64-min", read_plots, None, P + f"{-2**63},0,0,1,2\n",
+     "{f}, line 2, column 'scan': value -9223372036854775808 is out of range (expected an "
+     "integer in [-2^53, 2^53])"),
     ("time-1e308", read_plots, None, P + "1,1e308,0,1,2\n",
      "{f}, line 2, column 'time': value 1e308 is out of range (expected a finite number in "
      "[-1e12, 1e12])"),

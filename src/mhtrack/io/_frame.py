@@ -154,7 +154,7 @@ class Frame:
             self.fail(f"has type {col.type}, expected integers", column=name)
         v = col.fill_null(fill).to_numpy().astype(np.int64, copy=False)
         self.check(
-            (np.abs(v) > MAX_INDEX) & ~nulls, name,
+            ((v > MAX_INDEX) | (v < -MAX_INDEX)) & ~nulls, name,  # no np.abs: -2^63
             lambda r: f"value {clip(self.text(name, r))} is out of range (expected "
             f"{int_range(-MAX_INDEX, MAX_INDEX)})",
         )

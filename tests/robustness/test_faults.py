@@ -97,9 +97,14 @@ def test_writer_raising_midway_leaves_no_partial_file(tmp_path: Path,
     assert list(tmp_path.iterdir()) == []  # nothing that could read as tracks
 
 
+#: Runs of the killed study: enough that the kill (polled every 10 ms) falls mid-study
+#: even on an idle machine.
+RUNS = 12
+
+
 def _montecarlo(out: Path) -> list[str]:
     return [sys.executable, "-c", "from mhtrack.cli.main import main; main()", "montecarlo",
-            "crossing", "--runs", "4",
+            "crossing", "--runs", str(RUNS),
             "--scans", "8", "--trackers", "mht-agmm", "--workers", "1", "--no-progress",
             "--out", str(out)]
 
@@ -112,22 +117,22 @@ def test_study_killed_midrun_keeps_finished_runs_and_resumes(tmp_path: Path) -> 
     child = subprocess.Popen(_montecarlo(out), env=_env(), stdout=subprocess.DEVNULL,
                              stderr=subprocess.DEVNULL, start_new_session=True)
     try:
-        for _ in range(1200):  # until a run is finished (at most 120 s)
+        for _ in range(12000):  # until a run is finished (at most 120 s)
             done = sorted(runs.glob("run-*.parquet")) if runs.is_dir() else []
             if done or child.poll() is not None:
                 break
-            time.sleep(0.1)
+            time.sleep(0.01)
     finally:
         os.killpg(child.pid, signal.SIGKILL)
         child.wait()
     finished = {p.name: p.read_bytes() for p in runs.glob("run-*.parquet")}
-    assert 0 < len(finished) < 4, "the kill did not fall mid-study"
+    assert 0 < len(finished) < RUNS, f"the kill did not fall mid-study ({len(finished)})"
     partial = load_results(out)
     assert len(partial.records["mht-agmm"]) == len(finished)
 
     r = subprocess.run(_montecarlo(out), env=_env(), capture_output=True, text=True)
     assert r.returncode == 0, r.stderr
-    assert f"{4 - len(finished)} runs computed, {len(finished)} already done" in r.stdout
+    assert f"{RUNS - len(finished)} runs computed, {len(finished)} already done" in r.stdout
     for name, data in finished.items():  # finished runs kept as they were
         assert (runs / name).read_bytes() == data
     resumed = load_results(out)
@@ -139,4 +144,4 @@ def test_study_killed_midrun_keeps_finished_runs_and_resumes(tmp_path: Path) -> 
     keys = ("ospa_mean", "gospa_mean", "n_tracks")
     got = [[rec.get(k) for k in keys] for rec in resumed.records["mht-agmm"]]
     want = [[rec.get(k) for k in keys] for rec in fresh.records["mht-agmm"]]
-    assert got == want and len(got) == 4
+    assert got == want and len(got) == RUNS

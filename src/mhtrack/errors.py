@@ -21,7 +21,10 @@ from __future__ import annotations
 
 
 def short_number(x: float) -> str:
-    """Short form of a limit or a count in messages: ``1e6``, ``30``, ``5e7``, ``2.5e4``."""
+    """Short form of a limit or a count in messages: ``1e6``, ``30``, ``5e7``, ``2.5e4``
+    (``inf``, ``nan`` as such)."""
+    if x != x or abs(x) == float("inf"):
+        return str(float(x))
     if abs(x) >= 1e4:
         m, e = f"{x:.6e}".split("e")
         return f"{m.rstrip('0').rstrip('.')}e{int(e)}"

@@ -116,7 +116,8 @@ CSV_CASES = [
     ("range-negative", read_plots, REG, PRB + "1,0,1,1,2,100,3\n1,0,1,1,2,-5,3\n",
      "{f}, line 3, column 'range': range -5.0 is negative"),
     ("range-overflows", read_plots, REG, PRB + "1,0,1,1,2,1e200,3\n",
-     "{f}, line 2, column 'range': range 1e+200 is too large (its covariance overflows)"),
+     "{f}, line 2, column 'range': value 1e200 is out of range (expected a finite number "
+     "in [-1e15, 1e15])"),
     ("polar-needs-range", read_plots, REG, P + "1,0,0,1,2\n1,0,2,1,2\n",
      "{f}: missing column(s) 'range', 'bearing', needed by polar sensor(s) 2"),
     ("equal-times", read_plots, None, P + "79,79,0,1,2\n80,79,0,1,2\n",
@@ -129,12 +130,24 @@ CSV_CASES = [
      "{f}, line 4, column 'scan': scan 1000051 follows scan 50 (line 3): the 1000000 scan "
      "numbers between them would each be tracked as an empty scan, more than the 10000 "
      "allowed in one gap; renumber the scans"),
-    ("scan-gap-int64-extremes", read_plots, None,
-     P + f"{-2**63},0,0,1,2\n{2**63 - 1},1,0,1,2\n",
-     "{f}, line 3, column 'scan': scan 9223372036854775807 follows scan "
-     "-9223372036854775808 (line 2): the 18446744073709551614 scan numbers between them "
+    ("scan-gap-index-extremes", read_plots, None,
+     P + f"{-2**53},0,0,1,2\n{2**53},1,0,1,2\n",
+     "{f}, line 3, column 'scan': scan 9007199254740992 follows scan "
+     "-9007199254740992 (line 2): the 18014398509481983 scan numbers between them "
      "would each be tracked as an empty scan, more than the 10000 allowed in one gap; "
      "renumber the scans"),
+    ("scan-beyond-2^53", read_plots, None, P + f"{2**53 + 1},0,0,1,2\n",
+     "{f}, line 2, column 'scan': value 9007199254740993 is out of range (expected an "
+     "integer in [-2^53, 2^53])"),
+    ("scan-beyond-int64", read_plots, None, P + f"{10**20},0,0,1,2\n",
+     "{f}, line 2, column 'scan': value 100000000000000000000 is out of range (expected an "
+     "integer in [-2^53, 2^53])"),
+    ("scan-int64-min", read_plots, None, P + f"{-2**63},0,0,1,2\n",
+     "{f}, line 2, column 'scan': value -9223372036854775808 is out of range (expected an "
+     "integer in [-2^53, 2^53])"),
+    ("time-1e308", read_plots, None, P + "1,1e308,0,1,2\n",
+     "{f}, line 2, column 'time': value 1e308 is out of range (expected a finite number in "
+     "[-1e12, 1e12])"),
     ("scan-gaps-total", read_plots, None,
      P + "".join(f"{k * 5001},{k},0,1,2\n" for k in range(4)),
      "{f}, line 3, column 'scan': the file has 4 scans with plots but 15000 scan numbers "
@@ -403,6 +416,6 @@ def test_toml_none_is_refused(tmp_path: Path) -> None:
 
 def test_plot_coordinates_beyond_the_trackers_bound_are_located(tmp_path: Path) -> None:
     p = tmp_path / "plots.csv"
-    p.write_text("scan,time,sensor,x,y\n1,1,0,0,0\n1,1,0,1e30,0\n2,2,0,0,0\n")
+    p.write_text("scan,time,sensor,x,y\n1,1,0,0,0\n1,1,0,2e9,0\n2,2,0,0,0\n")
     with pytest.raises(InputError, match=r"line 3.*'x'.*beyond ±1e\+09 m"):
         read_plots(p)

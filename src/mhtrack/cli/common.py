@@ -8,6 +8,7 @@ from typing import Any
 
 import click
 
+from mhtrack import bounds as B
 from mhtrack.cli.terminal import progress_enabled, progress_option
 
 
@@ -15,6 +16,114 @@ class InputProblem(click.ClickException):
     """A user's input is wrong: one line on stderr, exit status 2 (as a usage error)."""
 
     exit_code = 2
+
+
+# ------------------------------------------------------------------ numbers at the edge
+#: Bounds of the number options, by option name (docs/errors.md, "Bounds"): (low, high).
+#: Every other integer option is within ±2^53 and every other float option finite and
+#: within ±1e15; an option's own range (e.g. ``--pd`` in [0, 1]) applies too.
+OPTION_BOUNDS: dict[str, tuple[float, float]] = {
+    "--seed": (0, B.MAX_SEED),
+    "--clutter-rate": (0.0, B.MAX_RATE),
+    "--clutter-density": (0.0, B.MAX_DENSITY),
+    "--birth-density": (0.0, B.MAX_DENSITY),
+    "--cutoff": (0.0, B.MAX_CUTOFF),
+    "--match-distance": (0.0, B.MAX_CUTOFF),
+    "--order": (1.0, B.MAX_ORDER),
+    "--max-age": (0.0, B.MAX_TIME_S),
+    "--reorder-window": (0.0, B.MAX_TIME_S),
+    "--workers": (1, 1024),
+}
+
+
+class BoundedInt(click.IntRange):
+    """An integer in ``[lo, hi]``; the message names the range."""
+
+    def __init__(self, lo: int, hi: int) -> None:
+        super().__init__(min=lo, max=hi)
+        self.lo, self.hi = lo, hi
+
+    def _describe_range(self) -> str:
+        return f"{B.show(self.lo)}<=x<={B.show(self.hi)}"
+
+    def convert(self, value: Any, param: click.Parameter | None,
+                ctx: click.Context | None) -> int:
+        try:
+            v = int(value) if not isinstance(value, str) else int(value.strip(), 10)
+        except (TypeError, ValueError):
+            v = None
+        if isinstance(value, bool) or v is None or not self.lo <= v <= self.hi:
+            self.fail(f"{B.clip(repr(str(value)))} is not {B.int_range(self.lo, self.hi)}",
+                      param, ctx)
+        return v
+
+
+class BoundedFloat(click.FloatRange):
+    """A finite number in ``[lo, hi]`` (``(lo, …`` / ``…, hi)`` when open)."""
+
+    def __init__(self, lo: float, hi: float, lo_open: bool = False,
+                 hi_open: bool = False) -> None:
+        super().__init__(min=lo, max=hi, min_open=lo_open, max_open=hi_open)
+        self.lo, self.hi, self.lo_open, self.hi_open = lo, hi, lo_open, hi_open
+
+    def _describe_range(self) -> str:
+        return (f"{B.show(self.lo)}{'<' if self.lo_open else '<='}x"
+                f"{'<' if self.hi_open else '<='}{B.show(self.hi)}")
+
+    def _range(self) -> str:
+        return (f"{'(' if self.lo_open else '['}{B.show(self.lo)}, {B.show(self.hi)}"
+                f"{')' if self.hi_open else ']'}")
+
+    def convert(self, value: Any, param: click.Parameter | None,
+                ctx: click.Context | None) -> float:
+        try:
+            v = float(value)
+        except (TypeError, ValueError, OverflowError):
+            v = float("nan")
+        ok = (self.lo < v if self.lo_open else self.lo <= v) and (
+            v < self.hi if self.hi_open else v <= self.hi)  # NaN fails both
+        if isinstance(value, bool) or not ok:
+            self.fail(f"{B.clip(repr(str(value)))} is not a finite number in {self._range()}",
+                      param, ctx)
+        return v
+
+
+def _bounded(param: click.Parameter) -> click.ParamType | None:
+    """The bounded type of a number option (``None`` for other parameters)."""
+    t = param.type
+    name = max(getattr(param, "opts", []) or [""], key=len)
+    if isinstance(t, BoundedInt | BoundedFloat):
+        return None
+    if isinstance(t, click.IntRange | click.FloatRange):
+        lo, hi = t.min, t.max
+        lo_open, hi_open = t.min_open, t.max_open
+    elif t in (click.INT, click.FLOAT):
+        lo = hi = None
+        lo_open = hi_open = False
+    else:
+        return None
+    is_int = isinstance(t, click.types.IntParamType)
+    default = (-B.MAX_INDEX, B.MAX_INDEX) if is_int else (-B.MAX_MAGNITUDE, B.MAX_MAGNITUDE)
+    blo, bhi = OPTION_BOUNDS.get(name, default)
+    if lo is None or lo < blo:
+        lo, lo_open = blo, False
+    if hi is None or hi > bhi:
+        hi, hi_open = bhi, False
+    if is_int:
+        return BoundedInt(int(lo) + int(lo_open), int(hi) - int(hi_open))
+    return BoundedFloat(float(lo), float(hi), lo_open, hi_open)
+
+
+def bound_number_options(command: click.Command) -> None:
+    """Give every number option of ``command`` (and of its subcommands) its bounds
+    (:data:`OPTION_BOUNDS`, :mod:`mhtrack.bounds`): a value out of range, NaN or
+    infinite is refused with one line naming the option and the range expected."""
+    for param in command.params:
+        bounded = _bounded(param)
+        if bounded is not None:
+            param.type = bounded
+    for sub in getattr(command, "commands", {}).values():
+        bound_number_options(sub)
 
 
 def scenario_options(f: Callable[..., Any]) -> Callable[..., Any]:
@@ -51,8 +160,11 @@ def load_scenario_arg(
         return preset(scenario, **overrides)
     path = Path(scenario)
     if path.suffix.lower() == ".toml" or path.exists():
-        if not path.is_file():
+        from mhtrack.io.paths import check_input_file
+
+        if not path.exists():
             raise click.BadParameter(f"no such scenario file: {path}", param_hint="SCENARIO")
+        check_input_file(path)
         return apply_overrides(load_scenario(path), **overrides)
     names = ", ".join(sorted(PRESETS))
     raise click.BadParameter(

@@ -111,7 +111,7 @@ def evaluate(tracks: Path, truth: Path, plots: Path | None, cutoff: float, order
     sensor_set = read_sensors(sensors_file) if sensors_file is not None else None
     frame = sensor_set.frame() if sensor_set is not None else None
     pl = read_plots(plots, sensors=sensor_set) if plots is not None else None
-    tr = read_tracks(tracks, frame=frame, plots=pl if pl is not None and pl.timed else None)
+    tr = read_tracks(tracks, frame=frame, plots=pl)
     gt = read_truth(truth, frame=frame)
     if at is None and not has_frames(tracks):
         at = "scans"  # tracks numbered by scan are scored at their scans, times checked
@@ -173,8 +173,7 @@ def plot(directory: Path, output: Path | None, title: str | None) -> None:
     fig = plot_scene(
         plots=plots,
         truth=read_truth(paths["truth"], frame=frame) if paths["truth"] else None,
-        tracks=read_tracks(paths["tracks"], frame=frame,
-                           plots=plots if plots is not None and plots.timed else None)
+        tracks=read_tracks(paths["tracks"], frame=frame, plots=plots)
         if paths["tracks"] else None,
         title=title,
         sites=sensor_sites(sensor_set) if sensor_set is not None else None,

@@ -13,7 +13,7 @@ import os
 import click
 
 from mhtrack import __version__
-from mhtrack.cli.common import InputProblem
+from mhtrack.cli.common import InputProblem, bound_number_options
 
 #: Errors that are the user's input, not a bug: reported as one line, no traceback.
 USER_ERRORS: tuple[type[BaseException], ...] = (ValueError, OSError, KeyError)
@@ -64,6 +64,7 @@ def _register() -> None:
     for module in modules:
         for command in module.COMMANDS:
             cli.add_command(command)
+    bound_number_options(cli)
 
 
 _register()

@@ -19,6 +19,16 @@ import pyarrow.compute as pc
 import pyarrow.csv as pacsv
 import pyarrow.parquet as pq
 
+from mhtrack.bounds import (
+    MAX_COLUMNS,
+    MAX_INDEX,
+    MAX_LINE_BYTES,
+    MAX_MAGNITUDE,
+    MAX_TIME_S,
+    clip,
+    float_range,
+    int_range,
+)
 from mhtrack.errors import InputError
 from mhtrack.io._source import PathArg, Source, file_format
 from mhtrack.io.atomic import atomic_path
@@ -31,6 +41,8 @@ _CONVERSION = re.compile(
     r"In CSV column #(\d+): CSV conversion error to (\w+): invalid value '(.*)'", re.S
 )
 _FIELD_COUNT = re.compile(r"Expected (\d+) columns, got (\d+)")
+#: Largest |value| of a float column, by name (``mhtrack.bounds``); others MAX_MAGNITUDE.
+FLOAT_BOUNDS = {"time": MAX_TIME_S}
 
 
 def _csv_header(src: Source) -> list[str]:
@@ -45,6 +57,14 @@ def _csv_header(src: Source) -> list[str]:
             end = re.search(rb"[\r\n]", stripped)
             if not chunk:
                 break
+            if end is None and len(stripped) > MAX_LINE_BYTES:
+                n = stripped.count(b",") + 1
+                if n > MAX_COLUMNS:
+                    raise src.error(f"header has more than {n} columns, more than the "
+                                    f"{MAX_COLUMNS} allowed", line=1)
+                raise src.error(f"header line is longer than {MAX_LINE_BYTES} bytes "
+                                f"(expected at most {MAX_COLUMNS} short column names)",
+                                line=1)
     if not stripped:
         raise src.error("file is empty (no header line)")
     raw = stripped[: end.start()] if end else stripped
@@ -53,6 +73,12 @@ def _csv_header(src: Source) -> list[str]:
     except UnicodeDecodeError:
         raise src.error("header line is not valid UTF-8 text") from None
     return next(csv.reader([text]))
+
+
+def _check_width(src: Source, names: list[str]) -> None:
+    if len(names) > MAX_COLUMNS:
+        raise src.error(f"header has {len(names)} columns, more than the {MAX_COLUMNS} "
+                        "allowed", line=1 if src.format == "csv" else None)
 
 
 class Frame:
@@ -109,17 +135,30 @@ class Frame:
                 col = col.cast(pa.int64())
             except pa.ArrowInvalid:  # uint64 beyond int64
                 v = col.to_numpy(zero_copy_only=False)
-                self.check(v > np.iinfo(np.int64).max, name, lambda r: f"value {v[r]} too large")
+                self.check(v > MAX_INDEX, name, lambda r: f"value {v[r]} is out of range "
+                           f"(expected {int_range(-MAX_INDEX, MAX_INDEX)})")
         elif pa.types.is_floating(col.type):
             v = col.to_numpy(zero_copy_only=False).astype(np.float64)
-            whole = np.isfinite(v) & (v == np.round(v)) & (np.abs(v) < 2.0**63)
+            whole = np.isfinite(v) & (v == np.round(v))
             self.check(
-                ~whole & ~nulls, name, lambda r: f"value {self.text(name, r)!r} is not an integer"
+                ~whole & ~nulls, name,
+                lambda r: f"value {clip(repr(self.text(name, r)))} is not an integer",
+            )
+            self.check(
+                (np.abs(v) > MAX_INDEX) & ~nulls, name,
+                lambda r: f"value {clip(self.text(name, r))} is out of range (expected "
+                f"{int_range(-MAX_INDEX, MAX_INDEX)})",
             )
             col = pa.chunked_array([pa.array(np.where(nulls, 0, v).astype(np.int64), mask=nulls)])
         else:
             self.fail(f"has type {col.type}, expected integers", column=name)
-        return col.fill_null(fill).to_numpy().astype(np.int64, copy=False)
+        v = col.fill_null(fill).to_numpy().astype(np.int64, copy=False)
+        self.check(
+            ((v > MAX_INDEX) | (v < -MAX_INDEX)) & ~nulls, name,  # no np.abs: -2^63
+            lambda r: f"value {clip(self.text(name, r))} is out of range (expected "
+            f"{int_range(-MAX_INDEX, MAX_INDEX)})",
+        )
+        return v
 
     def floats(self, name: str, *, nullable: bool = False, finite: bool = True) -> np.ndarray:
         """Column ``name`` as float64, missing cells as NaN (an error unless ``nullable``);
@@ -135,9 +174,19 @@ class Frame:
             self.check(
                 ~np.isfinite(v) & ~nulls,
                 name,
-                lambda r: f"value {self.text(name, r)!r} is not finite",
+                lambda r: f"value {clip(repr(self.text(name, r)))} is not finite",
             )
-        return np.ascontiguousarray(v, dtype=np.float64)
+        return self.bounded(name, np.ascontiguousarray(v, dtype=np.float64))
+
+    def bounded(self, name: str, v: np.ndarray) -> np.ndarray:
+        """``v`` (column ``name``), its finite values checked within ±the column's bound
+        (:data:`FLOAT_BOUNDS`, else ``MAX_MAGNITUDE``)."""
+        hi = FLOAT_BOUNDS.get(name, MAX_MAGNITUDE)
+        with np.errstate(invalid="ignore"):
+            bad = np.isfinite(v) & (np.abs(v) > hi)
+        self.check(bad, name, lambda r: f"value {clip(self.text(name, r))} is out of range "
+                   f"(expected {float_range(-hi, hi)})")
+        return v
 
 
 def column_names(path: PathArg) -> list[str]:
@@ -149,11 +198,14 @@ def column_names(path: PathArg) -> list[str]:
 
 def _column_names(src: Source) -> list[str]:
     if src.format == "csv":
-        return _csv_header(src)
-    try:
-        return pq.read_schema(src.path).names
-    except (pa.ArrowException, OSError) as e:
-        raise src.error(f"not a readable Parquet file ({e})") from None
+        names = _csv_header(src)
+    else:
+        try:
+            names = pq.read_schema(src.path).names
+        except (pa.ArrowException, OSError) as e:
+            raise src.error(f"not a readable Parquet file ({clip(str(e), 200)})") from None
+    _check_width(src, names)
+    return names
 
 
 def read_frame(
@@ -171,7 +223,9 @@ def read_frame(
         seen.add(name)
     missing = [c for c in required if c not in seen]
     if missing:
-        found = ", ".join(repr(c) for c in names)
+        found = ", ".join(clip(repr(c)) for c in names[:20])
+        if len(names) > 20:
+            found += f", … ({len(names)} columns)"
         raise src.error(
             f"missing required column(s) {', '.join(repr(c) for c in missing)} "
             f"({schema} files need {', '.join(required)}; found {found})"
@@ -187,12 +241,12 @@ def read_frame(
         except pa.ArrowInvalid as e:
             raise _csv_error(src, names, str(e)) from None
         except (pa.ArrowException, OSError) as e:
-            raise src.error(f"cannot read CSV ({e})") from None
+            raise src.error(f"cannot read CSV ({clip(str(e), 200)})") from None
     else:
         try:
             table = pq.read_table(src.path, columns=present)
         except (pa.ArrowException, OSError) as e:
-            raise src.error(f"not a readable Parquet file ({e})") from None
+            raise src.error(f"not a readable Parquet file ({clip(str(e), 200)})") from None
     return Frame(src, table)
 
 
@@ -202,23 +256,67 @@ def _csv_error(src: Source, names: list[str], message: str) -> InputError:
         utf8 = _utf8_error(src, names)
         if utf8 is not None:
             return utf8
+    if "straddling object" in message:
+        return _long_line(src, names)
     m = _CONVERSION.search(message)
     if m and int(m[1]) < len(names):
         name, value = names[int(m[1])], m[3]
-        what = "an integer" if m[2].startswith(("int", "uint")) else "a number"
+        integer = m[2].startswith(("int", "uint"))
+        what = "an integer" if integer else "a number"
         opts = pacsv.ConvertOptions(
             include_columns=[name], column_types={name: pa.string()}, null_values=[]
         )
         col = pacsv.read_csv(src.path, convert_options=opts).column(0)
         row = pc.index(col, value).as_py()
-        return src.error(
-            f"value {value!r} is not {what}", row=None if row < 0 else row, column=name
-        )
+        where = {"row": None if row < 0 else row, "column": name}
+        if integer and re.fullmatch(r"\s*[+-]?\d+\s*", value):
+            return src.error(f"value {clip(value.strip())} is out of range (expected "
+                             f"{int_range(-MAX_INDEX, MAX_INDEX)})", **where)
+        return src.error(f"value {clip(repr(value))} is not {what}", **where)
     m = _FIELD_COUNT.search(message)
     if m:
         line = src.line_with_field_count_not(int(m[1]))
         return src.error(f"expected {m[1]} comma-separated fields, found {m[2]}", line=line)
-    return src.error(f"cannot parse CSV ({message})")
+    return src.error(f"cannot parse CSV ({clip(message, 200)})")
+
+
+def _long_line(src: Source, names: list[str]) -> InputError:
+    """The first line longer than ``MAX_LINE_BYTES`` and its longest cell, found by
+    streaming the file (it may be large; no line is held in memory)."""
+    line, length, cell, cell_len, best = 1, 0, 0, 0, (0, 0)
+    prev_cr = False
+    with src.path.open("rb") as fh:
+        for block in iter(lambda: fh.read(1 << 20), b""):
+            start = 0
+            for m in re.finditer(rb"[,\r\n]", block):
+                n = m.start() - start
+                length, cell_len, start = length + n + 1, cell_len + n, m.end()
+                sep = m[0]
+                if sep == b"\n" and prev_cr and n == 0:
+                    prev_cr = False
+                    length -= 1
+                    continue
+                prev_cr = sep == b"\r"
+                best = max(best, (cell_len, -cell))
+                if sep == b",":
+                    cell, cell_len = cell + 1, 0
+                    continue
+                if length - 1 > MAX_LINE_BYTES:
+                    return _line_too_long(src, names, line, length - 1, best)
+                line, length, cell, cell_len, best = line + 1, 0, 0, 0, (0, 0)
+            n = len(block) - start
+            length, cell_len = length + n, cell_len + n
+    best = max(best, (cell_len, -cell))
+    return _line_too_long(src, names, line, length, best)
+
+
+def _line_too_long(src: Source, names: list[str], line: int, length: int,
+                   best: tuple[int, int]) -> InputError:
+    size, i = best[0], -best[1]
+    column = names[i] if i < len(names) else None
+    return src.error(f"cell of {size} characters, on a line of {length} bytes: longer than "
+                     f"the {MAX_LINE_BYTES} bytes a line may hold (expected a number)",
+                     line=line, column=column)
 
 
 def _utf8_error(src: Source, names: list[str]) -> InputError | None:

@@ -14,6 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from mhtrack.errors import InputError
+from mhtrack.io.paths import check_input_file
 
 PathArg = str | PathLike[str]
 
@@ -43,11 +44,7 @@ class Source:
 
     def check_readable(self) -> None:
         """Raise :class:`InputError` unless the path is a readable, non-empty file."""
-        p = self.path
-        if not p.exists():
-            raise self.error("no such file")
-        if p.is_dir():
-            raise self.error("is a directory, not a file")
+        p = check_input_file(self.path)
         try:
             with p.open("rb") as fh:
                 fh.read(1)

@@ -98,7 +98,7 @@ def _numbers(f: Frame, name: str, text: pa.Array) -> np.ndarray:
         f.fail(f"value {text[r].as_py()!r} is not a number (the first row's time "
                f"{text[0].as_py()!r} is seconds, so every row's must be)", row=r, column=name)
     f.check(~np.isfinite(v), name, lambda r: f"value {text[r].as_py()!r} is not finite")
-    return np.ascontiguousarray(v, np.float64)
+    return f.bounded(name, np.ascontiguousarray(v, np.float64))
 
 
 def _bad_iso(value: str) -> str:

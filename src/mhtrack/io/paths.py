@@ -1,14 +1,17 @@
-"""Output paths, checked before any work: nothing computed is lost to a bad ``--out``, and
-no input is ever overwritten by an output.
+"""Input and output paths, checked before any work: nothing computed is lost to a bad
+``--out``, no input is ever overwritten by an output, and no reader blocks on a FIFO.
 
 :func:`check_output_file` and :func:`check_output_dir` raise :class:`InputError` with one
 line naming the path and what is wrong; the commands call them before reading or
-computing anything.
+computing anything. :func:`check_input_file` is called by every reader before it opens a
+file: an input must be a regular file (a FIFO, a device or a socket is refused, not read
+with a timeout — refusing is deterministic and never hangs).
 """
 
 from __future__ import annotations
 
 import os
+import stat
 from collections.abc import Iterable
 from pathlib import Path
 
@@ -16,6 +19,30 @@ from mhtrack.errors import InputError
 
 #: File extensions of the tables mhtrack writes.
 TABLE_SUFFIXES = (".csv", ".parquet")
+
+
+def check_input_file(path: str | os.PathLike[str]) -> Path:
+    """``path`` names an existing regular file (symbolic links followed) that can be
+    opened for reading; else :class:`InputError` ``<path>: <what it is instead>``."""
+    name = str(path)
+    p = Path(path)
+    try:
+        mode = p.stat().st_mode
+    except FileNotFoundError:
+        raise InputError(f"{name}: no such file", file=name) from None
+    except OSError as e:
+        raise InputError(f"{name}: cannot read ({e.strerror or e})", file=name) from None
+    if stat.S_ISDIR(mode):
+        raise InputError(f"{name}: is a directory, not a file", file=name)
+    if not stat.S_ISREG(mode):
+        kind = ("a FIFO (named pipe)" if stat.S_ISFIFO(mode) else
+                "a device" if stat.S_ISCHR(mode) or stat.S_ISBLK(mode) else
+                "a socket" if stat.S_ISSOCK(mode) else "not a regular file")
+        raise InputError(f"{name}: is {kind}, not a regular file (inputs are read from "
+                         "regular files only)", file=name)
+    if not os.access(p, os.R_OK):
+        raise InputError(f"{name}: cannot read (permission denied)", file=name)
+    return p
 
 
 def _nearest_existing(path: Path) -> Path:

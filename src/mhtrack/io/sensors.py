@@ -20,6 +20,7 @@ from typing import Any
 
 import tomli_w
 
+from mhtrack.bounds import MAX_INDEX, MAX_MAGNITUDE, clip, float_problem, int_problem
 from mhtrack.errors import InputError
 from mhtrack.io._source import PathArg
 from mhtrack.io.atomic import atomic_write
@@ -101,7 +102,10 @@ class _Reader:
             return None
         if isinstance(v, bool) or not isinstance(v, int | float):
             raise self.fail(where, key, f"expected a number, got {_describe(v)}")
-        return float(v)
+        x = float(v)  # TOML integers fit in a float
+        if abs(x) > MAX_MAGNITUDE and x != float("inf") and x != -float("inf"):
+            raise self.fail(where, key, str(float_problem(v)))  # NaN, inf: checked later
+        return x
 
     def origin(self) -> tuple[float, float] | None:
         if "origin" not in self.data:
@@ -120,6 +124,8 @@ class _Reader:
                 raise self.fail(where, key, "missing (required for every sensor)")
         if isinstance(t["id"], bool) or not isinstance(t["id"], int):
             raise self.fail(where, "id", f"expected an integer, got {_describe(t['id'])}")
+        if (problem := int_problem(t["id"], 0, MAX_INDEX)) is not None:
+            raise self.fail(where, "id", problem)
         if not isinstance(t["kind"], str):
             raise self.fail(where, "kind", f"expected a string, got {_describe(t['kind'])}")
         fields: dict[str, Any] = {k: self.number(t, where, k) for k in _NUMBERS}
@@ -153,7 +159,7 @@ class _Reader:
 def _describe(v: object) -> str:
     kinds = {str: "string", dict: "table", list: "array", bool: "boolean", int: "integer",
              float: "float"}
-    text = repr(v) if not isinstance(v, dict | list) or len(repr(v)) < 40 else "…"
+    text = clip(repr(v)) if not isinstance(v, dict | list) or len(repr(v)) < 40 else "…"
     return f"{kinds.get(type(v), type(v).__name__)} {text}"
 
 

@@ -14,15 +14,16 @@ from __future__ import annotations
 import re
 import tomllib
 from collections.abc import Mapping
-from pathlib import Path
 from typing import Any
 
 import numpy as np
 import tomli_w
 
+from mhtrack.bounds import MAX_NESTING, clip
 from mhtrack.errors import InputError
 from mhtrack.io._source import PathArg
 from mhtrack.io.atomic import atomic_write
+from mhtrack.io.paths import check_input_file
 
 _AT = re.compile(r"\s*\(at line (\d+), column (\d+)\)\s*$")
 #: A message that starts with a key path: ``T: …``, ``targets[2].birth: …``.
@@ -38,11 +39,7 @@ def read_toml(path: PathArg) -> dict[str, Any]:
         message names the file and, for syntax errors, ``line L, column C``.
     """
     name = str(path)
-    p = Path(path)
-    if not p.exists():
-        raise InputError(f"{name}: no such file", file=name)
-    if p.is_dir():
-        raise InputError(f"{name}: is a directory, not a file", file=name)
+    p = check_input_file(path)
     try:
         data = p.read_bytes()
     except OSError as e:
@@ -56,7 +53,9 @@ def read_toml(path: PathArg) -> dict[str, Any]:
             file=name, line=line,
         ) from None
     try:
-        return tomllib.loads(text)
+        data = tomllib.loads(text)
+    except RecursionError:
+        data = None
     except tomllib.TOMLDecodeError as e:
         message = str(e)
         m = _AT.search(message)
@@ -68,6 +67,28 @@ def read_toml(path: PathArg) -> dict[str, Any]:
             ) from None
         message = message.replace(" (at end of document)", "")
         raise InputError(f"{name}, end of file: {message}", file=name) from None
+    key = None if data is None else too_deep(data)
+    if data is None or key is not None:
+        at = "" if key is None else f", key {clip(key, 60)!r}"
+        raise InputError(f"{name}{at}: tables and arrays nested more than {MAX_NESTING} "
+                         "levels deep", file=name, key=key)
+    return data
+
+
+def too_deep(value: Any, limit: int = MAX_NESTING) -> str | None:
+    """The key path of the first value nested deeper than ``limit`` tables/arrays in
+    ``value`` (parsed TOML or JSON), or ``None``; iterative, so it never recurses."""
+    stack: list[tuple[Any, str, int]] = [(value, "", 0)]
+    while stack:
+        v, path, depth = stack.pop()
+        if isinstance(v, dict | list):
+            if depth > limit:
+                return path or "(top level)"
+            items = v.items() if isinstance(v, dict) else enumerate(v)
+            for k, x in items:
+                sub = f"{path}[{k}]" if isinstance(k, int) else f"{path}.{k}" if path else k
+                stack.append((x, sub, depth + 1))
+    return None
 
 
 def key_error(path: PathArg, error: ValueError) -> InputError:

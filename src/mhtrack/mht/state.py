@@ -5,11 +5,18 @@ birth process's as ``birth__<name>``, the tentative history's as ``history__<nam
 clutter estimator's ``get_state()`` arrays as ``clutter__<i>``, and ``meta``: one JSON
 string with the format, the configuration, the estimator's name and state (arrays replaced
 by ``{"__ndarray__": key}``), the last scan's time and index and the id counters.
+
+:func:`load_state` reads nothing it has not checked: the archive's sizes and headers
+(:func:`mhtrack.io.npzfile.read_npz`), then ``meta`` and every array
+(:mod:`mhtrack.mht.state_checks`); each problem is one
+:class:`~mhtrack.errors.InputError` line naming the file and the member or field.
 """
 
 from __future__ import annotations
 
 import json
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
 from os import PathLike
 from typing import Any
@@ -18,8 +25,12 @@ import numpy as np
 
 from mhtrack.clutter.base import ClutterEstimator
 from mhtrack.clutter.known import KnownClutter
+from mhtrack.errors import InputError
 from mhtrack.io.atomic import atomic_path
+from mhtrack.io.npzfile import member_error, read_npz
+from mhtrack.io.tomlfile import too_deep
 from mhtrack.mht.config import MHTConfig
+from mhtrack.mht.state_checks import check_arrays, check_meta
 
 FORMAT = "mhtrack.mht.MHTTracker/3"
 
@@ -47,7 +58,10 @@ def decode(obj: Any, arrays: dict[str, np.ndarray]) -> Any:
     """Inverse of :func:`encode`."""
     if isinstance(obj, dict):
         if set(obj) == {"__ndarray__"}:
-            return arrays[obj["__ndarray__"]]
+            key = obj["__ndarray__"]
+            if not isinstance(key, str) or not key.startswith("clutter__") or key not in arrays:
+                raise ValueError(f"field clutter_state: array {key!r} is not in the file")
+            return arrays[key]
         return {k: decode(v, arrays) for k, v in obj.items()}
     if isinstance(obj, list):
         return [decode(v, arrays) for v in obj]
@@ -83,14 +97,56 @@ class SavedState:
         return {k.removeprefix(head): v for k, v in self.arrays.items() if k.startswith(head)}
 
 
-def load_state(path: str | PathLike[str], clutter: ClutterEstimator | None) -> SavedState:
-    """Read a file written by :func:`save_state`. ``clutter`` is an estimator of the saved
-    kind (its state is overwritten); it may be omitted for the ``known`` one."""
-    with np.load(path, allow_pickle=False) as data:
-        arrays = {k: data[k] for k in data.files}
-    meta = json.loads(str(arrays.pop("meta")))
+@contextmanager
+def located(path: str | PathLike[str], member: str) -> Iterator[None]:
+    """Turn an error raised while restoring ``member`` of the state file ``path`` into an
+    :class:`InputError` naming both (a part's own ``set_arrays``/``set_state`` checks)."""
+    try:
+        yield
+    except InputError:
+        raise
+    except (ValueError, TypeError, KeyError, IndexError, AttributeError) as e:
+        what = f"missing {e}" if isinstance(e, KeyError) else str(e)
+        raise member_error(path, member, f"cannot be restored ({what})") from None
+
+
+def _meta(path: str | PathLike[str], arrays: dict[str, np.ndarray]) -> dict[str, Any]:
+    raw = arrays.pop("meta", None)
+    if raw is None:
+        raise member_error(path, "meta", "missing (not an MHT tracker state)")
+    if raw.dtype.kind != "U" or raw.shape != ():
+        raise member_error(path, "meta", f"expected one JSON string, got {raw.dtype} "
+                           f"{raw.shape}")
+    try:
+        meta = json.loads(str(raw))
+    except (ValueError, RecursionError) as e:
+        raise member_error(path, "meta", f"not JSON ({e})") from None
+    if not isinstance(meta, dict):
+        raise member_error(path, "meta", f"expected a JSON object, got {type(meta).__name__}")
+    if too_deep(meta) is not None:
+        raise member_error(path, "meta", "nested too deep")
     if meta.get("format") != FORMAT:
-        raise ValueError(f"{path}: not an MHT tracker state ({meta.get('format')!r})")
+        raise member_error(path, "meta", f"not an MHT tracker state (format "
+                           f"{meta.get('format')!r}, expected {FORMAT!r})")
+    check_meta(path, meta)
+    return meta
+
+
+def load_state(path: str | PathLike[str], clutter: ClutterEstimator | None) -> SavedState:
+    """Read a file written by :func:`save_state`, checking it first (module docstring).
+    ``clutter`` is an estimator of the saved kind (its state is overwritten); it may be
+    omitted for the ``known`` one.
+
+    Raises
+    ------
+    InputError : the file is not a valid state (one line naming the file and member).
+    ValueError : ``clutter`` is not of the saved kind.
+    """
+    arrays = read_npz(path)
+    meta = _meta(path, arrays)
+    with located(path, "meta"):
+        config = MHTConfig.from_json(json.dumps(meta["config"]))
+    check_arrays(path, arrays, meta, config.n_scan)
     if clutter is None:
         if meta["clutter_name"] != KnownClutter.name:
             raise ValueError(
@@ -103,5 +159,8 @@ def load_state(path: str | PathLike[str], clutter: ClutterEstimator | None) -> S
             f"{path}: saved with clutter estimator {meta['clutter_name']!r}, "
             f"got {clutter.name!r}"
         )
-    clutter.set_state(decode(meta["clutter_state"], arrays))
-    return SavedState(MHTConfig.from_json(json.dumps(meta["config"])), clutter, meta, arrays)
+    with located(path, "meta"):
+        state = decode(meta.get("clutter_state"), arrays)
+    with located(path, "clutter_state"):
+        clutter.set_state(state)
+    return SavedState(config, clutter, meta, arrays)

@@ -65,7 +65,7 @@ from mhtrack.mht.pruning import prune_after_solve, prune_children, removed_after
 from mhtrack.mht.report import StepStats, confirmed_windows, report
 from mhtrack.mht.scoring import miss_increments, update_increment
 from mhtrack.mht.sprt import SPRT
-from mhtrack.mht.state import load_state, save_state
+from mhtrack.mht.state import load_state, located, save_state
 from mhtrack.mht.timed import gate_looked, merge_by_tree, split_looked
 from mhtrack.mht.tree import Leaves
 from mhtrack.mht.validate import validate_scan
@@ -246,10 +246,14 @@ class MHTTracker:
         if "time" not in leaves:  # saved before leaves had their own times
             leaves["time"] = np.full(len(leaves["score"]), meta["last_time"] or 0.0)
         trk._leaves = Leaves.from_arrays(leaves)
+        if trk._leaves.n_models != trk.motion.n_models:
+            raise ValueError(f"{path}: saved with {trk._leaves.n_models} IMM models, the "
+                             f"motion model given has {trk.motion.n_models}")
         trk._last_time, trk._last_index = meta["last_time"], meta["last_index"]
         trk.trees, trk.tracks = Counter(meta["next_tree"]), Counter(meta["next_track"])
         trk.nodes = Counter(meta["next_node"])
-        trk._history.set_arrays(saved.part("history"))
-        trk.birth.set_arrays(saved.part("birth"))
-        trk.coverage.set_arrays(saved.part("coverage"))
+        for part, owner in (("history", trk._history), ("birth", trk.birth),
+                            ("coverage", trk.coverage)):
+            with located(path, f"{part}__*"):
+                owner.set_arrays(saved.part(part))
         return trk

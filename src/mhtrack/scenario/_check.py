@@ -13,6 +13,7 @@ from typing import Any
 
 import numpy as np
 
+from mhtrack.bounds import MAX_INDEX, MAX_MAGNITUDE, clip
 from mhtrack.errors import short_number as fmt
 
 _KEYED = re.compile(r"^[A-Za-z_]\w*(\[\d+\])*(\.\w+(\[\d+\])*)*: ")
@@ -64,7 +65,11 @@ def keys(
 
 
 def _tname(v: object) -> str:
-    return type(v).__name__
+    return {dict: "table", list: "array"}.get(type(v), type(v).__name__)
+
+
+def _show(v: object) -> str:
+    return clip(repr(v))
 
 
 def number(
@@ -75,11 +80,13 @@ def number(
     lo_open: bool = False,
     hi: float | None = None,
     unit: str = "",
+    magnitude: bool = True,
 ) -> float:
     """A finite real number (bools rejected), optionally ``>= lo`` (or ``> lo``) and
-    ``<= hi`` (``unit`` is appended to ``hi`` in the message)."""
+    ``<= hi`` (``unit`` is appended to ``hi`` in the message); with ``magnitude``, also
+    within ±:data:`mhtrack.bounds.MAX_MAGNITUDE`."""
     if isinstance(v, bool) or not isinstance(v, int | float | np.integer | np.floating):
-        raise ValueError(f"{path}: expected a number, got {_tname(v)} {v!r}")
+        raise ValueError(f"{path}: expected a number, got {_tname(v)} {_show(v)}")
     try:
         x = float(v)
     except OverflowError:  # a Python int beyond the float range
@@ -90,12 +97,15 @@ def number(
         raise ValueError(f"{path}: must be {'>' if lo_open else '>='} {lo}, got {x}")
     if hi is not None and x > hi:
         raise ValueError(f"{path}: must be <= {fmt(hi)}{' ' + unit if unit else ''}, got {x}")
+    if magnitude and abs(x) > MAX_MAGNITUDE:
+        raise ValueError(f"{path}: must be within ±{fmt(MAX_MAGNITUDE)} (mhtrack.bounds), "
+                         f"got {x}")
     return x
 
 
 def bounded(v: object, path: str, limit: float, unit: str = "m") -> float:
     """A finite number with ``|v| <= limit`` (coordinates, velocities)."""
-    x = number(v, path)
+    x = number(v, path, magnitude=False)
     if abs(x) > limit:
         raise ValueError(f"{path}: must be within ±{fmt(limit)} {unit}, got {x}")
     return x
@@ -118,35 +128,44 @@ def detection_probability(v: object, path: str) -> float:
     return x
 
 
-def integer(v: object, path: str, *, lo: int | None = None) -> int:
-    """An integer (bools and floats rejected), optionally ``>= lo``."""
+def integer(v: object, path: str, *, lo: int | None = None,
+            hi: int | None = MAX_INDEX) -> int:
+    """An integer (bools and floats rejected), optionally ``>= lo``, and within
+    ``[-2^53, hi]`` (default ``hi = 2^53``, :data:`mhtrack.bounds.MAX_INDEX`; ``None``:
+    the caller checks the range)."""
     if isinstance(v, bool) or not isinstance(v, int | np.integer):
-        raise ValueError(f"{path}: expected an integer, got {_tname(v)} {v!r}")
+        raise ValueError(f"{path}: expected an integer, got {_tname(v)} {_show(v)}")
     if lo is not None and int(v) < lo:
-        raise ValueError(f"{path}: must be >= {lo}, got {int(v)}")
+        raise ValueError(f"{path}: must be >= {lo}, got {clip(str(int(v)))}")
+    if hi is not None and (int(v) > hi or int(v) < -MAX_INDEX):
+        raise ValueError(f"{path}: must be an integer in [{lo if lo is not None else -MAX_INDEX}"
+                         f", {hi}], got {clip(str(int(v)))}")
     return int(v)
 
 
 def string(v: object, path: str) -> str:
     if not isinstance(v, str):
-        raise ValueError(f"{path}: expected a string, got {_tname(v)} {v!r}")
+        raise ValueError(f"{path}: expected a string, got {_tname(v)} {_show(v)}")
     return v
 
 
 def array(
-    v: object, path: str, shape: tuple[int | None, ...], limit: float | None = None
+    v: object, path: str, shape: tuple[int | None, ...], limit: float | None = None,
+    *, magnitude: bool = True,
 ) -> np.ndarray:
     """A nested list of finite numbers of the given ``shape`` (``None`` = any length), each
     within ``±limit`` if given (in m); the error names the first offending element, e.g.
     ``means[1][0]``."""
     if len(shape) == 0:
-        return np.asarray(number(v, path) if limit is None else bounded(v, path, limit))
+        return np.asarray(number(v, path, magnitude=magnitude) if limit is None
+                          else bounded(v, path, limit))
     if not isinstance(v, list | tuple | np.ndarray):
-        raise ValueError(f"{path}: expected a list, got {_tname(v)} {v!r}")
+        raise ValueError(f"{path}: expected a list, got {_tname(v)} {_show(v)}")
     n = shape[0]
     if n is not None and len(v) != n:
         raise ValueError(f"{path}: expected {n} elements, got {len(v)}")
-    rows = [array(e, join(path, i), shape[1:], limit) for i, e in enumerate(v)]
+    rows = [array(e, join(path, i), shape[1:], limit, magnitude=magnitude)
+            for i, e in enumerate(v)]
     if not rows:
         return np.zeros((0, *[s or 0 for s in shape[1:]]))
     return np.stack(rows)

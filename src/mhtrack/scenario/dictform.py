@@ -15,6 +15,7 @@ from typing import Any
 
 import numpy as np
 
+from mhtrack.bounds import MAX_SEED
 from mhtrack.models.clutter import (
     GaussianMixtureClutter,
     Region,
@@ -131,7 +132,7 @@ def scenario_fields(d: Mapping[str, Any]) -> dict[str, Any]:
     # rotating radars draw their own clutter: the region's model is optional then
     ck.keys(d, "", _TOP_REQUIRED | (set() if rotating else {"clutter"}), _TOP_OPTIONAL)
     if "seed" in d:
-        ck.integer(d["seed"], "seed", lo=0)
+        ck.integer(d["seed"], "seed", lo=0, hi=MAX_SEED)
     name = ck.string(d.get("name", "custom"), "name")
     description = ck.string(d.get("description", ""), "description")
     T = check_period(d["T"])
@@ -252,14 +253,14 @@ def _target_from(v: object, path: str, first: int, last: int) -> AnyTarget:
                 raise ValueError(
                     f"{path}.scans[{i}]: must be > the previous scan ({sc[i]} <= {sc[i - 1]})"
                 )
-        st = ck.array(d["states"], f"{path}.states", (len(sc), 4))
+        st = ck.array(d["states"], f"{path}.states", (len(sc), 4), magnitude=False)
         for i, row in enumerate(st):
             check_state(row, f"{path}.states[{i}]")
         with ck.at(path):
             return RecordedTarget(tid, tuple(sc), tuple(map(tuple, st.tolist())))
     ck.keys(d, path, {"id", "state"}, {"birth", "death"})
     tid = ck.integer(d["id"], f"{path}.id", lo=0)
-    state = ck.array(d["state"], f"{path}.state", (4,))
+    state = ck.array(d["state"], f"{path}.state", (4,), magnitude=False)
     check_state(state, f"{path}.state")
     birth = ck.integer(d.get("birth", first), f"{path}.birth", lo=0)
     death = ck.integer(d.get("death", last), f"{path}.death", lo=0)

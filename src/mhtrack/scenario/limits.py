@@ -40,8 +40,8 @@ def check_sigma_v(v: object) -> float:
 
 def check_scan_range(first: object, last: object) -> tuple[int, int]:
     """Validated ``(first, last)``; at most :data:`MAX_SCANS` scans."""
-    f = ck.integer(first, "scans[0]", lo=0)
-    la = ck.integer(last, "scans[1]", lo=0)
+    f = ck.integer(first, "scans[0]", lo=0, hi=None)
+    la = ck.integer(last, "scans[1]", lo=0, hi=None)
     if f > la:
         raise ValueError(f"scans: first must be <= last, got [{f}, {la}]")
     if la - f + 1 > MAX_SCANS:

@@ -18,12 +18,16 @@ import contextlib
 import json
 import math
 from abc import ABC, abstractmethod
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import Any
 
+from mhtrack.errors import InputError
 from mhtrack.experiments.jobs.job import Job
 from mhtrack.io.atomic import atomic_path, atomic_write
+
+#: Checks a done job's record (raises ``ValueError("<field>: <problem>")``).
+RecordCheck = Callable[[Job, Mapping[str, Any]], None]
 
 ERROR_SUFFIX = ".error.txt"
 
@@ -64,8 +68,9 @@ class JsonRecords(RecordFormat):
 
     def read(self, path: Path) -> dict[str, Any]:
         d = self._load(path)
-        if d is None:
-            raise ValueError(f"{path}: not a job record")
+        if d is None or "result" not in d:
+            raise InputError(f"{path}: not a job record (expected a JSON object with 'job' "
+                             "and 'result')", file=str(path))
         return d["result"]
 
     def stored_hash(self, path: Path) -> str | None:
@@ -117,11 +122,19 @@ class ParquetRecords(RecordFormat):
             pq.write_table(table, tmp)
 
     def read(self, path: Path) -> dict[str, Any]:
+        import pyarrow as pa
         import pyarrow.parquet as pq
 
-        row = pq.read_table(path).to_pylist()[0]
+        try:
+            rows = pq.read_table(path).to_pylist()
+        except (OSError, pa.ArrowException) as e:
+            raise InputError(f"{path}: not a readable job record ({str(e)[:120]})",
+                             file=str(path)) from None
+        if len(rows) != 1:
+            raise InputError(f"{path}: a job record holds one row, this one {len(rows)}",
+                             file=str(path))
         return {k: (math.nan if v is None and k not in self.keep_none else v)
-                for k, v in row.items()}
+                for k, v in rows[0].items()}
 
     def stored_hash(self, path: Path) -> str | None:
         import pyarrow as pa
@@ -138,9 +151,11 @@ class ParquetRecords(RecordFormat):
 class JobStore:
     """Job records under ``root``, one file per job (module docstring)."""
 
-    def __init__(self, root: str | Path, fmt: RecordFormat) -> None:
+    def __init__(self, root: str | Path, fmt: RecordFormat,
+                 check: RecordCheck | None = None) -> None:
         self.root = Path(root)
         self.fmt = fmt
+        self.check = check
 
     def path(self, key: str) -> Path:
         """The record file of job ``key``."""
@@ -160,8 +175,24 @@ class JobStore:
         return self.stored_hash(job) == job.hash
 
     def load(self, job: Job) -> dict[str, Any]:
-        """The stored record of a done job."""
-        return self.fmt.read(self.path(job.key))
+        """The stored record of a done job, checked by the store's ``check`` (a record of
+        the wrong shape is an :class:`~mhtrack.errors.InputError` naming the file and
+        the field: ``jobs/grid-….json, key 'result.found': expected …``)."""
+        path = self.path(job.key)
+        record = self.fmt.read(path)
+        if not isinstance(record, dict):
+            raise InputError(f"{path}, key 'result': expected an object, got "
+                             f"{type(record).__name__}", file=str(path), key="result")
+        if self.check is not None:
+            try:
+                self.check(job, record)
+            except (ValueError, TypeError, KeyError) as e:
+                msg = str(e)
+                field, _, problem = msg.partition(": ")
+                key = f"result.{field}" if problem else "result"
+                raise InputError(f"{path}, key {key!r}: {problem or msg}", file=str(path),
+                                 key=key) from None
+        return record
 
     def error(self, job: Job) -> str | None:
         """The stored traceback of ``job``, if it failed (and has not succeeded since)."""

@@ -28,7 +28,34 @@ NOT_METRICS = frozenset({"run", "seed", "base_seed", *PARAMETERS})
 
 def run_store(out_dir: str | os.PathLike[str]) -> JobStore:
     """The job store of a study directory: ``runs/<tracker>/run-<i>.parquet``."""
-    return JobStore(Path(out_dir) / RUNS_DIR, RECORDS)
+    return JobStore(Path(out_dir) / RUNS_DIR, RECORDS, check=check_run_record)
+
+
+def check_run_record(job: Any, record: Mapping[str, Any]) -> None:
+    """A run file read back has what the summary reads: its ``run``, the ``scans`` and a
+    per-scan list of each per-scan metric as long (or null); raises
+    ``ValueError("<field>: <problem>")`` (named with the file by the store)."""
+    run = record.get("run")
+    if run != job.params["run"]:
+        raise ValueError(f"run: expected {job.params['run']}, got {run!r}")
+    scans = record.get("scans")
+    if not isinstance(scans, list) or not all(
+            isinstance(k, int | float) and not isinstance(k, bool) for k in scans):
+        raise ValueError(f"scans: expected a list of scan numbers, got {type(scans).__name__}")
+    for key in ("ospa", "gospa", "cardinality", "cardinality_true"):
+        v = record.get(key)
+        if v is not None and (not isinstance(v, list) or len(v) != len(scans)):
+            got = f"a list of {len(v)}" if isinstance(v, list) else type(v).__name__
+            raise ValueError(f"{key}: expected a list of {len(scans)} values (one per scan), "
+                             f"got {got}")
+    caps = record.get("caps")
+    if caps is not None:
+        try:
+            ok = isinstance(json.loads(caps), dict)
+        except (TypeError, ValueError, RecursionError):
+            ok = False
+        if not ok:
+            raise ValueError(f"caps: expected a JSON object as text, got {caps!r:.60}")
 
 
 @dataclass
@@ -142,7 +169,7 @@ def load_results(out_dir: str | os.PathLike[str]) -> MonteCarloResult:
     path = out_dir / SPEC_FILE
     if not path.is_file():
         raise FileNotFoundError(f"{out_dir}: no {SPEC_FILE}; not a Monte-Carlo directory")
-    spec = MonteCarloSpec.from_dict(json.loads(path.read_text()))
+    spec = MonteCarloSpec.from_file(path)
     store = run_store(out_dir)
     records: dict[str, list[dict[str, Any]]] = {t: [] for t in spec.trackers}
     failures: dict[str, dict[int, str]] = {t: {} for t in spec.trackers}

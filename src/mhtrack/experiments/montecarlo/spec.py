@@ -147,6 +147,12 @@ class MonteCarloSpec:
                    seed=d["seed"], config=d.get("config", {}),
                    run_kwargs=d.get("run_kwargs", {}))
 
+    @classmethod
+    def from_file(cls, path: str | Path) -> MonteCarloSpec:
+        """The study stored in ``path`` (``montecarlo.json``), every problem one
+        :class:`~mhtrack.errors.InputError` line naming the file and the key."""
+        return read_spec_file(Path(path))
+
     def job(self, tracker: str, run: int) -> Job:
         """The job of ``tracker`` on run ``run`` (its dict is the argument of
         :func:`~mhtrack.experiments.montecarlo.job.run_job`)."""
@@ -180,10 +186,7 @@ def check_study(spec: MonteCarloSpec, out_dir: Path) -> None:
     path = Path(out_dir) / SPEC_FILE
     if not path.is_file():
         return
-    try:
-        old = json.loads(path.read_text())
-    except (OSError, ValueError) as e:
-        raise SpecMismatchError(f"{path}: cannot read the stored study ({e})") from None
+    old = read_spec_file(path).to_dict()
     new = spec.to_dict()
     differ = [k for k in ("format", *STUDY_FIELDS) if _canonical(old.get(k)) != _canonical(new[k])]
     if differ:
@@ -192,3 +195,23 @@ def check_study(spec: MonteCarloSpec, out_dir: Path) -> None:
             f"(differing from {path}: {', '.join(differ)}); use another --out directory or "
             "delete that one"
         )
+
+
+def read_spec_file(path: Path) -> MonteCarloSpec:
+    """:meth:`MonteCarloSpec.from_file`."""
+    from mhtrack.io.jsonfile import key_error, read_json_object
+
+    d = read_json_object(path, "a Monte-Carlo study", ("scenario", "trackers", "runs", "seed"))
+    if not isinstance(d["trackers"], list):
+        raise key_error(path, "trackers", "expected an array of tracker names")
+    for key in ("config", "run_kwargs"):
+        if not isinstance(d.get(key, {}), dict):
+            raise key_error(path, key, "expected an object")
+    try:
+        return MonteCarloSpec.from_dict(d)
+    except SpecMismatchError:
+        raise
+    except (ValueError, TypeError) as e:
+        msg = str(e)
+        key = msg.split(":", 1)[0] if ":" in msg and " " not in msg.split(":", 1)[0] else None
+        raise key_error(path, key, msg.split(": ", 1)[1] if key else msg) from None

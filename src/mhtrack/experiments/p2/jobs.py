@@ -168,6 +168,53 @@ def run_job(job: Mapping[str, Any]) -> dict[str, Any]:
     return JOB_FUNCTIONS[job["kind"]](job)
 
 
+def _count(v: object, field: str) -> None:
+    if isinstance(v, bool) or not isinstance(v, int) or not 0 <= v <= 2**53:
+        raise ValueError(f"{field}: expected a count (an integer in [0, 2^53]), got {v!r}")
+
+
+def _seconds(v: object, field: str) -> None:
+    if isinstance(v, bool) or not isinstance(v, int | float) or not 0 <= v <= 1e12:
+        raise ValueError(f"{field}: expected seconds (a number in [0, 1e12]), got {v!r}")
+
+
+def _table(record: Mapping[str, Any], field: str, counts: Sequence[str],
+           seconds: Sequence[str]) -> None:
+    sub = record.get(field) if field else record
+    if not isinstance(sub, Mapping):
+        raise ValueError(f"{field}: expected an object, got {type(sub).__name__}")
+    at = f"{field}." if field else ""
+    for k in counts:
+        _count(sub.get(k), at + k)
+    for k in seconds:
+        _seconds(sub.get(k), at + k)
+
+
+def check_record(job: Job, record: Mapping[str, Any]) -> None:
+    """A stored record has the shape its job's function returns (checked before
+    :func:`~mhtrack.experiments.p2.aggregate.aggregate` reads it); raises
+    ``ValueError("<field>: <problem>")``."""
+    kind = job.params["kind"]
+    if kind == "grid":
+        n = len(job.params["thetas"])
+        for k in ("found", "false", "tracks"):
+            v = record.get(k)
+            if not isinstance(v, list) or len(v) != n:
+                got = f"a list of {len(v)}" if isinstance(v, list) else type(v).__name__
+                raise ValueError(f"{k}: expected a list of {n} counts (one per θ), got {got}")
+            for i, x in enumerate(v):
+                _count(x, f"{k}[{i}]")
+        _table(record, "", ("n_targets", "n_windows", "non_monotone_windows"), ("seconds",))
+    elif kind == "clustering":
+        for m in ("adaptive", "random"):
+            _table(record, m, ("k_correct", "clusters"), ("seconds",))
+        _count(record.get("n_scans"), "n_scans")
+    else:
+        for m in INITIATORS:
+            _table(record, m, ("found", "false", "tracks"), ("seconds",))
+        _table(record, "", ("n_targets", "n_windows", "n_scans"), ("fusion_seconds",))
+
+
 def make_jobs(runs: int, seed: int, thetas: Sequence[float], sigmas: Sequence[float],
               rates: Sequence[float], chunk: int = CHUNK) -> list[Job]:
     """All jobs of a study (module docstring); each keyed by its unique ``name``."""

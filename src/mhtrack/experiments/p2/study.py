@@ -26,7 +26,7 @@ from mhtrack.experiments.p2.constants import (
     SIGMAS,
     THETAS_DEG,
 )
-from mhtrack.experiments.p2.jobs import STORE_FORMAT, make_jobs, run_job
+from mhtrack.experiments.p2.jobs import STORE_FORMAT, check_record, make_jobs, run_job
 from mhtrack.io.jsonsafe import to_jsonable
 
 
@@ -64,7 +64,7 @@ def reproduce_p2(out_dir: str | os.PathLike[str], runs: int = 10, seed: int = 0,
         raise ValueError("thetas must be in [0, 180] degrees")
     jobs = make_jobs(runs, seed, thetas, SIGMAS if sigmas is None else sigmas,
                      RATES if rates is None else rates, chunk)
-    store = JobStore(out / JOBS_DIR, STORE_FORMAT)
+    store = JobStore(out / JOBS_DIR, STORE_FORMAT, check=check_record)
     t0 = time.perf_counter()
     done = run_jobs(jobs, run_job, store, executor=executor, workers=workers,
                     scheduler=scheduler, progress=progress, desc="reproduce p2")

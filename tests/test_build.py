@@ -147,3 +147,50 @@ def test_builder_imports_no_later_layer():
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                          check=True)
     assert out.stdout.strip() == "[]", out.stdout
+
+
+def _continue(trk, scans):
+    return [trk.step(s) for s in scans]
+
+
+@pytest.mark.parametrize("name", ["mht", "mht-gmm", "mht-agmm"])
+def test_load_tracker_needs_no_parts_and_continues_identically(tmp_path, name):
+    from mhtrack.scenario import simulate
+
+    scans = list(simulate(preset("crossing", scans=14), seed=2).plots.scans())
+    trk = build.make_tracker(name, build.default_config(preset("crossing")),
+                             clutter_density=3e-9 if name == "mht" else None)
+    _continue(trk, scans[:8])
+    trk.save(tmp_path / "s.npz")
+    back = build.load_tracker(tmp_path / "s.npz")
+    assert type(back.clutter) is type(trk.clutter) and back.recipe == trk.recipe
+    for a, b in zip(_continue(trk, scans[8:]), _continue(back, scans[8:]), strict=True):
+        assert a.track_id.tolist() == b.track_id.tolist()
+        assert a.x.tolist() == b.x.tolist() and a.y.tolist() == b.y.tolist()
+
+
+def test_load_tracker_rebuilds_radars_and_polar_clutter(tmp_path):
+    from async_fixture import simulate_async
+
+    from mhtrack.clutter.polar import PolarClutter
+
+    sim = simulate_async(duration=60.0)
+    frames = list(sim.plots.scans())
+    trk = build.make_tracker("mht-agmm", sensors=sim.sensors)
+    _continue(trk, frames[: len(frames) // 2])
+    trk.save(tmp_path / "a.npz")
+    back = build.load_tracker(tmp_path / "a.npz")
+    assert isinstance(back.clutter.estimator(1), PolarClutter)
+    assert back.coverage.sensors == sim.sensors
+    rest = frames[len(frames) // 2:]
+    for a, b in zip(_continue(trk, rest), _continue(back, rest), strict=True):
+        assert a.track_id.tolist() == b.track_id.tolist() and a.x.tolist() == b.x.tolist()
+
+
+def test_load_tracker_refuses_a_hand_assembled_tracker(tmp_path):
+    from mhtrack.clutter import GMMClutter
+    from mhtrack.mht import MHTTracker
+
+    MHTTracker(MHTConfig(), GMMClutter()).save(tmp_path / "h.npz")
+    with pytest.raises(ValueError, match="no recipe"):
+        build.load_tracker(tmp_path / "h.npz")

@@ -25,6 +25,8 @@ imports neither of those, nor plotting or the CLI.
 from __future__ import annotations
 
 import dataclasses
+import json
+import os
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
@@ -43,7 +45,7 @@ from mhtrack.initiation.factory import INITIATOR_CLASSES, make_initiator
 from mhtrack.initiation.fusion import AdaptiveKMeansFusion, KMeansFusion
 from mhtrack.mht import MHTConfig, MHTTracker
 from mhtrack.mht.coverage import RadarCoverage
-from mhtrack.models.radars import SensorSet
+from mhtrack.models.radars import RadarSensor, SensorSet
 from mhtrack.models.sensors import CartesianSensor
 from mhtrack.scenario import Scenario
 
@@ -137,8 +139,12 @@ def make_tracker(
     kappa = clutter_density if takes_clutter_density(name) else None
     estimator = TRACKER_ESTIMATORS[name]
     params = {} if clutter_params is None or estimator == "known" else dict(clutter_params)
+    recipe = {"name": name, "clutter_density": clutter_density,
+              "clutter_frame": clutter_frame, "clutter_params": params or None,
+              "sensors": None if sensors is None else sensors_recipe(sensors)}
     if sensors is None:
-        return MHTTracker(config, make_clutter_estimator(estimator, kappa=kappa, **params))
+        return _with_recipe(MHTTracker(
+            config, make_clutter_estimator(estimator, kappa=kappa, **params)), recipe)
     config = config_with(config, confirm_min_plots=max(config.confirm_min_plots,
                                                        TIMED_CONFIRM_MIN_PLOTS))
     if clutter_frame not in names.CLUTTER_FRAMES:
@@ -153,7 +159,58 @@ def make_tracker(
         lambda: make_clutter_estimator(estimator, kappa=kappa, **params),
         {s.id: s.period for s in sensors.sensors},
         initial=DEFAULT_CLUTTER_DENSITY if kappa is None else kappa, wrap=wrap)
-    return MHTTracker(config, clutter, coverage=RadarCoverage(sensors))
+    return _with_recipe(MHTTracker(config, clutter, coverage=RadarCoverage(sensors)), recipe)
+
+
+def _with_recipe(trk: MHTTracker, recipe: dict[str, Any]) -> MHTTracker:
+    trk.recipe = recipe
+    return trk
+
+
+def sensors_recipe(sensors: SensorSet) -> dict[str, Any]:
+    """``sensors`` as JSON-able values (:func:`sensors_from_recipe` reverses it)."""
+    return {"origin": None if sensors.origin is None else list(sensors.origin),
+            "sensors": [{k: (list(v) if isinstance(v, tuple) else v)
+                         for k, v in dataclasses.asdict(s).items()}
+                        for s in sensors.sensors]}
+
+
+def sensors_from_recipe(d: dict[str, Any]) -> SensorSet:
+    """The :class:`SensorSet` of :func:`sensors_recipe`."""
+    return SensorSet(None if d["origin"] is None else tuple(d["origin"]), tuple(
+        RadarSensor(**{k: (tuple(v) if isinstance(v, list) else v) for k, v in s.items()})
+        for s in d["sensors"]))
+
+
+def load_tracker(path: str | os.PathLike[str]) -> MHTTracker:
+    """Restore a tracker that :func:`make_tracker` built and ``save`` wrote, without
+    passing its parts again: the state holds the builder's recipe (tracker name, known
+    κ, clutter frame and estimator keywords, the radars), from which the clutter
+    estimator, motion model, birth process and coverage are rebuilt, then
+    :meth:`MHTTracker.load` restores their states. A tracker assembled by hand has no
+    recipe: load it with :meth:`MHTTracker.load` and its parts."""
+    from mhtrack.mht.state import saved_meta
+
+    meta = saved_meta(path)
+    recipe = meta.get("recipe")
+    if not isinstance(recipe, dict):
+        raise ValueError(f"{path}: saved by a tracker not made by mhtrack.build.make_tracker "
+                         "(no recipe): use MHTTracker.load(path, clutter, motion=..., "
+                         "birth=..., coverage=...)")
+    try:
+        sensors = (None if recipe.get("sensors") is None
+                   else sensors_from_recipe(recipe["sensors"]))
+        fresh = make_tracker(recipe["name"], MHTConfig.from_json(json.dumps(meta["config"])),
+                             clutter_density=recipe.get("clutter_density"), sensors=sensors,
+                             clutter_frame=recipe.get("clutter_frame", "polar"),
+                             clutter_params=recipe.get("clutter_params"))
+    except (KeyError, TypeError, ValueError) as e:
+        raise ValueError(f"{path}: member 'meta': field 'recipe' cannot be rebuilt "
+                         f"({e})") from None
+    trk = MHTTracker.load(path, fresh.clutter, motion=fresh.motion, birth=fresh.birth,
+                          coverage=fresh.coverage)
+    trk.recipe = recipe
+    return trk
 
 
 # ---------------------------------------------------------------------- defaults

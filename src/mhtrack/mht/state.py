@@ -132,6 +132,12 @@ def _meta(path: str | PathLike[str], arrays: dict[str, np.ndarray]) -> dict[str,
     return meta
 
 
+def saved_meta(path: str | PathLike[str]) -> dict[str, Any]:
+    """The checked JSON bookkeeping of a state file (configuration, estimator name, and
+    the builder's ``recipe`` when :func:`mhtrack.build.make_tracker` made the tracker)."""
+    return _meta(path, read_npz(path))
+
+
 def load_state(path: str | PathLike[str], clutter: ClutterEstimator | None) -> SavedState:
     """Read a file written by :func:`save_state`, checking it first (module docstring).
     ``clutter`` is an estimator of the saved kind (its state is overwritten); it may be
@@ -151,7 +157,8 @@ def load_state(path: str | PathLike[str], clutter: ClutterEstimator | None) -> S
         if meta["clutter_name"] != KnownClutter.name:
             raise ValueError(
                 f"{path}: saved with clutter estimator {meta['clutter_name']!r}; "
-                "pass one of that kind as clutter="
+                "pass one of that kind as clutter=, or load it with "
+                "mhtrack.build.load_tracker (trackers made by make_tracker)"
             )
         clutter = KnownClutter()
     elif clutter.name != meta["clutter_name"]:

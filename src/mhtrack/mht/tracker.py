@@ -44,6 +44,7 @@ from __future__ import annotations
 import time
 from collections.abc import Iterable
 from os import PathLike
+from typing import Any
 
 import numpy as np
 
@@ -107,6 +108,10 @@ class MHTTracker:
         self.coverage: Coverage = Everywhere(cfg.p_detection) if coverage is None else coverage
         self.birth: Birth = (make_birth(cfg, self.motion, self.coverage.plot_pd)
                              if birth is None else birth)
+        #: How :func:`mhtrack.build.make_tracker` made this tracker (JSON-able), saved
+        #: with its state so that :func:`mhtrack.build.load_tracker` can rebuild its
+        #: parts; ``None`` for a tracker assembled by hand.
+        self.recipe: dict[str, Any] | None = None
         self.sprt = SPRT.from_config(cfg)
         self.gate = Gate(cfg.gate_probability, cfg.max_gated_pairs)
         self._R = np.eye(2) * cfg.sigma_w**2
@@ -227,7 +232,8 @@ class MHTTracker:
         save_state(path, parts, self.clutter, self.config, {
             "last_time": self._last_time, "last_index": self._last_index,
             "next_tree": self.trees.next, "next_track": self.tracks.next,
-            "next_node": self.nodes.next})
+            "next_node": self.nodes.next,
+            **({} if self.recipe is None else {"recipe": self.recipe})})
 
     @classmethod
     def load(

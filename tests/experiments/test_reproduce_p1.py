@@ -142,8 +142,8 @@ def test_paired_comparisons_in_json_match_their_intervals(repro):
     js = json.loads((repro.out_dir / "table3.json").read_text())
     assert js["tracker_settings"] == "best"
     pairs = js["paired"]
-    # three tracker pairs × seven metrics (Tavg is not compared)
-    assert len(pairs) == 3 * 7
+    # three tracker pairs × nine metrics (P1's six without Tavg, OSPA, OSPA(2), HOTA)
+    assert len(pairs) == 3 * 9
     assert {(p["a"], p["b"]) for p in pairs} == {
         ("MHT-AGMM", "MHT-GMM"), ("MHT-AGMM", "MHT"), ("MHT-GMM", "MHT")}
     for p in pairs:
@@ -185,7 +185,7 @@ def test_paper_settings_side_by_side(tmp_path):
             assert f"| {label} | {src} |" in md
     # each tracker also against itself under the best settings
     cross = [c for c in paper.paired if "settings)" in c.a]
-    assert len(cross) == 3 * 7
+    assert len(cross) == 3 * 9
     js = json.loads((repro.out_dir / "table3-paper.json").read_text())
     assert set(js["other_settings"]) == {"best"}
     assert (repro.out_dir / "report-paper.md").is_file()

@@ -40,7 +40,8 @@ class Metric:
     unit: str = ""
 
 
-#: Columns of our Table 3: P1's seven plus the OSPA mean.
+#: Columns of our Table 3: P1's seven plus the OSPA mean, the OSPA(2) mean (window of
+#: 10 scans, docs/metrics.md) and HOTA (docs/metrics.md).
 TABLE3_METRICS: tuple[Metric, ...] = (
     Metric("rcc", "Rcc", True, 4),
     Metric("rmc", "Rmc", False, 4),
@@ -50,6 +51,8 @@ TABLE3_METRICS: tuple[Metric, ...] = (
     Metric("l_avg", "Lavg (s)", True, 2, " s"),
     Metric("l_max", "Lmax (s)", True, 2, " s"),
     Metric("ospa_mean", "OSPA mean (m)", False, 1, " m"),
+    Metric("ospa2_mean", "OSPA(2) mean (m)", False, 1, " m"),
+    Metric("hota", "HOTA", True, 4),
 )
 METRIC_BY_KEY = {m.key: m for m in TABLE3_METRICS}
 

@@ -56,6 +56,8 @@ PAIRS: tuple[tuple[str, str], ...] = (
 METRICS: dict[str, tuple[str, bool, int]] = {
     "iae_mean": ("clutter error ∫|κ̂ − κ| (plots/scan)", False, 2),
     "ospa_mean": ("OSPA mean (m)", False, 1),
+    "ospa2_mean": ("OSPA(2) mean (m)", False, 1),
+    "hota": ("HOTA", True, 4),
     "rcc": ("Rcc", True, 4),
     "coverage": ("coverage", True, 4),
     "mota": ("MOTA", True, 4),

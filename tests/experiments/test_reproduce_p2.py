@@ -67,7 +67,8 @@ def test_tables_show_the_measured_numbers(study):
 
 
 def test_curves_are_the_ratios_of_their_counts(study):
-    """p_true = found / initiable targets, p_false = false / tracks, per θ."""
+    """p_true = found / initiable targets, p_false = false / (false + found) (P2's
+    reading, duplicates once), p_false_tracks = false / tracks, per θ."""
     out, _ = study
     res = json.loads((out / "results.json").read_text())
     assert res["thetas_deg"] == list(THETAS)
@@ -78,7 +79,8 @@ def test_curves_are_the_ratios_of_their_counts(study):
         assert c["runs"] == 2 and c["n_windows"] == 14  # 7 windows of 4 of 10 scans
         for i in range(len(THETAS)):
             assert c["p_true"][i] == c["found"][i] / c["n_targets"]
-            assert c["p_false"][i] == c["false"][i] / c["tracks"][i]
+            assert c["p_false"][i] == c["false"][i] / (c["false"][i] + c["found"][i])
+            assert c["p_false_tracks"][i] == c["false"][i] / c["tracks"][i]
             assert c["tracks_per_window"][i] == c["tracks"][i] / 14
 
 
@@ -113,7 +115,8 @@ def test_hand_worked_aggregate():
     (c,) = a["curves"]
     assert (c["found"], c["false"], c["tracks"]) == ([4, 5], [1, 4], [5, 10])
     assert (c["n_targets"], c["n_windows"], c["runs"], c["non_monotone_windows"]) == (8, 3, 3, 1)
-    assert c["p_true"] == [4 / 8, 5 / 8] and c["p_false"] == [1 / 5, 4 / 10]
+    assert c["p_true"] == [4 / 8, 5 / 8] and c["p_false"] == [1 / 5, 4 / 9]
+    assert c["p_false_tracks"] == [1 / 5, 4 / 10]
     assert c["tracks_per_window"] == [5 / 3, 10 / 3]
     assert a["methods"]["runs"] == 0 and a["methods"]["logic"]["p_true"] is None
 

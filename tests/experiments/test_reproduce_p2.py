@@ -13,7 +13,7 @@ from mhtrack.experiments.initiation_runs import fused_scans, run_initiation
 from mhtrack.experiments.jobs import run_seeds
 from mhtrack.experiments.p2 import reproduce_p2
 from mhtrack.experiments.p2.aggregate import aggregate
-from mhtrack.experiments.p2.constants import FIGURES, THETAS_DEG
+from mhtrack.experiments.p2.constants import FIGURES, MODIFIED_HOUGH_LABELS, THETAS_DEG
 from mhtrack.experiments.p2.jobs import make_jobs, p2_scenario, run_job
 from mhtrack.initiation import Window, sliding_windows
 from mhtrack.initiation.logic import leg_angle, sweep_modified_logic
@@ -59,8 +59,8 @@ def test_tables_show_the_measured_numbers(study):
     out, _ = study
     res = json.loads((out / "results.json").read_text())
     tables = (out / "tables.md").read_text()
-    for m, label in (("modified-logic", "modified 3/4 logic"), ("modified-hough",
-                                                                "modified Hough")):
+    for m, label in (("modified-logic", "modified 3/4 logic"),
+                     ("modified-hough", MODIFIED_HOUGH_LABELS["best"])):
         row = next(line for line in tables.splitlines() if line.startswith(f"| {label} |"))
         me = res["methods"][m]
         assert f"| {me['p_true']:.3f} | {me['p_false']:.3f} |" in row

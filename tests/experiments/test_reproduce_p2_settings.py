@@ -47,3 +47,13 @@ def test_paired_methods_hand_example():
              and x["metric"] == "p_true")
     assert p["mean_diff"] == pytest.approx(np.mean([0.0, -0.1, 0.0]))
     assert p["n_identical"] == 2
+
+
+def test_ablation_one_run():
+    from mhtrack.experiments.p2.ablation import ablation
+
+    res = ablation(1)
+    assert len(res) == 6
+    for m in res.values():
+        assert 0.0 <= m["p_true"] <= 1.0 and 0.0 <= m["p_false"] <= 1.0
+        assert m["tracks_per_window"] >= m["false_per_window"] >= 0.0

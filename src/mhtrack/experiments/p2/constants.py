@@ -43,6 +43,15 @@ METHOD_LABELS = {"logic": "3/4 logic", "modified-logic": "modified 3/4 logic",
                  "hough": "Hough", "modified-hough": "modified Hough"}
 CLUSTER_LABELS = {"random": "K-means, random start (oracle k)",
                   "adaptive": "adaptive K-means (P2 §1.2)"}
+#: The adaptive fusion's label under each ``--tracker-settings`` (honest names: our
+#: additions named).
+ADAPTIVE_LABELS = {"paper": "adaptive K-means (P2 §1.2)",
+                   "best": "adaptive K-means (P2 §1.2) + one-plot-per-radar repair, merge, "
+                           "covariance gate (ours)"}
+#: The modified Hough's label under each setting.
+MODIFIED_HOUGH_LABELS = {"paper": "modified Hough (velocity, acceleration, time order, angle)",
+                         "best": "modified Hough (velocity, time order, angle; no "
+                                 "acceleration constraint)"}
 
 FIGURES = {"fig2": "fig2_clustering.png", "fig3": "fig3_ptrue_theta.png",
            "fig4": "fig4_pfalse_theta.png", "fig12_15": "fig12_15_initiated.png"}

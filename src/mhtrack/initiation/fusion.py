@@ -10,7 +10,8 @@ Fusers (:class:`~mhtrack.initiation.base.Fuser`: scikit-learn style ``fit``;
 * :class:`AdaptiveKMeansFusion` (P2 §1.2): adaptive initial centres, standard K-means,
   the one-plot-per-radar repair, then the merge of compatible clusters (ours); its
   parameters ``merge_probability`` and ``max_threshold`` set our covariance gate and
-  threshold cap (see :mod:`mhtrack.initiation.kmeans`).
+  threshold cap (see :mod:`mhtrack.initiation.kmeans`); ``enforce_one_per_radar``,
+  ``merge`` and ``gate`` switch our three steps (``AdaptiveKMeansFusion.paper()``: off).
 * :class:`KMeansFusion` (P2 §1.1): the ``k`` initial centres drawn at random among the
   plots (seeded), standard K-means, and the same one-plot-per-radar repair with ``ε(k)``
   of its own ``k``, but no merge.

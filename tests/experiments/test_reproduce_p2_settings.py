@@ -57,3 +57,18 @@ def test_ablation_one_run():
     for m in res.values():
         assert 0.0 <= m["p_true"] <= 1.0 and 0.0 <= m["p_false"] <= 1.0
         assert m["tracks_per_window"] >= m["false_per_window"] >= 0.0
+
+
+def test_bad_settings_are_refused(tmp_path):
+    from click.testing import CliRunner
+
+    from mhtrack.cli.reproduce_commands import reproduce
+    from mhtrack.experiments.p2 import reproduce_p2
+
+    with pytest.raises(ValueError, match="settings"):
+        reproduce_p2(tmp_path, 1, settings="fastest")
+    with pytest.raises(ValueError, match="clutter_per"):
+        reproduce_p2(tmp_path, 1, clutter_per="sensor")
+    r = CliRunner().invoke(reproduce, ["p2", "--out", str(tmp_path), "--tracker-settings",
+                                       "fastest"])
+    assert r.exit_code == 2 and "fastest" in r.output

@@ -13,7 +13,7 @@ from mhtrack.experiments.initiation_runs import fused_scans, run_initiation
 from mhtrack.experiments.jobs import run_seeds
 from mhtrack.experiments.p2 import reproduce_p2
 from mhtrack.experiments.p2.aggregate import aggregate
-from mhtrack.experiments.p2.constants import FIGURES, THETAS_DEG
+from mhtrack.experiments.p2.constants import FIGURES, MODIFIED_HOUGH_LABELS, THETAS_DEG
 from mhtrack.experiments.p2.jobs import make_jobs, p2_scenario, run_job
 from mhtrack.initiation import Window, sliding_windows
 from mhtrack.initiation.logic import leg_angle, sweep_modified_logic
@@ -59,15 +59,16 @@ def test_tables_show_the_measured_numbers(study):
     out, _ = study
     res = json.loads((out / "results.json").read_text())
     tables = (out / "tables.md").read_text()
-    for m, label in (("modified-logic", "modified 3/4 logic"), ("modified-hough",
-                                                                "modified Hough")):
+    for m, label in (("modified-logic", "modified 3/4 logic"),
+                     ("modified-hough", MODIFIED_HOUGH_LABELS["best"])):
         row = next(line for line in tables.splitlines() if line.startswith(f"| {label} |"))
         me = res["methods"][m]
         assert f"| {me['p_true']:.3f} | {me['p_false']:.3f} |" in row
 
 
 def test_curves_are_the_ratios_of_their_counts(study):
-    """p_true = found / initiable targets, p_false = false / tracks, per θ."""
+    """p_true = found / initiable targets, p_false = false / (false + found) (P2's
+    reading, duplicates once), p_false_tracks = false / tracks, per θ."""
     out, _ = study
     res = json.loads((out / "results.json").read_text())
     assert res["thetas_deg"] == list(THETAS)
@@ -78,7 +79,8 @@ def test_curves_are_the_ratios_of_their_counts(study):
         assert c["runs"] == 2 and c["n_windows"] == 14  # 7 windows of 4 of 10 scans
         for i in range(len(THETAS)):
             assert c["p_true"][i] == c["found"][i] / c["n_targets"]
-            assert c["p_false"][i] == c["false"][i] / c["tracks"][i]
+            assert c["p_false"][i] == c["false"][i] / (c["false"][i] + c["found"][i])
+            assert c["p_false_tracks"][i] == c["false"][i] / c["tracks"][i]
             assert c["tracks_per_window"][i] == c["tracks"][i] / 14
 
 
@@ -113,7 +115,8 @@ def test_hand_worked_aggregate():
     (c,) = a["curves"]
     assert (c["found"], c["false"], c["tracks"]) == ([4, 5], [1, 4], [5, 10])
     assert (c["n_targets"], c["n_windows"], c["runs"], c["non_monotone_windows"]) == (8, 3, 3, 1)
-    assert c["p_true"] == [4 / 8, 5 / 8] and c["p_false"] == [1 / 5, 4 / 10]
+    assert c["p_true"] == [4 / 8, 5 / 8] and c["p_false"] == [1 / 5, 4 / 9]
+    assert c["p_false_tracks"] == [1 / 5, 4 / 10]
     assert c["tracks_per_window"] == [5 / 3, 10 / 3]
     assert a["methods"]["runs"] == 0 and a["methods"]["logic"]["p_true"] is None
 

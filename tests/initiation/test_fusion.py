@@ -205,3 +205,39 @@ def test_split_inconsistent_leaves_only_consistent_clusters(seed):
         zh = np.linalg.solve(W.sum(0), np.einsum("nij,nj->i", W, z[i]))
         d = z[i] - zh
         assert np.einsum("ni,nij,nj->", d, W, d) <= chi2.ppf(0.999, 2 * (len(i) - 1)) + 1e-9
+
+
+@settings(max_examples=40, deadline=None)
+@given(plot_sets)
+def test_paper_fusion_is_p2_steps_only(case):
+    """``AdaptiveKMeansFusion.paper()`` = P2 §1.2's initial centres with the Euclidean
+    ε(k) then Lloyd, nothing after: same labels as composing the two steps by hand; and
+    ``gate=False`` equals switching the gate's two parameters off."""
+    from mhtrack.initiation.kmeans import adaptive_initial_centres, kmeans_lloyd
+
+    ns, counts, seed, box = case
+    rng = np.random.default_rng(seed)
+    sensor = np.repeat(np.arange(ns), counts)
+    z = rng.uniform(0, box, size=(len(sensor), 2))
+    R = np.broadcast_to(np.diag([400.0, 2500.0]), (len(z), 2, 2)).copy()
+    f = AdaptiveKMeansFusion.paper().fit(z, sensor, R)
+    if len(z):
+        c0, _, eps = adaptive_initial_centres(z, sensor)
+        _, labels, _ = kmeans_lloyd(z, c0)
+        np.testing.assert_array_equal(f.labels_, labels)
+        assert f.threshold_ == eps
+    a = AdaptiveKMeansFusion(gate=False).fit(z, sensor, R)
+    b = AdaptiveKMeansFusion(merge_probability=None, max_threshold=None).fit(z, sensor)
+    np.testing.assert_array_equal(a.labels_, b.labels_)
+
+
+def test_paper_fusion_may_break_one_plot_per_radar_and_best_does_not():
+    # radar 1 (3 plots, placed first) opens centres at 33, 79, 30; radar 0's 75 joins 79
+    # and 54 joins a centre; Lloyd then moves 54 alone and puts radar 1's 30 and 33 in
+    # one cluster — P2's steps keep it, our repair (best) splits it
+    z = np.array([[75.0, 0.0], [54.0, 0.0], [33.0, 0.0], [79.0, 0.0], [30.0, 0.0]])
+    sensor = np.array([0, 0, 1, 1, 1])
+    paper = AdaptiveKMeansFusion.paper().fit(z, sensor)
+    best = AdaptiveKMeansFusion().fit(z, sensor)
+    _check_one_plot_per_radar(best.labels_, sensor)
+    assert paper.labels_[2] == paper.labels_[4]  # 33 and 30, both radar 1

@@ -82,3 +82,27 @@ def test_votes_count_distinct_scans():
     votes, *_ = HoughInitiator().accumulate(w)
     assert votes.max() <= 3
     assert len(make_initiator("hough").initiate(w)) == 0
+
+
+def test_modified_hough_acceleration_constraint():
+    # collinear legs of 200, 200, 350 m in 1 s scans: speed change 150 m/s over the
+    # 1 s between the legs' midpoints — rejected by a_max = 100 m/s², kept by 200 or None
+    z = [[(0.0, 0.0)], [(200.0, 0.0)], [(400.0, 0.0)], [(750.0, 0.0)]]
+    sc = scans_of(z)
+    assert len(HoughInitiator(modified=True, region=REGION).initiate(sc)) == 1
+    assert len(HoughInitiator(modified=True, region=REGION, accel_max=200.0).initiate(sc)) == 1
+    assert len(HoughInitiator(modified=True, region=REGION, accel_max=100.0).initiate(sc)) == 0
+    # a constant speed passes any positive a_max
+    steady = scans_of([[(200.0 * k, 0.0)] for k in range(4)])
+    assert len(HoughInitiator(modified=True, region=REGION, accel_max=1.0).initiate(steady)) == 1
+    with pytest.raises(ValueError, match="accel_max"):
+        HoughInitiator(modified=True, accel_max=-1.0).check_parameters()
+
+
+def test_time_order_switch():
+    # the jumbled track passes with time_order=False and a loose angle limit only
+    jumbled = scans_of([[(0.0, 0.0)], [(400.0, 0.0)], [(200.0, 0.0)], [(600.0, 0.0)]])
+    on = HoughInitiator(modified=True, angle_limit_deg=180.0, region=REGION)
+    off = HoughInitiator(modified=True, angle_limit_deg=180.0, region=REGION, time_order=False)
+    assert len(on.initiate(jumbled)) == 0
+    assert len(off.initiate(jumbled)) == 1

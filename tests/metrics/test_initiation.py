@@ -43,7 +43,9 @@ def test_initiation_metrics_hand_example():
         window_seconds=[0.002, 0.004],
     )
     assert m.p_true == pytest.approx(2 / 4)      # {1, 3} of 3, none of 1
-    assert m.p_false == pytest.approx(3 / 6)
+    # P2's reading: 3 false against 2 found targets (the duplicate on 1 counts once)
+    assert m.p_false == pytest.approx(3 / 5)
+    assert m.p_false_tracks == pytest.approx(3 / 6)  # every track counted
     assert m.false_per_run == pytest.approx(1.5)
     assert m.false_per_window == pytest.approx(1.5)
     assert m.tracks_per_run == pytest.approx(3.0)

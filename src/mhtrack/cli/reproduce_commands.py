@@ -69,9 +69,16 @@ def p1(runs: int, out: Path, seed: int, tracker_settings: str, workers: int | No
               "fig2/fig3/fig4/fig12_15 PNG); finished jobs in OUT/jobs are skipped.")
 @click.option("--seed", type=click.IntRange(min=0), default=0, show_default=True,
               help="Base seed; run i simulates with a seed derived from (SEED, i) only.")
+@click.option("--tracker-settings", "settings", type=click.Choice(["best", "paper"]),
+              default="best", show_default=True,
+              help="paper: P2's steps only (adaptive K-means without our repair, merge and "
+              "gate; modified Hough with the acceleration constraint); best: ours.")
+@click.option("--clutter-per", type=click.Choice(["radar", "scan"]), default="radar",
+              show_default=True,
+              help="Read λ as clutter plots per radar per scan, or per scan over all radars.")
 @executor_options
-def p2(runs: int, out: Path, seed: int, workers: int | None, dask_scheduler: str | None,
-       progress: bool | None) -> None:
+def p2(runs: int, out: Path, seed: int, settings: str, clutter_per: str,
+       workers: int | None, dask_scheduler: str | None, progress: bool | None) -> None:
     """P2 (Gong, Dai & Ma 2013) on `multiradar`: Figs. 2, 3, 4, 12–15 and Tables 1–2.
 
     Fig. 3: p_true of the modified 3/4 logic against θ ∈ {0°, 10°, …, 180°} for
@@ -87,7 +94,8 @@ def p2(runs: int, out: Path, seed: int, workers: int | None, dask_scheduler: str
     run_on = executor_kwargs(workers, dask_scheduler, progress)
     try:
         with resume_on_interrupt("reproduce p2", out):
-            repro = reproduce_p2(out, runs, seed, **run_on)
+            repro = reproduce_p2(out, runs, seed, settings=settings, clutter_per=clutter_per,
+                                 **run_on)
     except ValueError as e:
         raise InputProblem(str(e)) from None
     paths = write_p2_report(repro)

@@ -10,7 +10,8 @@ Fusers (:class:`~mhtrack.initiation.base.Fuser`: scikit-learn style ``fit``;
 * :class:`AdaptiveKMeansFusion` (P2 §1.2): adaptive initial centres, standard K-means,
   the one-plot-per-radar repair, then the merge of compatible clusters (ours); its
   parameters ``merge_probability`` and ``max_threshold`` set our covariance gate and
-  threshold cap (see :mod:`mhtrack.initiation.kmeans`).
+  threshold cap (see :mod:`mhtrack.initiation.kmeans`); ``enforce_one_per_radar``,
+  ``merge`` and ``gate`` switch our three steps (``AdaptiveKMeansFusion.paper()``: off).
 * :class:`KMeansFusion` (P2 §1.1): the ``k`` initial centres drawn at random among the
   plots (seeded), standard K-means, and the same one-plot-per-radar repair with ``ε(k)``
   of its own ``k``, but no merge.
@@ -114,9 +115,11 @@ class _KMeansFuser(Fuser):
 
     def _finish(self, z: np.ndarray, sensor: np.ndarray, labels: np.ndarray, eps: float,
                 n_iter: int, adaptive: bool, R: np.ndarray | None = None,
-                gamma: float | None = None) -> None:
+                gamma: float | None = None, enforce: bool = True) -> None:
         if len(z):
-            labels = enforce_one_plot_per_sensor(z, sensor, labels, eps, R, gamma, self.caps_)
+            if enforce:
+                labels = enforce_one_plot_per_sensor(z, sensor, labels, eps, R, gamma,
+                                                     self.caps_)
             if adaptive:
                 labels = merge_compatible_clusters(z, sensor, labels, eps, R, gamma)
         k = int(labels.max()) + 1 if len(labels) else 0
@@ -146,6 +149,15 @@ class AdaptiveKMeansFusion(_KMeansFuser):
     consistency : probability ``p`` of a final χ² test of each cluster
         (:func:`split_inconsistent`, ours), which splits off the plots that cannot be of one
         point; needs ``R``. Default ``None`` (off: P2's clusters).
+    enforce_one_per_radar : after the K-means refinement, repair clusters holding two plots
+        of one radar by reassignment (ours, on; P2 states the rule but only for the
+        initial centres — :func:`~mhtrack.initiation.kmeans.enforce_one_plot_per_sensor`).
+    merge : merge compatible clusters after the refinement (ours, on;
+        :func:`~mhtrack.initiation.kmeans.merge_compatible_clusters`).
+    gate : use the covariance gate and threshold cap (``merge_probability``,
+        ``max_threshold``; ours, on); ``False``: P2's Euclidean ``ε(k)`` only.
+
+    ``AdaptiveKMeansFusion.paper()`` is P2 §1.2 as P2 states it: the three options off.
 
     Attributes (after :meth:`fit`)
     ----------
@@ -156,7 +168,11 @@ class AdaptiveKMeansFusion(_KMeansFuser):
 
     def __init__(self, *, weighting: str = "mean", merge_probability: float | None = 0.9999,
                  max_threshold: float | str | None = "auto", max_iter: int = 300,
-                 consistency: float | None = None) -> None:
+                 consistency: float | None = None, enforce_one_per_radar: bool = True,
+                 merge: bool = True, gate: bool = True) -> None:
+        self.enforce_one_per_radar = enforce_one_per_radar
+        self.merge = merge
+        self.gate = gate
         self.weighting = weighting
         self.merge_probability = merge_probability
         self.max_threshold = max_threshold
@@ -171,9 +187,11 @@ class AdaptiveKMeansFusion(_KMeansFuser):
         p = self.merge_probability
         if p is not None and not 0.0 < p < 1.0:
             raise ValueError(f"merge_probability must be in (0, 1) or None, got {p!r}")
+        if not self.gate:
+            p = None
         gamma = None if p is None else float(-2.0 * np.log1p(-p))  # χ²₂ quantile
         Ra = None if R is None else np.asarray(R, float).reshape(len(za), 2, 2)
-        cap = self.max_threshold
+        cap = self.max_threshold if self.gate else None
         if cap == "auto":
             # two plots of one target differ by N(0, R_i + R_j): farther than
             # sqrt(γ·2·max λmax(R)) fails the gate whatever their direction
@@ -190,11 +208,28 @@ class AdaptiveKMeansFusion(_KMeansFuser):
         if q is not None and not (isinstance(q, float) and 0.0 < q < 1.0):
             raise ValueError(f"consistency must be in (0, 1) or None, got {q!r}")
         _, labels, it = kmeans_lloyd(za, c0, max_iter=self.max_iter)
-        self._finish(za, s, labels, eps, it, adaptive=True, R=Ra, gamma=gamma)
+        self._finish(za, s, labels, eps, it, adaptive=self.merge, R=Ra, gamma=gamma,
+                     enforce=self.enforce_one_per_radar)
         if q is not None and Ra is not None and len(za):
             self.labels_ = split_inconsistent(za, Ra, self.labels_, q)
             self.cluster_centers_, _ = _means(za, self.labels_, int(self.labels_.max()) + 1)
         return self
+
+    @classmethod
+    def paper(cls, **params: object) -> AdaptiveKMeansFusion:
+        """P2 §1.2 as P2 states it: no repair, no merge, no gate (``params`` as
+        :meth:`__init__`)."""
+        kw: dict[str, object] = {"enforce_one_per_radar": False, "merge": False,
+                                 "gate": False, **params}
+        return cls(**kw)  # type: ignore[arg-type]
+
+
+#: Named settings of :class:`AdaptiveKMeansFusion`: ``"paper"`` (P2 §1.2 only) and
+#: ``"best"`` (ours: repair, merge, gate on — the default).
+FUSION_SETTINGS: dict[str, dict[str, bool]] = {
+    "paper": {"enforce_one_per_radar": False, "merge": False, "gate": False},
+    "best": {"enforce_one_per_radar": True, "merge": True, "gate": True},
+}
 
 
 class KMeansFusion(_KMeansFuser):

@@ -57,7 +57,10 @@ cross-range) it often is too small, and in clutter it is far too large:
   first, until none is left (:func:`merge_compatible_clusters`).
 
 With ``merge_probability=None, max_threshold=None`` (or plots without ``R``; then the
-merge uses ``ε``) only P2's Euclidean threshold is used.
+merge uses ``ε``) only P2's Euclidean threshold is used. In
+:class:`~mhtrack.initiation.fusion.AdaptiveKMeansFusion` the repair below, the merge and
+the gate are the named options ``enforce_one_per_radar``, ``merge`` and ``gate`` (all off
+in ``AdaptiveKMeansFusion.paper()``, P2's steps only).
 
 One plot per radar (P2 §1.2, §3.1). The K-means refinement ignores radars and may put two
 plots of one radar in a cluster. Such clusters are repaired, radar by radar: the plots of

@@ -15,8 +15,15 @@ Over all windows ``w`` of all runs (``T_w`` the initiable targets, ``K_w`` the t
 * ``p_true = Σ_w |{i ∈ T_w : some track of K_w is true for i}| / Σ_w |T_w|`` — share of
   initiable targets whose track is initiated within the window (P2's "probability of
   initiating a true track");
-* ``p_false = Σ_w #false tracks / Σ_w |K_w|`` — share of initiated tracks that are false
-  (P2's "false-track probability"; NaN when no track was initiated);
+* ``p_false = Σ_w #false / Σ_w (#false + #found_w)`` — P2's "false-track probability"
+  as read here, ``#found_w`` the initiable targets with a true track: duplicates count
+  **once** (P2 §2.2 gives no formula; P2 counts initiated *targets* — its detection
+  probability is per target — so a second true track on a found target is neither a
+  false track nor a second detection; read so, p_false grows with θ as P2's Fig. 4);
+  NaN when nothing was initiated;
+* ``p_false_tracks = Σ_w #false tracks / Σ_w |K_w|`` — share of initiated tracks that are
+  false, every duplicate counted (diluted by duplicates on true targets: ours before
+  2026-11, kept for comparison);
 * ``false_per_run = Σ_w #false / runs``, ``false_per_window = Σ_w #false / #windows``;
 * ``duplicates_per_run``: true tracks beyond the first for the same target and window;
 * ``t_window``: mean wall-clock seconds an initiator spends on one window (P2 Table 2
@@ -88,6 +95,7 @@ class InitiationMetrics:
 
     p_true: float
     p_false: float
+    p_false_tracks: float
     false_per_run: float
     false_per_window: float
     tracks_per_run: float
@@ -135,7 +143,8 @@ def initiation_metrics(
     secs = np.asarray(window_seconds if window_seconds is not None else [], float)
     return InitiationMetrics(
         p_true=n_found / n_t if n_t else float("nan"),
-        p_false=n_false / n_tracks if n_tracks else float("nan"),
+        p_false=(n_false / (n_false + n_found) if n_false + n_found else float("nan")),
+        p_false_tracks=n_false / n_tracks if n_tracks else float("nan"),
         false_per_run=n_false / n_runs,
         false_per_window=n_false / n_w if n_w else float("nan"),
         tracks_per_run=n_tracks / n_runs,

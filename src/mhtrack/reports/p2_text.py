@@ -13,9 +13,11 @@ import numpy as np
 
 from mhtrack.experiments.p2.aggregate import curve_for, nan_for_none
 from mhtrack.experiments.p2.constants import (
+    ADAPTIVE_LABELS,
     CLUSTER_LABELS,
     FIGURES,
     METHOD_LABELS,
+    MODIFIED_HOUGH_LABELS,
     PAPER_COMPLEXITY,
     PAPER_T_CLUSTER,
     PAPER_T_INIT,
@@ -46,9 +48,11 @@ def tables_markdown(res: Mapping[str, Any]) -> str:
         "ours mean k |",
         "|---|---|---|---|---|---|",
     ]
+    settings = res.get("settings", "best")
+    labels = {**CLUSTER_LABELS, "adaptive": ADAPTIVE_LABELS[settings]}
     for m in ("random", "adaptive"):
         c = cl[m]
-        lines.append(f"| {CLUSTER_LABELS[m]} | {PAPER_COMPLEXITY[m]} | {PAPER_T_CLUSTER[m]} | "
+        lines.append(f"| {labels[m]} | {PAPER_COMPLEXITY[m]} | {PAPER_T_CLUSTER[m]} | "
                      f"{_ms(c['t_scan'])} | {_f(c['k_correct_rate'])} | "
                      f"{_f(c['mean_clusters'], 2)} |")
     lines += [
@@ -61,9 +65,10 @@ def tables_markdown(res: Mapping[str, Any]) -> str:
         "ours false/window |",
         "|---|---|---|---|---|---|",
     ]
+    mlabels = {**METHOD_LABELS, "modified-hough": MODIFIED_HOUGH_LABELS[settings]}
     for m in INITIATORS:
         c = me[m]
-        lines.append(f"| {METHOD_LABELS[m]} | {PAPER_T_INIT[m]} | {_ms(c['t_window'])} | "
+        lines.append(f"| {mlabels[m]} | {PAPER_T_INIT[m]} | {_ms(c['t_window'])} | "
                      f"{_f(c['p_true'])} | {_f(c['p_false'])} | "
                      f"{_f(c['false_per_window'], 2)} |")
     lines += ["", "P2's times are from its machine and code (neither described in the "
@@ -161,9 +166,10 @@ def comparison_text(res: Mapping[str, Any]) -> list[str]:
                                 f"true ×{tmax / t20:.2f}")
             if grow:
                 txt += (" From 20° to the largest θ (counts, true tracks including "
-                        "duplicates of one target): " + "; ".join(grow) + ". p_false is a "
-                        "ratio: where a wider θ adds true tracks faster than false ones, it "
-                        "falls although the false tracks grow.")
+                        "duplicates of one target): " + "; ".join(grow) + ". p_false counts "
+                        "a found target once (P2's reading); counted per initiated track "
+                        "(p_false_tracks in results.json) duplicates on true targets dilute "
+                        "it.")
         out.append(txt)
     nm = sum(c["non_monotone_windows"] for c in res["curves"])
     nw = sum(c["n_windows"] for c in res["curves"])
@@ -178,8 +184,10 @@ def comparison_text(res: Mapping[str, Any]) -> list[str]:
                f"{_f(cl['random']['k_correct_rate'])} (P2: adaptive finds all 10 targets, "
                f"random start fails). Time ratio K-means / adaptive: ours "
                f"{_f(r1, 2)}, P2 {PAPER_T_CLUSTER['random'] / PAPER_T_CLUSTER['adaptive']:.2f}"
-               f". Ours runs the adaptive seeding plus a K-means refinement and the "
-               f"one-plot-per-radar repair, so it is not cheaper than one K-means run.")
+               f". Ours runs the adaptive seeding plus a K-means refinement"
+               + ("" if res.get("settings", "best") == "paper" else
+                  " and the one-plot-per-radar repair")
+               + ", so it is not cheaper than one K-means run.")
     rh = _speed_ratio(me, "hough", "logic", "t_window")
     rmh = _speed_ratio(me, "modified-hough", "logic", "t_window")
     rml = _speed_ratio(me, "modified-logic", "logic", "t_window")
@@ -200,23 +208,44 @@ def comparison_text(res: Mapping[str, Any]) -> list[str]:
                            for m, (a, b) in ranks.items())
                + ". P2: modified logic and modified Hough give the true tracks with the "
                "fewest false ones; plain Hough fails.")
+    for c in me.get("paired", []):
+        out.append(f"**Paired, {c['metric']}.** {c['sentence']}")
+    ml, mh = me["modified-logic"], me["modified-hough"]
+    if ml["false_per_window"] and mh["false_per_window"] is not None:
+        out.append(
+            f"**Modified logic vs modified Hough.** Ours: {_f(ml['false_per_window'], 2)} "
+            f"against {_f(mh['false_per_window'], 2)} false tracks per window (P2: about "
+            f"the same tracks, Figs. 12, 15). The two use P2's thresholds, which differ: "
+            f"the logic starts a track on 3 plots of 4 scans, the Hough on 4 votes of 4 "
+            f"scans. With the same M they agree (docs/reproduction.md, P2 Figs. 12–15: "
+            f"`python -m mhtrack.experiments.p2.ablation`).")
     return out
 
 
 def report_markdown(res: Mapping[str, Any], runs: int, seed: int,
                     wall: float | None) -> str:
+    settings = res.get("settings", "best")
+    per = ("clutter plots per scan over all radars" if res.get("clutter_per") == "scan"
+           else "clutter plots per radar per scan")
+    what = "P2's steps only" if settings == "paper" else "ours"
+    opts = "" if settings == "best" else f" --tracker-settings {settings}"
+    if res.get("clutter_per", "radar") != "radar":
+        opts += f" --clutter-per {res['clutter_per']}"
     lines = [
         "# Reproduction of P2 (adaptive K-means fusion + modified logic initiation)",
         "",
-        f"`mhtrack reproduce p2 --runs {runs} --seed {seed}`: `multiradar` preset (3 polar "
-        f"radars, 10 targets at 200 m/s, σθ = 0.3°), λ = clutter plots per radar per scan, "
-        f"adaptive K-means fusion, sliding windows of 4 scans (7 per run), gate 300 m, "
-        f"velocity gate 50–400 m/s. Run r uses seed `run_seeds({seed}, r + 1)[r]` for every "
-        f"θ and method. P2 uses 1000 runs per point.",
+        f"`mhtrack reproduce p2 --runs {runs} --seed {seed}{opts}`: `multiradar` preset (3 "
+        f"polar radars, 10 targets at 200 m/s, σθ = 0.3°), λ = {per}, "
+        f"fusion: {ADAPTIVE_LABELS[settings]}, sliding windows of 4 scans (7 per run), gate "
+        f"300 m, velocity gate 50–400 m/s; {MODIFIED_HOUGH_LABELS[settings]}. Settings: "
+        f"{settings} ({what}). Run r uses "
+        f"seed `run_seeds({seed}, r + 1)[r]` for every θ and method. P2 uses 1000 runs per "
+        f"point.",
         "",
         "Definitions (docs/initiation.md §3): p_true = initiable targets (seen in ≥ 3 "
         "scans of a window) with a true track / initiable targets; p_false = false tracks "
-        "/ initiated tracks.",
+        "/ (false tracks + targets found), a target with several true tracks counted once "
+        "(P2's reading); p_false_tracks (results.json) = false tracks / initiated tracks.",
         "",
     ]
     if wall is not None:

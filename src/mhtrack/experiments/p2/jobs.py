@@ -21,7 +21,11 @@ jobs whose stored hash matches:
 Run ``r`` simulates with ``run_seed(seed, r, "words")`` (:mod:`mhtrack.experiments.jobs.seeds`;
 the seed ``mhtrack initiate --seed S`` uses for its run ``r``): it depends on ``seed`` and
 ``r`` only, so every θ and every method sees the same plots. ``λ`` is the clutter rate per
-radar per scan (3 radars).
+radar per scan (3 radars; ``clutter_per="scan"``: λ/3 per radar).
+
+A job's ``settings`` (absent: ``"best"``) and ``clutter_per`` (absent: ``"radar"``)
+select the fusion and initiator options (:data:`~mhtrack.experiments.p2.constants.SETTINGS`);
+the keys are stored only when not the default, so the default jobs keep their hashes.
 
 Job functions are top-level functions of plain data (picklable for the pool and Dask).
 A job's key is its ``name``; its hash (JSON with ``json.dumps``' default separators, as
@@ -37,6 +41,7 @@ from typing import Any
 import numpy as np
 
 from mhtrack.experiments.initiation_runs import (
+    FusedRun,
     fuse,
     initiators,
     n_targets_seen,
@@ -44,7 +49,15 @@ from mhtrack.experiments.initiation_runs import (
     targets_seen,
 )
 from mhtrack.experiments.jobs import SPACED, Job, JsonRecords, run_seed
-from mhtrack.experiments.p2.constants import CHUNK, LOGIC_PARAMS, RATE0, SIGMA0, THETA0
+from mhtrack.experiments.p2.constants import (
+    CHUNK,
+    FUSION_PARAMS,
+    INITIATOR_PARAMS,
+    LOGIC_PARAMS,
+    RATE0,
+    SIGMA0,
+    THETA0,
+)
 from mhtrack.initiation import Window
 from mhtrack.initiation.logic import sweep_modified_logic
 from mhtrack.metrics.initiation import initiable_targets, track_targets
@@ -59,6 +72,29 @@ def p2_scenario(sigma_range: float = SIGMA0, clutter_rate: float = RATE0) -> Sce
     """``multiradar`` with every radar's range σ set to ``sigma_range`` (m) and
     ``clutter_rate`` clutter plots per radar per scan."""
     return preset("multiradar", clutter_rate=clutter_rate, sigma_range=sigma_range)
+
+
+def job_scenario(job: Mapping[str, Any]) -> Scenario:
+    """The job's scenario; ``clutter_per="scan"`` spreads λ over the radars."""
+    sc = p2_scenario(job["sigma"], job["rate"])
+    if job.get("clutter_per", "radar") == "scan" and job["rate"]:
+        sc = p2_scenario(job["sigma"], job["rate"] / len(sc.sensors))
+    return sc
+
+
+def fused_run(sc: Scenario, seed: int, settings: str = "best") -> FusedRun:
+    """Simulate and fuse one run with the fusion options of ``settings``."""
+    params = FUSION_PARAMS[settings]
+    if not params:
+        return simulate_and_fuse(sc, seed)
+    sim = simulate(sc, seed)
+    raw = list(sim.plots.scans())
+    fused, secs = [], []
+    for s in raw:
+        t0 = time.perf_counter()
+        fused.append(fuse(s, "adaptive", run_seed=seed, **params).scan)
+        secs.append(time.perf_counter() - t0)
+    return FusedRun(seed, sim.truth, raw, fused, secs)
 
 
 def _initiable(raw_win: Sequence[Any]) -> np.ndarray:
@@ -77,15 +113,16 @@ def _score(window: Window, flat: np.ndarray, targets: np.ndarray) -> tuple[int, 
 def grid_job(job: Mapping[str, Any]) -> dict[str, Any]:
     """One ``grid`` job: runs ``start … stop − 1`` at ``(sigma, rate)``, every θ.
     Returns plain per-θ counts summed over the runs' windows."""
-    sc = p2_scenario(job["sigma"], job["rate"])
+    sc = job_scenario(job)
+    settings = job.get("settings", "best")
     thetas = job["thetas"]
     n = len(thetas)
     found, false, tracks = np.zeros(n, np.int64), np.zeros(n, np.int64), np.zeros(n, np.int64)
     n_targets = n_windows = non_monotone = 0
     t0 = time.perf_counter()
     for r in range(job["start"], job["stop"]):
-        for raw_win, win in simulate_and_fuse(sc, run_seed(job["seed"], r, "words")
-                                              ).windows(4):
+        for raw_win, win in fused_run(sc, run_seed(job["seed"], r, "words"), settings
+                                      ).windows(4):
             w = Window.from_scans(win)
             targets = _initiable(raw_win)
             n_targets += len(targets)
@@ -104,7 +141,8 @@ def grid_job(job: Mapping[str, Any]) -> dict[str, Any]:
 
 def clustering_job(job: Mapping[str, Any]) -> dict[str, Any]:
     """One ``clustering`` job: adaptive vs random-start K-means on every scan (no clutter)."""
-    sc = p2_scenario(job["sigma"], job["rate"])
+    sc = job_scenario(job)
+    fparams = FUSION_PARAMS[job.get("settings", "best")]
     out: dict[str, Any] = {m: {"k_correct": 0, "seconds": 0.0, "clusters": 0}
                            for m in ("adaptive", "random")}
     n_scans = 0
@@ -115,7 +153,7 @@ def clustering_job(job: Mapping[str, Any]) -> dict[str, Any]:
             k_true = n_targets_seen(scan)
             for m in ("adaptive", "random"):
                 t0 = time.perf_counter()
-                f = fuse(scan, m, run_seed=rs)
+                f = fuse(scan, m, run_seed=rs, **(fparams if m == "adaptive" else {}))
                 out[m]["seconds"] += time.perf_counter() - t0
                 out[m]["k_correct"] += int(f.n_clusters == k_true)
                 out[m]["clusters"] += int(f.n_clusters)
@@ -123,22 +161,30 @@ def clustering_job(job: Mapping[str, Any]) -> dict[str, Any]:
     return out
 
 
-def _initiators(region: tuple[float, ...]) -> dict[str, Any]:
-    """The four initiators with the study's settings (those of ``mhtrack initiate``)."""
-    return initiators(region, theta_deg=THETA0, **LOGIC_PARAMS)
+def _initiators(region: tuple[float, ...], settings: str = "best") -> dict[str, Any]:
+    """The four initiators with the study's settings (those of ``mhtrack initiate``, plus
+    :data:`~mhtrack.experiments.p2.constants.INITIATOR_PARAMS` of ``settings``)."""
+    out = initiators(region, theta_deg=THETA0, **LOGIC_PARAMS)
+    for m, extra in INITIATOR_PARAMS[settings].items():
+        for k, v in extra.items():
+            setattr(out[m], k, v)
+    return out
 
 
 def methods_job(job: Mapping[str, Any]) -> dict[str, Any]:
     """One ``methods`` job: the four initiators at θ = 20° (time per window: stacking
     the fused window + initiating, as ``mhtrack initiate``)."""
-    sc = p2_scenario(job["sigma"], job["rate"])
-    inits = _initiators(sc.region.as_tuple())
+    sc = job_scenario(job)
+    settings = job.get("settings", "best")
+    inits = _initiators(sc.region.as_tuple(), settings)
     out: dict[str, Any] = {m: {"found": 0, "false": 0, "tracks": 0, "seconds": 0.0}
                            for m in INITIATORS}
     n_targets = n_windows = n_scans = 0
     fusion_seconds = 0.0
     for r in range(job["start"], job["stop"]):
-        run = simulate_and_fuse(sc, run_seed(job["seed"], r, "words"))
+        run = fused_run(sc, run_seed(job["seed"], r, "words"), settings)
+        before = {m: (out[m]["found"], out[m]["false"], out[m]["tracks"]) for m in inits}
+        t_before, w_before = n_targets, n_windows
         fusion_seconds += sum(run.fusion_seconds)
         n_scans += len(run.fusion_seconds)
         for raw_win, win in run.windows(4):
@@ -154,6 +200,11 @@ def methods_job(job: Mapping[str, Any]) -> dict[str, Any]:
                 out[m]["found"] += f
                 out[m]["false"] += fa
                 out[m]["tracks"] += n
+        for m in inits:  # this run's counts, for paired comparisons
+            out[m].setdefault("per_run", []).append(
+                [out[m][k] - b for k, b in zip(("found", "false", "tracks"), before[m],
+                                                strict=True)]
+                + [n_targets - t_before, n_windows - w_before])
     out.update(n_targets=n_targets, n_windows=n_windows, n_scans=n_scans,
                fusion_seconds=fusion_seconds)
     return out
@@ -216,8 +267,14 @@ def check_record(job: Job, record: Mapping[str, Any]) -> None:
 
 
 def make_jobs(runs: int, seed: int, thetas: Sequence[float], sigmas: Sequence[float],
-              rates: Sequence[float], chunk: int = CHUNK) -> list[Job]:
+              rates: Sequence[float], chunk: int = CHUNK, *, settings: str = "best",
+              clutter_per: str = "radar") -> list[Job]:
     """All jobs of a study (module docstring); each keyed by its unique ``name``."""
+    opts: dict[str, str] = {}
+    if settings != "best":
+        opts["settings"] = settings
+    if clutter_per != "radar":
+        opts["clutter_per"] = clutter_per
     points = [(float(s), RATE0) for s in sigmas] + [(SIGMA0, float(r)) for r in rates]
     points = list(dict.fromkeys(points))
     chunks = [(a, min(a + chunk, runs)) for a in range(0, runs, chunk)]
@@ -227,7 +284,7 @@ def make_jobs(runs: int, seed: int, thetas: Sequence[float], sigmas: Sequence[fl
             **extra: Any) -> None:
         params: dict[str, Any] = {"kind": kind, "name": f"{name}-r{a}-{b}", "sigma": sigma,
                                   "rate": rate, "start": a, "stop": b, "seed": int(seed),
-                                  **extra}
+                                  **extra, **opts}
         jobs.append(Job.of(params["name"], params, SPACED))
 
     for a, b in chunks:

@@ -18,11 +18,13 @@ from mhtrack.experiments.jobs import JobStore, run_jobs
 from mhtrack.experiments.p2.aggregate import aggregate
 from mhtrack.experiments.p2.constants import (
     CHUNK,
+    CLUTTER_PER,
     JOBS_DIR,
     PAPER_COMPLEXITY,
     PAPER_T_CLUSTER,
     PAPER_T_INIT,
     RATES,
+    SETTINGS,
     SIGMAS,
     THETAS_DEG,
 )
@@ -50,9 +52,17 @@ def reproduce_p2(out_dir: str | os.PathLike[str], runs: int = 10, seed: int = 0,
                  thetas: Sequence[float] | None = None, sigmas: Sequence[float] | None = None,
                  rates: Sequence[float] | None = None, executor: str = "local",
                  workers: int | None = None, scheduler: Any = None, progress: bool = False,
-                 chunk: int = CHUNK) -> P2Reproduction:
+                 chunk: int = CHUNK, settings: str = "best",
+                 clutter_per: str = "radar") -> P2Reproduction:
     """Run (or resume) the P2 study into ``out_dir/jobs/`` and aggregate it. ``thetas``
-    (deg), ``sigmas`` (m) and ``rates`` default to P2's grids."""
+    (deg), ``sigmas`` (m) and ``rates`` default to P2's grids; ``settings`` ``"best"``
+    (ours) or ``"paper"`` (P2's steps only); ``clutter_per`` ``"radar"`` (λ per radar per
+    scan) or ``"scan"`` (λ per scan over all radars) — :mod:`~mhtrack.experiments.p2.constants`."""
+    if settings not in SETTINGS:
+        raise ValueError(f"settings must be one of {', '.join(SETTINGS)}, got {settings!r}")
+    if clutter_per not in CLUTTER_PER:
+        raise ValueError(f"clutter_per must be one of {', '.join(CLUTTER_PER)}, "
+                         f"got {clutter_per!r}")
     if runs < 1:
         raise ValueError(f"runs must be >= 1, got {runs}")
     if seed < 0:
@@ -63,7 +73,8 @@ def reproduce_p2(out_dir: str | os.PathLike[str], runs: int = 10, seed: int = 0,
     if not all(0 <= x <= 180 for x in thetas):
         raise ValueError("thetas must be in [0, 180] degrees")
     jobs = make_jobs(runs, seed, thetas, SIGMAS if sigmas is None else sigmas,
-                     RATES if rates is None else rates, chunk)
+                     RATES if rates is None else rates, chunk, settings=settings,
+                     clutter_per=clutter_per)
     store = JobStore(out / JOBS_DIR, STORE_FORMAT, check=check_record)
     t0 = time.perf_counter()
     done = run_jobs(jobs, run_job, store, executor=executor, workers=workers,
@@ -76,5 +87,7 @@ def reproduce_p2(out_dir: str | os.PathLike[str], runs: int = 10, seed: int = 0,
                                             "complexity": PAPER_COMPLEXITY},
                jobs={"total": len(jobs), "computed": done.computed,
                      "failed": sorted(done.errors)})
+    if settings != "best" or clutter_per != "radar":
+        res.update(settings=settings, clutter_per=clutter_per)
     return P2Reproduction(out, runs, seed, to_jsonable(res), done.computed, done.skipped,
                           done.errors, wall)

@@ -12,7 +12,8 @@ reference of each figure:
 * otherwise the **previous release**: the library at ``--previous`` (default
   :data:`PREVIOUS`, main before issue 18's speed work), extracted with ``git archive`` to a
   temporary directory and run in a subprocess with ``PYTHONPATH`` on its ``src`` — the
-  same benchmark code on the old library.
+  same benchmark code on the old library. Ours and the previous release run in turn,
+  ``--repeat`` times each (medians), as fresh subprocesses alike.
 
 Each pair is measured back to back in the same run, so the ratio holds while the machine is
 loaded (it is shared); the absolute times are only as good as the load allows. Tracker
@@ -193,13 +194,25 @@ def previous_src(rev: str) -> Path:
     return d / "src"
 
 
-def on_previous(name: str, a: argparse.Namespace) -> dict:
-    """Figure ``name`` measured by this script on the previous release's library."""
-    env = {**os.environ, "PYTHONPATH": str(previous_src(a.previous))}
+def on_library(name: str, a: argparse.Namespace, src: Path) -> dict:
+    """Figure ``name`` measured by this script, in a subprocess, on the library in ``src``."""
+    env = {**os.environ, "PYTHONPATH": str(src)}
     cmd = [sys.executable, __file__, "--ours-json", name,
            "--opensky-scans", str(a.opensky_scans), "--scale-scans", str(a.scale_scans)]
     out = subprocess.run(cmd, env=env, capture_output=True, text=True, check=True)
     return json.loads(out.stdout.strip().splitlines()[-1])
+
+
+def paired(name: str, key: str, a: argparse.Namespace) -> tuple[dict, dict]:
+    """Ours and the previous release's, run in turn ``--repeat`` times (ours, previous,
+    ours, …: a drift of the machine's speed hits both); each side's run with the median
+    ``key``."""
+    runs: dict[str, list[dict]] = {"ours": [], "previous": []}
+    for _ in range(a.repeat):
+        runs["ours"].append(on_library(name, a, ROOT / "src"))
+        runs["previous"].append(on_library(name, a, previous_src(a.previous)))
+    med = {k: sorted(v, key=lambda r: r[key])[len(v) // 2] for k, v in runs.items()}
+    return med["ours"], med["previous"]
 
 
 # ------------------------------------------------------------------ report
@@ -220,7 +233,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--previous", default=PREVIOUS, help="git revision of the reference")
     ap.add_argument("--opensky-scans", type=int, default=3,
                     help="opensky-radars scans of 10 s (Stone Soup takes ~10 s per scan)")
-    ap.add_argument("--scale-scans", type=int, default=10)
+    ap.add_argument("--scale-scans", type=int, default=25)
+    ap.add_argument("--repeat", type=int, default=3,
+                    help="runs of each side of a previous-release figure (medians)")
     ap.add_argument("--out", type=Path, default=HERE / "results.md")
     ap.add_argument("--ours-json", metavar="FIGURE", help=argparse.SUPPRESS)
     a = ap.parse_args(argv)
@@ -230,11 +245,12 @@ def main(argv: list[str] | None = None) -> int:
     rows = []
     for name in a.figure or list(FIGURES):
         what, fn, key, unit, target = FIGURES[name]
-        ours = fn(a)
         if name in STONESOUP:
+            ours = fn(a)
             ref, ref_name = STONESOUP[name](a), "Stone Soup GNN"
         else:
-            ref, ref_name = on_previous(name, a), f"previous release {a.previous}"
+            ours, ref = paired(name, key, a)
+            ref_name = f"previous release {a.previous}"
         ratio = ref[key] / ours[key]
         extra = {k: v for k, v in ours.items() if k != key}
         extra_ref = {k: v for k, v in ref.items() if k != key}

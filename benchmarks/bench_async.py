@@ -104,8 +104,9 @@ def compare(a: argparse.Namespace) -> None:
           f" = {fastest / results['mhtrack'][0]:.1f}x  (target >= 10)")
 
 
-def throughput(a: argparse.Namespace) -> None:
-    """An hour (``--duration``) of three rotating radars from the tests' generator."""
+def throughput(a: argparse.Namespace) -> dict[str, float]:
+    """An hour (``--duration``) of three rotating radars from the tests' generator; the
+    figures (also printed) as a dict."""
     from async_fixture import Radar, default_targets, simulate_async
 
     radars = [
@@ -143,6 +144,8 @@ def throughput(a: argparse.Namespace) -> None:
           f"{1e3 * wall / plots.n_scans:.2f} ms/frame)")
     print(f"targets {a.targets}: followed {len(followed)}, track ids "
           f"{np.unique(on.track_id).size}, false tracks {false}")
+    return {"wall_s": wall, "plots": len(plots), "frames": plots.n_scans,
+            "followed": len(followed), "targets": a.targets}
 
 
 def main() -> None:

@@ -20,9 +20,11 @@ from mhtrack.records import PlotTable, TrackTable
 
 def run_stonesoup_jpda(
     plots: PlotTable, *, sigma_w: float, sigma_v: float, p_detection: float,
-    clutter_density: float,
+    clutter_density: float, kind: str = "jpda",
 ) -> tuple[TrackTable, np.ndarray]:
-    """Track ``plots`` with Stone Soup's JPDA; return its tracks and seconds per scan."""
+    """Track ``plots`` with Stone Soup's JPDA (``kind="gnn"``: GNN with 2-D assignment on
+    the same PDA hypotheses, ``MultiTargetTracker``); return its tracks and seconds per
+    scan."""
     from stonesoup.dataassociator.neighbour import GNNWith2DAssignment
     from stonesoup.dataassociator.probability import JPDAwithEHM
     from stonesoup.deleter.time import UpdateTimeStepsDeleter
@@ -36,7 +38,7 @@ def run_stonesoup_jpda(
         ConstantVelocity,
     )
     from stonesoup.predictor.kalman import KalmanPredictor
-    from stonesoup.tracker.simple import MultiTargetMixtureTracker
+    from stonesoup.tracker.simple import MultiTargetMixtureTracker, MultiTargetTracker
     from stonesoup.types.detection import Detection
     from stonesoup.types.state import GaussianState
     from stonesoup.updater.kalman import KalmanUpdater
@@ -49,7 +51,7 @@ def run_stonesoup_jpda(
     updater = KalmanUpdater(meas)
     hyp = PDAHypothesiser(predictor, updater, clutter_spatial_density=clutter_density,
                           prob_detect=p_detection, prob_gate=0.999)
-    associator = JPDAwithEHM(hyp)
+    associator = GNNWith2DAssignment(hyp) if kind == "gnn" else JPDAwithEHM(hyp)
     deleter = UpdateTimeStepsDeleter(3)
     init_assoc = GNNWith2DAssignment(
         DistanceHypothesiser(predictor, updater, Mahalanobis(), missed_distance=3)
@@ -67,7 +69,8 @@ def run_stonesoup_jpda(
              seconds=float(sc.time)), measurement_model=meas) for z in sc.z})
         for sc in scans
     ]
-    tracker = MultiTargetMixtureTracker(
+    tracker_class = MultiTargetTracker if kind == "gnn" else MultiTargetMixtureTracker
+    tracker = tracker_class(
         initiator=initiator, deleter=deleter, detector=feed, data_associator=associator,
         updater=updater,
     )

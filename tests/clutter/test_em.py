@@ -11,12 +11,11 @@ from mhtrack.clutter.em import (
     e_step,
     fit_em,
     gaussian_log_pdf,
-    kmeanspp_centres,
     logsumexp_rows,
     m_step,
-    mixture_from_centres,
     removal_gain,
 )
+from mhtrack.clutter.seeding import kmeanspp_centres, mixture_from_centres
 
 
 def _three_blobs(seed: int = 0, n: int = 150) -> tuple[np.ndarray, np.ndarray]:
@@ -173,3 +172,43 @@ def test_bic_drops_bumps_on_uniform_clutter_and_keeps_clumps() -> None:
     assert m.n_components >= 2
     near = lambda c: np.min(np.hypot(*(m.means - c).T))  # noqa: E731
     assert near([1000.0, 1000.0]) < 100 and near([-2500.0, 2500.0]) < 500
+
+
+def _reference_fit(z, mix, *, min_points, bic, tol=1e-4, max_iter=100):
+    """EM from the public steps, each recomputing its densities (no reuse)."""
+    prev, n_iter = -np.inf, 0
+    for n_iter in range(1, max_iter + 1):  # noqa: B007
+        ll, resp = e_step(z, mix)
+        mix, nk = m_step(z, resp, mix.background_box)
+        keep = nk >= min_points
+        if bic and mix.n_components:
+            keep &= removal_gain(z, mix) >= 3.0 * np.log(len(z))
+        deleted = int((~keep).sum())
+        if deleted:
+            w = mix.weights[keep]
+            w = w * (1.0 - mix.background_weight) / w.sum() if w.sum() > 0 else w
+            mix = Mixture(w, mix.means[keep], mix.covariances[keep], mix.background_weight,
+                          mix.background_box)
+        if mix.n_components == 0:
+            break
+        if not deleted and abs(ll - prev) < tol * abs(prev):
+            break
+        prev = ll
+    return mix, float(np.mean(mix.log_pdf(z))), n_iter
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_fit_em_reuses_densities_bit_for_bit(seed: int) -> None:
+    """``fit_em`` computes each mixture's densities once and keeps the surviving columns
+    after a deletion: the same floats as the plain loop over the public steps."""
+    rng = np.random.default_rng(seed)
+    z = np.concatenate((rng.uniform(-4000, 4000, (300, 2)), rng.normal(800, 150, (60, 2))))
+    box = (-4500.0, 4500.0, -4500.0, 4500.0)
+    init = mixture_from_centres(z, kmeanspp_centres(z, 8, np.random.default_rng(seed)),
+                                reg_covar=1e-6, background_box=box, background_weight=0.05)
+    want, ll, n_iter = _reference_fit(z, init, min_points=3.0, bic=seed % 2 == 0)
+    got = fit_em(z, init, reg_covar=1e-6, min_points=3.0, bic=seed % 2 == 0)
+    assert got.n_iter == n_iter and got.log_likelihood == ll
+    assert np.array_equal(got.mixture.means, want.means)
+    assert np.array_equal(got.mixture.covariances, want.covariances)
+    assert np.array_equal(got.mixture.weights, want.weights)

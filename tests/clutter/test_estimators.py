@@ -15,7 +15,8 @@ from mhtrack.clutter import (
     GMMClutter,
     KnownClutter,
 )
-from mhtrack.clutter.em import fit_em, kmeanspp_centres, mixture_from_centres
+from mhtrack.clutter.em import fit_em
+from mhtrack.clutter.seeding import kmeanspp_centres, mixture_from_centres
 from mhtrack.models.clutter import GaussianMixtureClutter, Region
 from mhtrack.records import Scan
 

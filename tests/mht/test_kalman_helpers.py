@@ -82,3 +82,40 @@ def test_gate_sweep_with_many_plots_matches_gate():
     b = gate_sweep(x, P, z, R, 13.8)
     assert len(a) > 1000
     assert np.array_equal(a.track, b.track) and np.array_equal(a.plot, b.plot)
+
+
+class _Leaves:
+    """What :meth:`Gate.pairs` reads of the leaves: their number, scores and tracks."""
+
+    def __init__(self, score, track):
+        self.score, self.track = score, track
+
+    def __len__(self):
+        return len(self.score)
+
+
+def test_gate_within_budget_gates_confirmed_then_best_leaves():
+    """With a budget below the candidates, the leaves of confirmed tracks and then the
+    best-scoring ones are gated (whole leaves, in that order, while their candidates fit);
+    their pairs are the reference gate's, the others get none."""
+    from mhtrack.mht.gating import Gate
+
+    rng = np.random.default_rng(5)
+    M = 120
+    x, P = _tracks(rng, M)
+    z = rng.uniform(-4000, 4000, (400, 2))
+    R = np.eye(2) * 1e4
+    leaves = _Leaves(rng.normal(size=M), np.where(rng.random(M) < 0.2, 7, -1))
+    counts = gate_candidate_counts(x, P, z, R, gate_threshold(0.999))
+    for budget in (10**9, int(counts.sum()), int(counts.sum()) // 3):
+        gate = Gate(0.999, budget)
+        gate.max_pairs = budget
+        caps: dict[str, int] = {}
+        g = gate.pairs(leaves, x, P, z, R, caps)
+        order = np.lexsort((-leaves.score, leaves.track < 0))
+        sel = np.sort(order[np.cumsum(counts[order]) <= budget])
+        want = ref.gate(x[sel], P[sel], z, R, gate.gamma)
+        assert np.array_equal(g.track, sel[want.track]) and np.array_equal(g.plot, want.plot)
+        np.testing.assert_allclose(g.loglik, want.loglik, rtol=1e-12, atol=1e-12)
+        assert caps.get("max_gated_pairs", 0) == M - sel.size
+        assert (sel.size < M) == (budget < counts.sum())

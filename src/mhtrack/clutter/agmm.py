@@ -22,7 +22,7 @@ Gaussian whose removal costs the fit less than the BIC price of its six paramete
 P1 step 1 initialises means and covariances with "random numbers in 1–100", which makes no
 sense in metres on an 8 km region (every mean would start in one corner 100 m wide); we
 seed the means by k-means++ among the plots from a seeded generator instead
-(:func:`mhtrack.clutter.em.kmeanspp_centres`).
+(:func:`mhtrack.clutter.seeding.kmeanspp_centres`).
 """
 
 from __future__ import annotations

@@ -90,11 +90,8 @@ class Mixture:
 
     def weighted_log_prob(self, z: np.ndarray) -> np.ndarray:
         """(n, K+1) ``log π_j + log f_j(z)``; column 0 the background (``−inf`` if none)."""
-        out = np.empty((len(z), self.n_components + 1))
-        with np.errstate(divide="ignore"):
-            out[:, 0] = np.log(self.background_weight) + self.log_background(z)
-            out[:, 1:] = np.log(self.weights) + gaussian_log_pdf(z, self.means, self.covariances)
-        return out
+        return _weighted(self, gaussian_log_pdf(z, self.means, self.covariances),
+                         self.log_background(z))
 
     def log_pdf(self, z: np.ndarray) -> np.ndarray:
         """``log c(z)`` (P1 eqs. 6, 13) at (n, 2) positions."""
@@ -197,12 +194,24 @@ def e_step(
     (column 0 the background), computed as ``exp(log π_j f_j − logsumexp)``."""
     wlp = mix.weighted_log_prob(z)
     norm = logsumexp_rows(wlp)
-    resp = np.exp(wlp - norm[:, None])
+    return _mean_ll(norm, sample_weight), np.exp(wlp - norm[:, None])
+
+
+def _weighted(mix: Mixture, glp: np.ndarray, log_bg: np.ndarray) -> np.ndarray:
+    """(n, K+1) ``log π_j + log f_j(z)`` from the Gaussians' (n, K) ``log N`` and the
+    background's (n,) ``log u``: the one formula of :meth:`Mixture.weighted_log_prob`."""
+    out = np.empty((len(log_bg), mix.n_components + 1))
+    with np.errstate(divide="ignore"):
+        out[:, 0] = np.log(mix.background_weight) + log_bg
+        out[:, 1:] = np.log(mix.weights) + glp
+    return out
+
+
+def _mean_ll(norm: np.ndarray, sample_weight: np.ndarray | None) -> float:
+    """``L = (1/Σs) Σ_i s_i log c(z_i)`` from the rows' ``log c``."""
     if sample_weight is None:
-        ll = float(norm.mean())
-    else:
-        ll = float(sample_weight @ norm / sample_weight.sum())
-    return ll, resp
+        return float(norm.mean())
+    return float(sample_weight @ norm / sample_weight.sum())
 
 
 def m_step(
@@ -287,22 +296,37 @@ def fit_em(
     scikit-learn's ``GaussianMixture(covariance_type="full")`` EM from the same
     initialisation: after ``max_iter`` iterations ``log_likelihood`` equals its ``score``.
     """
+    # Each mixture's (n, K) Gaussian log-densities are computed once: the E-step of the
+    # next iteration, the BIC test and the final L reuse them, and a deletion keeps the
+    # surviving columns (elementwise formulas: the same floats as recomputing them).
+    log_bg = init.log_background(z)  # the box is fixed
     mix = init
+    wlp = _weighted(mix, gaussian_log_pdf(z, mix.means, mix.covariances), log_bg)
+    norm: np.ndarray | None = None
+    resp: np.ndarray | None = None
     prev = -np.inf
     converged = False
     n_pruned = 0
     n_iter = 0
     for n_iter in range(1, max_iter + 1):  # noqa: B007
-        ll, resp = e_step(z, mix, sample_weight)
+        if norm is None or resp is None:  # E-step (P1 eq. 9)
+            norm = logsumexp_rows(wlp)
+            resp = np.exp(wlp - norm[:, None])
+        ll = _mean_ll(norm, sample_weight)
         mix, nk = m_step(z, resp, mix.background_box, sample_weight=sample_weight,
                          reg_covar=reg_covar, background_floor=background_floor)
+        glp = gaussian_log_pdf(z, mix.means, mix.covariances)
+        wlp, norm, resp = _weighted(mix, glp, log_bg), None, None
         keep = nk >= min_points
         if min_contrast > 0 and mix.background_box is not None:
             peak = mix.weights / (2.0 * np.pi * np.sqrt(det2(mix.covariances)))
             keep &= peak >= min_contrast * mix.background_weight / mix.background_area
         if bic and mix.background_box is not None and mix.n_components:
             n_eff = float(len(z) if sample_weight is None else sample_weight.sum())
-            keep &= removal_gain(z, mix, sample_weight) >= 3.0 * np.log(max(n_eff, 1.0))
+            norm = logsumexp_rows(wlp)
+            resp = np.exp(wlp - norm[:, None])
+            gain = _removal_gain(mix, resp[:, 1:], norm, log_bg, sample_weight)
+            keep &= gain >= 3.0 * np.log(max(n_eff, 1.0))
         if prune is not None and keep.any():
             w = np.where(keep, mix.weights, 0.0)
             keep &= prune(w / w.sum())
@@ -312,13 +336,15 @@ def fit_em(
         if deleted:
             mix = _drop(mix, keep)
             n_pruned += deleted
+            wlp, norm, resp = _weighted(mix, glp[:, keep], log_bg), None, None
         if mix.n_components == 0:
             break
         if not deleted and abs(ll - prev) < tol * abs(prev):
             converged = True
             break
         prev = ll
-    final = float(np.average(mix.log_pdf(z), weights=sample_weight))
+    final = float(np.average(logsumexp_rows(wlp) if norm is None else norm,
+                             weights=sample_weight))
     return EMResult(mix, final, n_iter, converged, n_pruned)
 
 
@@ -334,67 +360,18 @@ def removal_gain(
     denser than elsewhere, gains many nats. Needs a background box."""
     wlp = mix.weighted_log_prob(z)
     norm = logsumexp_rows(wlp)
-    resp = np.exp(wlp[:, 1:] - norm[:, None])
+    return _removal_gain(mix, np.exp(wlp[:, 1:] - norm[:, None]), norm,
+                         mix.log_background(z), sample_weight)
+
+
+def _removal_gain(
+    mix: Mixture, resp: np.ndarray, norm: np.ndarray, log_bg: np.ndarray,
+    sample_weight: np.ndarray | None,
+) -> np.ndarray:
+    """:func:`removal_gain` from the Gaussians' (n, K) responsibilities, the rows'
+    ``log c(z_i)`` and the background's ``log u(z_i)``."""
     with np.errstate(divide="ignore"):
-        to_bg = np.exp(np.log(mix.weights)[None, :] + mix.log_background(z)[:, None]
-                       - norm[:, None])
+        to_bg = np.exp(np.log(mix.weights)[None, :] + log_bg[:, None] - norm[:, None])
     ratio = np.maximum(1.0 - resp + to_bg, 1e-300)
     per = -np.log(ratio)
     return per.sum(axis=0) if sample_weight is None else sample_weight @ per
-
-
-# ------------------------------------------------------------------ initialisation
-def kmeanspp_centres(
-    z: np.ndarray, k: int, rng: np.random.Generator, existing: np.ndarray | None = None
-) -> np.ndarray:
-    """Up to ``k`` new centres drawn from the rows of ``z`` by k-means++ ``D²`` sampling
-    (Arthur & Vassilvitskii 2007; the first one uniformly unless ``existing`` centres are
-    given, to which distances are then measured). Stops early when every remaining plot
-    sits on a centre (``D² = 0``), so identical plots give one centre."""
-    chosen: list[np.ndarray] = []
-    if existing is not None and len(existing):
-        d2 = ((z[:, None, :] - existing[None, :, :]) ** 2).sum(axis=2).min(axis=1)
-    else:
-        first = z[int(rng.integers(len(z)))]
-        chosen.append(first)
-        d2 = ((z - first) ** 2).sum(axis=1)
-    while len(chosen) < k:
-        total = d2.sum()
-        if not total > 0:
-            break
-        i = int(np.searchsorted(np.cumsum(d2), rng.random() * total, side="right"))
-        c = z[min(i, len(z) - 1)]
-        chosen.append(c)
-        d2 = np.minimum(d2, ((z - c) ** 2).sum(axis=1))
-    return np.array(chosen, float).reshape(-1, 2)
-
-
-def mixture_from_centres(
-    z: np.ndarray,
-    centres: np.ndarray,
-    *,
-    reg_covar: float,
-    background_box: tuple[float, float, float, float] | None = None,
-    background_weight: float = 0.0,
-) -> Mixture:
-    """A starting mixture: each plot goes to its nearest centre (a hard E-step), then one
-    M-step. A centre with fewer than 3 plots (too few for a 2×2 covariance) gets the
-    data's covariance divided by the number of centres (+ ``reg_covar``); a centre with no
-    plot keeps its position with a tiny weight."""
-    k = len(centres)
-    d2 = ((z[:, None, :] - centres[None, :, :]) ** 2).sum(axis=2)
-    lab = d2.argmin(axis=1)
-    counts = np.bincount(lab, minlength=k).astype(float)
-    data_cov = np.cov(z.T, bias=True).reshape(2, 2) if len(z) > 1 else np.zeros((2, 2))
-    broad = data_cov / k + reg_covar * np.eye(2)
-    means = centres.astype(float).copy()
-    cov = np.repeat(broad[None], k, axis=0)
-    for j in np.flatnonzero(counts >= 1):
-        pts = z[lab == j]
-        means[j] = pts.mean(axis=0)
-        if len(pts) >= 3:
-            d = pts - means[j]
-            cov[j] = d.T @ d / len(pts) + reg_covar * np.eye(2)
-    w = np.maximum(counts, 1e-3)
-    w = (1.0 - background_weight) * w / w.sum()
-    return Mixture(w, means, cov, float(background_weight), background_box)

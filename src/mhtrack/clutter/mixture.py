@@ -27,14 +27,8 @@ from typing import Any, Literal
 import numpy as np
 
 from mhtrack.clutter.base import ClutterEstimator
-from mhtrack.clutter.em import (
-    Mixture,
-    PruneRule,
-    fit_em,
-    kmeanspp_centres,
-    mahalanobis2,
-    mixture_from_centres,
-)
+from mhtrack.clutter.em import Mixture, PruneRule, fit_em, mahalanobis2
+from mhtrack.clutter.seeding import kmeanspp_centres, mixture_from_centres
 from mhtrack.models.clutter import Region
 from mhtrack.records import Scan
 

@@ -119,12 +119,23 @@ def gate_sweep(
     """
     x = np.asarray(x, float).reshape(-1, 4)
     z = np.asarray(z, float).reshape(-1, 2)
-    M, N = len(x), len(z)
-    R, shared = plot_covariances(R, N)
-    e = np.zeros(0, np.int64)
-    if M == 0 or N == 0:
+    R, shared = plot_covariances(R, len(z))
+    if len(x) == 0 or len(z) == 0:
+        e = np.zeros(0, np.int64)
         return Gated(e, e, np.zeros(0), np.zeros(0))
-    tq, lo, hi, order = _sweep_boxes(x, P, z, R, shared, gamma)
+    return _pairs_in_boxes(x, P, z, R, shared, gamma, _sweep_boxes(x, P, z, R, shared, gamma))
+
+
+def _pairs_in_boxes(
+    x: np.ndarray, P: np.ndarray, z: np.ndarray, R: np.ndarray, shared: bool, gamma: float,
+    boxes: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray],
+) -> Gated:
+    """The exact test of :func:`gate_sweep` on the candidates of :func:`_sweep_boxes`
+    (any boxes holding every gated pair give the same result: the test is per pair and
+    the pairs are sorted at the end)."""
+    N = len(z)
+    e = np.zeros(0, np.int64)
+    tq, lo, hi, order = boxes
     cnt = hi - lo
     ti = np.repeat(tq, cnt)
     pj = order[np.repeat(lo - np.cumsum(cnt) + cnt, cnt) + np.arange(int(cnt.sum()))]
@@ -174,15 +185,23 @@ class Gate:
         """The pairs of :func:`gate_sweep` of states ``xp``, ``Pp`` within the work budget
         (class docstring), with the Gaussian ``loglik`` of ``xp, Pp``."""
         budget = self.max_pairs
-        if len(leaves) * len(z) <= budget:
+        if len(leaves) * len(z) <= budget or len(leaves) == 0 or len(z) == 0:
             return gate_sweep(xp, Pp, z, R, self.gamma)
-        counts = gate_candidate_counts(xp, Pp, z, R, self.gamma)
+        # the candidate boxes are found once: counted against the budget, then tested
+        R, shared = plot_covariances(R, len(z))
+        boxes = _sweep_boxes(xp, Pp, z, R, shared, self.gamma)
+        tq, lo, hi, plot_order = boxes
+        counts = np.bincount(tq, weights=hi - lo, minlength=len(leaves)).astype(np.int64)
         if counts.sum() <= budget:
-            return gate_sweep(xp, Pp, z, R, self.gamma)
+            return _pairs_in_boxes(xp, Pp, z, R, shared, self.gamma, boxes)
         order = np.lexsort((-leaves.score, leaves.track < 0))
         sel = np.sort(order[np.cumsum(counts[order]) <= budget])
         caps["max_gated_pairs"] = len(leaves) - sel.size
-        g = gate_sweep(xp[sel], Pp[sel], z, R, self.gamma)
+        new_index = np.full(len(leaves), -1, np.int64)
+        new_index[sel] = np.arange(sel.size)
+        q = new_index[tq] >= 0
+        g = _pairs_in_boxes(xp[sel], Pp[sel], z, R, shared, self.gamma,
+                            (new_index[tq[q]], lo[q], hi[q], plot_order))
         return Gated(sel[g.track], g.plot, g.d2, g.loglik)
 
 

@@ -21,6 +21,7 @@ filter of :mod:`mhtrack.models.kalman`.
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -64,10 +65,7 @@ class CVModelSet(MotionModel):
         one interval per row; ``π_ii = exp(−|dt|/τ)`` (a negative ``dt``, a plot slightly
         older than the track, still lets the mode change)."""
         if np.ndim(dt) == 0:
-            stay = math.exp(-dt / self.mode_time)
-            pi = np.full((self.r, self.r), (1.0 - stay) / (self.r - 1))
-            np.fill_diagonal(pi, stay)
-            return pi
+            return _transition(self.r, self.mode_time, float(dt))
         stay = np.exp(-np.abs(np.asarray(dt, float)) / self.mode_time)
         pi = np.repeat(((1.0 - stay) / (self.r - 1))[:, None, None], self.r, axis=1)
         pi = np.repeat(pi, self.r, axis=2)
@@ -88,14 +86,14 @@ class CVModelSet(MotionModel):
             mubar = np.einsum("mi,mij->mj", mu, pi)
             pim = pi
         w = pim * mu[:, :, None] / np.maximum(mubar, 1e-300)[:, None, :]  # (M,i,j)
-        x0 = np.einsum("mij,mia->mja", w, xm)
+        x0 = _mix_sum(w[..., None], xm[:, :, None, :])  # (M, j, 4)
         d = xm[:, :, None, :] - x0[:, None, :, :]  # (M, i, j, 4)
-        P0 = np.einsum("mij,miab->mjab", w, Pm) + np.einsum("mij,mija,mijb->mjab", w, d, d)
-        xp = np.empty_like(x0)
-        Pp = np.empty_like(P0)
-        for j, s in enumerate(self.sigmas):
-            xp[:, j], Pp[:, j] = kalman.predict_cv(x0[:, j], P0[:, j], dt,
-                                                   ConstantVelocity(s).Q(dt))
+        wd = w[..., None] * d
+        P0 = (_mix_sum(w[..., None, None], Pm[:, :, None])
+              + _mix_sum(wd[..., :, None], d[..., None, :]))
+        Q = (_process_noise(self.sigmas, float(dt)) if np.ndim(dt) == 0
+             else np.stack([ConstantVelocity(s).Q(dt) for s in self.sigmas], axis=-3))
+        xp, Pp = kalman.predict_cv(x0, P0, dt, Q)  # every model at once
         return xp, Pp, mubar
 
     # ------------------------------------------------------------------ MotionModel
@@ -134,11 +132,39 @@ class CVModelSet(MotionModel):
                       self.initial_mu(len(x)))
 
 
+@functools.lru_cache(maxsize=64)
+def _transition(r: int, mode_time: float, dt: float) -> np.ndarray:
+    """``π`` (r, r) for one interval (read-only; cached: synchronous scans repeat ``dt``)."""
+    stay = math.exp(-dt / mode_time)
+    pi = np.full((r, r), (1.0 - stay) / (r - 1))
+    np.fill_diagonal(pi, stay)
+    pi.setflags(write=False)
+    return pi
+
+
+@functools.lru_cache(maxsize=64)
+def _process_noise(sigmas: tuple[float, ...], dt: float) -> np.ndarray:
+    """Every model's ``Q(dt)``, (r, 4, 4) (read-only; cached as :func:`_transition`)."""
+    q = np.stack([ConstantVelocity(s).Q(dt) for s in sigmas])
+    q.setflags(write=False)
+    return q
+
+
+def _mix_sum(w: np.ndarray, a: np.ndarray) -> np.ndarray:
+    """``Σ_i w_i a_i`` over axis 1, summed in model order ``((w_0 a_0 + w_1 a_1) + …)``:
+    the products and the order of ``np.einsum``'s sum, in a few whole-array operations."""
+    out = w[:, 0] * a[:, 0]
+    for i in range(1, w.shape[1]):
+        out = out + w[:, i] * a[:, i]
+    return out
+
+
 def combine(xm: np.ndarray, Pm: np.ndarray, mu: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Moment-matched single Gaussian of the model mixture: ``(x, P)``, (M, 4), (M, 4, 4)."""
-    x = np.einsum("mj,mja->ma", mu, xm)
+    x = _mix_sum(mu[..., None], xm)
     d = xm - x[:, None, :]
-    P = np.einsum("mj,mjab->mab", mu, Pm) + np.einsum("mj,mja,mjb->mab", mu, d, d)
+    P = _mix_sum(mu[..., None, None], Pm) + _mix_sum((mu[..., None] * d)[..., None],
+                                                      d[..., None, :])
     return x, 0.5 * (P + np.swapaxes(P, -1, -2))
 
 

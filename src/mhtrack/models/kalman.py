@@ -28,18 +28,20 @@ def predict_cv(
     """Prediction with the constant-velocity ``F(dt) = I + dt·E``: ``x⁻ = F x``,
     ``P⁻ = F P Fᵀ + Q`` done as two row/column updates ``P[pos] += dt·P[vel]`` on the
     whole stack. ``dt`` is one interval, or one per row (M,) with ``Q`` (M, 4, 4)
-    (asynchronous plots: each track to its own plot's time)."""
+    (asynchronous plots: each track to its own plot's time). Leading axes beyond the
+    first are allowed (``x`` (M, …, 4), ``P`` (M, …, 4, 4), ``Q`` broadcasting to ``P``:
+    the IMM's models at once)."""
     xp = x.copy()
     Pp = P.copy()
     if np.ndim(dt) == 0:
-        xp[:, 0::2] += dt * x[:, 1::2]
-        Pp[:, 0::2, :] += dt * Pp[:, 1::2, :]
-        Pp[:, :, 0::2] += dt * Pp[:, :, 1::2]
+        xp[..., 0::2] += dt * x[..., 1::2]
+        Pp[..., 0::2, :] += dt * Pp[..., 1::2, :]
+        Pp[..., :, 0::2] += dt * Pp[..., :, 1::2]
     else:
-        d = np.asarray(dt, float)
-        xp[:, 0::2] += d[:, None] * x[:, 1::2]
-        Pp[:, 0::2, :] += d[:, None, None] * Pp[:, 1::2, :]
-        Pp[:, :, 0::2] += d[:, None, None] * Pp[:, :, 1::2]
+        d = np.asarray(dt, float).reshape((-1,) + (1,) * (x.ndim - 1))
+        xp[..., 0::2] += d * x[..., 1::2]
+        Pp[..., 0::2, :] += d[..., None] * Pp[..., 1::2, :]
+        Pp[..., :, 0::2] += d[..., None] * Pp[..., :, 1::2]
     Pp += Q
     return xp, 0.5 * (Pp + np.swapaxes(Pp, -1, -2))
 

@@ -1,0 +1,64 @@
+"""Starting mixtures for EM (:mod:`mhtrack.clutter.em`): k-means++ seeds among the plots
+(Arthur & Vassilvitskii 2007), then one hard assignment and one M-step."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from mhtrack.clutter.em import Mixture
+
+
+def kmeanspp_centres(
+    z: np.ndarray, k: int, rng: np.random.Generator, existing: np.ndarray | None = None
+) -> np.ndarray:
+    """Up to ``k`` new centres drawn from the rows of ``z`` by k-means++ ``D²`` sampling
+    (Arthur & Vassilvitskii 2007; the first one uniformly unless ``existing`` centres are
+    given, to which distances are then measured). Stops early when every remaining plot
+    sits on a centre (``D² = 0``), so identical plots give one centre."""
+    chosen: list[np.ndarray] = []
+    if existing is not None and len(existing):
+        d2 = ((z[:, None, :] - existing[None, :, :]) ** 2).sum(axis=2).min(axis=1)
+    else:
+        first = z[int(rng.integers(len(z)))]
+        chosen.append(first)
+        d2 = ((z - first) ** 2).sum(axis=1)
+    while len(chosen) < k:
+        total = d2.sum()
+        if not total > 0:
+            break
+        i = int(np.searchsorted(np.cumsum(d2), rng.random() * total, side="right"))
+        c = z[min(i, len(z) - 1)]
+        chosen.append(c)
+        d2 = np.minimum(d2, ((z - c) ** 2).sum(axis=1))
+    return np.array(chosen, float).reshape(-1, 2)
+
+
+def mixture_from_centres(
+    z: np.ndarray,
+    centres: np.ndarray,
+    *,
+    reg_covar: float,
+    background_box: tuple[float, float, float, float] | None = None,
+    background_weight: float = 0.0,
+) -> Mixture:
+    """A starting mixture: each plot goes to its nearest centre (a hard E-step), then one
+    M-step. A centre with fewer than 3 plots (too few for a 2×2 covariance) gets the
+    data's covariance divided by the number of centres (+ ``reg_covar``); a centre with no
+    plot keeps its position with a tiny weight."""
+    k = len(centres)
+    d2 = ((z[:, None, :] - centres[None, :, :]) ** 2).sum(axis=2)
+    lab = d2.argmin(axis=1)
+    counts = np.bincount(lab, minlength=k).astype(float)
+    data_cov = np.cov(z.T, bias=True).reshape(2, 2) if len(z) > 1 else np.zeros((2, 2))
+    broad = data_cov / k + reg_covar * np.eye(2)
+    means = centres.astype(float).copy()
+    cov = np.repeat(broad[None], k, axis=0)
+    for j in np.flatnonzero(counts >= 1):
+        pts = z[lab == j]
+        means[j] = pts.mean(axis=0)
+        if len(pts) >= 3:
+            d = pts - means[j]
+            cov[j] = d.T @ d / len(pts) + reg_covar * np.eye(2)
+    w = np.maximum(counts, 1e-3)
+    w = (1.0 - background_weight) * w / w.sum()
+    return Mixture(w, means, cov, float(background_weight), background_box)

@@ -223,3 +223,25 @@ def test_cli_rejects_both_executors(tmp_path):
     r = CliRunner().invoke(reproduce, ["p1", "--workers", "1", "--dask-scheduler",
                                        "tcp://x:1", "--out", str(tmp_path)])
     assert r.exit_code != 0 and "not both" in r.output
+
+
+def test_caps_reported_per_run(repro, report):
+    # Every run's caps are in table3.json and the report says, per tracker, in how many
+    # runs and at how many scans per run they acted — read back from the stored runs.
+    js = json.loads((repro.out_dir / "table3.json").read_text())
+    md = report.report_path.read_text()
+    assert "## Hard caps, per run" in md
+    for t, recs in repro.result.records.items():
+        rows = js["caps_per_run"][t]
+        assert [r["run"] for r in rows] == [r["run"] for r in recs]
+        for row, rec in zip(rows, recs, strict=True):
+            stored = json.loads(rec["caps"] or "{}")
+            assert row["scans"] == stored.get("scans", 0)
+            assert {k: v for k, v in row.items() if k not in ("run", "scans")} == {
+                k: v for k, v in stored.items() if k != "scans"}
+        n_hit = sum(1 for r in rows if r["scans"] > 0)
+        label = {"mht": "MHT", "mht-gmm": "MHT-GMM", "mht-agmm": "MHT-AGMM"}[t]
+        if n_hit:
+            assert f"* {label}: caps acted in {n_hit} of {len(rows)} runs" in md
+        else:
+            assert f"* {label}: no cap acted in any of its {len(rows)} runs." in md

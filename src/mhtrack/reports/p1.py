@@ -87,7 +87,8 @@ def write_p1_report(repro: P1Reproduction) -> P1Report:
           "other_settings": {k: {"description": TRACKER_SETTINGS[k].description,
                                  "runs": r.spec.runs, "table": repro.other_tables[k]}
                              for k, r in repro.others.items()},
-          "paired": [c.to_dict() for c in repro.paired]}  # NaN (no value) written as null
+          "paired": [c.to_dict() for c in repro.paired],  # NaN (no value) written as null
+          "caps_per_run": repro.result.caps_per_run()}
     json_path = atomic_write(out_dir / settings_file(TABLE_JSON, st),
                              json.dumps(to_jsonable(js), indent=1) + "\n")
     figures = _figures(repro)

@@ -274,6 +274,7 @@ def report_markdown(repro: P1Reproduction, figures: Mapping[str, Path]) -> str:
         "",
         paired_table(repro.paired, DIGITS, LABELS),
     ]
+    parts += ["## Hard caps, per run", "", caps_text(res, spec.trackers), ""]
     if failed or res.missing:
         parts += ["**Failed runs**: " + ", ".join(f"{t} run {i}" for t, i in failed)
                   + (" ; not run: " + ", ".join(f"{t} run {i}" for t, i in res.missing)
@@ -301,6 +302,27 @@ def report_markdown(repro: P1Reproduction, figures: Mapping[str, Path]) -> str:
         "",
     ]
     return "\n".join(parts)
+
+
+def caps_text(res: Any, trackers: Sequence[str]) -> str:
+    """Per tracker: in how many runs the MHT's hard caps acted, how many scans per run
+    (min / median / max) and each run's count (the full counts per cap are in
+    ``table3.json``'s ``caps_per_run``)."""
+    lines = []
+    for t, rows in ((t, res.caps_per_run().get(t, [])) for t in trackers):
+        label = TRACKER_LABELS.get(t, t)
+        hit = [r for r in rows if r["scans"] > 0]
+        if not hit:
+            lines.append(f"* {label}: no cap acted in any of its {len(rows)} runs.")
+            continue
+        sc = sorted(r["scans"] for r in rows)
+        names = sorted({k for r in hit for k in r if k not in ("run", "scans")})
+        per_run = ", ".join(f"{r['run']}: {r['scans']}" for r in rows)
+        lines.append(f"* {label}: caps acted in {len(hit)} of {len(rows)} runs "
+                     f"({', '.join(names)}); scans with a cap acting per run min "
+                     f"{sc[0]} / median {sc[len(sc) // 2]} / max {sc[-1]}. "
+                     f"Run: scans — {per_run}.")
+    return "\n".join(lines)
 
 
 def _same(a: Any, b: Any) -> bool:

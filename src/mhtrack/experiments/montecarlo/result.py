@@ -77,6 +77,23 @@ class MonteCarloResult:
         return {t: sum(1 for r in recs if json.loads(r.get("caps") or "{}"))
                 for t, recs in self.records.items()}
 
+    def caps_per_run(self) -> dict[str, list[dict[str, Any]]]:
+        """Per tracker, each successful run's hard caps: ``{"run", "scans", <cap>: count}``
+        (``scans``: scans at which any cap acted; a cap's count: what it cut over the
+        run); ``{"run": i, "scans": 0}`` for a run no cap touched."""
+        out: dict[str, list[dict[str, Any]]] = {}
+        for t, recs in self.records.items():
+            rows = []
+            for r in recs:
+                caps = json.loads(r.get("caps") or "{}")
+                scans = caps.pop("scans", None)
+                if scans is None:  # runs stored before the count of scans existed
+                    scans = len({k for v in json.loads(r.get("cap_scans") or "{}").values()
+                                 for k in v})
+                rows.append({"run": int(r["run"]), "scans": int(scans), **caps})
+            out[t] = rows
+        return out
+
     @property
     def ok(self) -> bool:
         return not any(self.failures.values()) and not self.missing

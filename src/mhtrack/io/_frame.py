@@ -17,7 +17,6 @@ import numpy as np
 import pyarrow as pa
 import pyarrow.compute as pc
 import pyarrow.csv as pacsv
-import pyarrow.parquet as pq
 
 from mhtrack.bounds import (
     MAX_COLUMNS,
@@ -198,6 +197,8 @@ def _column_names(src: Source) -> list[str]:
     if src.format == "csv":
         names = _csv_header(src)
     else:
+        import pyarrow.parquet as pq  # only for Parquet files (fast start)
+
         try:
             names = pq.read_schema(src.path).names
         except (pa.ArrowException, OSError) as e:
@@ -241,6 +242,8 @@ def read_frame(
         except (pa.ArrowException, OSError) as e:
             raise src.error(f"cannot read CSV ({clip(str(e), 200)})") from None
     else:
+        import pyarrow.parquet as pq
+
         try:
             table = pq.read_table(src.path, columns=present)
         except (pa.ArrowException, OSError) as e:
@@ -346,6 +349,8 @@ def write_frame(path: PathArg, columns: Mapping[str, pa.Array]) -> None:
                     opts = pacsv.WriteOptions(include_header=False, quoting_style="none")
                     pacsv.write_csv(table, fh, opts)
             else:
+                import pyarrow.parquet as pq
+
                 pq.write_table(table, str(tmp))
     except OSError as e:
         raise InputError(f"{path}: cannot write ({e.strerror or e})", file=str(path)) from None

@@ -29,7 +29,7 @@ import json
 import os
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import numpy.typing as npt
@@ -47,7 +47,9 @@ from mhtrack.mht import MHTConfig, MHTTracker
 from mhtrack.mht.coverage import RadarCoverage
 from mhtrack.models.radars import RadarSensor, SensorSet
 from mhtrack.models.sensors import CartesianSensor
-from mhtrack.scenario import Scenario
+
+if TYPE_CHECKING:
+    from mhtrack.scenario import Scenario
 
 # ---------------------------------------------------------------- clutter estimators
 

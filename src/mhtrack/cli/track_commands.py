@@ -199,7 +199,6 @@ def _read_input(plots: Path, scenario_file: Path | None, sensors_file: Path | No
     from mhtrack.io.plots import check_scan_times, is_timed
     from mhtrack.io.sensors import read_sensors
     from mhtrack.io.timed_plots import DEFAULT_REORDER_WINDOW_S
-    from mhtrack.scenario import load_scenario
 
     window = DEFAULT_REORDER_WINDOW_S if reorder_window_s is None else reorder_window_s
     timed = is_timed(plots)
@@ -219,6 +218,8 @@ def _read_input(plots: Path, scenario_file: Path | None, sensors_file: Path | No
     sensors = None
     scenario = None
     if scenario_file is not None and not timed:
+        from mhtrack.scenario import load_scenario
+
         scenario = load_scenario(scenario_file)
         sensors = {s.id: s for s in scenario.sensors}
     table = read_plots(plots, sensors=sensors, reorder_window_s=window)

@@ -19,7 +19,7 @@ from __future__ import annotations
 import dataclasses
 from collections.abc import Iterable
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from tqdm.auto import tqdm
@@ -32,12 +32,14 @@ from mhtrack.build import (
     tracker_fuser,
 )
 from mhtrack.initiation.fusion import AdaptiveKMeansFusion
-from mhtrack.metrics import Evaluation, evaluate
 from mhtrack.mht import MHTConfig, MHTTracker, StepStats
 from mhtrack.models.radars import SensorSet
 from mhtrack.names import OUTPUTS, TRACKER_FUSIONS
 from mhtrack.records import PlotTable, Scan, TrackTable
-from mhtrack.scenario import Scenario, Simulation, simulate
+
+if TYPE_CHECKING:  # loaded by run_scenario only (fast start of `mhtrack track`)
+    from mhtrack.metrics import Evaluation
+    from mhtrack.scenario import Scenario, Simulation
 
 
 def fuse_scan(scan: Scan, fuser: AdaptiveKMeansFusion | None = None) -> Scan:
@@ -198,6 +200,9 @@ def run_scenario(
     (:func:`make_tracker`). A scenario of rotating radars (plots with their own
     times) is tracked as ``mhtrack track --sensors`` tracks it: frame by frame, unfused,
     with the radars' coverage and per-radar clutter."""
+    from mhtrack.metrics import evaluate
+    from mhtrack.scenario import simulate
+
     sim = simulate(scenario, seed=seed)
     config = default_config(scenario) if config is None else config
     timed = sim.plots.timed

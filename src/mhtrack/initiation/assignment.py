@@ -17,10 +17,6 @@ time, each counted: :data:`MAX_CANDIDATES` and :data:`MAX_EXACT_ROWS`.
 from __future__ import annotations
 
 import numpy as np
-from scipy.optimize import linear_sum_assignment
-from scipy.sparse import coo_matrix, csr_matrix
-from scipy.sparse.csgraph import connected_components, min_weight_full_bipartite_matching
-from scipy.spatial import cKDTree
 
 from mhtrack.models.linalg2 import lmax2, mahalanobis2
 
@@ -52,6 +48,7 @@ def allowed_pairs(
     with more than ``max_per_plot`` allowed centres keeps the cheapest (ties: lower centre index).
     Returns ``(i, j, cost, stay, plots cut)``, pairs by plot then centre.
     """
+    from scipy.spatial import cKDTree
     stat = R is not None and Rc is not None and gamma is not None
     m = len(z)
     if stat:
@@ -98,6 +95,7 @@ def assign_dense(allowed: np.ndarray, cost: np.ndarray, stay: float) -> np.ndarr
     ``i`` takes an ``allowed`` column at ``cost`` or stays alone at ``stay``
     (``linear_sum_assignment`` on ``[cost | stay·I]`` with disallowed entries
     ``2·stay + 1``). Returns the column per row or ``−1``."""
+    from scipy.optimize import linear_sum_assignment
     m, c = allowed.shape
     out = np.full(m, -1, np.int64)
     big = 2.0 * stay + 1.0
@@ -115,6 +113,8 @@ def _assign_sparse(rows: np.ndarray, cols: np.ndarray, cost: np.ndarray, m: int,
     """:func:`assign_dense` on the allowed pairs alone (LAPJVsp,
     ``min_weight_full_bipartite_matching``); every cost shifted by 1 (a row is matched
     exactly once, so the optimum is unchanged) to keep them non-zero."""
+    from scipy.sparse import csr_matrix
+    from scipy.sparse.csgraph import min_weight_full_bipartite_matching
     out = np.full(m, -1, np.int64)
     r = np.concatenate((rows, np.arange(m)))
     k = np.concatenate((cols, c + np.arange(m)))
@@ -158,6 +158,8 @@ def sparse_gated_assignment(
     :data:`MAX_CANDIDATES` cheapest allowed centres (``fusion_candidates``: plots that had
     more); a component of more than :data:`MAX_EXACT_ROWS` plots (that does
     not fit :data:`DENSE_ENTRIES`) is assigned greedily (``fusion_greedy``: its plots)."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
     m = len(z)
     out = np.full(m, -1, np.int64)
     i, j, cost, stay, n_cut = allowed_pairs(z, centres, eps, R, Rc, gamma)
@@ -227,6 +229,7 @@ def gated_assignment(
     Above :data:`DENSE_ENTRIES` entries: :func:`sparse_gated_assignment` (its caps are
     counted in ``caps``).
     """
+    from scipy.spatial import cKDTree
     m = len(z)
     out = np.full(m, -1, np.int64)
     if m == 0 or len(centres) == 0:

@@ -81,8 +81,6 @@ from __future__ import annotations
 from functools import partial
 
 import numpy as np
-from scipy.spatial import cKDTree
-from scipy.spatial.distance import pdist
 
 from mhtrack.initiation.assignment import gated_assignment as _gated_assignment
 from mhtrack.initiation.neighbours import SortedDistances, close_pairs
@@ -93,6 +91,7 @@ from mhtrack.models.linalg2 import lmax2, mahalanobis2
 def sorted_distances(z: np.ndarray) -> np.ndarray:
     """All pairwise distances ``‖z_i − z_j‖``, ``i < j``, sorted ascending (P2 §1.2 step 2).
     O(n²) memory: for many plots use :class:`~mhtrack.initiation.neighbours.SortedDistances`."""
+    from scipy.spatial.distance import pdist
     return np.sort(pdist(np.asarray(z, float).reshape(-1, 2)))
 
 
@@ -208,6 +207,7 @@ def kmeans_lloyd(
     final labels. Equals ``sklearn.cluster.KMeans(init=centres, n_init=1, tol=0)``
     when no cluster empties.
     """
+    from scipy.spatial import cKDTree
     z = np.asarray(z, float).reshape(-1, 2)
     c = np.asarray(centres, float).reshape(-1, 2).copy()
     if len(z) == 0 or len(c) == 0:

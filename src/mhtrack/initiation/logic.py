@@ -30,9 +30,12 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from itertools import chain
+from typing import TYPE_CHECKING
 
 import numpy as np
-from scipy.spatial import cKDTree
+
+if TYPE_CHECKING:
+    from scipy.spatial import cKDTree
 
 from mhtrack.initiation.base import Initiator, check_window_and_speeds
 from mhtrack.initiation.window import (
@@ -125,6 +128,7 @@ def branch_tracks(window: Window, thetas: np.ndarray, *, gate_radius: float = 30
     n_scans) flat plot indices (``-1`` a miss) and their intervals ``lo``, ``hi``; the
     tracks of limit ``θ`` are ``path[(lo <= θ) & (θ < hi)]``, in the initiator's order.
     """
+    from scipy.spatial import cKDTree
     ths = np.sort(np.asarray(thetas, float))
     N, M = n_scans, min_plots
     max_miss = N - M

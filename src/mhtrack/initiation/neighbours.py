@@ -18,10 +18,12 @@ assignment of plots to centres is :mod:`mhtrack.initiation.assignment`.
 from __future__ import annotations
 
 from collections.abc import Callable
+from typing import TYPE_CHECKING
 
 import numpy as np
-from scipy.spatial import cKDTree
-from scipy.spatial.distance import pdist
+
+if TYPE_CHECKING:
+    from scipy.spatial import cKDTree
 
 #: Up to this many pairs ``C(n, 2)`` the distances are all computed (``pdist``, 8 MiB).
 DENSE_PAIRS = 1 << 20
@@ -65,6 +67,7 @@ class SortedDistances:
     """
 
     def __init__(self, z: np.ndarray, need: int, cap: float | None = None) -> None:
+        from scipy.spatial.distance import pdist
         z = np.asarray(z, float).reshape(-1, 2)
         n = len(z)
         self._len = n * (n - 1) // 2
@@ -81,6 +84,7 @@ class SortedDistances:
         self._sparse(z, need, cap)
 
     def _sparse(self, z: np.ndarray, need: int, cap: float | None) -> None:
+        from scipy.spatial import cKDTree
         tree = cKDTree(z)
         budget = max(PAIR_BUDGET_FACTOR * need, DENSE_PAIRS)
         hi = _knn_bound(tree, z, need)
@@ -169,6 +173,7 @@ def close_pairs(points: np.ndarray, radius: float, own_radius: np.ndarray | None
     its ``own_radius`` (a point's pairs that ``keep`` can accept must lie within it, e.g. a
     Mahalanobis gate's bound), and ``keep`` is applied chunk by chunk, so memory is
     O(kept pairs); the pairs come sorted by ``i`` then ``j``."""
+    from scipy.spatial import cKDTree
     tree = cKDTree(points)
     n = len(points)
     if n < 2 or _pairs_within(tree, radius) <= max(DENSE_PAIRS, PAIRS_PER_POINT * n):

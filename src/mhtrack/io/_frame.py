@@ -17,7 +17,6 @@ import numpy as np
 import pyarrow as pa
 import pyarrow.compute as pc
 import pyarrow.csv as pacsv
-import pyarrow.parquet as pq
 
 from mhtrack.bounds import (
     MAX_COLUMNS,
@@ -30,6 +29,7 @@ from mhtrack.bounds import (
     int_range,
 )
 from mhtrack.errors import InputError
+from mhtrack.io._arrow import from_numpy, is_null, to_numpy
 from mhtrack.io._source import PathArg, Source, file_format
 from mhtrack.io.atomic import atomic_path
 
@@ -115,10 +115,7 @@ class Frame:
 
     def nulls(self, name: str) -> np.ndarray:
         """Boolean mask of the missing (empty / null) cells of column ``name``."""
-        col = self.table.column(name)
-        if col.null_count == 0:
-            return np.zeros(self.n, bool)
-        return col.is_null().to_numpy(zero_copy_only=False)
+        return is_null(self.table.column(name))
 
     def _no_nulls(self, name: str, nulls: np.ndarray) -> None:
         self.check(nulls, name, lambda row: "value is missing")
@@ -138,7 +135,7 @@ class Frame:
                 self.check(v > MAX_INDEX, name, lambda r: f"value {v[r]} is out of range "
                            f"(expected {int_range(-MAX_INDEX, MAX_INDEX)})")
         elif pa.types.is_floating(col.type):
-            v = col.to_numpy(zero_copy_only=False).astype(np.float64)
+            v = to_numpy(col.cast(pa.float64()), fill=np.nan)
             whole = np.isfinite(v) & (v == np.round(v))
             self.check(
                 ~whole & ~nulls, name,
@@ -149,10 +146,10 @@ class Frame:
                 lambda r: f"value {clip(self.text(name, r))} is out of range (expected "
                 f"{int_range(-MAX_INDEX, MAX_INDEX)})",
             )
-            col = pa.chunked_array([pa.array(np.where(nulls, 0, v).astype(np.int64), mask=nulls)])
+            col = from_numpy(np.where(nulls, 0, v), pa.int64(), nulls)
         else:
             self.fail(f"has type {col.type}, expected integers", column=name)
-        v = col.fill_null(fill).to_numpy().astype(np.int64, copy=False)
+        v = to_numpy(col, fill=fill)
         self.check(
             ((v > MAX_INDEX) | (v < -MAX_INDEX)) & ~nulls, name,  # no np.abs: -2^63
             lambda r: f"value {clip(self.text(name, r))} is out of range (expected "
@@ -169,7 +166,7 @@ class Frame:
         nulls = self.nulls(name)
         if not nullable:
             self._no_nulls(name, nulls)
-        v = col.cast(pa.float64(), safe=False).fill_null(np.nan).to_numpy()
+        v = to_numpy(col.cast(pa.float64(), safe=False), fill=np.nan)
         if finite:
             self.check(
                 ~np.isfinite(v) & ~nulls,
@@ -200,6 +197,8 @@ def _column_names(src: Source) -> list[str]:
     if src.format == "csv":
         names = _csv_header(src)
     else:
+        import pyarrow.parquet as pq  # only for Parquet files (fast start)
+
         try:
             names = pq.read_schema(src.path).names
         except (pa.ArrowException, OSError) as e:
@@ -243,6 +242,8 @@ def read_frame(
         except (pa.ArrowException, OSError) as e:
             raise src.error(f"cannot read CSV ({clip(str(e), 200)})") from None
     else:
+        import pyarrow.parquet as pq
+
         try:
             table = pq.read_table(src.path, columns=present)
         except (pa.ArrowException, OSError) as e:
@@ -348,6 +349,8 @@ def write_frame(path: PathArg, columns: Mapping[str, pa.Array]) -> None:
                     opts = pacsv.WriteOptions(include_header=False, quoting_style="none")
                     pacsv.write_csv(table, fh, opts)
             else:
+                import pyarrow.parquet as pq
+
                 pq.write_table(table, str(tmp))
     except OSError as e:
         raise InputError(f"{path}: cannot write ({e.strerror or e})", file=str(path)) from None
@@ -355,10 +358,10 @@ def write_frame(path: PathArg, columns: Mapping[str, pa.Array]) -> None:
 
 def int_array(values: np.ndarray, missing: np.ndarray | None = None) -> pa.Array:
     """int64 array for writing; ``missing`` rows become nulls (empty CSV cells)."""
-    return pa.array(np.asarray(values, np.int64), type=pa.int64(), mask=missing)
+    return from_numpy(values, pa.int64(), missing)
 
 
 def float_array(values: np.ndarray, *, nan_as_null: bool = False) -> pa.Array:
     """float64 array for writing; with ``nan_as_null`` NaN becomes a null (empty CSV cell)."""
     v = np.asarray(values, np.float64)
-    return pa.array(v, type=pa.float64(), mask=np.isnan(v) if nan_as_null else None)
+    return from_numpy(v, pa.float64(), np.isnan(v) if nan_as_null else None)

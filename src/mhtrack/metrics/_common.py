@@ -15,7 +15,6 @@ from dataclasses import dataclass
 
 import numpy as np
 import numpy.typing as npt
-from scipy.optimize import linear_sum_assignment
 
 from mhtrack.records import PlotTable, TrackTable, TruthTable
 
@@ -76,6 +75,7 @@ def assign_capped(D: np.ndarray, c: float, p: float) -> tuple[np.ndarray, np.nda
     The cost is computed in units of ``c`` (``(min(d, c)/c)^p`` ∈ [0, 1]) so that large
     ``c^p`` cannot overflow; the minimiser is the same.
     """
+    from scipy.optimize import linear_sum_assignment
     if D.size == 0:
         e = np.zeros(0, np.int64)
         return e, e

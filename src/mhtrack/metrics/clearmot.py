@@ -12,7 +12,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import linear_sum_assignment
 
 from mhtrack.metrics._common import (
     ScanIndexed,
@@ -200,6 +199,7 @@ def _match_scan(
 
     Rows of ``D`` are truths in ascending target id, columns tracks in ascending id ``kid``.
     """
+    from scipy.optimize import linear_sum_assignment
     nt, nk = D.shape
     allowed = np.less_equal(D, d_match)
     # 1. keep remembered correspondences still within d_match

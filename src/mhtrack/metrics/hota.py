@@ -13,7 +13,6 @@ from dataclasses import dataclass
 
 import numpy as np
 import numpy.typing as npt
-from scipy.optimize import linear_sum_assignment
 
 from mhtrack.metrics._common import (
     ScanIndexed,
@@ -134,6 +133,7 @@ def hota(tracks: TrackTable, truth: TruthTable, d_max: float, *,
 
 def hota_indexed(data: ScanIndexed, d_max: float) -> HOTAResult:
     """:func:`hota` on checked, scan-indexed tables and a checked ``d_max``."""
+    from scipy.optimize import linear_sum_assignment
     na = len(ALPHAS)
     tp, fn, fp = np.zeros(na), np.zeros(na), np.zeros(na)
     loc = np.zeros(na)

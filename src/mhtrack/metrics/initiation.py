@@ -43,7 +43,6 @@ from collections.abc import Sequence
 from dataclasses import asdict, dataclass
 
 import numpy as np
-from scipy.optimize import linear_sum_assignment
 
 from mhtrack.metrics._common import pairwise_distance
 
@@ -162,6 +161,7 @@ def fused_plot_errors(fused: np.ndarray, truth: np.ndarray) -> np.ndarray:
     """Distance from each true position to the fused plot assigned to it (optimal
     assignment minimising the total distance; a target without a fused plot left, when
     there are fewer fused plots than targets, gets none). Returns (min(n, m),)."""
+    from scipy.optimize import linear_sum_assignment
     f = np.asarray(fused, float).reshape(-1, 2)
     t = np.asarray(truth, float).reshape(-1, 2)
     if len(f) == 0 or len(t) == 0:

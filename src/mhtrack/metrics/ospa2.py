@@ -13,7 +13,6 @@ from dataclasses import dataclass
 
 import numpy as np
 import numpy.typing as npt
-from scipy.optimize import linear_sum_assignment
 
 from mhtrack.metrics._common import ScanIndex, ScanIndexed, checked_distance_input
 from mhtrack.records import TrackTable, TruthTable
@@ -120,6 +119,7 @@ def _window_states(rows_of: ScanIndex, ids: np.ndarray, pos: np.ndarray, a: int,
 def _window_ospa2(data: ScanIndexed, a: int, b: int, c: float, p: float
                   ) -> tuple[float, float, float]:
     """(distance, localisation, cardinality) of OSPA(2) over evaluated scans ``a … b−1``."""
+    from scipy.optimize import linear_sum_assignment
     X, hx = _window_states(data.truth_rows, data.truth.target_id, data.truth.positions, a, b)
     Y, hy = _window_states(data.track_rows, data.tracks.track_id, data.tracks.positions, a, b)
     m, n = X.shape[1], Y.shape[1]

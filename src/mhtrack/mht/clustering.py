@@ -14,8 +14,6 @@ plots*): the same plot may sit in column 1 of one tree and column 0 of another, 
 from __future__ import annotations
 
 import numpy as np
-from scipy.sparse import coo_matrix
-from scipy.sparse.csgraph import connected_components
 
 from mhtrack.mht.tree import NO_PLOT
 
@@ -61,6 +59,9 @@ def cluster_trees(tree: np.ndarray, window: np.ndarray, *,
         return tree_index, np.arange(n_trees, dtype=np.int64)
     label = _min_label_components(tree_index[leaf], key, n_trees)
     if label is None:  # pathological chain: let scipy do it
+        from scipy.sparse import coo_matrix
+        from scipy.sparse.csgraph import connected_components
+
         n_keys = int(key.max()) + 1
         n = n_trees + n_keys
         graph = coo_matrix(

@@ -136,7 +136,16 @@ def best_hypothesis(
     if hard.size:
         by_cluster = np.argsort(leaf_cluster, kind="stable")
         bounds = np.r_[0, np.cumsum(sizes)]
-        for c in hard.tolist():
+        cap = BNB_MAX_LEAVES if max_cluster_size is None else min(BNB_MAX_LEAVES,
+                                                                  max_cluster_size)
+        small = hard[sizes[hard] <= cap]
+        for members in _solve_small(s, tree_index, w, leaf_cluster, small, by_id, chosen):
+            pick, exact = solve_milp(
+                s[members], tree_index[members], w[members], node_limit, by_id=by_id
+            )
+            n_limited += not exact
+            chosen.append(members[pick])
+        for c in hard[sizes[hard] > cap].tolist():
             members = by_cluster[bounds[c] : bounds[c + 1]]
             if max_cluster_size is not None and members.size > max_cluster_size:
                 pick = solve_greedy(s[members], tree_index[members], w[members], by_id=by_id)
@@ -234,6 +243,60 @@ def _branch_and_bound(
     options = []  # per tree: [(score, mask, index)] best first
     for a, b in itertools.pairwise(starts):
         options.append([(float(s[i]), masks[i], int(pos[i])) for i in order[a:b].tolist()])
+    best = _search(options, node_limit)
+    return None if best is None else np.sort(np.asarray(best, np.int64))
+
+
+def _solve_small(
+    s: np.ndarray, tree_index: np.ndarray, w: np.ndarray, leaf_cluster: np.ndarray,
+    clusters: np.ndarray, by_id: bool, chosen: list,
+) -> list[np.ndarray]:
+    """:func:`_branch_and_bound` on every cluster in ``clusters`` at once (all scores
+    positive): the options of all of them are built from one sort and one set of plot
+    keys (a plot's bit is its rank among the cluster's keys — any one-to-one numbering
+    gives the same conflicts), then searched one cluster at a time. Appends each choice
+    to ``chosen``; returns the members of the clusters whose search passed
+    :data:`BNB_NODE_LIMIT` (for ``milp``, as :func:`solve_exact` does)."""
+    if clusters.size == 0:
+        return []
+    on = np.zeros(int(leaf_cluster.max()) + 1, bool)
+    on[clusters] = True
+    idx = np.flatnonzero(on[leaf_cluster])
+    leaf, key = plot_keys(w[idx], by_id=by_id)
+    c = leaf_cluster[idx][leaf]
+    by_key = np.lexsort((key, c))
+    c, key, leaf = c[by_key], key[by_key], leaf[by_key]
+    first = np.r_[True, c[1:] != c[:-1]]
+    dense = np.cumsum(first | np.r_[True, key[1:] != key[:-1]]) - 1
+    local = dense - np.maximum.accumulate(np.where(first, dense, 0))
+    low = local < 63
+    m = np.zeros(idx.size, np.uint64)
+    np.bitwise_or.at(m, leaf[low], np.left_shift(np.uint64(1), local[low].astype(np.uint64)))
+    masks = m.tolist()
+    for i, k in zip(leaf[~low].tolist(), local[~low].tolist(), strict=True):
+        masks[i] |= 1 << k
+    order = np.lexsort((idx, -s[idx], tree_index[idx], leaf_cluster[idx]))
+    rows = zip(leaf_cluster[idx][order].tolist(), tree_index[idx][order].tolist(),
+               s[idx][order].tolist(), idx[order].tolist(), order.tolist(), strict=True)
+    limited: list[np.ndarray] = []
+    picks: list[int] = []
+    groups = itertools.groupby(rows, key=lambda r: r[0])
+    for _, rows_c in groups:
+        options = [[(sc, masks[j], i) for _, _, sc, i, j in opts]
+                   for _, opts in itertools.groupby(rows_c, key=lambda r: r[1])]
+        best = _search(options, BNB_NODE_LIMIT)
+        if best is None:
+            limited.append(np.sort(np.asarray([i for o in options for _, _, i in o])))
+        else:
+            picks.extend(best)
+    chosen.append(np.asarray(picks, np.int64))
+    return limited
+
+
+def _search(options: list[list[tuple[float, int, int]]], node_limit: int) -> list[int] | None:
+    """Branch-and-bound over trees; ``options[t]``: tree ``t``'s ``(score, plot mask,
+    leaf)``, best first (ties: lower leaf). The chosen leaves, or ``None`` after
+    ``node_limit`` nodes."""
     options.sort(key=lambda opts: (-opts[0][0], opts[0][2]))
     bound = [0.0] * (len(options) + 1)
     for t in range(len(options) - 1, -1, -1):
@@ -266,7 +329,7 @@ def _branch_and_bound(
         for sc, m, i in reversed(options[t]):
             if not m & used:
                 stack.append((t + 1, used | m, val + sc, (*sel, i)))
-    return np.sort(np.asarray(best_sel, np.int64))
+    return best_sel
 
 
 def solve_milp(

@@ -276,14 +276,18 @@ def _solve_small(
     for i, k in zip(leaf[~low].tolist(), local[~low].tolist(), strict=True):
         masks[i] |= 1 << k
     order = np.lexsort((idx, -s[idx], tree_index[idx], leaf_cluster[idx]))
-    rows = zip(leaf_cluster[idx][order].tolist(), tree_index[idx][order].tolist(),
-               s[idx][order].tolist(), idx[order].tolist(), order.tolist(), strict=True)
+    tc = tree_index[idx][order]
+    t_start = segment_starts(tc)  # trees of one cluster are consecutive
+    c_of_tree = leaf_cluster[idx][order][t_start]
+    c_start = [*segment_starts(c_of_tree).tolist(), t_start.size]
+    rows = list(zip(s[idx][order].tolist(), [masks[j] for j in order.tolist()],
+                    idx[order].tolist(), strict=True))
+    bounds = [*t_start.tolist(), tc.size]
+    trees = [rows[a:b] for a, b in itertools.pairwise(bounds)]
     limited: list[np.ndarray] = []
     picks: list[int] = []
-    groups = itertools.groupby(rows, key=lambda r: r[0])
-    for _, rows_c in groups:
-        options = [[(sc, masks[j], i) for _, _, sc, i, j in opts]
-                   for _, opts in itertools.groupby(rows_c, key=lambda r: r[1])]
+    for a, b in itertools.pairwise(c_start):
+        options = trees[a:b]
         best = _search(options, BNB_NODE_LIMIT)
         if best is None:
             limited.append(np.sort(np.asarray([i for o in options for _, _, i in o])))

@@ -136,22 +136,18 @@ def best_hypothesis(
     if hard.size:
         by_cluster = np.argsort(leaf_cluster, kind="stable")
         bounds = np.r_[0, np.cumsum(sizes)]
-        cap = BNB_MAX_LEAVES if max_cluster_size is None else min(BNB_MAX_LEAVES,
-                                                                  max_cluster_size)
-        small = hard[sizes[hard] <= cap]
-        for members in _solve_small(s, tree_index, w, leaf_cluster, small, by_id, chosen):
-            pick, exact = solve_milp(
-                s[members], tree_index[members], w[members], node_limit, by_id=by_id
-            )
-            n_limited += not exact
-            chosen.append(members[pick])
-        for c in hard[sizes[hard] > cap].tolist():
-            members = by_cluster[bounds[c] : bounds[c + 1]]
+        # small clusters: branch-and-bound, all at once; what it cannot finish and
+        # clusters over BNB_MAX_LEAVES (as solve_exact): milp; over max_cluster_size: greedy
+        cap = min(BNB_MAX_LEAVES, BNB_MAX_LEAVES if max_cluster_size is None else max_cluster_size)
+        small = sizes[hard] <= cap
+        rest = _solve_small(s, tree_index, w, leaf_cluster, hard[small], by_id, chosen)
+        rest += [by_cluster[bounds[c] : bounds[c + 1]] for c in hard[~small].tolist()]
+        for members in rest:
             if max_cluster_size is not None and members.size > max_cluster_size:
                 pick = solve_greedy(s[members], tree_index[members], w[members], by_id=by_id)
                 n_greedy += 1
             else:
-                pick, exact = solve_exact(
+                pick, exact = solve_milp(
                     s[members], tree_index[members], w[members], node_limit, by_id=by_id
                 )
                 n_limited += not exact
@@ -240,9 +236,8 @@ def _branch_and_bound(
     masks = conflict_masks(window[pos], by_id)
     order = np.lexsort((-s, tree[pos]))
     starts = [*segment_starts(tree[pos][order]).tolist(), pos.size]
-    options = []  # per tree: [(score, mask, index)] best first
-    for a, b in itertools.pairwise(starts):
-        options.append([(float(s[i]), masks[i], int(pos[i])) for i in order[a:b].tolist()])
+    options = [[(float(s[i]), masks[i], int(pos[i])) for i in order[a:b].tolist()]
+               for a, b in itertools.pairwise(starts)]  # per tree, best first
     best = _search(options, node_limit)
     return None if best is None else np.sort(np.asarray(best, np.int64))
 
@@ -251,17 +246,13 @@ def _solve_small(
     s: np.ndarray, tree_index: np.ndarray, w: np.ndarray, leaf_cluster: np.ndarray,
     clusters: np.ndarray, by_id: bool, chosen: list,
 ) -> list[np.ndarray]:
-    """:func:`_branch_and_bound` on every cluster in ``clusters`` at once (all scores
-    positive): the options of all of them are built from one sort and one set of plot
-    keys (a plot's bit is its rank among the cluster's keys — any one-to-one numbering
-    gives the same conflicts), then searched one cluster at a time. Appends each choice
-    to ``chosen``; returns the members of the clusters whose search passed
-    :data:`BNB_NODE_LIMIT` (for ``milp``, as :func:`solve_exact` does)."""
+    """:func:`_branch_and_bound` on all ``clusters`` (scores > 0), their options built
+    from one sort and one set of plot keys (bit: the key's rank in its cluster; any 1-to-1
+    numbering gives the same conflicts). Appends the choices to ``chosen``; returns the
+    members of the clusters whose search passed :data:`BNB_NODE_LIMIT` (for ``milp``)."""
     if clusters.size == 0:
         return []
-    on = np.zeros(int(leaf_cluster.max()) + 1, bool)
-    on[clusters] = True
-    idx = np.flatnonzero(on[leaf_cluster])
+    idx = np.flatnonzero(np.isin(leaf_cluster, clusters))
     leaf, key = plot_keys(w[idx], by_id=by_id)
     c = leaf_cluster[idx][leaf]
     by_key = np.lexsort((key, c))
@@ -276,16 +267,14 @@ def _solve_small(
     for i, k in zip(leaf[~low].tolist(), local[~low].tolist(), strict=True):
         masks[i] |= 1 << k
     order = np.lexsort((idx, -s[idx], tree_index[idx], leaf_cluster[idx]))
-    tc = tree_index[idx][order]
-    t_start = segment_starts(tc)  # trees of one cluster are consecutive
+    t_start = segment_starts(tree_index[idx][order])  # trees of one cluster are consecutive
     c_of_tree = leaf_cluster[idx][order][t_start]
     c_start = [*segment_starts(c_of_tree).tolist(), t_start.size]
     rows = list(zip(s[idx][order].tolist(), [masks[j] for j in order.tolist()],
                     idx[order].tolist(), strict=True))
-    bounds = [*t_start.tolist(), tc.size]
+    bounds = [*t_start.tolist(), order.size]
     trees = [rows[a:b] for a, b in itertools.pairwise(bounds)]
-    limited: list[np.ndarray] = []
-    picks: list[int] = []
+    limited, picks = [], []
     for a, b in itertools.pairwise(c_start):
         options = trees[a:b]
         best = _search(options, BNB_NODE_LIMIT)
@@ -305,7 +294,6 @@ def _search(options: list[list[tuple[float, int, int]]], node_limit: int) -> lis
     bound = [0.0] * (len(options) + 1)
     for t in range(len(options) - 1, -1, -1):
         bound[t] = bound[t + 1] + options[t][0][0]
-
     # greedy incumbent: a lower bound that prunes early
     best_val, best_sel, used = 0.0, [], 0
     for opts in options:
@@ -315,8 +303,7 @@ def _search(options: list[list[tuple[float, int, int]]], node_limit: int) -> lis
                 best_val += sc
                 best_sel.append(i)
                 break
-    nodes = 0
-    n_trees = len(options)
+    nodes, n_trees = 0, len(options)
     stack: list[tuple[int, int, float, tuple[int, ...]]] = [(0, 0, 0.0, ())]
     while stack:
         t, used, val, sel = stack.pop()

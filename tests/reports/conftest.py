@@ -36,6 +36,19 @@ FIGURES_JS = """JSON.stringify(Array.from(document.querySelectorAll('div.plotly-
               drawn: d.querySelectorAll('g.scatterlayer g.trace').length,
               svg: d.querySelectorAll('svg.main-svg').length,
               points: d.querySelectorAll('g.scatterlayer path.point').length})))"""
+#: A promise that resolves once every Plotly figure has drawn all its traces, then two
+#: more animation frames (so the screenshot shows the finished page): the wait is for the
+#: page's own event, not for a time.
+DRAWN_JS = """new Promise(done => {
+  const ready = () => Array.from(document.querySelectorAll('div.plotly-graph-div'))
+    .filter(d => d.data !== undefined)  // Plotly.newPlot sets data during the page's load
+    .every(d => d.querySelectorAll('svg.main-svg').length
+                && d.querySelectorAll('g.scatterlayer g.trace').length >= (d.data || []).length);
+  const tick = () => ready()
+    ? requestAnimationFrame(() => requestAnimationFrame(() => done(true)))
+    : requestAnimationFrame(tick);
+  tick();
+})"""
 #: Local schemes: anything else requested by the page went to the network.
 LOCAL = ("file:", "data:", "about:", "blob:", "chrome:", "devtools:")
 
@@ -137,8 +150,10 @@ class Chromium:
         self.send("Page.navigate", {"url": url})
         self.wait_event("Page.loadEventFired", timeout=120)
 
-    def evaluate(self, expression: str) -> Any:
-        r = self.send("Runtime.evaluate", {"expression": expression, "returnByValue": True})
+    def evaluate(self, expression: str, *, await_promise: bool = False,
+                 timeout: float = 60.0) -> Any:
+        r = self.send("Runtime.evaluate", {"expression": expression, "returnByValue": True,
+                                           "awaitPromise": await_promise}, timeout=timeout)
         return r["result"].get("value")
 
     def screenshot(self, path: Path, width: int, most_height: int = 12000) -> Path:
@@ -189,22 +204,16 @@ class Chromium:
 
 
 def check_page(exe: str, page: Path, work: Path, *, width: int = 1400,
-               settle_s: float = 0.5, draw_s: float = 60.0) -> PageCheck:
-    """Open ``page`` in headless Chromium, wait (at most ``draw_s``) until Plotly has drawn
-    every figure, and report (see :class:`PageCheck`); the screenshot goes to
-    ``work/<page stem>.png``."""
+               hang_s: float = 900.0) -> PageCheck:
+    """Open ``page`` in headless Chromium, wait until Plotly has drawn every figure
+    (:data:`DRAWN_JS`; ``hang_s`` only guards against a browser that never answers), and
+    report (see :class:`PageCheck`); the screenshot goes to ``work/<page stem>.png``."""
     work.mkdir(parents=True, exist_ok=True)
     b = Chromium(exe, work / "profile")
     try:
         b.open(page.resolve().as_uri(), width)
-        figures: list[dict[str, Any]] = []
-        deadline = time.monotonic() + draw_s
-        while time.monotonic() < deadline:  # until every figure has drawn its traces
-            figures = json.loads(b.evaluate(FIGURES_JS))
-            if all(f["svg"] and f["drawn"] >= f["given"] for f in figures):
-                break
-            time.sleep(0.2)
-        time.sleep(settle_s)
+        b.evaluate(DRAWN_JS, await_promise=True, timeout=hang_s)
+        figures = json.loads(b.evaluate(FIGURES_JS))
         shot = b.screenshot(work / f"{page.stem}.png", width)
         errors, requests = b.problems()
         return PageCheck(figures, errors, requests, shot)

@@ -97,7 +97,7 @@ def test_the_check_sees_errors_and_network(open_in_browser, tmp_path):
                     '<img src="http://127.0.0.1:9/x.png">'
                     "<script>console.error('broken'); undefinedFunction();</script>"
                     "</body></html>")
-    check = open_in_browser(page, draw_s=1.0)
+    check = open_in_browser(page)
     assert any("undefinedFunction" in e for e in check.errors), check.errors
     assert any("broken" in e for e in check.errors), check.errors
     assert check.requests == ["http://127.0.0.1:9/x.png"]

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import click
 
@@ -55,9 +56,7 @@ def p1(runs: int, out: Path, seed: int, tracker_settings: str, workers: int | No
     res = repro.result
     click.echo(report.table_md)
     click.echo(f"{res.computed} runs computed, {res.skipped} already done.")
-    click.echo("wrote:")
-    for p in report.paths:
-        click.echo(f"  {p}{'/' if p.is_dir() else ''}")
+    _wrote(report.paths)
     exit_if_runs_failed("reproduce p1", res)
 
 
@@ -102,15 +101,8 @@ def p2(runs: int, out: Path, seed: int, settings: str, clutter_per: str,
     click.echo((repro.out_dir / "tables.md").read_text(encoding="utf-8"))
     click.echo(f"{repro.computed} jobs computed, {repro.skipped} already done "
                f"({repro.wall_seconds:.1f} s).")
-    click.echo("wrote:")
-    for p in paths:
-        click.echo(f"  {p}{'/' if p.is_dir() else ''}")
-    if repro.errors:
-        names = sorted(repro.errors)
-        click.echo(f"mhtrack reproduce p2: {len(names)} job(s) failed "
-                   f"({', '.join(names[:10])}); tracebacks in "
-                   f"{repro.out_dir}/jobs/<name>.error.txt", err=True)
-        click.get_current_context().exit(1)
+    _wrote(paths)
+    _exit_if_jobs_failed("p2", repro.errors, f"{repro.out_dir}/jobs/<name>.error.txt")
 
 
 @reproduce.command("clutter-shift")
@@ -155,13 +147,24 @@ def clutter_shift(runs: int, out: Path, seed: int, ablation_runs: int, workers: 
         if c.a == "agmm" and c.b == "gmm":
             click.echo(f"* {c.sentence}")
     click.echo(f"{study.computed} jobs computed, {study.skipped} already done.")
+    _wrote(rep.paths)
+    _exit_if_jobs_failed("clutter-shift", study.errors, f"{out}/jobs/")
+
+
+def _wrote(paths: Any) -> None:
+    """List the files and folders a study wrote (folders with a trailing ``/``)."""
     click.echo("wrote:")
-    for p in rep.paths:
+    for p in paths:
         click.echo(f"  {p}{'/' if p.is_dir() else ''}")
-    if study.errors:
-        names = sorted(study.errors)
-        click.echo(f"mhtrack reproduce clutter-shift: {len(names)} job(s) failed "
-                   f"({', '.join(names[:10])}); tracebacks in {out}/jobs/", err=True)
+
+
+def _exit_if_jobs_failed(study: str, errors: Any, where: str) -> None:
+    """One line naming the failed jobs (the first ten) and where their tracebacks are,
+    then exit status 1; nothing when no job failed."""
+    if errors:
+        names = sorted(errors)
+        click.echo(f"mhtrack reproduce {study}: {len(names)} job(s) failed "
+                   f"({', '.join(names[:10])}); tracebacks in {where}", err=True)
         click.get_current_context().exit(1)
 
 

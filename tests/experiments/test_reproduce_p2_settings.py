@@ -72,3 +72,42 @@ def test_bad_settings_are_refused(tmp_path):
     r = CliRunner().invoke(reproduce, ["p2", "--out", str(tmp_path), "--tracker-settings",
                                        "fastest"])
     assert r.exit_code == 2 and "fastest" in r.output
+
+
+@pytest.mark.parametrize("settings", ["paper", "best"])
+def test_example_figures_use_the_settings_of_the_study(settings):
+    """Figs. 12–15 show what the study's jobs run: the example's fused window and tracks
+    equal those of ``fused_run`` and ``_initiators`` with the same settings (and Fig. 2's
+    adaptive panel is the fusion of those settings, under its honest label)."""
+    from mhtrack.experiments.jobs import run_seed
+    from mhtrack.experiments.p2.constants import ADAPTIVE_LABELS, FUSION_PARAMS
+    from mhtrack.experiments.p2.examples import fig2_example, fig12_15_example
+    from mhtrack.experiments.p2.jobs import fused_run
+    from mhtrack.initiation import Window
+    from mhtrack.initiation.fusion import AdaptiveKMeansFusion
+
+    ex = fig12_15_example(0, settings)
+    sc = p2_scenario()
+    raw, win = next(fused_run(sc, run_seed(0, 0, "words"), settings).windows(4))
+    w = Window.from_scans(win)
+    np.testing.assert_array_equal(ex.fused.z, w.z)
+    inits = _initiators(sc.region.as_tuple(), settings)
+    for m, tracks in ex.tracks.items():
+        np.testing.assert_array_equal(tracks.origins(ex.fused), inits[m].initiate(w).origins(w))
+    f2 = fig2_example(0, settings)
+    assert ADAPTIVE_LABELS[settings] in f2.fused
+    ref = AdaptiveKMeansFusion(**FUSION_PARAMS[settings]).fuse(f2.scan)
+    np.testing.assert_array_equal(f2.fused[ADAPTIVE_LABELS[settings]].scan.z, ref.scan.z)
+
+
+def test_paper_and_best_fusions_differ_somewhere():
+    """The settings change the fused plots (otherwise the test above could not fail on a
+    mix-up): on the first run at the nominal setting some fused scan differs."""
+    from mhtrack.experiments.jobs import run_seed
+    from mhtrack.experiments.p2.jobs import fused_run
+
+    sc = p2_scenario()
+    a = fused_run(sc, run_seed(0, 0, "words"), "paper").fused
+    b = fused_run(sc, run_seed(0, 0, "words"), "best").fused
+    assert any(len(x.z) != len(y.z) or not np.array_equal(x.z, y.z)
+               for x, y in zip(a, b, strict=True))

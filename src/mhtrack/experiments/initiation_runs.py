@@ -58,9 +58,12 @@ def fuse(scan: Scan, method: str, *, run_seed: int = 0, weighting: str = "mean",
 
 
 def fused_scans(scans: Sequence[Scan], fusion: str, *, run_seed: int = 0,
-                weighting: str = "mean") -> tuple[list[Scan], list[float]]:
+                weighting: str = "mean", params: Mapping[str, Any] | None = None
+                ) -> tuple[list[Scan], list[float]]:
     """The scans fused by ``fusion`` (``"adaptive-kmeans"``, ``"kmeans"`` — the random
-    K-means of :func:`fuse` — or ``"none"``) and the seconds spent on each."""
+    K-means of :func:`fuse` — or ``"none"``) and the seconds spent on each; ``params``
+    are options of the fusion (e.g. P2's own steps only, ``reproduce p2
+    --tracker-settings paper``)."""
     if fusion == "none":
         return list(scans), [0.0] * len(scans)
     methods = {"adaptive-kmeans": "adaptive", "kmeans": "random"}
@@ -70,7 +73,8 @@ def fused_scans(scans: Sequence[Scan], fusion: str, *, run_seed: int = 0,
     out, secs = [], []
     for s in scans:
         t0 = time.perf_counter()
-        out.append(fuse(s, methods[fusion], run_seed=run_seed, weighting=weighting).scan)
+        out.append(fuse(s, methods[fusion], run_seed=run_seed, weighting=weighting,
+                        **(params or {})).scan)
         secs.append(time.perf_counter() - t0)
     return out, secs
 
@@ -93,11 +97,14 @@ class FusedRun:
 
 
 def simulate_and_fuse(scenario: Scenario, run_seed: int, fusion: str = "adaptive-kmeans",
-                      *, weighting: str = "mean") -> FusedRun:
-    """Simulate ``scenario`` with ``run_seed`` and fuse every scan with ``fusion``."""
+                      *, weighting: str = "mean", params: Mapping[str, Any] | None = None
+                      ) -> FusedRun:
+    """Simulate ``scenario`` with ``run_seed`` and fuse every scan with ``fusion``
+    (options ``params``, :func:`fused_scans`)."""
     sim = simulate(scenario, run_seed)
     raw = list(sim.plots.scans())
-    fused, secs = fused_scans(raw, fusion, run_seed=run_seed, weighting=weighting)
+    fused, secs = fused_scans(raw, fusion, run_seed=run_seed, weighting=weighting,
+                              params=params)
     return FusedRun(run_seed, sim.truth, raw, fused, secs)
 
 
@@ -220,13 +227,16 @@ class ClusteringExample:
     truth_xy: np.ndarray
 
 
-def clustering_example(scenario: Scenario, seed: int, *, scan_number: int = 0
-                       ) -> ClusteringExample:
-    """Random vs adaptive K-means on scan ``scan_number`` of the first run of ``seed``."""
+def clustering_example(scenario: Scenario, seed: int, *, scan_number: int = 0,
+                       adaptive_params: Mapping[str, Any] | None = None,
+                       adaptive_label: str = CLUSTER_NAMES["adaptive"]) -> ClusteringExample:
+    """Random vs adaptive K-means on scan ``scan_number`` of the first run of ``seed``;
+    ``adaptive_params`` are the adaptive fusion's options, ``adaptive_label`` its name."""
     rs = run_seeds(seed, 1, "words")[0]
     sim = simulate(scenario, rs)
     scan = list(sim.plots.scans())[scan_number]
-    fused = {CLUSTER_NAMES[m]: fuse(scan, m, run_seed=rs) for m in ("random", "adaptive")}
+    fused = {CLUSTER_NAMES["random"]: fuse(scan, "random", run_seed=rs),
+             adaptive_label: fuse(scan, "adaptive", run_seed=rs, **(adaptive_params or {}))}
     return ClusteringExample(scenario.name, scan, fused,
                              sim.truth.positions[np.isin(sim.truth.scan, [scan.index])])
 
@@ -246,14 +256,22 @@ def initiation_example(scenario: Scenario, seed: int, *, fusion: str = "adaptive
                        theta_deg: float = 20.0, window_number: int = 0,
                        gate_radius: float = 300.0, v_min: float = 50.0,
                        v_max: float = 400.0, methods: Sequence[str] = INITIATORS,
-                       run: int = 0) -> InitiationExample:
+                       run: int = 0, fusion_params: Mapping[str, Any] | None = None,
+                       initiator_params: Mapping[str, Mapping[str, Any]] | None = None,
+                       ) -> InitiationExample:
     """Every initiator of ``methods`` on window ``window_number`` of run ``run`` of
-    ``seed``, with the CLI's settings (Hough accumulators over the scenario's region)."""
-    fr = simulate_and_fuse(scenario, run_seeds(seed, run + 1, "words")[run], fusion)
+    ``seed``, with the CLI's settings (Hough accumulators over the scenario's region),
+    the fusion's options ``fusion_params`` and, per method, the initiator attributes
+    ``initiator_params`` (a study's settings)."""
+    fr = simulate_and_fuse(scenario, run_seeds(seed, run + 1, "words")[run], fusion,
+                           params=fusion_params)
     raw_win, win = list(fr.windows(4))[window_number]
     w = Window.from_scans(win)
     inits = initiators(scenario.region.as_tuple(), theta_deg=theta_deg,
                        gate_radius=gate_radius, v_min=v_min, v_max=v_max)
+    for m, extra in (initiator_params or {}).items():
+        for k, v in extra.items():
+            setattr(inits[m], k, v)
     tracks = {m: inits[m].initiate(w) for m in methods}
     return InitiationExample(Window.from_scans(raw_win), w, tracks,
                              fr.truth.positions[np.isin(fr.truth.scan, w.scans)])

@@ -13,9 +13,11 @@ from pathlib import Path
 from mhtrack.experiments.p2 import P2Reproduction
 from mhtrack.experiments.p2.aggregate import curve_for
 from mhtrack.experiments.p2.constants import (
+    ADAPTIVE_LABELS,
     FIGURES,
     JOBS_DIR,
     METHOD_LABELS,
+    MODIFIED_HOUGH_LABELS,
     RATE0,
     REPORT_FILE,
     RESULTS_FILE,
@@ -58,25 +60,26 @@ def _theta_figures(repro: P2Reproduction) -> None:
         save_figure(fig, out / FIGURES[name], dpi=110)
 
 
-def _fig2(seed: int, path: Path) -> None:
+def _fig2(seed: int, path: Path, settings: str) -> None:
     from mhtrack.plotting.initiation import clustering_figure
 
-    ex = fig2_example(seed)
+    ex = fig2_example(seed, settings)
     fig = clustering_figure(ex.scan, ex.fused, ex.truth_xy,
                             title=f"{ex.scenario}, scan {ex.scan.index}")
     save_figure(fig, path, dpi=100, tight=False)
 
 
-def _fig12_15(seed: int, path: Path) -> None:
+def _fig12_15(seed: int, path: Path, settings: str) -> None:
     from mhtrack.plotting.initiation import initiated_tracks_figure
 
-    ex = fig12_15_example(seed)
+    ex = fig12_15_example(seed, settings)
     s = ex.fused.scans
-    titles = {m: f"P2 Fig. {n}: {METHOD_LABELS[m]}" for m, n in FIGURE_NUMBERS.items()}
+    labels = {**METHOD_LABELS, "modified-hough": MODIFIED_HOUGH_LABELS[settings]}
+    titles = {m: f"P2 Fig. {n}: {labels[m]}" for m, n in FIGURE_NUMBERS.items()}
     fig = initiated_tracks_figure(
         ex.fused, ex.tracks, ex.truth_xy, titles,
         title=f"multiradar, run 0, scans {s[0]}–{s[-1]}, σr = 20 m, λ = 50, θ = 20°, "
-              f"adaptive K-means fusion")
+              f"{ADAPTIVE_LABELS[settings]} (settings: {settings})")
     save_figure(fig, path, dpi=100)
 
 
@@ -88,7 +91,7 @@ def write_p2_report(repro: P2Reproduction) -> list[Path]:
     _theta_figures(repro)
     for fn, name in ((_fig2, "fig2"), (_fig12_15, "fig12_15")):
         try:
-            fn(repro.seed, out / FIGURES[name])
+            fn(repro.seed, out / FIGURES[name], res.get("settings", "best"))
         except Exception:  # a figure must not lose the study
             atomic_write(out / f"{FIGURES[name]}.error.txt", traceback.format_exc())
     atomic_write(out / TABLES_FILE, tables_markdown(res))

@@ -12,7 +12,15 @@ from mhtrack.experiments.initiation_runs import (
     n_targets_seen,
 )
 from mhtrack.experiments.jobs import run_seed
-from mhtrack.experiments.p2.constants import LOGIC_PARAMS, RATE0, SIGMA0, THETA0
+from mhtrack.experiments.p2.constants import (
+    ADAPTIVE_LABELS,
+    FUSION_PARAMS,
+    INITIATOR_PARAMS,
+    LOGIC_PARAMS,
+    RATE0,
+    SIGMA0,
+    THETA0,
+)
 from mhtrack.experiments.p2.jobs import p2_scenario
 from mhtrack.scenario import simulate
 
@@ -20,10 +28,10 @@ from mhtrack.scenario import simulate
 FIGURE_NUMBERS = {"modified-logic": 12, "logic": 13, "hough": 14, "modified-hough": 15}
 
 
-def fig2_example(seed: int) -> ClusteringExample:
-    """P2 Fig. 2: random vs adaptive K-means on the first scan of run 0 (no clutter) where
-    random-start K-means gets ``k`` wrong (P2 Fig. 2(a) shows such a failure); scan 0 if
-    there is none."""
+def fig2_example(seed: int, settings: str = "best") -> ClusteringExample:
+    """P2 Fig. 2: random vs adaptive K-means (with the fusion options of ``settings``) on
+    the first scan of run 0 (no clutter) where random-start K-means gets ``k`` wrong (P2
+    Fig. 2(a) shows such a failure); scan 0 if there is none."""
     sc = p2_scenario(SIGMA0, 0.0)
     rs = run_seed(seed, 0, "words")
     number = 0
@@ -31,11 +39,16 @@ def fig2_example(seed: int) -> ClusteringExample:
         if fuse(scan, "random", run_seed=rs).n_clusters != n_targets_seen(scan):
             number = i
             break
-    return clustering_example(sc, seed, scan_number=number)
+    return clustering_example(sc, seed, scan_number=number,
+                              adaptive_params=FUSION_PARAMS[settings],
+                              adaptive_label=ADAPTIVE_LABELS[settings])
 
 
-def fig12_15_example(seed: int) -> InitiationExample:
+def fig12_15_example(seed: int, settings: str = "best") -> InitiationExample:
     """P2 Figs. 12–15: the four initiators on the first fused window of run 0 at
-    σr = 20 m, λ = 50, θ = 20°."""
+    σr = 20 m, λ = 50, θ = 20°, with the fusion and initiator options of ``settings``
+    (those of the study's jobs)."""
     return initiation_example(p2_scenario(SIGMA0, RATE0), seed, theta_deg=THETA0,
-                              methods=tuple(FIGURE_NUMBERS), **LOGIC_PARAMS)
+                              methods=tuple(FIGURE_NUMBERS), **LOGIC_PARAMS,
+                              fusion_params=FUSION_PARAMS[settings],
+                              initiator_params=INITIATOR_PARAMS[settings])

@@ -84,17 +84,7 @@ def job_scenario(job: Mapping[str, Any]) -> Scenario:
 
 def fused_run(sc: Scenario, seed: int, settings: str = "best") -> FusedRun:
     """Simulate and fuse one run with the fusion options of ``settings``."""
-    params = FUSION_PARAMS[settings]
-    if not params:
-        return simulate_and_fuse(sc, seed)
-    sim = simulate(sc, seed)
-    raw = list(sim.plots.scans())
-    fused, secs = [], []
-    for s in raw:
-        t0 = time.perf_counter()
-        fused.append(fuse(s, "adaptive", run_seed=seed, **params).scan)
-        secs.append(time.perf_counter() - t0)
-    return FusedRun(seed, sim.truth, raw, fused, secs)
+    return simulate_and_fuse(sc, seed, params=FUSION_PARAMS[settings])
 
 
 def _initiable(raw_win: Sequence[Any]) -> np.ndarray:

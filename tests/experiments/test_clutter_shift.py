@@ -111,3 +111,28 @@ def test_ablation_cached_and_explained(tmp_path):
     text = analysis_text(ab)
     for c in ab.paired:
         assert c.sentence in text
+
+
+def _timeless(records):
+    """The records without their wall-clock fields (the only thing allowed to differ)."""
+    drop = ("seconds", "wall", "time_s", "t_avg")
+    return {m: [{k: v for k, v in r.items() if not any(d in k for d in drop)} for r in rs]
+            for m, rs in records.items()}
+
+
+def test_two_workers_and_dask_give_the_same_study(study, tmp_path):
+    """Same input, same output with any executor: local workers 2 and a Dask cluster give
+    the records and paired comparisons of the in-process run (issue 17 item 4)."""
+    two = cs.clutter_shift(tmp_path / "w2", runs=3, seed=2, scenario=short(), resolution=40,
+                           workers=2)
+    assert _timeless(two.records) == _timeless(study.records)
+    assert [c.to_dict() for c in two.paired] == [c.to_dict() for c in study.paired]
+    distributed = pytest.importorskip("distributed")
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                                  dashboard_address=None) as cluster:
+        dk = cs.clutter_shift(tmp_path / "dask", runs=3, seed=2, scenario=short(),
+                              resolution=40, executor="dask",
+                              scheduler=cluster.scheduler_address)
+    assert dk.computed == 12 and not dk.errors
+    assert _timeless(dk.records) == _timeless(study.records)
+    assert [c.to_dict() for c in dk.paired] == [c.to_dict() for c in study.paired]

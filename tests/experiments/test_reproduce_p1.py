@@ -245,3 +245,32 @@ def test_caps_reported_per_run(repro, report):
             assert f"* {label}: caps acted in {n_hit} of {len(rows)} runs" in md
         else:
             assert f"* {label}: no cap acted in any of its {len(rows)} runs." in md
+
+
+def _timeless_table(path):
+    """table3.json without the timing column (Tavg) — the only thing allowed to differ."""
+    d = json.loads(path.read_text())
+    for row in d["table"].values():
+        row.pop("t_avg", None)
+    d["paired"] = [c for c in d["paired"] if c["metric"] != "t_avg"]
+    return d
+
+
+def test_two_workers_and_dask_give_the_same_table(repro, report, tmp_path):
+    """Same command, same Table 3 with any executor (issue 17 item 4): local workers 2 and
+    a Dask cluster against the in-process study of the fixture."""
+    ref = _timeless_table(repro.out_dir / "table3.json")
+    for name, kw in (("w2", {"workers": 2}), ("dask", None)):
+        if kw is None:
+            distributed = pytest.importorskip("distributed")
+            with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                                          dashboard_address=None) as cluster:
+                st = reproduce_p1(tmp_path / name, runs=2, seed=3,
+                                  scenario=preset("crossing", scans=15), executor="dask",
+                                  scheduler=cluster.scheduler_address)
+        else:
+            st = reproduce_p1(tmp_path / name, runs=2, seed=3,
+                              scenario=preset("crossing", scans=15), **kw)
+        assert st.result.computed == 6
+        write_p1_report(st)
+        assert _timeless_table(tmp_path / name / "table3.json") == ref, name

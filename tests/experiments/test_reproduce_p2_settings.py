@@ -88,7 +88,7 @@ def test_example_figures_use_the_settings_of_the_study(settings):
 
     ex = fig12_15_example(0, settings)
     sc = p2_scenario()
-    raw, win = next(fused_run(sc, run_seed(0, 0, "words"), settings).windows(4))
+    _raw, win = next(fused_run(sc, run_seed(0, 0, "words"), settings).windows(4))
     w = Window.from_scans(win)
     np.testing.assert_array_equal(ex.fused.z, w.z)
     inits = _initiators(sc.region.as_tuple(), settings)

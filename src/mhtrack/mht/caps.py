@@ -5,7 +5,35 @@ telling the user.
 plots ``n`` (every plot may start a tree, each tree's leaves gate the next plots) and
 with the confirmed tracks ``t`` carried into it. With ``n' = min(n, BURST_PLOTS)``:
 
-======================== =============================================="""
+======================== ==============================================
+``max_births_per_scan``  ``max(floor, n')``
+``max_trees``            ``max(floor, 5·n' + t)``
+``max_leaves``           ``max(floor, 16·n' + 50·t)``
+``max_gated_pairs``      ``max(floor, 150·n' + 50·t)``
+======================== ==============================================
+
+the floors being the configured values (``MHTConfig``), so that nothing changes up to
+~900 plots and 100 tracks per scan, and a burst of more than ``BURST_PLOTS`` plots gets
+the limits of ``BURST_PLOTS``.
+
+**Overload rule** (:func:`mhtrack.mht.pruning.cap_per_plot`, with ``scale_caps``). At a
+scan where the leaf caps would act — after SPRT deletion and score-drop pruning some
+tree still has more than ``max_leaves_per_tree`` children, or all trees more than
+``max_leaves`` minus this scan's births — the children are first cut to what the scan
+can use: each plot keeps its ``CHILDREN_PER_PLOT`` best children over all trees, each
+tree its ``MISSES_PER_TREE`` best miss children (ties: lower index). The best global
+hypothesis uses a plot at most once and a tree at most once, so these are its
+alternatives for every plot and every tree; the children kept are at most
+``4·n + 2·(trees)``, proportional to the scan's plots and trees instead of
+``300·(trees)``. Where no leaf cap would act (MHT-GMM and MHT-AGMM on ``crossing``,
+``opensky``, ``multiradar``) the rule does nothing; where they act on every scan — plain
+MHT, whose known κ = 1e−9 makes every clutter plot worth a new tree and every tree
+branch on every plot — it keeps a few hundred leaves per scan instead of ~10 000
+(``docs/mht.md``, *Hard caps*). The fixed caps still apply after it. It is counted as
+``max_leaves_per_plot`` (children cut) in ``StepStats.caps``.
+
+Nothing here depends on time: the same input gives the same cuts on any machine.
+"""
 
 from __future__ import annotations
 
@@ -23,6 +51,8 @@ BURST_PLOTS = 20_000
 #: Coefficients of :func:`scaled_limits` (per plot ``n'``, per confirmed track ``t``).
 TREES_PER_PLOT, LEAVES_PER_PLOT, PAIRS_PER_PLOT = 5, 16, 150
 LEAVES_PER_TRACK = PAIRS_PER_TRACK = 50
+#: The overload rule (module docstring): children kept per plot, misses kept per tree.
+CHILDREN_PER_PLOT, MISSES_PER_TREE = 4, 2
 #: The caps :func:`scaled_limits` scales.
 SCALED = ("max_births_per_scan", "max_trees", "max_leaves", "max_gated_pairs")
 

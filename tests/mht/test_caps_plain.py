@@ -91,7 +91,7 @@ def _blob_scans(n_scans: int, n_clutter: int, seed: int) -> list[Scan]:
     scans = []
     for k in range(1, n_scans + 1):
         target = np.array([[-2000.0 + 50.0 * k, 0.0]]) + rng.normal(0, 100, (1, 2))
-        blob = rng.normal(0, 50, (n_clutter, 2)) + [500.0, 500.0]
+        blob = rng.normal(0, 50, (n_clutter, 2)) + np.array([500.0, 500.0])
         s = Scan.from_positions(k, float(k), np.vstack((target, blob)))
         scans.append(dataclasses.replace(s, origin=np.r_[1, np.full(n_clutter, -1)]))
     return scans

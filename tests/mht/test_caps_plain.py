@@ -8,11 +8,18 @@ import dataclasses
 import numpy as np
 from hypothesis import given
 from hypothesis import strategies as st
+from test_caps import _scene_scans
 
 from mhtrack.clutter import KnownClutter
 from mhtrack.experiments import track
 from mhtrack.mht import MHTConfig, MHTTracker
-from mhtrack.mht.caps import CHILDREN_PER_PLOT, MISSES_PER_TREE
+from mhtrack.mht.caps import (
+    CHILDREN_PER_PLOT,
+    LEAVES_PER_PLOT,
+    LEAVES_PER_TRACK,
+    MISSES_PER_TREE,
+    scene_leaves,
+)
 from mhtrack.mht.pruning import (
     cap_leaves,
     cap_leaves_per_tree,
@@ -120,16 +127,38 @@ def test_plain_mht_in_a_blob_is_bounded_and_reported():
                   < 400.0)
 
 
-def test_where_no_leaf_cap_acts_the_rule_changes_nothing():
-    """The true κ: no leaf cap acts, so scale_caps on and off (same limits below 900
-    plots) give the same tracks, bit for bit."""
-    scans = _blob_scans(8, 15, 2)
-    kappa = 15 / (2 * np.pi * 50.0**2 * 9)  # the blob's plots over ~3σ
-    tables = []
-    for scale in (True, False):
-        run = track(MHTTracker(MHTConfig(scale_caps=scale), KnownClutter(kappa)),
-                    PlotTable.from_scans(scans))
-        assert not run.caps
-        tables.append(run.tracks)
+def _same_tracks(a, b) -> None:
+    assert len(a) > 0
     for f in ("scan", "track_id", "x", "y", "vx", "vy", "score", "plot"):
-        np.testing.assert_array_equal(getattr(tables[0], f), getattr(tables[1], f))
+        np.testing.assert_array_equal(getattr(a, f), getattr(b, f))
+
+
+def test_where_no_leaf_cap_acts_the_rule_changes_nothing():
+    """Four crossing targets in uniform clutter with the true κ: no leaf cap acts, so
+    scale_caps on and off (same limits below 900 plots) give the same tracks, bit for
+    bit."""
+    scans = _scene_scans(40, 12, 4)
+    runs = [track(MHTTracker(MHTConfig(scale_caps=scale), KnownClutter(40 / 8000.0**2)),
+                  PlotTable.from_scans(scans)) for scale in (True, False)]
+    assert not runs[0].caps and not runs[1].caps
+    _same_tracks(runs[0].tracks, runs[1].tracks)
+
+
+def test_scene_leaves_hand_worked():
+    # 44 plots, 7 confirmed tracks: 16·44 + 50·7; a burst counts BURST_PLOTS plots
+    assert scene_leaves(MHTConfig(), 44, 7) == 16 * 44 + 50 * 7 == 1054
+    assert (LEAVES_PER_PLOT, LEAVES_PER_TRACK) == (16, 50)
+    assert scene_leaves(MHTConfig(), 10**6, 0) == scene_leaves(MHTConfig(), 20_000, 0)
+    assert scene_leaves(MHTConfig(scale_caps=False), 44, 7) is None
+
+
+def test_a_leaf_cap_within_the_scene_budget_acts_as_before():
+    """A per-tree cap that acts while the children stay below 16·n + 50·t (as in the
+    1 000-target scene; here 10 clutter plots per scan): the overload rule does not
+    act, the cap cuts as it did."""
+    scans = _scene_scans(10, 12, 5)
+    runs = [track(MHTTracker(MHTConfig(max_leaves_per_tree=3, scale_caps=scale),
+                             KnownClutter(10 / 8000.0**2)), PlotTable.from_scans(scans))
+            for scale in (True, False)]
+    assert runs[0].caps == runs[1].caps and "max_leaves_per_tree" in runs[0].caps
+    _same_tracks(runs[0].tracks, runs[1].tracks)

@@ -73,6 +73,16 @@ def scaled_limits(cfg: MHTConfig, n_plots: int, n_tracks: int) -> dict[str, int]
     }
 
 
+def scene_leaves(cfg: MHTConfig, n_plots: int, n_tracks: int) -> int | None:
+    """The leaves a scan of ``n_plots`` plots entered with ``n_tracks`` confirmed tracks
+    supports, ``16·n' + 50·t`` — :func:`scaled_limits`' ``max_leaves`` without its
+    floor — above which the overload rule may act (module docstring); ``None`` when
+    ``cfg.scale_caps`` is off."""
+    if not cfg.scale_caps:
+        return None
+    return LEAVES_PER_PLOT * min(int(n_plots), BURST_PLOTS) + LEAVES_PER_TRACK * int(n_tracks)
+
+
 def scan_config(cfg: MHTConfig, n_plots: int, n_tracks: int) -> MHTConfig:
     """``cfg`` with :func:`scaled_limits` for this scan (``cfg`` itself when they are its
     own values)."""

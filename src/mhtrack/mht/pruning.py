@@ -149,17 +149,21 @@ def _taken(up: np.ndarray, ut: np.ndarray, cols: np.ndarray, tree: np.ndarray) -
 
 
 def prune_children(leaves: Leaves, children: Children, n_births: int, sprt: SPRT,
-                   cfg: MHTConfig, caps: dict[str, int]) -> Children:
+                   cfg: MHTConfig, caps: dict[str, int],
+                   scene_leaves: int | None = None) -> Children:
     """Before the (costly) Kalman update: SPRT deletion, score-drop pruning within a
-    tree, then the caps on leaves per tree and on all leaves (``n_births`` of
-    ``max_leaves`` are kept for this scan's new trees)."""
+    tree, the overload rule (``scene_leaves``: the leaves the scan supports,
+    :func:`mhtrack.mht.caps.scene_leaves`; ``None``: off), then the caps on leaves per
+    tree and on all leaves (``n_births`` of ``max_leaves`` and of ``scene_leaves`` are
+    kept for this scan's new trees)."""
     children = children.take(sprt.keep(children.score, children.peak,
                                        leaves.track[children.parent] < 0))
     tree = leaves.tree[children.parent]
     keep = score_drop_keep(tree, children.score, cfg.prune_drop)
     children, tree = children.take(keep), tree[keep]
-    if cfg.scale_caps and leaf_caps_act(tree, max(cfg.max_leaves - n_births, 0),
-                                        cfg.max_leaves_per_tree):
+    if (scene_leaves is not None and tree.size > scene_leaves - n_births
+            and leaf_caps_act(tree, max(cfg.max_leaves - n_births, 0),
+                              cfg.max_leaves_per_tree)):
         keep, cut = cap_per_plot(tree, children.plot, children.score)
         if cut:
             caps["max_leaves_per_plot"] = cut

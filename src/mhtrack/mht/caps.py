@@ -16,21 +16,27 @@ the floors being the configured values (``MHTConfig``), so that nothing changes 
 ~900 plots and 100 tracks per scan, and a burst of more than ``BURST_PLOTS`` plots gets
 the limits of ``BURST_PLOTS``.
 
-**Overload rule** (:func:`mhtrack.mht.pruning.cap_per_plot`, with ``scale_caps``). At a
-scan where the leaf caps would act — after SPRT deletion and score-drop pruning some
-tree still has more than ``max_leaves_per_tree`` children, or all trees more than
-``max_leaves`` minus this scan's births — the children are first cut to what the scan
-can use: each plot keeps its ``CHILDREN_PER_PLOT`` best children over all trees, each
-tree its ``MISSES_PER_TREE`` best miss children (ties: lower index). The best global
-hypothesis uses a plot at most once and a tree at most once, so these are its
-alternatives for every plot and every tree; the children kept are at most
-``4·n + 2·(trees)``, proportional to the scan's plots and trees instead of
-``300·(trees)``. Where no leaf cap would act (MHT-GMM and MHT-AGMM on ``crossing``,
-``opensky``, ``multiradar``) the rule does nothing; where they act on every scan — plain
-MHT, whose known κ = 1e−9 makes every clutter plot worth a new tree and every tree
-branch on every plot — it keeps a few hundred leaves per scan instead of ~10 000
-(``docs/mht.md``, *Hard caps*). The fixed caps still apply after it. It is counted as
-``max_leaves_per_plot`` (children cut) in ``StepStats.caps``.
+**Overload rule** (:func:`mhtrack.mht.pruning.cap_per_plot`, with ``scale_caps``). A
+scan of ``n`` plots entered with ``t`` confirmed tracks supports ``16·n' + 50·t`` leaves
+(:func:`scene_leaves`: ``max_leaves``' scaled value without its floor). At a scan where,
+after SPRT deletion and score-drop pruning, the children exceed that (less this scan's
+births) **and** a leaf cap would act — some tree has more than ``max_leaves_per_tree``
+children, or all trees more than ``max_leaves`` less the births — the children are
+first cut to what the scan can use: each plot keeps its ``CHILDREN_PER_PLOT`` best
+children over all trees, each tree its ``MISSES_PER_TREE`` best miss children (ties:
+lower index). The best global hypothesis uses a plot at most once and a tree at most
+once, so these are its alternatives for every plot and every tree; at most
+``4·n + 2·trees`` children are kept, proportional to the scan's plots and trees
+instead of ``300·trees``, and a clutter burst stays bounded by them. The fixed caps
+still apply after it. Counted as ``max_leaves_per_plot`` (children cut) in
+``StepStats.caps``.
+
+It acts only where the old caps acted, and not where a cap trims a scene that is within
+its budget (1 000 targets in 5 000 clutter plots: the per-tree cap acts as before).
+MHT-GMM and MHT-AGMM on ``crossing``, ``opensky``, ``multiradar`` never meet it; plain
+MHT (known κ = 1e−9: every clutter plot is worth a new tree, every tree branches on every
+plot) meets it on nearly every scan and keeps ~300 leaves instead of ~10 000
+(``docs/mht.md``, *Hard caps*).
 
 Nothing here depends on time: the same input gives the same cuts on any machine.
 """

@@ -195,13 +195,17 @@ def cap_per_plot(tree: np.ndarray, plot: np.ndarray, score: np.ndarray,
     """The overload rule (``mhtrack.mht.caps``): keep the ``per_plot`` best children of
     each plot over all trees and the ``per_tree_miss`` best miss children of each tree
     (ties: lower index). Returns (keep, removed); at most
-    ``per_plot · plots + per_tree_miss · trees`` children are kept."""
+    ``per_plot · plots + per_tree_miss · trees`` children are kept.
+
+    One stable argsort of ``group + (max − score)/(range + 1)`` (as :func:`_rank_in_tree`;
+    scores closer than ~1e−11 of their range count as ties)."""
     if score.size == 0:
         return np.ones(0, bool), 0
     upd = plot >= 0
     key = np.where(upd, plot, -1 - tree)  # misses grouped by tree, apart from the plots
-    order = np.argsort(-score, kind="stable")  # best first, ties by index, then
-    order = order[np.argsort(key[order], kind="stable")]  # grouped by key (integer sort)
+    hi = float(score.max())
+    u = (hi - score) / (hi - float(score.min()) + 1.0)
+    order = np.argsort((key - key.min()) + u, kind="stable")
     k = key[order]
     new = np.r_[True, k[1:] != k[:-1]]
     rank = np.empty(score.size, np.int64)

@@ -17,11 +17,10 @@ class StepStats:
     """What one :meth:`~mhtrack.mht.tracker.MHTTracker.step` did.
 
     ``caps`` maps each hard cap that acted to how many leaves (``max_leaves_per_tree``,
-    ``max_leaves``, the overload rule's ``max_leaves_per_plot``), trees (``max_trees``),
-    plots or initiated tracks (``max_births_per_scan``) or clusters (``max_cluster_size``)
-    it cut; empty when none acted. ``n_births`` counts the trees started at this scan.
-    ``limits``: the caps that scale with the scene and their values at this scan
-    (:func:`mhtrack.mht.caps.scaled_limits`).
+    ``max_leaves``), trees (``max_trees``), plots or initiated tracks
+    (``max_births_per_scan``) or clusters (``max_cluster_size``) it cut; empty when none
+    acted. ``n_births`` counts the trees started at this scan. ``limits``: the caps that
+    scale with the scene and their values at this scan (:func:`mhtrack.mht.caps.scaled_limits`).
     """
 
     scan: int

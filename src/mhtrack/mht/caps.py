@@ -5,7 +5,41 @@ telling the user.
 plots ``n`` (every plot may start a tree, each tree's leaves gate the next plots) and
 with the confirmed tracks ``t`` carried into it. With ``n' = min(n, BURST_PLOTS)``:
 
-======================== =============================================="""
+======================== ==============================================
+``max_births_per_scan``  ``max(floor, n')``
+``max_trees``            ``max(floor, 5·n' + t)``
+``max_leaves``           ``max(floor, 16·n' + 50·t)``
+``max_gated_pairs``      ``max(floor, 150·n' + 50·t)``
+======================== ==============================================
+
+the floors being the configured values (``MHTConfig``), so that nothing changes up to
+~900 plots and 100 tracks per scan, and a burst of more than ``BURST_PLOTS`` plots gets
+the limits of ``BURST_PLOTS``.
+
+**Overload rule** (:func:`mhtrack.mht.pruning.cap_per_plot`, with ``scale_caps``). A
+scan of ``n`` plots entered with ``t`` confirmed tracks supports ``16·n' + 50·t`` leaves
+(:func:`scene_leaves`: ``max_leaves``' scaled value without its floor). At a scan where,
+after SPRT deletion and score-drop pruning, the children exceed that (less this scan's
+births) **and** a leaf cap would act — some tree has more than ``max_leaves_per_tree``
+children, or all trees more than ``max_leaves`` less the births — the children are
+first cut to what the scan can use: each plot keeps its ``CHILDREN_PER_PLOT`` best
+children over all trees, each tree its ``MISSES_PER_TREE`` best miss children (ties:
+lower index). The best global hypothesis uses a plot at most once and a tree at most
+once, so these are its alternatives for every plot and every tree; at most
+``4·n + 2·trees`` children are kept, proportional to the scan's plots and trees
+instead of ``300·trees``, and a clutter burst stays bounded by them. The fixed caps
+still apply after it. Counted as ``max_leaves_per_plot`` (children cut) in
+``StepStats.caps``.
+
+It acts only where the old caps acted, and not where a cap trims a scene that is within
+its budget (1 000 targets in 5 000 clutter plots: the per-tree cap acts as before).
+MHT-GMM and MHT-AGMM on ``crossing``, ``opensky``, ``multiradar`` never meet it; plain
+MHT (known κ = 1e−9: every clutter plot is worth a new tree, every tree branches on every
+plot) meets it on nearly every scan and keeps ~300 leaves instead of ~10 000
+(``docs/mht.md``, *Hard caps*).
+
+Nothing here depends on time: the same input gives the same cuts on any machine.
+"""
 
 from __future__ import annotations
 
@@ -23,6 +57,8 @@ BURST_PLOTS = 20_000
 #: Coefficients of :func:`scaled_limits` (per plot ``n'``, per confirmed track ``t``).
 TREES_PER_PLOT, LEAVES_PER_PLOT, PAIRS_PER_PLOT = 5, 16, 150
 LEAVES_PER_TRACK = PAIRS_PER_TRACK = 50
+#: The overload rule (module docstring): children kept per plot, misses kept per tree.
+CHILDREN_PER_PLOT, MISSES_PER_TREE = 4, 2
 #: The caps :func:`scaled_limits` scales.
 SCALED = ("max_births_per_scan", "max_trees", "max_leaves", "max_gated_pairs")
 
@@ -41,6 +77,16 @@ def scaled_limits(cfg: MHTConfig, n_plots: int, n_tracks: int) -> dict[str, int]
         "max_gated_pairs": max(floors["max_gated_pairs"],
                                PAIRS_PER_PLOT * n + PAIRS_PER_TRACK * t),
     }
+
+
+def scene_leaves(cfg: MHTConfig, n_plots: int, n_tracks: int) -> int | None:
+    """The leaves a scan of ``n_plots`` plots entered with ``n_tracks`` confirmed tracks
+    supports, ``16·n' + 50·t`` — :func:`scaled_limits`' ``max_leaves`` without its
+    floor — above which the overload rule may act (module docstring); ``None`` when
+    ``cfg.scale_caps`` is off."""
+    if not cfg.scale_caps:
+        return None
+    return LEAVES_PER_PLOT * min(int(n_plots), BURST_PLOTS) + LEAVES_PER_TRACK * int(n_tracks)
 
 
 def scan_config(cfg: MHTConfig, n_plots: int, n_tracks: int) -> MHTConfig:

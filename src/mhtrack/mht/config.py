@@ -86,8 +86,10 @@ class MHTConfig:
     scale_caps : the caps ``max_births_per_scan``, ``max_trees``, ``max_leaves`` and
         ``max_gated_pairs`` grow with the scan's plots and confirmed tracks, the values
         below being their floors (:func:`mhtrack.mht.caps.scaled_limits`; unchanged up to
-        900 plots and 100 tracks per scan, bounded in a burst of over 20 000). Default True; False:
-        the values below at every scan.
+        900 plots and 100 tracks per scan, bounded in a burst of over 20 000), and the
+        overload rule cuts the children to 4 per plot and 2 misses per tree where a leaf
+        cap would act on more children than the scan supports (:mod:`mhtrack.mht.caps`).
+        Default True; False: the values below at every scan, no overload rule.
     max_leaves_per_tree : hard cap on the leaves of one tree (best scores kept).
         Default 300 (above the largest trees, ~290 leaves, of the crossing scenario with
         40 uniform clutter plots per scan and the true κ).

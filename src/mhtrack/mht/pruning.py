@@ -12,6 +12,7 @@ from dataclasses import replace
 
 import numpy as np
 
+from mhtrack.mht.caps import CHILDREN_PER_PLOT, MISSES_PER_TREE
 from mhtrack.mht.config import MHTConfig
 from mhtrack.mht.extend import Children
 from mhtrack.mht.hypothesis import GlobalHypothesis
@@ -148,15 +149,25 @@ def _taken(up: np.ndarray, ut: np.ndarray, cols: np.ndarray, tree: np.ndarray) -
 
 
 def prune_children(leaves: Leaves, children: Children, n_births: int, sprt: SPRT,
-                   cfg: MHTConfig, caps: dict[str, int]) -> Children:
+                   cfg: MHTConfig, caps: dict[str, int],
+                   scene_leaves: int | None = None) -> Children:
     """Before the (costly) Kalman update: SPRT deletion, score-drop pruning within a
-    tree, then the caps on leaves per tree and on all leaves (``n_births`` of
-    ``max_leaves`` are kept for this scan's new trees)."""
+    tree, the overload rule (``scene_leaves``: the leaves the scan supports,
+    :func:`mhtrack.mht.caps.scene_leaves`; ``None``: off), then the caps on leaves per
+    tree and on all leaves (``n_births`` of ``max_leaves`` and of ``scene_leaves`` are
+    kept for this scan's new trees)."""
     children = children.take(sprt.keep(children.score, children.peak,
                                        leaves.track[children.parent] < 0))
     tree = leaves.tree[children.parent]
     keep = score_drop_keep(tree, children.score, cfg.prune_drop)
     children, tree = children.take(keep), tree[keep]
+    if (scene_leaves is not None and tree.size > scene_leaves - n_births
+            and leaf_caps_act(tree, max(cfg.max_leaves - n_births, 0),
+                              cfg.max_leaves_per_tree)):
+        keep, cut = cap_per_plot(tree, children.plot, children.score)
+        if cut:
+            caps["max_leaves_per_plot"] = cut
+            children, tree = children.take(keep), tree[keep]
     keep, cut = cap_leaves_per_tree(tree, children.score, cfg.max_leaves_per_tree)
     if cut:
         caps["max_leaves_per_tree"] = cut
@@ -168,6 +179,39 @@ def prune_children(leaves: Leaves, children: Children, n_births: int, sprt: SPRT
         caps["max_leaves"] = cut
         children = children.take(keep)
     return children
+
+
+def leaf_caps_act(tree: np.ndarray, budget: int, per_tree: int) -> bool:
+    """Whether the leaf caps would cut these children (sorted by ``tree``): more than
+    ``budget`` in all, or more than ``per_tree`` in one tree."""
+    if tree.size > budget:
+        return True
+    return bool(np.diff(np.r_[segment_starts(tree), tree.size]).max(initial=0) > per_tree)
+
+
+def cap_per_plot(tree: np.ndarray, plot: np.ndarray, score: np.ndarray,
+                 per_plot: int = CHILDREN_PER_PLOT,
+                 per_tree_miss: int = MISSES_PER_TREE) -> tuple[np.ndarray, int]:
+    """The overload rule (``mhtrack.mht.caps``): keep the ``per_plot`` best children of
+    each plot over all trees and the ``per_tree_miss`` best miss children of each tree
+    (ties: lower index). Returns (keep, removed); at most
+    ``per_plot · plots + per_tree_miss · trees`` children are kept.
+
+    One stable argsort of ``group + (max − score)/(range + 1)`` (as :func:`_rank_in_tree`;
+    scores closer than ~1e−11 of their range count as ties)."""
+    if score.size == 0:
+        return np.ones(0, bool), 0
+    upd = plot >= 0
+    key = np.where(upd, plot, -1 - tree)  # misses grouped by tree, apart from the plots
+    hi = float(score.max())
+    u = (hi - score) / (hi - float(score.min()) + 1.0)
+    order = np.argsort((key - key.min()) + u, kind="stable")
+    k = key[order]
+    new = np.r_[True, k[1:] != k[:-1]]
+    rank = np.empty(score.size, np.int64)
+    rank[order] = np.arange(score.size) - np.flatnonzero(new)[np.cumsum(new) - 1]
+    keep = rank < np.where(upd, per_plot, per_tree_miss)
+    return keep, int(score.size - np.count_nonzero(keep))
 
 
 def removed_after_solve(leaves: Leaves, hyp: GlobalHypothesis,

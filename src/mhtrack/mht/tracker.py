@@ -51,7 +51,7 @@ import numpy as np
 from mhtrack.clutter.base import ClutterEstimator
 from mhtrack.clutter.known import KnownClutter
 from mhtrack.mht.births import Birth, make_birth
-from mhtrack.mht.caps import SCALED, CapWarnings, scan_config, solver_caps
+from mhtrack.mht.caps import SCALED, CapWarnings, scan_config, scene_leaves, solver_caps
 from mhtrack.mht.config import MHTConfig
 from mhtrack.mht.coverage import Coverage, Everywhere, Looks
 from mhtrack.mht.extend import grow_children, propose_children
@@ -145,8 +145,8 @@ class MHTTracker:
         cfg, ftime = self.config, float(scan.time)
         caps: dict[str, int] = {}
         z, R, rows = validate_scan(scan, self._R, self._last_time, self._last_index)
-        lim = scan_config(cfg, len(z), int(np.count_nonzero(
-            self._leaves.chosen & (self._leaves.track >= 0))))  # caps scaled to the scan
+        n_tracks = int(np.count_nonzero(self._leaves.chosen & (self._leaves.track >= 0)))
+        lim = scan_config(cfg, len(z), n_tracks)  # caps scaled to the scan
         self.gate.max_pairs = lim.max_gated_pairs
         self.birth.limit(lim.max_births_per_scan)
         by_id = self.coverage.per_tree_looks
@@ -163,7 +163,7 @@ class MHTTracker:
                                     update_dl)
         cand = self.birth.propose(scan, z, R, rows, kappa, in_gates, caps)
         children = prune_children(leaves, children, len(cand) + len(idle), self.sprt, lim,
-                                  caps)
+                                  caps, scene_leaves(cfg, len(z), n_tracks))
         grown = grow_children(leaves, pred, children, z, R, rows, self.motion, ftime,
                               pair_pred, scan.t)
         births = self.birth.seed(scan, cand, grown.window, self.trees, caps)

@@ -77,6 +77,9 @@ def _columns(z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return np.ascontiguousarray(z[:, 0]), np.ascontiguousarray(z[:, 1])
 
 
+_min, _max = np.minimum.reduce, np.maximum.reduce  # exact, without the methods' wrappers
+
+
 def gaussian_log_pdf(z: np.ndarray, means: np.ndarray, covariances: np.ndarray) -> np.ndarray:
     """(n, K) ``log N(z_i; μ_j, Σ_j)`` (:func:`log_pdf_t`)."""
     maha, det = maha_det_t(*offsets_t(*_columns(z), means), covariances)
@@ -134,24 +137,26 @@ class Mixture:
         if self.background_box is None:
             return np.full(len(z), -np.inf)
         x0, x1, y0, y1 = self.background_box
-        inside = (z[:, 0] >= x0) & (z[:, 0] <= x1) & (z[:, 1] >= y0) & (z[:, 1] <= y1)
+        x, y = z[:, 0], z[:, 1]
+        if len(z) and (_min(x) >= x0 and _max(x) <= x1 and _min(y) >= y0 and _max(y) <= y1):
+            return np.full(len(z), -np.log(self.background_area))  # all inside the box
+        inside = (x >= x0) & (x <= x1) & (y >= y0) & (y <= y1)
         return np.where(inside, -np.log(self.background_area), -np.inf)
 
     def _weighted_t(self, z: np.ndarray) -> np.ndarray:
-        maha, det = maha_det_t(*offsets_t(*_columns(z), self.means), self.covariances)
-        glp = log_pdf_t(maha, det)
-        with np.errstate(divide="ignore"):
-            return weighted_t(self, glp, self.log_background(z))
+        """(K+1, n) :func:`weighted_t` at ``z``; caller ignores log 0 warnings."""
+        maha, det = maha_det_t(*offsets_t(z[:, 0], z[:, 1], self.means), self.covariances)
+        return weighted_t(self, log_pdf_t(maha, det), self.log_background(z))
 
     def weighted_log_prob(self, z: np.ndarray) -> np.ndarray:
         """(n, K+1) ``log π_j + log f_j(z)``; column 0 the background (``−inf`` if none)."""
-        return np.ascontiguousarray(self._weighted_t(z).T)
+        with np.errstate(divide="ignore"):
+            return np.ascontiguousarray(self._weighted_t(z).T)
 
     def log_pdf(self, z: np.ndarray) -> np.ndarray:
         """``log c(z)`` (P1 eqs. 6, 13) at (n, 2) positions."""
-        w = self._weighted_t(z)
         with np.errstate(divide="ignore"):
-            return _lse_t(w)
+            return _lse_t(self._weighted_t(z))
 
     def pdf(self, z: np.ndarray) -> np.ndarray:
         """``c(z)`` (P1 eq. 13), per m², at (n, 2) positions; 0 where it underflows.

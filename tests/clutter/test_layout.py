@@ -109,9 +109,9 @@ def test_density_pieces_match_the_plain_code_bit_for_bit(seed: int) -> None:
 
 def test_init_log_pdf_is_only_a_shortcut() -> None:
     z, init, kw = _case(2)
-    from mhtrack.clutter.density import log_pdf_t, maha_det_t, offsets_t
+    from mhtrack.clutter.density import log_pdf_t, maha_det_t, offsets_t, plots_t
 
-    glp = log_pdf_t(*maha_det_t(*offsets_t(z[:, 0], z[:, 1], init.means), init.covariances))
+    glp = log_pdf_t(*maha_det_t(*offsets_t(plots_t(z), init.means), init.covariances))
     a, b = fit_em(z, init, **kw), fit_em(z, init, init_log_pdf=glp, **kw)
     assert a.log_likelihood == b.log_likelihood and same(a.mixture.means, b.mixture.means)
     assert same(glp.T, plain_em.gaussian_log_pdf(z, init.means, init.covariances))

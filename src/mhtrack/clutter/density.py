@@ -54,10 +54,15 @@ def logsumexp_rows(a: np.ndarray) -> np.ndarray:
         return _lse_t(a.T)
 
 
-def offsets_t(zx: np.ndarray, zy: np.ndarray, means: np.ndarray
-              ) -> tuple[np.ndarray, np.ndarray]:
-    """(K, n) ``x_i − μ_jx`` and ``y_i − μ_jy`` from the plots' coordinates ``zx, zy``."""
-    return zx - means[:, 0:1], zy - means[:, 1:2]
+def plots_t(z: np.ndarray, copy: bool = True) -> np.ndarray:
+    """(2, 1, n) coordinates of (n, 2) plots, a row-major copy (or a view) for
+    :func:`offsets_t`."""
+    return (np.ascontiguousarray(z.T) if copy else z.T)[:, None, :]
+
+
+def offsets_t(z_t: np.ndarray, means: np.ndarray) -> np.ndarray:
+    """(2, K, n) ``x_i − μ_jx`` and ``y_i − μ_jy`` from :func:`plots_t`'s ``z_t``."""
+    return z_t - means.T[:, :, None]
 
 
 def maha_det_t(dx_t: np.ndarray, dy_t: np.ndarray, cov: np.ndarray
@@ -73,22 +78,18 @@ def log_pdf_t(maha_t: np.ndarray, det: np.ndarray) -> np.ndarray:
     return -LOG_2PI - 0.5 * np.log(det) - 0.5 * maha_t
 
 
-def _columns(z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    return np.ascontiguousarray(z[:, 0]), np.ascontiguousarray(z[:, 1])
-
-
 _min, _max = np.minimum.reduce, np.maximum.reduce  # exact, without the methods' wrappers
 
 
 def gaussian_log_pdf(z: np.ndarray, means: np.ndarray, covariances: np.ndarray) -> np.ndarray:
     """(n, K) ``log N(z_i; μ_j, Σ_j)`` (:func:`log_pdf_t`)."""
-    maha, det = maha_det_t(*offsets_t(*_columns(z), means), covariances)
+    maha, det = maha_det_t(*offsets_t(plots_t(z), means), covariances)
     return np.ascontiguousarray(log_pdf_t(maha, det).T)
 
 
 def mahalanobis2(z: np.ndarray, means: np.ndarray, covariances: np.ndarray) -> np.ndarray:
     """(n, K) squared Mahalanobis distances ``dᵀΣ_j⁻¹d`` of every plot to every component."""
-    return np.ascontiguousarray(maha_det_t(*offsets_t(*_columns(z), means), covariances)[0].T)
+    return np.ascontiguousarray(maha_det_t(*offsets_t(plots_t(z), means), covariances)[0].T)
 
 
 def weighted_t(mix: Mixture, glp_t: np.ndarray, log_bg: np.ndarray) -> np.ndarray:
@@ -145,7 +146,8 @@ class Mixture:
 
     def _weighted_t(self, z: np.ndarray) -> np.ndarray:
         """(K+1, n) :func:`weighted_t` at ``z``; caller ignores log 0 warnings."""
-        maha, det = maha_det_t(*offsets_t(z[:, 0], z[:, 1], self.means), self.covariances)
+        maha, det = maha_det_t(*offsets_t(plots_t(z, copy=False), self.means),
+                                self.covariances)
         return weighted_t(self, log_pdf_t(maha, det), self.log_background(z))
 
     def weighted_log_prob(self, z: np.ndarray) -> np.ndarray:

@@ -52,6 +52,7 @@ from mhtrack.clutter.density import (
     mahalanobis2,
     offsets_t,
     plot_sums,
+    plots_t,
     weighted_t,
 )
 
@@ -111,19 +112,18 @@ def m_step(
 
     Returns the new mixture and the effective counts ``n_j`` of the Gaussians.
     """
-    zx, zy = np.ascontiguousarray(z[:, 0]), np.ascontiguousarray(z[:, 1])
-    mix, nk, _ = _m_step(z, zx, zy, resp.T, background_box, sample_weight, reg_covar,
+    mix, nk, _ = _m_step(z, plots_t(z), resp.T, background_box, sample_weight, reg_covar,
                          background_floor)
     return mix, nk
 
 
 def _m_step(
-    z: np.ndarray, zx: np.ndarray, zy: np.ndarray, resp_t: np.ndarray,
+    z: np.ndarray, z_t: np.ndarray, resp_t: np.ndarray,
     box: tuple[float, float, float, float] | None, sample_weight: np.ndarray | None,
     reg_covar: float, background_floor: float,
     sums: tuple[np.ndarray, np.ndarray] | None = None,
-) -> tuple[Mixture, np.ndarray, tuple[np.ndarray, np.ndarray]]:
-    """:func:`m_step` from the (K+1, n) responsibilities, also returning the (K, n) offsets
+) -> tuple[Mixture, np.ndarray, np.ndarray]:
+    """:func:`m_step` from the (K+1, n) responsibilities, also returning the (2, K, n) offsets
     ``z_i − μ_j`` to the new means. ``sums``: the row-major (n, K+1) responsibilities and
     their column sums if at hand (no sample weights). The means are the plot-major
     ``(r[:, 1:].T @ z) / n_j``: one BLAS product on the row-major operand of the formula."""
@@ -137,18 +137,14 @@ def _m_step(
     total = nk_all.sum()
     nk = nk_all[1:]
     means = (r[:, 1:].T @ z) / nk[:, None]
-    dx, dy = offsets_t(zx, zy, means)
-    rg = r_t[1:]
-    prods = np.empty((3 * k, len(zx)))  # Σ r dx², Σ r dy², Σ r dx dy: one sum of 3K rows
-    rdx = rg * dx
-    np.multiply(rdx, dx, out=prods[:k])
-    np.multiply(rg * dy, dy, out=prods[k:2 * k])
-    np.multiply(rdx, dy, out=prods[2 * k:])
-    sxx, syy, sxy = plot_sums(prods, k).reshape(3, k) / nk
-    cov = np.empty((k, 2, 2))
-    cov[:, 0, 0] = sxx + reg_covar
-    cov[:, 1, 1] = syy + reg_covar
-    cov[:, 0, 1] = cov[:, 1, 0] = sxy
+    d = offsets_t(z_t, means)
+    prods = np.empty((3 * k, len(z)))  # Σ r dx², Σ r dy², Σ r dx dy: one sum of 3K rows
+    rd = r_t[1:] * d  # r dx, r dy
+    np.multiply(rd, d, out=prods[:2 * k].reshape(2, k, -1))
+    np.multiply(rd[0], d[1], out=prods[2 * k:])
+    q = plot_sums(prods, k).reshape(3, k) / nk
+    q[:2] += reg_covar
+    cov = q[[0, 2, 2, 1]].T.reshape(k, 2, 2)  # [[Σxx, Σxy], [Σxy, Σyy]]
     if box is None:
         w0 = 0.0
         w = nk / nk.sum()
@@ -156,7 +152,7 @@ def _m_step(
         w0 = max(nk_all[0] / total, background_floor)
         g = nk.sum()
         w = (1.0 - w0) * nk / g if g > 0 else nk * 0.0
-    return Mixture(w, means, cov, float(w0), box), nk, (dx, dy)
+    return Mixture(w, means, cov, float(w0), box), nk, d
 
 
 def _drop(mix: Mixture, keep: np.ndarray) -> Mixture:
@@ -215,7 +211,7 @@ def fit_em(
     # M-step's offsets z − μ and the determinants serve the densities and the contrast
     # test. Every float is the one the plain loop over e_step/m_step gives
     # (tests/clutter/test_em.py).
-    zx, zy = np.ascontiguousarray(z[:, 0]), np.ascontiguousarray(z[:, 1])
+    z_t = plots_t(z)
     with np.errstate(divide="ignore"):
         log_bg = init.log_background(z)  # the box is fixed
         # inside the box log u is one number (the usual case: the box holds the data)
@@ -225,7 +221,7 @@ def fit_em(
         mix = init
         glp = init_log_pdf
         if glp is None:
-            glp = log_pdf_t(*maha_det_t(*offsets_t(zx, zy, mix.means), mix.covariances))
+            glp = log_pdf_t(*maha_det_t(*offsets_t(z_t, mix.means), mix.covariances))
         wlp = weighted_t(mix, glp, log_bg)
         norm: np.ndarray | None = None
         resp: np.ndarray | None = None
@@ -239,7 +235,7 @@ def fit_em(
                 norm = _lse_t(wlp)
                 resp = np.exp(wlp - norm)
             ll = _mean_ll(norm, sample_weight)
-            mix, nk, dxy = _m_step(z, zx, zy, resp, mix.background_box, sample_weight,
+            mix, nk, dxy = _m_step(z, z_t, resp, mix.background_box, sample_weight,
                                    reg_covar, background_floor, sums)
             maha, det = maha_det_t(*dxy, mix.covariances)
             glp = log_pdf_t(maha, det)

@@ -27,7 +27,7 @@ from typing import Any, Literal
 import numpy as np
 
 from mhtrack.clutter.base import ClutterEstimator
-from mhtrack.clutter.density import log_pdf_t, maha_det_t, offsets_t
+from mhtrack.clutter.density import log_pdf_t, maha_det_t, offsets_t, plots_t
 from mhtrack.clutter.em import Mixture, PruneRule, fit_em
 from mhtrack.clutter.seeding import kmeanspp_centres, mixture_from_centres
 from mhtrack.models.clutter import Region
@@ -331,8 +331,8 @@ class MixtureClutter(ClutterEstimator):
         bg = max(prev.background_weight, self._start_weight()) if self.background else 0.0
         w = prev.weights * (1.0 - bg) / prev.weights.sum()
         means, cov = prev.means, prev.covariances
-        zx, zy = np.ascontiguousarray(z[:, 0]), np.ascontiguousarray(z[:, 1])
-        maha, det = maha_det_t(*offsets_t(zx, zy, means), cov)
+        z_t = plots_t(z)
+        maha, det = maha_det_t(*offsets_t(z_t, means), cov)
         glp = log_pdf_t(maha, det)
         free = self.n_components - prev.n_components
         if free > 0:
@@ -342,12 +342,12 @@ class MixtureClutter(ClutterEstimator):
                 centres = kmeanspp_centres(novel, free, rng(), existing=means)
                 if len(centres):
                     new = mixture_from_centres(novel, centres, reg_covar=self.reg_covar)
-                    share = far.mean()  # the novel plots' share of the data
+                    share = float(novel.shape[0]) / len(far)  # novel plots' share: mean(far)
                     w = np.concatenate((w * (1.0 - share), new.weights * share * (1.0 - bg)))
                     means = np.concatenate((means, new.means))
                     cov = np.concatenate((cov, new.covariances))
                     glp = np.concatenate((glp, log_pdf_t(*maha_det_t(
-                        *offsets_t(zx, zy, new.means), new.covariances))))
+                        *offsets_t(z_t, new.means), new.covariances))))
         return Mixture(w, means, cov, bg, box), glp
 
 

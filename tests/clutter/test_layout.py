@@ -121,3 +121,23 @@ def test_mixture_is_still_importable_from_em() -> None:
     from mhtrack.clutter import em
 
     assert em.Mixture is Mixture
+
+
+@pytest.mark.parametrize("seed", range(20))
+def test_seeding_matches_the_plain_code_bit_for_bit(seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    z = rng.normal(0.0, 500.0, (int(rng.integers(1, 40)), 2))
+    if seed % 4 == 3:
+        z = np.repeat(z[:2], 4, axis=0)  # duplicate plots: D² reaches 0
+    existing = rng.normal(0.0, 500.0, (3, 2)) if seed % 2 else None
+    k = int(rng.integers(1, 9))
+    got = kmeanspp_centres(z, k, np.random.default_rng(seed), existing=existing)
+    want = plain_em.kmeanspp_centres(z, k, np.random.default_rng(seed), existing=existing)
+    assert same(got, want)
+    box = (-5000.0, 5000.0, -5000.0, 5000.0)
+    a = mixture_from_centres(z, got, reg_covar=100.0, background_box=box,
+                             background_weight=0.05)
+    b = plain_em.mixture_from_centres(z, want, reg_covar=100.0, background_box=box,
+                                      background_weight=0.05)
+    for name in ("weights", "means", "covariances"):
+        assert same(getattr(a, name), getattr(b, name))

@@ -1,6 +1,6 @@
 """The EM of ``mhtrack.clutter.em`` written plainly, plot-major ``(n, K)`` arrays, every
 density recomputed: the code as it was before the component-major layout (main 46050f2,
-``src/mhtrack/clutter/em.py``). Tests compare the library with it bit for bit."""
+``src/mhtrack/clutter/em.py`` and ``seeding.py``). Tests compare the library with it bit for bit."""
 
 import numpy as np
 
@@ -124,3 +124,51 @@ def fit_em(z, init, *, sample_weight=None, reg_covar=1e-6, tol=1e-4, max_iter=10
         prev = ll
     final = float(np.average(logsumexp_rows(weighted_log_prob(mix, z)), weights=sw))
     return mix, final, n_iter, converged, n_pruned
+
+
+def kmeanspp_centres(
+    z, k, rng, existing=None
+):
+    chosen = []
+    if existing is not None and len(existing):
+        d2 = ((z[:, None, :] - existing[None, :, :]) ** 2).sum(axis=2).min(axis=1)
+    else:
+        first = z[int(rng.integers(len(z)))]
+        chosen.append(first)
+        d2 = ((z - first) ** 2).sum(axis=1)
+    while len(chosen) < k:
+        total = d2.sum()
+        if not total > 0:
+            break
+        i = int(np.searchsorted(np.cumsum(d2), rng.random() * total, side="right"))
+        c = z[min(i, len(z) - 1)]
+        chosen.append(c)
+        d2 = np.minimum(d2, ((z - c) ** 2).sum(axis=1))
+    return np.array(chosen, float).reshape(-1, 2)
+
+
+def mixture_from_centres(
+    z,
+    centres,
+    *,
+    reg_covar,
+    background_box=None,
+    background_weight=0.0,
+):
+    k = len(centres)
+    d2 = ((z[:, None, :] - centres[None, :, :]) ** 2).sum(axis=2)
+    lab = d2.argmin(axis=1)
+    counts = np.bincount(lab, minlength=k).astype(float)
+    data_cov = np.cov(z.T, bias=True).reshape(2, 2) if len(z) > 1 else np.zeros((2, 2))
+    broad = data_cov / k + reg_covar * np.eye(2)
+    means = centres.astype(float).copy()
+    cov = np.repeat(broad[None], k, axis=0)
+    for j in np.flatnonzero(counts >= 1):
+        pts = z[lab == j]
+        means[j] = pts.mean(axis=0)
+        if len(pts) >= 3:
+            d = pts - means[j]
+            cov[j] = d.T @ d / len(pts) + reg_covar * np.eye(2)
+    w = np.maximum(counts, 1e-3)
+    w = (1.0 - background_weight) * w / w.sum()
+    return Mixture(w, means, cov, float(background_weight), background_box)

@@ -15,21 +15,24 @@ def kmeanspp_centres(
     (Arthur & Vassilvitskii 2007; the first one uniformly unless ``existing`` centres are
     given, to which distances are then measured). Stops early when every remaining plot
     sits on a centre (``D² = 0``), so identical plots give one centre."""
+    # NumPy's reductions called directly (the ones .sum/.min/cumsum call): same floats
+    add = np.add
     chosen: list[np.ndarray] = []
     if existing is not None and len(existing):
-        d2 = ((z[:, None, :] - existing[None, :, :]) ** 2).sum(axis=2).min(axis=1)
+        d2 = np.minimum.reduce(add.reduce((z[:, None, :] - existing[None, :, :]) ** 2,
+                                          axis=2), axis=1)
     else:
         first = z[int(rng.integers(len(z)))]
         chosen.append(first)
-        d2 = ((z - first) ** 2).sum(axis=1)
+        d2 = add.reduce((z - first) ** 2, axis=1)
     while len(chosen) < k:
-        total = d2.sum()
+        total = add.reduce(d2)
         if not total > 0:
             break
-        i = int(np.searchsorted(np.cumsum(d2), rng.random() * total, side="right"))
+        i = int(add.accumulate(d2).searchsorted(rng.random() * total, side="right"))
         c = z[min(i, len(z) - 1)]
         chosen.append(c)
-        d2 = np.minimum(d2, ((z - c) ** 2).sum(axis=1))
+        d2 = np.minimum(d2, add.reduce((z - c) ** 2, axis=1))
     return np.array(chosen, float).reshape(-1, 2)
 
 
@@ -57,7 +60,7 @@ def mixture_from_centres(
         cov[:] = data_cov / k + reg
     for j in np.flatnonzero(counts >= 1):
         pts = z[lab == j]
-        means[j] = pts.mean(axis=0)
+        means[j] = np.add.reduce(pts, axis=0) / len(pts)  # pts.mean(axis=0)
         if len(pts) >= 3:
             d = pts - means[j]
             cov[j] = d.T @ d / len(pts) + reg

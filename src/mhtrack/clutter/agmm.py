@@ -47,9 +47,12 @@ def keep_mass(weights: np.ndarray, mass: float = P1_MASS) -> np.ndarray:
     if w.size == 0:
         return keep
     order = np.argsort(-w, kind="stable")
-    csum = np.cumsum(w[order])
-    above = np.flatnonzero(csum > mass)
-    m = int(above[0]) + 1 if above.size else w.size
+    m, csum = w.size, 0.0
+    for i, v in enumerate(w[order].tolist()):  # np.cumsum's additions, in its order
+        csum += v
+        if csum > mass:
+            m = i + 1
+            break
     keep[order[:m]] = True
     return keep
 

@@ -30,7 +30,9 @@ _gaussian_mixture.py``), with optional sample weights ``s_i``:
 objective of P1 eq. 7, which EM never decreases — rather than P1's ``Q`` (eq. 10): at the
 E-step they differ by the entropy of the responsibilities, and ``L`` is what scikit-learn
 monitors (and returns from ``score``), so the two codes can be checked against each other.
-All 2×2 arithmetic is closed-form (:mod:`mhtrack.models.linalg2`) on whole ``(n, K)`` arrays.
+All 2×2 arithmetic is closed-form (:mod:`mhtrack.models.linalg2`) on whole arrays, held
+component-major (:mod:`mhtrack.clutter.density`: the layout, and why the floats are those
+of the plain plot-major formulas).
 """
 
 from __future__ import annotations
@@ -40,107 +42,27 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from mhtrack.models.linalg2 import LOG_2PI, det2, sym_det2, sym_mahalanobis2
+from mhtrack.clutter.density import (
+    Mixture,
+    _lse_t,
+    gaussian_log_pdf,
+    log_pdf_t,
+    logsumexp_rows,
+    maha_det_t,
+    mahalanobis2,
+    offsets_t,
+    plot_sums,
+    plots_t,
+    weighted_t,
+)
+
+__all__ = ["EMResult", "Mixture", "PruneRule", "e_step", "fit_em", "gaussian_log_pdf",
+           "logsumexp_rows", "m_step", "mahalanobis2", "removal_gain"]
 
 _EPS10 = 10.0 * np.finfo(float).eps  # sklearn adds this to n_j so that no n_j is 0
 
 #: A pruning rule: normalised Gaussian weights (K,) → mask of the components to keep.
 PruneRule = Callable[[np.ndarray], np.ndarray]
-
-
-@dataclass(frozen=True)
-class Mixture:
-    """Gaussian mixture in 2-D with an optional uniform background component.
-
-    Attributes
-    ----------
-    weights : (K,) Gaussian weights ``π_j``; ``weights.sum() + background_weight == 1``.
-    means : (K, 2) means ``μ_j`` (m).
-    covariances : (K, 2, 2) covariances ``Σ_j`` (m²).
-    background_weight : ``π₀`` (0 without a background).
-    background_box : ``(xmin, xmax, ymin, ymax)`` of the uniform background, or ``None``.
-    """
-
-    weights: np.ndarray
-    means: np.ndarray
-    covariances: np.ndarray
-    background_weight: float = 0.0
-    background_box: tuple[float, float, float, float] | None = None
-
-    @property
-    def n_components(self) -> int:
-        """Number of Gaussian components ``K``."""
-        return len(self.weights)
-
-    @property
-    def background_area(self) -> float:
-        """Area ``A`` of the background box (m²); ``inf`` without one."""
-        if self.background_box is None:
-            return float("inf")
-        x0, x1, y0, y1 = self.background_box
-        return (x1 - x0) * (y1 - y0)
-
-    def log_background(self, z: np.ndarray) -> np.ndarray:
-        """``log u(z)``: ``−log A`` inside the box, ``−inf`` outside (or without a box)."""
-        if self.background_box is None:
-            return np.full(len(z), -np.inf)
-        x0, x1, y0, y1 = self.background_box
-        inside = (z[:, 0] >= x0) & (z[:, 0] <= x1) & (z[:, 1] >= y0) & (z[:, 1] <= y1)
-        return np.where(inside, -np.log(self.background_area), -np.inf)
-
-    def weighted_log_prob(self, z: np.ndarray) -> np.ndarray:
-        """(n, K+1) ``log π_j + log f_j(z)``; column 0 the background (``−inf`` if none)."""
-        return _weighted(self, gaussian_log_pdf(z, self.means, self.covariances),
-                         self.log_background(z))
-
-    def log_pdf(self, z: np.ndarray) -> np.ndarray:
-        """``log c(z)`` (P1 eqs. 6, 13) at (n, 2) positions."""
-        return logsumexp_rows(self.weighted_log_prob(z))
-
-    def pdf(self, z: np.ndarray) -> np.ndarray:
-        """``c(z)`` (P1 eq. 13), per m², at (n, 2) positions; 0 where it underflows.
-
-        For many positions (maps, quadrature) each Gaussian is evaluated only inside the
-        axis-aligned box ``|Δx| ≤ r√Σxx, |Δy| ≤ r√Σyy`` with ``r² = 1490``: outside it
-        ``exp(−½ dᵀΣ⁻¹d) < e⁻⁷⁴⁵`` underflows to 0 anyway, so the result is the same.
-        """
-        z = np.asarray(z, dtype=float)
-        if len(z) * max(self.n_components, 1) <= 65_536:
-            return np.exp(self.log_pdf(z))
-        out = self.background_weight * np.exp(self.log_background(z))
-        a, b, c = self.covariances[:, 0, 0], self.covariances[:, 0, 1], self.covariances[:, 1, 1]
-        norm = self.weights / (2.0 * np.pi * np.sqrt(sym_det2(a, b, c)))
-        r = np.sqrt(1490.0)
-        for j in range(self.n_components):
-            dx, dy = z[:, 0] - self.means[j, 0], z[:, 1] - self.means[j, 1]
-            sel = np.flatnonzero((np.abs(dx) <= r * np.sqrt(a[j]))
-                                 & (np.abs(dy) <= r * np.sqrt(c[j])))
-            q, _ = sym_mahalanobis2(dx[sel], dy[sel], a[j], b[j], c[j])
-            out[sel] += norm[j] * np.exp(-0.5 * q)
-        return out
-
-    def to_state(self) -> dict[str, object]:
-        """JSON-able values and arrays (inverse: :meth:`from_state`)."""
-        return {
-            "weights": self.weights.copy(),
-            "means": self.means.copy(),
-            "covariances": self.covariances.copy(),
-            "background_weight": float(self.background_weight),
-            "background_box": None if self.background_box is None
-            else [float(v) for v in self.background_box],
-        }
-
-    @classmethod
-    def from_state(cls, s: dict[str, object]) -> Mixture:
-        """Rebuild a mixture from :meth:`to_state`'s output."""
-        box = s["background_box"]
-        return cls(
-            np.asarray(s["weights"], float).reshape(-1),
-            np.asarray(s["means"], float).reshape(-1, 2),
-            np.asarray(s["covariances"], float).reshape(-1, 2, 2),
-            float(s["background_weight"]),  # type: ignore[arg-type]
-            None if box is None else tuple(float(v) for v in box),  # type: ignore[arg-type]
-        )
 
 
 @dataclass(frozen=True)
@@ -159,34 +81,6 @@ class EMResult:
     n_pruned: int
 
 
-def logsumexp_rows(a: np.ndarray) -> np.ndarray:
-    """``log Σ_j exp(a_ij)`` per row, stable; ``−inf`` for a row of ``−inf``."""
-    if a.shape[1] == 0:
-        return np.full(a.shape[0], -np.inf)
-    m = a.max(axis=1)
-    m_safe = np.where(np.isfinite(m), m, 0.0)
-    with np.errstate(divide="ignore"):
-        return np.log(np.exp(a - m_safe[:, None]).sum(axis=1)) + m_safe
-
-
-def gaussian_log_pdf(z: np.ndarray, means: np.ndarray, covariances: np.ndarray) -> np.ndarray:
-    """(n, K) ``log N(z_i; μ_j, Σ_j) = −log 2π − ½ log|Σ| − ½ dᵀΣ⁻¹d`` (this sum order, not
-    :func:`~mhtrack.models.linalg2.gaussian_loglik2`'s, which rounds differently)."""
-    maha, det = _maha_det(z, means, covariances)
-    return -LOG_2PI - 0.5 * np.log(det) - 0.5 * maha
-
-
-def mahalanobis2(z: np.ndarray, means: np.ndarray, covariances: np.ndarray) -> np.ndarray:
-    """(n, K) squared Mahalanobis distances ``dᵀΣ_j⁻¹d`` of every plot to every component."""
-    return _maha_det(z, means, covariances)[0]
-
-
-def _maha_det(z: np.ndarray, means: np.ndarray, cov: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(n, K) ``dᵀΣ_j⁻¹d`` and (K,) ``|Σ_j|`` (``linalg2.sym_mahalanobis2``)."""
-    return sym_mahalanobis2(z[:, 0:1] - means[:, 0], z[:, 1:2] - means[:, 1],
-                            cov[:, 0, 0], cov[:, 0, 1], cov[:, 1, 1])
-
-
 def e_step(
     z: np.ndarray, mix: Mixture, sample_weight: np.ndarray | None = None
 ) -> tuple[float, np.ndarray]:
@@ -197,20 +91,11 @@ def e_step(
     return _mean_ll(norm, sample_weight), np.exp(wlp - norm[:, None])
 
 
-def _weighted(mix: Mixture, glp: np.ndarray, log_bg: np.ndarray) -> np.ndarray:
-    """(n, K+1) ``log π_j + log f_j(z)`` from the Gaussians' (n, K) ``log N`` and the
-    background's (n,) ``log u``: the one formula of :meth:`Mixture.weighted_log_prob`."""
-    out = np.empty((len(log_bg), mix.n_components + 1))
-    with np.errstate(divide="ignore"):
-        out[:, 0] = np.log(mix.background_weight) + log_bg
-        out[:, 1:] = np.log(mix.weights) + glp
-    return out
-
-
 def _mean_ll(norm: np.ndarray, sample_weight: np.ndarray | None) -> float:
-    """``L = (1/Σs) Σ_i s_i log c(z_i)`` from the rows' ``log c``."""
+    """``L = (1/Σs) Σ_i s_i log c(z_i)`` from the plots' ``log c`` (unweighted: ``mean``'s
+    own sum and division, without its wrapper)."""
     if sample_weight is None:
-        return float(norm.mean())
+        return float(np.add.reduce(norm) / len(norm))
     return float(sample_weight @ norm / sample_weight.sum())
 
 
@@ -227,26 +112,47 @@ def m_step(
 
     Returns the new mixture and the effective counts ``n_j`` of the Gaussians.
     """
-    r = resp if sample_weight is None else resp * sample_weight[:, None]
-    nk_all = r.sum(axis=0) + _EPS10
+    mix, nk, _ = _m_step(z, plots_t(z), resp.T, background_box, sample_weight, reg_covar,
+                         background_floor)
+    return mix, nk
+
+
+def _m_step(
+    z: np.ndarray, z_t: np.ndarray, resp_t: np.ndarray,
+    box: tuple[float, float, float, float] | None, sample_weight: np.ndarray | None,
+    reg_covar: float, background_floor: float,
+    sums: tuple[np.ndarray, np.ndarray] | None = None,
+) -> tuple[Mixture, np.ndarray, np.ndarray]:
+    """:func:`m_step` from the (K+1, n) responsibilities, also returning the (2, K, n) offsets
+    ``z_i − μ_j`` to the new means. ``sums``: the row-major (n, K+1) responsibilities and
+    their column sums if at hand (no sample weights). The means are the plot-major
+    ``(r[:, 1:].T @ z) / n_j``: one BLAS product on the row-major operand of the formula."""
+    r_t = resp_t if sample_weight is None else resp_t * sample_weight
+    if sums is None:
+        r = np.ascontiguousarray(r_t.T)
+        sums = r, r.sum(axis=0)
+    r, col = sums
+    k = r_t.shape[0] - 1
+    nk_all = col + _EPS10
     total = nk_all.sum()
     nk = nk_all[1:]
-    rg = r[:, 1:]
-    means = (rg.T @ z) / nk[:, None]
-    dx = z[:, 0:1] - means[:, 0]
-    dy = z[:, 1:2] - means[:, 1]
-    cov = np.empty((len(nk), 2, 2))
-    cov[:, 0, 0] = (rg * dx * dx).sum(axis=0) / nk + reg_covar
-    cov[:, 1, 1] = (rg * dy * dy).sum(axis=0) / nk + reg_covar
-    cov[:, 0, 1] = cov[:, 1, 0] = (rg * dx * dy).sum(axis=0) / nk
-    if background_box is None:
+    means = (r[:, 1:].T @ z) / nk[:, None]
+    d = offsets_t(z_t, means)
+    prods = np.empty((3 * k, len(z)))  # Σ r dx², Σ r dy², Σ r dx dy: one sum of 3K rows
+    rd = r_t[1:] * d  # r dx, r dy
+    np.multiply(rd, d, out=prods[:2 * k].reshape(2, k, -1))
+    np.multiply(rd[0], d[1], out=prods[2 * k:])
+    q = plot_sums(prods, k).reshape(3, k) / nk
+    q[:2] += reg_covar
+    cov = q[[0, 2, 2, 1]].T.reshape(k, 2, 2)  # [[Σxx, Σxy], [Σxy, Σyy]]
+    if box is None:
         w0 = 0.0
         w = nk / nk.sum()
     else:
         w0 = max(nk_all[0] / total, background_floor)
         g = nk.sum()
         w = (1.0 - w0) * nk / g if g > 0 else nk * 0.0
-    return Mixture(w, means, cov, float(w0), background_box), nk
+    return Mixture(w, means, cov, float(w0), box), nk, d
 
 
 def _drop(mix: Mixture, keep: np.ndarray) -> Mixture:
@@ -272,6 +178,7 @@ def fit_em(
     background_floor: float = 0.0,
     min_contrast: float = 0.0,
     bic: bool = False,
+    init_log_pdf: np.ndarray | None = None,
 ) -> EMResult:
     """Run EM (P1 eqs. 9–11, plus optional pruning, P1 step c) from ``init``.
 
@@ -291,60 +198,75 @@ def fit_em(
     bic : with a background, delete Gaussians whose :func:`removal_gain` is below the BIC
         price of their six parameters (2 mean, 3 covariance, 1 weight),
         ``½·6·ln n = 3 ln n`` nats for ``n`` (weighted) plots (Schwarz 1978).
+    init_log_pdf : (K, n) log-densities ``log N(z_i; μ_j, Σ_j)`` of ``init``'s Gaussians
+        (:func:`~mhtrack.clutter.density.log_pdf_t`) when the caller has them.
 
     With ``prune=None``, ``min_points=0``, no background and no sample weights, this is
     scikit-learn's ``GaussianMixture(covariance_type="full")`` EM from the same
     initialisation: after ``max_iter`` iterations ``log_likelihood`` equals its ``score``.
     """
-    # Each mixture's (n, K) Gaussian log-densities are computed once: the E-step of the
-    # next iteration, the BIC test and the final L reuse them, and a deletion keeps the
-    # surviving columns (elementwise formulas: the same floats as recomputing them).
-    log_bg = init.log_background(z)  # the box is fixed
-    mix = init
-    wlp = _weighted(mix, gaussian_log_pdf(z, mix.means, mix.covariances), log_bg)
-    norm: np.ndarray | None = None
-    resp: np.ndarray | None = None
-    prev = -np.inf
-    converged = False
-    n_pruned = 0
-    n_iter = 0
-    for n_iter in range(1, max_iter + 1):  # noqa: B007
-        if norm is None or resp is None:  # E-step (P1 eq. 9)
-            norm = logsumexp_rows(wlp)
-            resp = np.exp(wlp - norm[:, None])
-        ll = _mean_ll(norm, sample_weight)
-        mix, nk = m_step(z, resp, mix.background_box, sample_weight=sample_weight,
-                         reg_covar=reg_covar, background_floor=background_floor)
-        glp = gaussian_log_pdf(z, mix.means, mix.covariances)
-        wlp, norm, resp = _weighted(mix, glp, log_bg), None, None
-        keep = nk >= min_points
-        if min_contrast > 0 and mix.background_box is not None:
-            peak = mix.weights / (2.0 * np.pi * np.sqrt(det2(mix.covariances)))
-            keep &= peak >= min_contrast * mix.background_weight / mix.background_area
-        if bic and mix.background_box is not None and mix.n_components:
-            n_eff = float(len(z) if sample_weight is None else sample_weight.sum())
-            norm = logsumexp_rows(wlp)
-            resp = np.exp(wlp - norm[:, None])
-            gain = _removal_gain(mix, resp[:, 1:], norm, log_bg, sample_weight)
-            keep &= gain >= 3.0 * np.log(max(n_eff, 1.0))
-        if prune is not None and keep.any():
-            w = np.where(keep, mix.weights, 0.0)
-            keep &= prune(w / w.sum())
-        deleted = int((~keep).sum())
-        if deleted and not (keep.any() or mix.background_box is not None):
-            deleted = 0  # nothing would be left: keep the components, not an empty model
-        if deleted:
-            mix = _drop(mix, keep)
-            n_pruned += deleted
-            wlp, norm, resp = _weighted(mix, glp[:, keep], log_bg), None, None
-        if mix.n_components == 0:
-            break
-        if not deleted and abs(ll - prev) < tol * abs(prev):
-            converged = True
-            break
-        prev = ll
-    final = float(np.average(logsumexp_rows(wlp) if norm is None else norm,
-                             weights=sample_weight))
+    # Each mixture's Gaussian log-densities are computed once: the E-step of the next
+    # iteration, the BIC test and the final L reuse them, and a deletion keeps the
+    # surviving rows (elementwise formulas: the same floats as recomputing them). The
+    # M-step's offsets z − μ and the determinants serve the densities and the contrast
+    # test. Every float is the one the plain loop over e_step/m_step gives
+    # (tests/clutter/test_em.py).
+    z_t = plots_t(z)
+    with np.errstate(divide="ignore"):
+        log_bg = init.log_background(z)  # the box is fixed
+        # inside the box log u is one number (the usual case: the box holds the data)
+        bg0 = log_bg[0] if len(log_bg) and (log_bg == log_bg[0]).all() else None
+        price = 3.0 * np.log(max(float(len(z) if sample_weight is None
+                                       else sample_weight.sum()), 1.0)) if bic else 0.0
+        mix = init
+        glp = init_log_pdf
+        if glp is None:
+            glp = log_pdf_t(*maha_det_t(*offsets_t(z_t, mix.means), mix.covariances))
+        wlp = weighted_t(mix, glp, log_bg)
+        norm: np.ndarray | None = None
+        resp: np.ndarray | None = None
+        sums: tuple[np.ndarray, np.ndarray] | None = None
+        prev = -np.inf
+        converged = False
+        n_pruned = 0
+        n_iter = 0
+        for n_iter in range(1, max_iter + 1):  # noqa: B007
+            if norm is None or resp is None:  # E-step (P1 eq. 9)
+                norm = _lse_t(wlp)
+                resp = np.exp(wlp - norm)
+            ll = _mean_ll(norm, sample_weight)
+            mix, nk, dxy = _m_step(z, z_t, resp, mix.background_box, sample_weight,
+                                   reg_covar, background_floor, sums)
+            maha, det = maha_det_t(*dxy, mix.covariances)
+            glp = log_pdf_t(maha, det)
+            wlp, norm, resp, sums = weighted_t(mix, glp, log_bg), None, None, None
+            keep = nk >= min_points
+            if min_contrast > 0 and mix.background_box is not None:
+                peak = mix.weights / (2.0 * np.pi * np.sqrt(det[:, 0]))  # det2(Σ) = |Σ|
+                keep &= peak >= min_contrast * mix.background_weight / mix.background_area
+            if bic and mix.background_box is not None and mix.n_components:
+                norm = _lse_t(wlp)
+                resp, gain, sums = _e_step_gain(mix, wlp, norm, log_bg, sample_weight, bg0)
+                keep &= gain >= price
+            if prune is not None and keep.any():
+                w = np.where(keep, mix.weights, 0.0)
+                keep &= prune(w / w.sum())
+            deleted = len(keep) - int(np.count_nonzero(keep))
+            if deleted and not (keep.any() or mix.background_box is not None):
+                deleted = 0  # nothing would be left: keep the components, not an empty model
+            if deleted:
+                mix = _drop(mix, keep)
+                n_pruned += deleted
+                wlp, norm, resp, sums = weighted_t(mix, glp[keep], log_bg), None, None, None
+            if mix.n_components == 0:
+                break
+            if not deleted and abs(ll - prev) < tol * abs(prev):
+                converged = True
+                break
+            prev = ll
+        last = _lse_t(wlp) if norm is None else norm
+    final = (_mean_ll(last, None) if sample_weight is None
+             else float(np.average(last, weights=sample_weight)))
     return EMResult(mix, final, n_iter, converged, n_pruned)
 
 
@@ -360,18 +282,54 @@ def removal_gain(
     denser than elsewhere, gains many nats. Needs a background box."""
     wlp = mix.weighted_log_prob(z)
     norm = logsumexp_rows(wlp)
-    return _removal_gain(mix, np.exp(wlp[:, 1:] - norm[:, None]), norm,
-                         mix.log_background(z), sample_weight)
+    with np.errstate(divide="ignore"):
+        return _removal_gain(mix, np.exp(wlp[:, 1:] - norm[:, None]).T, norm,
+                             mix.log_background(z), sample_weight)
+
+
+def _e_step_gain(
+    mix: Mixture, wlp: np.ndarray, norm: np.ndarray, log_bg: np.ndarray,
+    sample_weight: np.ndarray | None, bg0: float | None,
+) -> tuple[np.ndarray, np.ndarray, tuple[np.ndarray, np.ndarray] | None]:
+    """The (K+1, n) responsibilities ``exp(wlp − norm)``, :func:`removal_gain` and, for the
+    next M-step, the row-major responsibilities with their column sums. The responsibilities
+    and the terms of the gain sit side by side in one (n, 2K+1) row-major array summed once
+    (:func:`~mhtrack.clutter.density.plot_sums`: each column as alone, for K ≥ 2)."""
+    k = mix.n_components
+    if sample_weight is not None or k < 2:
+        resp = np.exp(wlp - norm)
+        return resp, _removal_gain(mix, resp[1:], norm, log_bg, sample_weight, bg0), None
+    both = np.empty((2 * k + 1, len(norm)))
+    resp = np.exp(wlp - norm, out=both[:k + 1])
+    _neg_log_ratio(mix, resp[1:], norm, log_bg, bg0, both[k + 1:])
+    nat = np.ascontiguousarray(both.T)
+    col = nat.sum(axis=0)
+    return resp, col[k + 1:], (np.ascontiguousarray(nat[:, :k + 1]), col[:k + 1])
 
 
 def _removal_gain(
     mix: Mixture, resp: np.ndarray, norm: np.ndarray, log_bg: np.ndarray,
-    sample_weight: np.ndarray | None,
+    sample_weight: np.ndarray | None, bg0: float | None = None,
 ) -> np.ndarray:
-    """:func:`removal_gain` from the Gaussians' (n, K) responsibilities, the rows'
-    ``log c(z_i)`` and the background's ``log u(z_i)``."""
-    with np.errstate(divide="ignore"):
-        to_bg = np.exp(np.log(mix.weights)[None, :] + log_bg[:, None] - norm[:, None])
-    ratio = np.maximum(1.0 - resp + to_bg, 1e-300)
-    per = -np.log(ratio)
-    return per.sum(axis=0) if sample_weight is None else sample_weight @ per
+    """:func:`removal_gain` from the Gaussians' (K, n) responsibilities, the plots'
+    ``log c(z_i)`` and the background's ``log u(z_i)`` (``bg0``: its value if the same for
+    every plot). The caller ignores divide-by-zero warnings (``log π_j = −∞``)."""
+    per = _neg_log_ratio(mix, resp, norm, log_bg, bg0, np.empty(resp.shape))
+    if sample_weight is None:
+        return plot_sums(per, len(per))
+    return sample_weight @ np.ascontiguousarray(per.T)
+
+
+def _neg_log_ratio(mix: Mixture, resp: np.ndarray, norm: np.ndarray, log_bg: np.ndarray,
+                   bg0: float | None, out: np.ndarray) -> np.ndarray:
+    """(K, n) terms ``−log max(1 − r_ij + π_j u(z_i)/c(z_i), 1e−300)`` of the gain, in
+    ``out``."""
+    if bg0 is None:
+        to_bg = np.exp(np.log(mix.weights)[:, None] + log_bg - norm)
+    else:  # (log π_j + log u) − log c per element, as above, with log u one number
+        to_bg = np.exp((np.log(mix.weights) + bg0)[:, None] - norm)
+    np.subtract(1.0, resp, out=out)
+    out += to_bg
+    np.maximum(out, 1e-300, out=out)
+    np.log(out, out=out)
+    return np.negative(out, out=out)

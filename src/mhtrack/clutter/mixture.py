@@ -27,7 +27,8 @@ from typing import Any, Literal
 import numpy as np
 
 from mhtrack.clutter.base import ClutterEstimator
-from mhtrack.clutter.em import Mixture, PruneRule, fit_em, mahalanobis2
+from mhtrack.clutter.density import log_pdf_t, maha_det_t, offsets_t, plots_t
+from mhtrack.clutter.em import Mixture, PruneRule, fit_em
 from mhtrack.clutter.seeding import kmeanspp_centres, mixture_from_centres
 from mhtrack.models.clutter import Region
 from mhtrack.records import Scan
@@ -194,11 +195,12 @@ class MixtureClutter(ClutterEstimator):
         if in_track_gates is not None and self.source == "outside-gates":
             kept = kept[~mask]
             z = z[kept]
-        rng = np.random.default_rng(np.random.SeedSequence(self.seed, spawn_key=(self.n_updates_,)))
+        rng = _LazyRng(self.seed, self.n_updates_)
         self.n_updates_ += 1
         self._window.append(z.copy())
         self._kept = kept
-        self.count_ = float(np.mean([len(w) for w in self._window]))  # Poisson ML
+        # Poisson ML: the mean count (integer sum, exact as np.mean's float sum)
+        self.count_ = float(sum(len(w) for w in self._window)) / len(self._window)
         pooled = np.concatenate(self._window) if len(self._window) > 1 else self._window[0]
         if len(pooled) == 0:
             self.mixture_ = None
@@ -206,18 +208,18 @@ class MixtureClutter(ClutterEstimator):
             self.log_likelihood_ = float("nan")
             return
         if len(pooled) > self.max_points:
-            keep = np.sort(rng.choice(len(pooled), self.max_points, replace=False))
+            keep = np.sort(rng().choice(len(pooled), self.max_points, replace=False))
             self.n_subsampled_ += len(pooled) - self.max_points
             pooled = pooled[keep]
         box = self._box(pooled)
-        init = self._warm_init(pooled, box, rng) if self.warm_start else None
+        init, glp = self._warm_init(pooled, box, rng) if self.warm_start else (None, None)
         if init is None:
-            init = self._cold_init(pooled, box, rng)
+            init = self._cold_init(pooled, box, rng())
         res = fit_em(
             pooled, init, reg_covar=self.reg_covar, tol=self.tol, max_iter=self.max_iter,
             prune=self._prune_rule(), min_points=self.min_points,
             background_floor=self.background_floor, min_contrast=self.min_contrast,
-            bic=self.bic,
+            bic=self.bic, init_log_pdf=glp,
         )
         self.mixture_ = res.mixture
         self.n_iter_, self.converged_ = res.n_iter, res.converged
@@ -298,7 +300,8 @@ class MixtureClutter(ClutterEstimator):
             return None
         if self.region is not None:
             return self.region.as_tuple()
-        lo, hi = z.min(axis=0), z.max(axis=0)
+        x, y = z[:, 0], z[:, 1]  # per column: the same extremes, faster than axis=0
+        lo, hi = np.array([x.min(), y.min()]), np.array([x.max(), y.max()])
         mid, half = 0.5 * (lo + hi), 0.5 * (hi - lo) * 1.1
         half = np.maximum(half, 0.5 * self.min_extent)
         return (float(mid[0] - half[0]), float(mid[0] + half[0]),
@@ -318,25 +321,46 @@ class MixtureClutter(ClutterEstimator):
 
     def _warm_init(
         self, z: np.ndarray, box: tuple[float, float, float, float] | None,
-        rng: np.random.Generator,
-    ) -> Mixture | None:
-        """Previous Gaussians + new ones seeded among unexplained plots (``None``: cold)."""
+        rng: _LazyRng,
+    ) -> tuple[Mixture | None, np.ndarray | None]:
+        """Previous Gaussians + new ones seeded among unexplained plots (``None``: cold),
+        with the (K, n) log-densities of its Gaussians at ``z`` (for :func:`fit_em`)."""
         prev = self.mixture_
         if prev is None or prev.n_components == 0:
-            return None
+            return None, None
         bg = max(prev.background_weight, self._start_weight()) if self.background else 0.0
         w = prev.weights * (1.0 - bg) / prev.weights.sum()
         means, cov = prev.means, prev.covariances
+        z_t = plots_t(z)
+        maha, det = maha_det_t(*offsets_t(z_t, means), cov)
+        glp = log_pdf_t(maha, det)
         free = self.n_components - prev.n_components
         if free > 0:
-            far = mahalanobis2(z, means, cov).min(axis=1) > CHI2_2_99
+            far = maha.min(axis=0) > CHI2_2_99
             if far.sum() >= max(self.min_points, 1.0):
                 novel = z[far]
-                centres = kmeanspp_centres(novel, free, rng, existing=means)
+                centres = kmeanspp_centres(novel, free, rng(), existing=means)
                 if len(centres):
                     new = mixture_from_centres(novel, centres, reg_covar=self.reg_covar)
-                    share = far.mean()  # the novel plots' share of the data
+                    share = float(novel.shape[0]) / len(far)  # novel plots' share: mean(far)
                     w = np.concatenate((w * (1.0 - share), new.weights * share * (1.0 - bg)))
                     means = np.concatenate((means, new.means))
                     cov = np.concatenate((cov, new.covariances))
-        return Mixture(w, means, cov, bg, box)
+                    glp = np.concatenate((glp, log_pdf_t(*maha_det_t(
+                        *offsets_t(z_t, new.means), new.covariances))))
+        return Mixture(w, means, cov, bg, box), glp
+
+
+class _LazyRng:
+    """The scan's generator ``default_rng(SeedSequence(seed, spawn_key=(u,)))``, made on
+    first call (most warm-started scans draw nothing) and the same one after."""
+
+    def __init__(self, seed: int, u: int) -> None:
+        self._key = (seed, u)
+        self._rng: np.random.Generator | None = None
+
+    def __call__(self) -> np.random.Generator:
+        if self._rng is None:
+            seed, u = self._key
+            self._rng = np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(u,)))
+        return self._rng

@@ -15,21 +15,24 @@ def kmeanspp_centres(
     (Arthur & Vassilvitskii 2007; the first one uniformly unless ``existing`` centres are
     given, to which distances are then measured). Stops early when every remaining plot
     sits on a centre (``D² = 0``), so identical plots give one centre."""
+    # NumPy's reductions called directly (the ones .sum/.min/cumsum call): same floats
+    add = np.add
     chosen: list[np.ndarray] = []
     if existing is not None and len(existing):
-        d2 = ((z[:, None, :] - existing[None, :, :]) ** 2).sum(axis=2).min(axis=1)
+        d2 = np.minimum.reduce(add.reduce((z[:, None, :] - existing[None, :, :]) ** 2,
+                                          axis=2), axis=1)
     else:
         first = z[int(rng.integers(len(z)))]
         chosen.append(first)
-        d2 = ((z - first) ** 2).sum(axis=1)
+        d2 = add.reduce((z - first) ** 2, axis=1)
     while len(chosen) < k:
-        total = d2.sum()
+        total = add.reduce(d2)
         if not total > 0:
             break
-        i = int(np.searchsorted(np.cumsum(d2), rng.random() * total, side="right"))
+        i = int(add.accumulate(d2).searchsorted(rng.random() * total, side="right"))
         c = z[min(i, len(z) - 1)]
         chosen.append(c)
-        d2 = np.minimum(d2, ((z - c) ** 2).sum(axis=1))
+        d2 = np.minimum(d2, add.reduce((z - c) ** 2, axis=1))
     return np.array(chosen, float).reshape(-1, 2)
 
 
@@ -49,16 +52,29 @@ def mixture_from_centres(
     d2 = ((z[:, None, :] - centres[None, :, :]) ** 2).sum(axis=2)
     lab = d2.argmin(axis=1)
     counts = np.bincount(lab, minlength=k).astype(float)
-    data_cov = np.cov(z.T, bias=True).reshape(2, 2) if len(z) > 1 else np.zeros((2, 2))
-    broad = data_cov / k + reg_covar * np.eye(2)
+    reg = reg_covar * np.eye(2)
     means = centres.astype(float).copy()
-    cov = np.repeat(broad[None], k, axis=0)
+    cov = np.empty((k, 2, 2))
+    if (counts < 3).any():  # some centre keeps the broad covariance
+        data_cov = _cov_biased(z) if len(z) > 1 else np.zeros((2, 2))
+        cov[:] = data_cov / k + reg
     for j in np.flatnonzero(counts >= 1):
         pts = z[lab == j]
-        means[j] = pts.mean(axis=0)
+        means[j] = np.add.reduce(pts, axis=0) / len(pts)  # pts.mean(axis=0)
         if len(pts) >= 3:
             d = pts - means[j]
-            cov[j] = d.T @ d / len(pts) + reg_covar * np.eye(2)
+            cov[j] = d.T @ d / len(pts) + reg
     w = np.maximum(counts, 1e-3)
     w = (1.0 - background_weight) * w / w.sum()
     return Mixture(w, means, cov, float(background_weight), background_box)
+
+
+def _cov_biased(z: np.ndarray) -> np.ndarray:
+    """``np.cov(z.T, bias=True)`` of (n ≥ 2, 2) plots: NumPy's own steps for this case
+    (copy, subtract the row means, ``dot(X, Xᵀ)``, times ``1/n``), without its argument
+    handling — the same floats."""
+    x = np.array(z.T, ndmin=2, dtype=np.float64)
+    x -= x.mean(axis=1)[:, None]
+    c = np.dot(x, x.T.conj())
+    c *= np.true_divide(1, x.shape[1])
+    return c

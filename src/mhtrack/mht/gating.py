@@ -7,7 +7,9 @@ For a predicted leaf ``(x⁻, P⁻)`` and a plot ``z`` with covariance ``R``::
 
 ``d²`` is χ² with 2 degrees of freedom, so ``γ = −2 ln(1 − P_G)`` holds a fraction ``P_G``
 of true plots (:func:`gate_threshold`). The pairs are found by a sweep over plot strips
-(:func:`gate_sweep`) without forming the M × N matrix; :class:`Gate` is the tracker's
+(:func:`gate_sweep`) without forming the M × N matrix — or, when M × N is small
+(≤ :data:`DENSE_MAX_PAIRS`), on that whole matrix at once, which costs fewer NumPy calls
+and gives the same pairs and floats; :class:`Gate` is the tracker's
 stage: the work budget ``max_gated_pairs`` and the motion model's likelihood for the score.
 """
 
@@ -44,6 +46,11 @@ class Gated:
 
     def __len__(self) -> int:
         return len(self.track)
+
+
+#: Largest ``M × N`` (tracks × plots) tested as one dense matrix by :func:`gate_sweep`
+#: (a few NumPy calls on arrays of this size cost less than the sweep's bookkeeping).
+DENSE_MAX_PAIRS = 8192
 
 
 def plot_covariances(R: np.ndarray, n: int) -> tuple[np.ndarray, bool]:
@@ -123,7 +130,30 @@ def gate_sweep(
     if len(x) == 0 or len(z) == 0:
         e = np.zeros(0, np.int64)
         return Gated(e, e, np.zeros(0), np.zeros(0))
+    if len(x) * len(z) <= DENSE_MAX_PAIRS:
+        return _dense_pairs(x, P, z, R, shared, gamma)
     return _pairs_in_boxes(x, P, z, R, shared, gamma, _sweep_boxes(x, P, z, R, shared, gamma))
+
+
+def _dense_pairs(
+    x: np.ndarray, P: np.ndarray, z: np.ndarray, R: np.ndarray, shared: bool, gamma: float
+) -> Gated:
+    """The exact test of :func:`gate_sweep` on every (track, plot) pair as an (M, N)
+    matrix: the same elementwise operations on the same operands as
+    :func:`_pairs_in_boxes` (so the same floats), pairs in row-major order — by track,
+    then plot."""
+    Rb = R if shared else R.transpose(1, 2, 0)  # (2, 2) or (2, 2, N)
+    s00 = P[:, 0, 0][:, None] + Rb[0, 0]
+    s01 = P[:, 0, 2][:, None] + Rb[0, 1]
+    s11 = P[:, 2, 2][:, None] + Rb[1, 1]
+    n0 = z[:, 0] - x[:, 0][:, None]
+    n1 = z[:, 1] - x[:, 2][:, None]
+    d2, det = sym_mahalanobis2(n0, n1, s00, s01, s11)
+    keep = d2 <= gamma
+    ti, pj = np.nonzero(keep)
+    d2 = d2[keep]
+    det = det[ti, 0] if shared else det[keep]
+    return Gated(ti, pj, d2, gaussian_loglik2(d2, det))
 
 
 def _pairs_in_boxes(

@@ -37,6 +37,8 @@ def miss_increments(p_detection: np.ndarray, gate_probability: float | None = No
     once per distinct ``P_D`` with :func:`miss_increment`, so a constant ``P_D`` gives
     exactly the scalar increment."""
     pd = np.asarray(p_detection, float)
+    if pd.size and (pd == pd.flat[0]).all():  # one P_D (every leaf looked at alike)
+        return np.full(pd.shape, miss_increment(float(pd.flat[0]), gate_probability))
     values, inverse = np.unique(pd, return_inverse=True)
     return np.array([miss_increment(float(v), gate_probability) for v in values],
                     float)[inverse.reshape(-1)] if pd.size else np.zeros(0)

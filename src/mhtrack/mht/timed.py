@@ -43,9 +43,11 @@ def split_looked(leaves: Leaves, looks: Looks) -> tuple[Leaves, Looks, Leaves]:
     """``(looked, their looks, idle)``: the leaves of the trees the frame looked at
     (``P_D > 0`` at one of their leaves) and the others (the same objects when every tree
     was looked at)."""
+    if (looks.pd > 0).all():  # every leaf looked at: no tree is carried
+        return leaves, looks, leaves.take(slice(0, 0))
     mask = looked_trees(leaves.tree, looks.pd)
     if mask.all():
-        return leaves, looks, leaves.take(np.zeros(0, np.int64))
+        return leaves, looks, leaves.take(slice(0, 0))
     return (leaves.take(mask), Looks(looks.pd[mask], looks.certain[mask]),
             leaves.take(~mask))
 

@@ -79,14 +79,15 @@ class Leaves:
                    np.zeros((0, width), np.int64), np.zeros(0, bool), np.zeros((0, r)),
                    np.zeros((0, r, 4)), np.zeros((0, r, 4, 4)), i, i, f)
 
-    def take(self, idx: np.ndarray) -> Leaves:
-        """Rows ``idx`` (an index array or boolean mask), in that order."""
-        return Leaves(*(getattr(self, f.name)[idx] for f in fields(self)))
+    def take(self, idx: np.ndarray | slice) -> Leaves:
+        """Rows ``idx`` (an index array, boolean mask or slice), in that order."""
+        return Leaves(*[getattr(self, f)[idx] for f in _FIELDS])
 
     @classmethod
     def concat(cls, a: Leaves, b: Leaves) -> Leaves:
-        return cls(*(np.concatenate((getattr(a, f.name), getattr(b, f.name)))
-                     for f in fields(cls)))
+        if len(b) == 0:  # the arrays are never written in place: share them
+            return a
+        return cls(*[np.concatenate((getattr(a, f), getattr(b, f))) for f in _FIELDS])
 
     def arrays(self) -> dict[str, np.ndarray]:
         """The columns by name (for saving)."""
@@ -108,6 +109,9 @@ class Leaves:
     @property
     def n_trees(self) -> int:
         return int(segment_starts(self.tree).size)
+
+
+_FIELDS = tuple(f.name for f in fields(Leaves))
 
 
 def segment_starts(sorted_keys: np.ndarray) -> np.ndarray:

@@ -82,15 +82,16 @@ def _sweep_boxes(
     width = max(2 * float(hx.mean()), float(np.ptp(z[:, 0])) / (4 * np.sqrt(N) + 1), 1e-6)
     col = np.floor((z[:, 0] - x0) / width).astype(np.int64)
     order = np.lexsort((z[:, 1], col))
-    key = col[order] * height + (z[order, 1] - y0)
+    key = col[order] * height + (z[:, 1].take(order) - y0)
     n_cols = int(col.max()) + 1
     c_lo = np.clip(np.floor((x[:, 0] - hx - x0) / width).astype(np.int64), 0, n_cols)
     c_hi = np.clip(np.floor((x[:, 0] + hx - x0) / width).astype(np.int64), -1, n_cols - 1)
     nc = np.maximum(c_hi - c_lo + 1, 0)
     tq = np.repeat(np.arange(M, dtype=np.int64), nc)
     cq = np.repeat(c_lo - np.cumsum(nc) + nc, nc) + np.arange(int(nc.sum()))
-    ylo = np.clip(x[tq, 2] - hy[tq] - y0, -0.5, height - 0.5)
-    yhi = np.clip(x[tq, 2] + hy[tq] - y0, -0.5, height - 0.5)
+    xq, hq = x[:, 2].take(tq), hy.take(tq)
+    ylo = np.clip(xq - hq - y0, -0.5, height - 0.5)
+    yhi = np.clip(xq + hq - y0, -0.5, height - 0.5)
     lo = np.searchsorted(key, cq * height + ylo, side="left")
     hi = np.searchsorted(key, cq * height + yhi, side="right")
     return tq, lo, hi, order
@@ -172,15 +173,15 @@ def _pairs_in_boxes(
     if ti.size == 0:
         return Gated(e, e, np.zeros(0), np.zeros(0))
     if shared:
-        s00 = P[ti, 0, 0] + R[0, 0]
-        s01 = P[ti, 0, 2] + R[0, 1]
-        s11 = P[ti, 2, 2] + R[1, 1]
+        s00 = P[:, 0, 0].take(ti) + R[0, 0]
+        s01 = P[:, 0, 2].take(ti) + R[0, 1]
+        s11 = P[:, 2, 2].take(ti) + R[1, 1]
     else:
-        s00 = P[ti, 0, 0] + R[pj, 0, 0]
-        s01 = P[ti, 0, 2] + R[pj, 0, 1]
-        s11 = P[ti, 2, 2] + R[pj, 1, 1]
-    n0 = z[pj, 0] - x[ti, 0]
-    n1 = z[pj, 1] - x[ti, 2]
+        s00 = P[:, 0, 0].take(ti) + R[:, 0, 0].take(pj)
+        s01 = P[:, 0, 2].take(ti) + R[:, 0, 1].take(pj)
+        s11 = P[:, 2, 2].take(ti) + R[:, 1, 1].take(pj)
+    n0 = z[:, 0].take(pj) - x[:, 0].take(ti)
+    n1 = z[:, 1].take(pj) - x[:, 2].take(ti)
     d2, det = sym_mahalanobis2(n0, n1, s00, s01, s11)
     keep = d2 <= gamma
     ti, pj, d2, det = ti[keep], pj[keep], d2[keep], det[keep]

@@ -95,8 +95,8 @@ def gate_timed(gate: Gate, leaves: Leaves, pred: States, z: np.ndarray, R: np.nd
     coarse = gate.pairs(leaves, pred.x, Pc, z, 2.0 * R, caps)
     ti, pj = coarse.track, coarse.plot
     pp = motion.predict(leaves.states().take(ti), t[pj] - leaves.time[ti])
-    Rp = R if R.ndim == 2 else R[pj]
-    d2, det = sym_mahalanobis2(z[pj, 0] - pp.x[:, 0], z[pj, 1] - pp.x[:, 2],
+    Rp = R if R.ndim == 2 else R.take(pj, axis=0)
+    d2, det = sym_mahalanobis2(z[:, 0].take(pj) - pp.x[:, 0], z[:, 1].take(pj) - pp.x[:, 2],
                                pp.P[:, 0, 0] + Rp[..., 0, 0], pp.P[:, 0, 2] + Rp[..., 0, 1],
                                pp.P[:, 2, 2] + Rp[..., 1, 1])
     keep = np.flatnonzero(d2 <= gamma)

@@ -16,7 +16,7 @@ from dataclasses import dataclass, fields
 
 import numpy as np
 
-from mhtrack.models.motion import POS, VEL, States
+from mhtrack.models.motion import States, row_index
 
 NO_PLOT = -1
 
@@ -81,7 +81,10 @@ class Leaves:
 
     def take(self, idx: np.ndarray | slice) -> Leaves:
         """Rows ``idx`` (an index array, boolean mask or slice), in that order."""
-        return Leaves(*[getattr(self, f)[idx] for f in _FIELDS])
+        if isinstance(idx, slice):
+            return Leaves(*[getattr(self, f)[idx] for f in _FIELDS])
+        idx = row_index(idx)
+        return Leaves(*[getattr(self, f).take(idx, axis=0) for f in _FIELDS])
 
     @classmethod
     def concat(cls, a: Leaves, b: Leaves) -> Leaves:
@@ -145,10 +148,11 @@ def one_point_state(z: np.ndarray, R: np.ndarray, v_max: float) -> tuple[np.ndar
     but bounded by ``v_max`` at 2σ)."""
     n = len(z)
     x = np.zeros((n, 4))
-    x[:, POS] = z
+    x[:, 0], x[:, 2] = z[:, 0], z[:, 1]
     P = np.zeros((n, 4, 4))
-    P[:, POS[:, None], POS[None, :]] = R
-    P[:, VEL, VEL] = (0.5 * v_max) ** 2
+    P[:, 0, 0], P[:, 0, 2] = R[..., 0, 0], R[..., 0, 1]
+    P[:, 2, 0], P[:, 2, 2] = R[..., 1, 0], R[..., 1, 1]
+    P[:, 1, 1] = P[:, 3, 3] = (0.5 * v_max) ** 2
     return x, P
 
 

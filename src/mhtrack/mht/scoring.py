@@ -39,9 +39,11 @@ def miss_increments(p_detection: np.ndarray, gate_probability: float | None = No
     pd = np.asarray(p_detection, float)
     if pd.size and (pd == pd.flat[0]).all():  # one P_D (every leaf looked at alike)
         return np.full(pd.shape, miss_increment(float(pd.flat[0]), gate_probability))
-    values, inverse = np.unique(pd, return_inverse=True)
-    return np.array([miss_increment(float(v), gate_probability) for v in values],
-                    float)[inverse.reshape(-1)] if pd.size else np.zeros(0)
+    if pd.size == 0:
+        return np.zeros(0)
+    values = np.unique(pd)  # sorted; the increment of each, then per leaf by its P_D
+    inc = np.array([miss_increment(float(v), gate_probability) for v in values], float)
+    return inc.take(np.searchsorted(values, pd.reshape(-1)))
 
 
 def update_increment(

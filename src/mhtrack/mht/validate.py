@@ -45,11 +45,17 @@ def validate_scan(
     R = np.asarray(scan.R, dtype=float)
     if R.shape != (n, 2, 2):
         raise ValueError(f"scan {scan.index}: R has shape {R.shape}, expected ({n}, 2, 2)")
-    unset = np.isnan(R).all(axis=(1, 2))  # PlotTable.from_scans: "use the tracker's R"
-    if unset.any():
-        R = R.copy()
-        R[unset] = default_R
-    bad = ~(np.isfinite(R).all(axis=(1, 2)) & (R[:, 0, 0] > 0) & (det2(R) > 0))
+    finite = bool(np.isfinite(R).all())
+    if not finite:
+        unset = np.isnan(R).all(axis=(1, 2))  # PlotTable.from_scans: "use the tracker's R"
+        if unset.any():
+            R = R.copy()
+            R[unset] = default_R
+            finite = bool(np.isfinite(R).all())
+    good = (R[:, 0, 0] > 0) & (det2(R) > 0)
+    if not finite:
+        good &= np.isfinite(R).all(axis=(1, 2))
+    bad = ~good
     if bad.any():
         i = int(np.flatnonzero(bad)[0])
         raise ValueError(

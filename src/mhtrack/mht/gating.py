@@ -150,10 +150,11 @@ def _dense_pairs(
     n0 = z[:, 0] - x[:, 0][:, None]
     n1 = z[:, 1] - x[:, 2][:, None]
     d2, det = sym_mahalanobis2(n0, n1, s00, s01, s11)
-    keep = d2 <= gamma
-    ti, pj = np.nonzero(keep)
-    d2 = d2[keep]
-    det = det[ti, 0] if shared else det[keep]
+    flat = np.flatnonzero(d2 <= gamma)  # row-major: by track, then plot
+    ti = flat // len(z)
+    pj = flat - ti * len(z)
+    d2 = d2.ravel().take(flat)
+    det = det.ravel().take(ti if shared else flat)  # (M, 1) when R is shared
     return Gated(ti, pj, d2, gaussian_loglik2(d2, det))
 
 

@@ -121,8 +121,9 @@ class CVModelSet(MotionModel):
         """The mixture likelihood ``ln Σ_j μ̄_j N(z; H x⁻_j, S_j)`` of the gated pairs."""
         if len(track) == 0:
             return loglik
-        ll = model_logliks(pred.xm.take(track, axis=0), pred.Pm.take(track, axis=0),
-                           z.take(plot, axis=0), R if R.ndim == 2 else R.take(plot, axis=0))
+        # only the position terms of each pair's leaf are copied, not its whole state
+        terms = [t.take(track, axis=0) for t in _position_terms(pred.xm, pred.Pm)]
+        ll = _logliks(terms, z.take(plot, axis=0), R if R.ndim == 2 else R.take(plot, axis=0))
         return mixture_loglik(pred.mu.take(track, axis=0), ll)
 
     def new_states(self, x: np.ndarray, P: np.ndarray) -> States:
@@ -171,13 +172,25 @@ def combine(xm: np.ndarray, Pm: np.ndarray, mu: np.ndarray) -> tuple[np.ndarray,
 def model_logliks(xm: np.ndarray, Pm: np.ndarray, z: np.ndarray, R: np.ndarray) -> np.ndarray:
     """Per row and model, ``ln N(z; H x_j, H P_j Hᵀ + R)``: ``xm`` (K, r, 4), ``Pm``
     (K, r, 4, 4), ``z`` (K, 2), ``R`` (2, 2) or (K, 2, 2). Returns (K, r)."""
+    return _logliks(_position_terms(xm, Pm), z, R)
+
+
+def _position_terms(xm: np.ndarray, Pm: np.ndarray) -> tuple[np.ndarray, ...]:
+    """What the plot likelihood reads of each model's state: ``x, y, Pxx, Pxy, Pyy``."""
+    return xm[..., 0], xm[..., 2], Pm[..., 0, 0], Pm[..., 0, 2], Pm[..., 2, 2]
+
+
+def _logliks(terms: tuple[np.ndarray, ...] | list[np.ndarray], z: np.ndarray,
+             R: np.ndarray) -> np.ndarray:
+    """:func:`model_logliks` from the :func:`_position_terms` (K, r) of the rows."""
+    x, y, pxx, pxy, pyy = terms
     R = np.asarray(R, float)
     Rb = R if R.ndim == 2 else R[:, None]
-    s00 = Pm[..., 0, 0] + Rb[..., 0, 0]
-    s01 = Pm[..., 0, 2] + Rb[..., 0, 1]
-    s11 = Pm[..., 2, 2] + Rb[..., 1, 1]
-    n0 = z[:, None, 0] - xm[..., 0]
-    n1 = z[:, None, 1] - xm[..., 2]
+    s00 = pxx + Rb[..., 0, 0]
+    s01 = pxy + Rb[..., 0, 1]
+    s11 = pyy + Rb[..., 1, 1]
+    n0 = z[:, None, 0] - x
+    n1 = z[:, None, 1] - y
     d2, det = sym_mahalanobis2(n0, n1, s00, s01, s11)
     return gaussian_loglik2(d2, det)
 

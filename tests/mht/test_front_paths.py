@@ -56,7 +56,8 @@ def test_looked_trees_is_the_per_tree_maximum():
 
 def test_miss_increments_are_the_scalar_increment_of_each_leaf():
     rng = np.random.default_rng(4)
-    for pd in (np.full(7, 0.9), rng.choice([0.0, 0.85, 0.9], 40), np.zeros(0), np.zeros(3)):
+    for pd in (np.full(7, 0.9), rng.choice([0.0, 0.85, 0.9], 40), rng.choice([0.0, 0.8], 9),
+               np.zeros(0), np.zeros(3)):
         for pg in (None, 0.999):
             got = miss_increments(pd, pg)
             want = [miss_increment(float(p), pg) for p in pd]

@@ -143,7 +143,10 @@ class RadarCoverage(Coverage):
         self._site: dict[int, tuple[float, float] | None] = {}
 
     def _sensor_id(self, scan: Scan) -> int:
-        ids = np.unique(np.asarray(scan.sensor, np.int64))
+        sensor = np.asarray(scan.sensor, np.int64)
+        if sensor.size and (sensor == sensor.flat[0]).all():
+            return int(sensor.flat[0])
+        ids = np.unique(sensor)
         if ids.size != 1:
             raise ValueError(f"frame {scan.index}: RadarCoverage needs the plots of one "
                              f"sensor per frame, got sensors {ids.tolist()}")
@@ -175,8 +178,9 @@ class RadarCoverage(Coverage):
         dt = tf - np.asarray(time, float)
         px = x[:, 0] + x[:, 1] * dt - site[0]
         py = x[:, 2] + x[:, 3] * dt - site[1]
+        dist = np.hypot(px, py)
         if sensor.max_range is not None:
-            looked &= np.hypot(px, py) <= sensor.max_range
+            looked &= dist <= sensor.max_range
         if sensor.period is not None and len(scan):
             omega = 360.0 / sensor.period
             span = tf - t0
@@ -184,13 +188,15 @@ class RadarCoverage(Coverage):
                 z = np.asarray(scan.z, float).reshape(-1, 2)
                 beam = np.radians(grid_bearing(z[:, 0] - site[0], z[:, 1] - site[1])
                                   + omega * (tf - t_plots))
-                a_f = math.degrees(math.atan2(np.sin(beam).mean(), np.cos(beam).mean()))
+                # the circular mean; np.add.reduce(·)/n is ndarray.mean's own formula
+                n = beam.size
+                a_f = math.degrees(math.atan2(np.add.reduce(np.sin(beam)) / n,
+                                              np.add.reduce(np.cos(beam)) / n))
                 d0 = t0 - tf
                 q0 = grid_bearing(px + x[:, 1] * d0, py + x[:, 3] * d0)
                 phi_f = (a_f - grid_bearing(px, py)) % 360.0
                 phi_0 = (a_f - omega * span - q0) % 360.0
-                sig = np.sqrt(np.maximum(P[:, 0, 0], P[:, 2, 2])) / np.maximum(
-                    np.hypot(px, py), 1.0)
+                sig = np.sqrt(np.maximum(P[:, 0, 0], P[:, 2, 2])) / np.maximum(dist, 1.0)
                 band = np.minimum(3.0 * np.degrees(sig) + 3.0 * (sensor.sigma_bearing_deg
                                                                  or 0.0), MAX_EDGE_DEG)
                 crossed = phi_f < phi_0

@@ -14,7 +14,7 @@ import numpy as np
 
 from mhtrack.mht.gating import Gated
 from mhtrack.mht.tree import NO_PLOT, Leaves
-from mhtrack.models.motion import MotionModel, States
+from mhtrack.models.motion import MotionModel, States, row_index
 
 
 @dataclass(frozen=True, slots=True)
@@ -36,8 +36,9 @@ class Children:
         return int(self.parent.shape[0])
 
     def take(self, idx: np.ndarray) -> Children:
-        return Children(self.parent[idx], self.plot[idx], self.score[idx], self.peak[idx],
-                        self.pair[idx])
+        idx = row_index(idx)
+        return Children(self.parent.take(idx), self.plot.take(idx), self.score.take(idx),
+                        self.peak.take(idx), self.pair.take(idx))
 
 
 def propose_children(
@@ -83,11 +84,13 @@ def grow_children(
     if upd.size:
         pj = plot[upd]
         start = st.take(upd) if pair_pred is None else pair_pred.take(children.pair[upd])
-        st.put(upd, motion.update(start, z[pj], R if R.ndim == 2 else R[pj]))
+        st.put(upd, motion.update(start, z.take(pj, axis=0),
+                                  R if R.ndim == 2 else R.take(pj, axis=0)))
         if plot_time is not None:
             child_time[upd] = plot_time[pj]
     new_col = np.where(plot >= 0, rows[np.maximum(plot, 0)] if rows.size else NO_PLOT, NO_PLOT)
-    window = np.concatenate((leaves.window[par, 1:], new_col[:, None]), axis=1)
+    window = np.concatenate((leaves.window.take(par, axis=0)[:, 1:], new_col[:, None]),
+                            axis=1)
     return Leaves(
         x=st.x,
         P=st.P,

@@ -7,7 +7,9 @@ For a predicted leaf ``(x⁻, P⁻)`` and a plot ``z`` with covariance ``R``::
 
 ``d²`` is χ² with 2 degrees of freedom, so ``γ = −2 ln(1 − P_G)`` holds a fraction ``P_G``
 of true plots (:func:`gate_threshold`). The pairs are found by a sweep over plot strips
-(:func:`gate_sweep`) without forming the M × N matrix; :class:`Gate` is the tracker's
+(:func:`gate_sweep`) without forming the M × N matrix — or, when M × N is small
+(≤ :data:`DENSE_MAX_PAIRS`), on that whole matrix at once, which costs fewer NumPy calls
+and gives the same pairs and floats; :class:`Gate` is the tracker's
 stage: the work budget ``max_gated_pairs`` and the motion model's likelihood for the score.
 """
 
@@ -46,6 +48,11 @@ class Gated:
         return len(self.track)
 
 
+#: Largest ``M × N`` (tracks × plots) tested as one dense matrix by :func:`gate_sweep`
+#: (a few NumPy calls on arrays of this size cost less than the sweep's bookkeeping).
+DENSE_MAX_PAIRS = 8192
+
+
 def plot_covariances(R: np.ndarray, n: int) -> tuple[np.ndarray, bool]:
     """``(R, shared)``: one (2, 2) covariance for all ``n`` plots, or (n, 2, 2)."""
     R = np.asarray(R, float)
@@ -75,15 +82,16 @@ def _sweep_boxes(
     width = max(2 * float(hx.mean()), float(np.ptp(z[:, 0])) / (4 * np.sqrt(N) + 1), 1e-6)
     col = np.floor((z[:, 0] - x0) / width).astype(np.int64)
     order = np.lexsort((z[:, 1], col))
-    key = col[order] * height + (z[order, 1] - y0)
+    key = col[order] * height + (z[:, 1].take(order) - y0)
     n_cols = int(col.max()) + 1
     c_lo = np.clip(np.floor((x[:, 0] - hx - x0) / width).astype(np.int64), 0, n_cols)
     c_hi = np.clip(np.floor((x[:, 0] + hx - x0) / width).astype(np.int64), -1, n_cols - 1)
     nc = np.maximum(c_hi - c_lo + 1, 0)
     tq = np.repeat(np.arange(M, dtype=np.int64), nc)
     cq = np.repeat(c_lo - np.cumsum(nc) + nc, nc) + np.arange(int(nc.sum()))
-    ylo = np.clip(x[tq, 2] - hy[tq] - y0, -0.5, height - 0.5)
-    yhi = np.clip(x[tq, 2] + hy[tq] - y0, -0.5, height - 0.5)
+    xq, hq = x[:, 2].take(tq), hy.take(tq)
+    ylo = np.clip(xq - hq - y0, -0.5, height - 0.5)
+    yhi = np.clip(xq + hq - y0, -0.5, height - 0.5)
     lo = np.searchsorted(key, cq * height + ylo, side="left")
     hi = np.searchsorted(key, cq * height + yhi, side="right")
     return tq, lo, hi, order
@@ -123,7 +131,31 @@ def gate_sweep(
     if len(x) == 0 or len(z) == 0:
         e = np.zeros(0, np.int64)
         return Gated(e, e, np.zeros(0), np.zeros(0))
+    if len(x) * len(z) <= DENSE_MAX_PAIRS:
+        return _dense_pairs(x, P, z, R, shared, gamma)
     return _pairs_in_boxes(x, P, z, R, shared, gamma, _sweep_boxes(x, P, z, R, shared, gamma))
+
+
+def _dense_pairs(
+    x: np.ndarray, P: np.ndarray, z: np.ndarray, R: np.ndarray, shared: bool, gamma: float
+) -> Gated:
+    """The exact test of :func:`gate_sweep` on every (track, plot) pair as an (M, N)
+    matrix: the same elementwise operations on the same operands as
+    :func:`_pairs_in_boxes` (so the same floats), pairs in row-major order — by track,
+    then plot."""
+    Rb = R if shared else R.transpose(1, 2, 0)  # (2, 2) or (2, 2, N)
+    s00 = P[:, 0, 0][:, None] + Rb[0, 0]
+    s01 = P[:, 0, 2][:, None] + Rb[0, 1]
+    s11 = P[:, 2, 2][:, None] + Rb[1, 1]
+    n0 = z[:, 0] - x[:, 0][:, None]
+    n1 = z[:, 1] - x[:, 2][:, None]
+    d2, det = sym_mahalanobis2(n0, n1, s00, s01, s11)
+    flat = np.flatnonzero(d2 <= gamma)  # row-major: by track, then plot
+    ti = flat // len(z)
+    pj = flat - ti * len(z)
+    d2 = d2.ravel().take(flat)
+    det = det.ravel().take(ti if shared else flat)  # (M, 1) when R is shared
+    return Gated(ti, pj, d2, gaussian_loglik2(d2, det))
 
 
 def _pairs_in_boxes(
@@ -142,15 +174,15 @@ def _pairs_in_boxes(
     if ti.size == 0:
         return Gated(e, e, np.zeros(0), np.zeros(0))
     if shared:
-        s00 = P[ti, 0, 0] + R[0, 0]
-        s01 = P[ti, 0, 2] + R[0, 1]
-        s11 = P[ti, 2, 2] + R[1, 1]
+        s00 = P[:, 0, 0].take(ti) + R[0, 0]
+        s01 = P[:, 0, 2].take(ti) + R[0, 1]
+        s11 = P[:, 2, 2].take(ti) + R[1, 1]
     else:
-        s00 = P[ti, 0, 0] + R[pj, 0, 0]
-        s01 = P[ti, 0, 2] + R[pj, 0, 1]
-        s11 = P[ti, 2, 2] + R[pj, 1, 1]
-    n0 = z[pj, 0] - x[ti, 0]
-    n1 = z[pj, 1] - x[ti, 2]
+        s00 = P[:, 0, 0].take(ti) + R[:, 0, 0].take(pj)
+        s01 = P[:, 0, 2].take(ti) + R[:, 0, 1].take(pj)
+        s11 = P[:, 2, 2].take(ti) + R[:, 1, 1].take(pj)
+    n0 = z[:, 0].take(pj) - x[:, 0].take(ti)
+    n1 = z[:, 1].take(pj) - x[:, 2].take(ti)
     d2, det = sym_mahalanobis2(n0, n1, s00, s01, s11)
     keep = d2 <= gamma
     ti, pj, d2, det = ti[keep], pj[keep], d2[keep], det[keep]

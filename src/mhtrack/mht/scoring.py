@@ -37,9 +37,18 @@ def miss_increments(p_detection: np.ndarray, gate_probability: float | None = No
     once per distinct ``P_D`` with :func:`miss_increment`, so a constant ``P_D`` gives
     exactly the scalar increment."""
     pd = np.asarray(p_detection, float)
-    values, inverse = np.unique(pd, return_inverse=True)
-    return np.array([miss_increment(float(v), gate_probability) for v in values],
-                    float)[inverse.reshape(-1)] if pd.size else np.zeros(0)
+    if pd.size and (pd == pd.flat[0]).all():  # one P_D (every leaf looked at alike)
+        return np.full(pd.shape, miss_increment(float(pd.flat[0]), gate_probability))
+    if pd.size == 0:
+        return np.zeros(0)
+    lo, hi = pd.min(), pd.max()
+    low = pd == lo
+    if (low | (pd == hi)).all():  # two values (a sensor's P_D and 0, typically)
+        return np.where(low, miss_increment(float(lo), gate_probability),
+                        miss_increment(float(hi), gate_probability)).reshape(-1)
+    values = np.unique(pd)  # sorted; the increment of each, then per leaf by its P_D
+    inc = np.array([miss_increment(float(v), gate_probability) for v in values], float)
+    return inc.take(np.searchsorted(values, pd.reshape(-1)))
 
 
 def update_increment(

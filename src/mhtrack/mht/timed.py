@@ -26,26 +26,29 @@ import numpy as np
 
 from mhtrack.mht.coverage import Looks
 from mhtrack.mht.gating import Gate, Gated
-from mhtrack.mht.tree import Leaves, segment_ids
+from mhtrack.mht.tree import Leaves
 from mhtrack.models.linalg2 import gaussian_loglik2, sym_mahalanobis2
 from mhtrack.models.motion import MotionModel, States
 
 
 def looked_trees(tree: np.ndarray, pd: np.ndarray) -> np.ndarray:
     """Mask over leaves (sorted by ``tree``): the leaf's tree has a leaf with ``pd > 0``."""
-    if tree.size == 0:
-        return np.zeros(0, bool)
-    starts, seg = segment_ids(tree)
-    return np.maximum.reduceat((pd > 0).astype(np.int8), starts)[seg] > 0
+    looked = tree[pd > 0]  # sorted, as ``tree``
+    if looked.size == 0:
+        return np.zeros(tree.size, bool)
+    at = np.minimum(np.searchsorted(looked, tree), looked.size - 1)
+    return looked.take(at) == tree
 
 
 def split_looked(leaves: Leaves, looks: Looks) -> tuple[Leaves, Looks, Leaves]:
     """``(looked, their looks, idle)``: the leaves of the trees the frame looked at
     (``P_D > 0`` at one of their leaves) and the others (the same objects when every tree
     was looked at)."""
+    if (looks.pd > 0).all():  # every leaf looked at: no tree is carried
+        return leaves, looks, leaves.take(slice(0, 0))
     mask = looked_trees(leaves.tree, looks.pd)
     if mask.all():
-        return leaves, looks, leaves.take(np.zeros(0, np.int64))
+        return leaves, looks, leaves.take(slice(0, 0))
     return (leaves.take(mask), Looks(looks.pd[mask], looks.certain[mask]),
             leaves.take(~mask))
 
@@ -93,8 +96,8 @@ def gate_timed(gate: Gate, leaves: Leaves, pred: States, z: np.ndarray, R: np.nd
     coarse = gate.pairs(leaves, pred.x, Pc, z, 2.0 * R, caps)
     ti, pj = coarse.track, coarse.plot
     pp = motion.predict(leaves.states().take(ti), t[pj] - leaves.time[ti])
-    Rp = R if R.ndim == 2 else R[pj]
-    d2, det = sym_mahalanobis2(z[pj, 0] - pp.x[:, 0], z[pj, 1] - pp.x[:, 2],
+    Rp = R if R.ndim == 2 else R.take(pj, axis=0)
+    d2, det = sym_mahalanobis2(z[:, 0].take(pj) - pp.x[:, 0], z[:, 1].take(pj) - pp.x[:, 2],
                                pp.P[:, 0, 0] + Rp[..., 0, 0], pp.P[:, 0, 2] + Rp[..., 0, 1],
                                pp.P[:, 2, 2] + Rp[..., 1, 1])
     keep = np.flatnonzero(d2 <= gamma)

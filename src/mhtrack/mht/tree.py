@@ -16,7 +16,7 @@ from dataclasses import dataclass, fields
 
 import numpy as np
 
-from mhtrack.models.motion import POS, VEL, States
+from mhtrack.models.motion import States, row_index
 
 NO_PLOT = -1
 
@@ -79,14 +79,18 @@ class Leaves:
                    np.zeros((0, width), np.int64), np.zeros(0, bool), np.zeros((0, r)),
                    np.zeros((0, r, 4)), np.zeros((0, r, 4, 4)), i, i, f)
 
-    def take(self, idx: np.ndarray) -> Leaves:
-        """Rows ``idx`` (an index array or boolean mask), in that order."""
-        return Leaves(*(getattr(self, f.name)[idx] for f in fields(self)))
+    def take(self, idx: np.ndarray | slice) -> Leaves:
+        """Rows ``idx`` (an index array, boolean mask or slice), in that order."""
+        if isinstance(idx, slice):
+            return Leaves(*[getattr(self, f)[idx] for f in _FIELDS])
+        idx = row_index(idx)
+        return Leaves(*[getattr(self, f).take(idx, axis=0) for f in _FIELDS])
 
     @classmethod
     def concat(cls, a: Leaves, b: Leaves) -> Leaves:
-        return cls(*(np.concatenate((getattr(a, f.name), getattr(b, f.name)))
-                     for f in fields(cls)))
+        if len(b) == 0:  # the arrays are never written in place: share them
+            return a
+        return cls(*[np.concatenate((getattr(a, f), getattr(b, f))) for f in _FIELDS])
 
     def arrays(self) -> dict[str, np.ndarray]:
         """The columns by name (for saving)."""
@@ -110,11 +114,17 @@ class Leaves:
         return int(segment_starts(self.tree).size)
 
 
+_FIELDS = tuple(f.name for f in fields(Leaves))
+
+
 def segment_starts(sorted_keys: np.ndarray) -> np.ndarray:
     """Start index of each run of equal values in ``sorted_keys`` (empty for no rows)."""
     if sorted_keys.size == 0:
         return np.zeros(0, np.int64)
-    return np.flatnonzero(np.r_[True, sorted_keys[1:] != sorted_keys[:-1]])
+    new = np.empty(sorted_keys.size, bool)
+    new[0] = True
+    np.not_equal(sorted_keys[1:], sorted_keys[:-1], out=new[1:])
+    return np.flatnonzero(new)
 
 
 def segment_ids(sorted_keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -141,10 +151,11 @@ def one_point_state(z: np.ndarray, R: np.ndarray, v_max: float) -> tuple[np.ndar
     but bounded by ``v_max`` at 2σ)."""
     n = len(z)
     x = np.zeros((n, 4))
-    x[:, POS] = z
+    x[:, 0], x[:, 2] = z[:, 0], z[:, 1]
     P = np.zeros((n, 4, 4))
-    P[:, POS[:, None], POS[None, :]] = R
-    P[:, VEL, VEL] = (0.5 * v_max) ** 2
+    P[:, 0, 0], P[:, 0, 2] = R[..., 0, 0], R[..., 0, 1]
+    P[:, 2, 0], P[:, 2, 2] = R[..., 1, 0], R[..., 1, 1]
+    P[:, 1, 1] = P[:, 3, 3] = (0.5 * v_max) ** 2
     return x, P
 
 

@@ -35,33 +35,27 @@ def validate_scan(
         if t.size != n or not np.isfinite(t).all() or (t > scan.time).any():
             raise ValueError(f"scan {scan.index}: plot times must be {n} finite values "
                              f"<= the frame's time {scan.time} s")
-    bad = ~np.isfinite(z).all(axis=1)
-    if bad.any():
-        i = int(np.flatnonzero(bad)[0])
-        raise ValueError(
-            f"scan {scan.index}: plot row {int(rows[i])} has a non-finite position "
-            f"{z[i].tolist()}"
-        )
-    far = np.abs(z).max(axis=1) > MAX_COORDINATE if n else np.zeros(0, bool)
-    if far.any():
-        i = int(np.flatnonzero(far)[0])
-        raise ValueError(
-            f"scan {scan.index}: plot row {int(rows[i])} lies at {z[i].tolist()} m, "
-            f"beyond ±{MAX_COORDINATE:g} m of the frame's origin (a unit or parsing "
-            "error?)"
-        )
-    if n > 1 and np.unique(rows).size != n:
+    if not (np.abs(z) <= MAX_COORDINATE).all():  # false for NaN and ±inf too
+        _position_error(scan, z, rows)
+    # row ids of a PlotTable's scan ascend: unique without sorting
+    if n > 1 and not (rows[1:] > rows[:-1]).all() and np.unique(rows).size != n:
         raise ValueError(f"scan {scan.index}: plot row ids are not unique")
     if scan.R is None:
         return z, default_R, rows
     R = np.asarray(scan.R, dtype=float)
     if R.shape != (n, 2, 2):
         raise ValueError(f"scan {scan.index}: R has shape {R.shape}, expected ({n}, 2, 2)")
-    unset = np.isnan(R).all(axis=(1, 2))  # PlotTable.from_scans: "use the tracker's R"
-    if unset.any():
-        R = R.copy()
-        R[unset] = default_R
-    bad = ~(np.isfinite(R).all(axis=(1, 2)) & (R[:, 0, 0] > 0) & (det2(R) > 0))
+    finite = bool(np.isfinite(R).all())
+    if not finite:
+        unset = np.isnan(R).all(axis=(1, 2))  # PlotTable.from_scans: "use the tracker's R"
+        if unset.any():
+            R = R.copy()
+            R[unset] = default_R
+            finite = bool(np.isfinite(R).all())
+    good = (R[:, 0, 0] > 0) & (det2(R) > 0)
+    if not finite:
+        good &= np.isfinite(R).all(axis=(1, 2))
+    bad = ~good
     if bad.any():
         i = int(np.flatnonzero(bad)[0])
         raise ValueError(
@@ -69,3 +63,21 @@ def validate_scan(
             f"{R[i].tolist()}"
         )
     return z, R, rows
+
+
+def _position_error(scan: Scan, z: np.ndarray, rows: np.ndarray) -> None:
+    """Raise for the first plot of ``z`` (n, 2) with a non-finite position, else for the
+    first beyond ``MAX_COORDINATE``."""
+    bad = ~np.isfinite(z).all(axis=1)
+    if bad.any():
+        i = int(np.flatnonzero(bad)[0])
+        raise ValueError(
+            f"scan {scan.index}: plot row {int(rows[i])} has a non-finite position "
+            f"{z[i].tolist()}"
+        )
+    i = int(np.flatnonzero(np.abs(z).max(axis=1) > MAX_COORDINATE)[0])
+    raise ValueError(
+        f"scan {scan.index}: plot row {int(rows[i])} lies at {z[i].tolist()} m, "
+        f"beyond ±{MAX_COORDINATE:g} m of the frame's origin (a unit or parsing "
+        "error?)"
+    )

@@ -121,9 +121,10 @@ class CVModelSet(MotionModel):
         """The mixture likelihood ``ln Σ_j μ̄_j N(z; H x⁻_j, S_j)`` of the gated pairs."""
         if len(track) == 0:
             return loglik
-        ll = model_logliks(pred.xm[track], pred.Pm[track], z[plot],
-                           R if R.ndim == 2 else R[plot])
-        return mixture_loglik(pred.mu[track], ll)
+        # only the position terms of each pair's leaf are copied, not its whole state
+        terms = [t.take(track, axis=0) for t in _position_terms(pred.xm, pred.Pm)]
+        ll = _logliks(terms, z.take(plot, axis=0), R if R.ndim == 2 else R.take(plot, axis=0))
+        return mixture_loglik(pred.mu.take(track, axis=0), ll)
 
     def new_states(self, x: np.ndarray, P: np.ndarray) -> States:
         """Every model at ``x``, ``P`` with equal probabilities."""
@@ -171,23 +172,58 @@ def combine(xm: np.ndarray, Pm: np.ndarray, mu: np.ndarray) -> tuple[np.ndarray,
 def model_logliks(xm: np.ndarray, Pm: np.ndarray, z: np.ndarray, R: np.ndarray) -> np.ndarray:
     """Per row and model, ``ln N(z; H x_j, H P_j Hᵀ + R)``: ``xm`` (K, r, 4), ``Pm``
     (K, r, 4, 4), ``z`` (K, 2), ``R`` (2, 2) or (K, 2, 2). Returns (K, r)."""
+    return _logliks(_position_terms(xm, Pm), z, R)
+
+
+def _position_terms(xm: np.ndarray, Pm: np.ndarray) -> tuple[np.ndarray, ...]:
+    """What the plot likelihood reads of each model's state: ``x, y, Pxx, Pxy, Pyy``."""
+    return xm[..., 0], xm[..., 2], Pm[..., 0, 0], Pm[..., 0, 2], Pm[..., 2, 2]
+
+
+def _logliks(terms: tuple[np.ndarray, ...] | list[np.ndarray], z: np.ndarray,
+             R: np.ndarray) -> np.ndarray:
+    """:func:`model_logliks` from the :func:`_position_terms` (K, r) of the rows."""
+    x, y, pxx, pxy, pyy = terms
     R = np.asarray(R, float)
     Rb = R if R.ndim == 2 else R[:, None]
-    s00 = Pm[..., 0, 0] + Rb[..., 0, 0]
-    s01 = Pm[..., 0, 2] + Rb[..., 0, 1]
-    s11 = Pm[..., 2, 2] + Rb[..., 1, 1]
-    n0 = z[:, None, 0] - xm[..., 0]
-    n1 = z[:, None, 1] - xm[..., 2]
+    s00 = pxx + Rb[..., 0, 0]
+    s01 = pxy + Rb[..., 0, 1]
+    s11 = pyy + Rb[..., 1, 1]
+    n0 = z[:, None, 0] - x
+    n1 = z[:, None, 1] - y
     d2, det = sym_mahalanobis2(n0, n1, s00, s01, s11)
     return gaussian_loglik2(d2, det)
+
+
+def _row_max(a: np.ndarray) -> np.ndarray:
+    """``a.max(axis=1)`` of (K, r) as ``r − 1`` whole-column ``np.maximum`` (the same
+    values: a maximum is one of its operands)."""
+    r = a.shape[1]
+    out = np.maximum(a[:, 0], a[:, 1]) if r > 1 else a[:, 0].copy()
+    for j in range(2, r):
+        out = np.maximum(out, a[:, j])
+    return out
+
+
+def _row_sum(a: np.ndarray) -> np.ndarray:
+    """``a.sum(axis=1)`` of (K, r): for ``r < 8`` NumPy adds a row's entries in order,
+    ``((a_0 + a_1) + a_2) + …``, done here as whole-column additions (the same floats,
+    without a reduction over a short axis); wider rows take NumPy's own sum."""
+    if a.shape[1] >= 8:
+        return a.sum(axis=1)
+    r = a.shape[1]
+    out = a[:, 0] + a[:, 1] if r > 1 else a[:, 0].copy()
+    for j in range(2, r):
+        out = out + a[:, j]
+    return out
 
 
 def mixture_loglik(mubar: np.ndarray, ll: np.ndarray) -> np.ndarray:
     """``ln Σ_j μ̄_j exp(ll_j)`` per row (log-sum-exp), ``mubar`` and ``ll`` (K, r)."""
     with np.errstate(divide="ignore"):
         a = np.log(mubar) + ll
-    m = a.max(axis=1)
-    return m + np.log(np.exp(a - m[:, None]).sum(axis=1))
+    m = _row_max(a)
+    return m + np.log(_row_sum(np.exp(a - m[:, None])))
 
 
 def update(
@@ -199,9 +235,9 @@ def update(
     ll = model_logliks(xm, Pm, z, R)
     with np.errstate(divide="ignore"):
         a = np.log(mubar) + ll
-    a -= a.max(axis=1, keepdims=True)
+    a -= _row_max(a)[:, None]
     mu = np.exp(a)
-    mu /= mu.sum(axis=1, keepdims=True)
+    mu /= _row_sum(mu)[:, None]
     R = np.asarray(R, float)
     Rr = R if R.ndim == 2 else np.repeat(R, r, axis=0)
     xn, Pn = kalman.update_position(xm.reshape(K * r, 4), Pm.reshape(K * r, 4, 4),

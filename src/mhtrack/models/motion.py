@@ -26,6 +26,16 @@ POS = np.array([0, 2])
 VEL = np.array([1, 3])
 
 
+def row_index(idx: np.ndarray) -> np.ndarray:
+    """``idx`` (an index array or boolean mask over rows) as row numbers, for
+    ``ndarray.take(…, axis=0)`` — the same rows as ``a[idx]``, copied without the cost
+    of fancy indexing over trailing axes."""
+    idx = np.asarray(idx)
+    if idx.dtype == bool:
+        return np.flatnonzero(idx)
+    return idx if idx.dtype.kind in "iu" else idx.astype(np.intp)
+
+
 @dataclass(frozen=True, slots=True)
 class States:
     """Stacked track states: ``x`` (M, 4), ``P`` (M, 4, 4) — for a mixture their
@@ -39,8 +49,11 @@ class States:
     mu: np.ndarray
 
     def take(self, idx: np.ndarray) -> States:
-        """Rows ``idx`` (copies)."""
-        return States(self.x[idx], self.P[idx], self.xm[idx], self.Pm[idx], self.mu[idx])
+        """Rows ``idx`` (an index array or boolean mask; copies)."""
+        idx = row_index(idx)
+        return States(self.x.take(idx, axis=0), self.P.take(idx, axis=0),
+                      self.xm.take(idx, axis=0), self.Pm.take(idx, axis=0),
+                      self.mu.take(idx, axis=0))
 
     def put(self, idx: np.ndarray, other: States) -> None:
         """Overwrite rows ``idx`` with ``other``'s rows (in place)."""

@@ -27,7 +27,7 @@ import numpy as np
 
 from mhtrack.mht.numbering import Counter
 from mhtrack.mht.tree import Leaves, new_trees
-from mhtrack.models.motion import MotionModel
+from mhtrack.models.motion import MotionModel, row_index
 from mhtrack.records import Scan
 
 
@@ -50,9 +50,11 @@ class BirthCandidates:
         return int(self.score.shape[0])
 
     def take(self, idx: np.ndarray) -> BirthCandidates:
-        return BirthCandidates(self.x[idx], self.P[idx], self.score[idx], self.peak[idx],
-                               self.window[idx], self.n_updates[idx],
-                               None if self.time is None else self.time[idx])
+        idx = row_index(idx)
+        return BirthCandidates(self.x.take(idx, axis=0), self.P.take(idx, axis=0),
+                               self.score.take(idx), self.peak.take(idx),
+                               self.window.take(idx, axis=0), self.n_updates.take(idx),
+                               None if self.time is None else self.time.take(idx))
 
     @classmethod
     def empty(cls, width: int) -> BirthCandidates:

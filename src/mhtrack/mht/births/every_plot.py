@@ -62,9 +62,10 @@ class EveryPlotBirth(Birth):
             caps["max_births_per_scan"] = sel.size - self.max_per_scan
             sel = np.sort(order[: self.max_per_scan])
         n = sel.size
-        x, P = one_point_state(z[sel], R if R.ndim == 2 else R[sel], self.v_max)
+        x, P = one_point_state(z.take(sel, axis=0), R if R.ndim == 2 else R.take(sel, axis=0),
+                               self.v_max)
         window = np.full((n, self.width), NO_PLOT, np.int64)
-        window[:, -1] = rows[sel]
-        start = np.asarray(score[sel], float)
+        window[:, -1] = rows.take(sel)
+        start = np.asarray(score.take(sel), float)
         return BirthCandidates(x, P, start, start.copy(), window, np.ones(n, np.int64),
-                               scan.plot_times()[sel])
+                               scan.plot_times().take(sel))

@@ -114,7 +114,10 @@ def segment_starts(sorted_keys: np.ndarray) -> np.ndarray:
     """Start index of each run of equal values in ``sorted_keys`` (empty for no rows)."""
     if sorted_keys.size == 0:
         return np.zeros(0, np.int64)
-    return np.flatnonzero(np.r_[True, sorted_keys[1:] != sorted_keys[:-1]])
+    new = np.empty(sorted_keys.size, bool)  # not np.r_: ~5 µs of index-trick overhead
+    new[0] = True
+    np.not_equal(sorted_keys[1:], sorted_keys[:-1], out=new[1:])
+    return np.flatnonzero(new)
 
 
 def segment_ids(sorted_keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -23,7 +23,8 @@ import itertools
 
 import numpy as np
 
-from mhtrack.mht.clustering import changes, raw_plot_keys
+from mhtrack.mht.clustering import raw_plot_keys
+from mhtrack.mht.tree import changes
 
 #: One tree's options, best first: ``(score, plot mask, leaf)``.
 Option = tuple[float, int, int]

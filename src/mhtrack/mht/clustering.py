@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from mhtrack.mht.tree import NO_PLOT
+from mhtrack.mht.tree import NO_PLOT, changes
 
 
 def plot_keys(window: np.ndarray, *, by_id: bool = False) -> tuple[np.ndarray, np.ndarray]:
@@ -44,15 +44,6 @@ def raw_plot_keys(window: np.ndarray, *, by_id: bool = False) -> tuple[np.ndarra
         return leaf.astype(np.int64), plot.astype(np.int64)
     span = int(plot.max()) + 1
     return leaf.astype(np.int64), col.astype(np.int64) * span + plot
-
-
-def changes(sorted_keys: np.ndarray) -> np.ndarray:
-    """Mask over rows of ``sorted_keys``: the row starts a run of equal values (the first
-    row always)."""
-    flag = np.empty(sorted_keys.size, bool)
-    flag[:1] = True
-    np.not_equal(sorted_keys[1:], sorted_keys[:-1], out=flag[1:])
-    return flag
 
 
 def dense_index(tree: np.ndarray) -> np.ndarray:

@@ -27,7 +27,7 @@ from dataclasses import dataclass, fields
 
 import numpy as np
 
-from mhtrack.mht.tree import Leaves
+from mhtrack.mht.tree import Leaves, changes
 from mhtrack.records import TrackTable
 
 
@@ -77,8 +77,9 @@ class TentativeHistory:
         tracks reported at it (chosen, confirmed)."""
         if self.depth:
             self._log.append(_Logged.of(scan, time, leaves))
-            used = leaves.window[leaves.chosen & (leaves.track >= 0), -1]
-            self._claimed.append(np.unique(used[used >= 0]))
+            used = np.sort(leaves.window[leaves.chosen & (leaves.track >= 0), -1])
+            used = used[used >= 0]
+            self._claimed.append(used[changes(used)])  # np.unique, without its set-up
 
     def backfill(self, leaves: Leaves, rows: np.ndarray) -> TrackTable:
         """The ancestors of leaves ``rows`` (just confirmed, ``track >= 0``) at the logged

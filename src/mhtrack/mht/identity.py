@@ -41,11 +41,15 @@ def hand_over(leaves: Leaves, previous: Reported, *, by_id: bool = False) -> Lea
     then lower track id; each tree and each id at most once. A plot is shared at the same
     scan column, or (``by_id``: frames of several sensors) by its id in any column."""
     track = leaves.track
+    if previous.track.size == 0:
+        return leaves
     chosen = np.flatnonzero(leaves.chosen)
     carried = track[chosen]
-    lost = ~np.isin(previous.track, carried[carried >= 0])
     cand = chosen[carried < 0]
-    if not (lost.any() and cand.size):
+    if cand.size == 0:
+        return leaves
+    lost = ~contains(carried[carried >= 0], previous.track)
+    if not lost.any():
         return leaves
     track = track.copy()
     lost_ids, lost_win = previous.track[lost], previous.window[lost]
@@ -67,6 +71,17 @@ def hand_over(leaves: Leaves, previous: Reported, *, by_id: bool = False) -> Lea
         track[track == tid] = -1  # the old tree gives the id up
         track[leaves.tree == leaves.tree[cand[c]]] = tid
     return replace(leaves, track=track)
+
+
+def contains(values: np.ndarray, query: np.ndarray) -> np.ndarray:
+    """``np.isin(query, values)`` by one sort and a binary search (no set-up cost of
+    ``np.isin`` on the few values of one scan)."""
+    if values.size == 0:
+        return np.zeros(query.shape, bool)
+    v = np.sort(values)
+    j = np.searchsorted(v, query)
+    np.minimum(j, v.size - 1, out=j)
+    return v[j] == query
 
 
 def confirm(leaves: Leaves, confirms: np.ndarray, tracks: Counter) -> Leaves:

@@ -42,7 +42,7 @@ class StepStats:
         return cls(scan=int(scan.index), n_plots=n_plots, n_leaves=len(leaves),
                    n_trees=leaves.n_trees, n_clusters=hyp.n_clusters,
                    largest_cluster=hyp.largest_cluster, n_confirmed=len(out), time_s=time_s,
-                   caps=caps, n_births=int(np.unique(births.tree).size),
+                   caps=caps, n_births=births.n_trees,
                    limits={} if limits is None else limits)
 
 

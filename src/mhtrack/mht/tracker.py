@@ -58,7 +58,7 @@ from mhtrack.mht.extend import grow_children, propose_children
 from mhtrack.mht.gating import Gate, plots_in_confirmed_gates
 from mhtrack.mht.history import TentativeHistory
 from mhtrack.mht.hypothesis import best_hypothesis
-from mhtrack.mht.identity import Reported, confirm, hand_over, newly_confirmed
+from mhtrack.mht.identity import Reported, confirm, contains, hand_over, newly_confirmed
 from mhtrack.mht.intensity import clutter_intensity
 from mhtrack.mht.numbering import Counter, number_nodes
 from mhtrack.mht.predict import predict_leaves
@@ -201,7 +201,7 @@ class MHTTracker:
         estimator (their optional hooks)."""
         used = confirmed_windows(leaves)
         self.birth.forget_used(used)
-        self.clutter.forget(np.isin(rows, used[:, -1]))
+        self.clutter.forget(contains(used[:, -1], rows))
 
     def run(
         self, scans: Iterable[Scan] | PlotTable, stats: list[StepStats] | None = None,

@@ -46,8 +46,10 @@ class _Logged:
     t: np.ndarray  # each leaf's own time
 
     @classmethod
-    def of(cls, scan: int, time: float, leaves: Leaves) -> _Logged:
-        sel = np.flatnonzero(leaves.track < 0)
+    def of(cls, scan: int, time: float, leaves: Leaves,
+           rows: np.ndarray | None = None) -> _Logged:
+        tentative = leaves.track < 0
+        sel = np.flatnonzero(tentative if rows is None else tentative & rows)
         node = leaves.node[sel]
         if node.size > 1 and (np.diff(node) <= 0).any():
             sel = sel[np.argsort(node, kind="stable")]
@@ -72,12 +74,17 @@ class TentativeHistory:
         #: per logged scan, the sorted plot rows the output gives a track at that scan
         self._claimed: deque[np.ndarray] = deque(maxlen=max(self.depth, 1))
 
-    def record(self, scan: int, time: float, leaves: Leaves) -> None:
+    def record(self, scan: int, time: float, leaves: Leaves,
+               rows: np.ndarray | None = None) -> None:
         """Keep the tentative leaves (``track < 0``) of this scan, and the plots of the
-        tracks reported at it (chosen, confirmed)."""
+        tracks reported at it (chosen, confirmed); ``rows`` (mask): of those leaves only
+        (the leaves a frame stepped), as if given ``leaves.take(rows)``."""
         if self.depth:
-            self._log.append(_Logged.of(scan, time, leaves))
-            used = np.sort(leaves.window[leaves.chosen & (leaves.track >= 0), -1])
+            self._log.append(_Logged.of(scan, time, leaves, rows))
+            rep = leaves.chosen & (leaves.track >= 0)
+            if rows is not None:
+                rep &= rows
+            used = np.sort(leaves.window[rep, -1])
             used = used[used >= 0]
             self._claimed.append(used[changes(used)])  # np.unique, without its set-up
 

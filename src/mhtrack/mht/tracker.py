@@ -179,8 +179,7 @@ class MHTTracker:
         leaves = hand_over(leaves, previous, by_id=by_id)
         leaves = confirm(leaves, self.sprt.confirms(leaves), self.tracks)
         self.last_backfill = self._history.backfill(leaves, newly_confirmed(leaves, first_new))
-        self._history.record(int(scan.index), ftime,
-                             leaves if is_new is None else leaves.take(is_new))
+        self._history.record(int(scan.index), ftime, leaves, is_new)
         self._forget(leaves, rows)
         self._leaves, self._last_time, self._last_index = leaves, ftime, int(scan.index)
         out = report(scan, leaves, is_new)

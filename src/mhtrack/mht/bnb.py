@@ -13,8 +13,7 @@ unrolled for the commonest cluster, two trees, with the same sums and comparison
 same order: the same choice, without the stack.
 
 :func:`solve_small` builds every clashing cluster's options from one sort and one set of
-plot keys, and remembers each cluster's answer by its exact input (:class:`Memo`): a
-cluster that a frame of rotating radars did not touch is the same problem again.
+plot keys.
 """
 
 from __future__ import annotations
@@ -23,37 +22,29 @@ import itertools
 
 import numpy as np
 
-from mhtrack.mht.clustering import raw_plot_keys
 from mhtrack.mht.tree import changes
 
 #: One tree's options, best first: ``(score, plot mask, leaf)``.
 Option = tuple[float, int, int]
 
 
-class Memo:
-    """Answers of :func:`search` by their exact input, kept from one call to the next
-    (:func:`solve_small`). A cache only: a cluster's choice is the same with or without
-    it (same input, same deterministic search)."""
-
-    def __init__(self) -> None:
-        self.last: dict[tuple, tuple[int, ...] | None] = {}
-
-    def __len__(self) -> int:
-        return len(self.last)
-
-
 def solve_small(
-    s: np.ndarray, tree_index: np.ndarray, w: np.ndarray, leaf_cluster: np.ndarray,
-    in_small: np.ndarray, by_id: bool, node_limit: int, memo: Memo | None = None,
+    s: np.ndarray, tree_index: np.ndarray, keys: tuple[np.ndarray, np.ndarray],
+    leaf_cluster: np.ndarray, in_small: np.ndarray, node_limit: int,
 ) -> tuple[np.ndarray, list[np.ndarray]]:
     """:func:`search` on every cluster ``c`` with ``in_small[c]`` (candidate leaves:
-    scores ``s`` > 0, trees ``tree_index``, windows ``w``, clusters ``leaf_cluster``).
+    scores ``s`` > 0, trees ``tree_index``, plot keys ``keys`` = ``(leaf, key)`` of
+    :func:`~mhtrack.mht.clustering.raw_plot_keys`, clusters ``leaf_cluster``).
     Plot masks: bit = the plot's rank among its cluster's keys (any one-to-one numbering
     gives the same conflicts). Returns the chosen leaves and the members of each cluster
     whose search passed ``node_limit`` (for ``milp``)."""
-    idx = np.flatnonzero(in_small[leaf_cluster])
+    member = in_small[leaf_cluster]
+    idx = np.flatnonzero(member)
     lc = leaf_cluster[idx]
-    leaf, raw = raw_plot_keys(w[idx], by_id=by_id)
+    on = member[keys[0]]
+    position = np.cumsum(member)
+    position -= 1
+    leaf, raw = position[keys[0][on]], keys[1][on]  # leaf: position in idx
     c = lc[leaf]
     by_key = np.lexsort((raw, c))
     c, raw, leaf = c[by_key], raw[by_key], leaf[by_key]

@@ -74,34 +74,41 @@ def cluster_trees(tree: np.ndarray, window: np.ndarray, *,
         numbered in order of each cluster's smallest tree id (deterministic).
     """
     tree_index = dense_index(tree)
-    n_trees = int(tree_index.max()) + 1 if tree_index.size else 0
     leaf, raw = raw_plot_keys(window, by_id=by_id)
+    return tree_index, tree_clusters(tree_index, leaf, raw)
+
+
+def tree_clusters(tree_index: np.ndarray, leaf: np.ndarray, key: np.ndarray) -> np.ndarray:
+    """The ``tree_cluster`` of :func:`cluster_trees` from its parts: each leaf's tree
+    index (dense, ``0 … T−1``) and the leaves' ``(leaf, key)`` plot pairs
+    (:func:`raw_plot_keys` or :func:`plot_keys`)."""
+    n_trees = int(tree_index.max()) + 1 if tree_index.size else 0
     if leaf.size == 0:
-        return tree_index, np.arange(n_trees, dtype=np.int64)
-    label = _min_label_components(tree_index[leaf], raw, n_trees)
+        return np.arange(n_trees, dtype=np.int64)
+    label = _min_label_components(tree_index[leaf], key, n_trees)
     if label is not None:
         # every tree is labelled with the smallest tree of its cluster: the clusters in
         # order of their smallest tree are the labels in increasing order
         rank = np.cumsum(label == np.arange(n_trees))
         rank -= 1
-        return tree_index, rank[label]
+        return rank[label]
     # pathological chain: let scipy do it
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import connected_components
 
-    _, key = np.unique(raw, return_inverse=True)
-    key = key.reshape(-1)
-    n_keys = int(key.max()) + 1
+    _, dense = np.unique(key, return_inverse=True)
+    dense = dense.reshape(-1)
+    n_keys = int(dense.max()) + 1
     n = n_trees + n_keys
     graph = coo_matrix(
-        (np.ones(leaf.size, np.int8), (tree_index[leaf], n_trees + key)), shape=(n, n)
+        (np.ones(leaf.size, np.int8), (tree_index[leaf], n_trees + dense)), shape=(n, n)
     )
     label = connected_components(graph, directed=False)[1][:n_trees]
     # number clusters by their smallest tree (first appearance in tree order)
     _, first, inv = np.unique(label, return_index=True, return_inverse=True)
     rank = np.empty(first.size, np.int64)
     rank[np.argsort(first, kind="stable")] = np.arange(first.size)
-    return tree_index, rank[inv.reshape(-1)]
+    return rank[inv.reshape(-1)]
 
 
 def _min_label_components(
@@ -128,7 +135,7 @@ def _min_label_components(
         new = label.copy()
         new[t_ids] = np.minimum(label[t_ids], tree_min)
         new = new[new]  # pointer jumping: label[i] <= i always
-        if np.array_equal(new, label):
+        if not (new != label).any():
             return label
         label = new
     return None

@@ -35,7 +35,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from mhtrack.mht.bnb import search, solve_small
-from mhtrack.mht.clustering import cluster_trees, plot_keys, raw_plot_keys
+from mhtrack.mht.clustering import dense_index, plot_keys, raw_plot_keys, tree_clusters
 from mhtrack.mht.murty import conflict_masks, n_best_hypotheses
 from mhtrack.mht.track_probability import leaf_probabilities
 from mhtrack.mht.tree import segment_starts
@@ -116,7 +116,10 @@ def best_hypothesis(
     if cand.size == 0:
         return _empty(score.size)
     s, w = score[cand], np.asarray(window)[cand]
-    tree_index, tree_cluster = cluster_trees(np.asarray(tree)[cand], w, by_id=by_id)
+    # clusters (as cluster_trees), the plot keys computed once for every step below
+    tree_index = dense_index(np.asarray(tree)[cand])
+    keys = raw_plot_keys(w, by_id=by_id)
+    tree_cluster = tree_clusters(tree_index, *keys)
     leaf_cluster = tree_cluster[tree_index]
     n_clusters = int(tree_cluster.max()) + 1
     sizes = np.bincount(leaf_cluster, minlength=n_clusters)
@@ -124,12 +127,15 @@ def best_hypothesis(
     # best leaf of each tree (highest score, then lowest index)
     order = np.lexsort((-s, tree_index))  # stable: ties keep index order
     best = order[segment_starts(tree_index[order])]
-    bl, bk = raw_plot_keys(w[best], by_id=by_id)
+    is_best = np.zeros(cand.size, bool)
+    is_best[best] = True
+    on_best = is_best[keys[0]]
+    bl, bk = keys[0][on_best], keys[1][on_best]
     clash = np.zeros(n_clusters, bool)
     if bk.size > 1:  # two best leaves on one plot: their (common) cluster clashes
         by_key = np.argsort(bk, kind="stable")
         dup = by_key[1:][bk[by_key[1:]] == bk[by_key[:-1]]]
-        clash[leaf_cluster[best[bl[dup]]]] = True
+        clash[leaf_cluster[bl[dup]]] = True
     chosen = [best[~clash[leaf_cluster[best]]]]
     n_greedy = n_limited = 0
     hard = np.flatnonzero(clash)
@@ -140,7 +146,7 @@ def best_hypothesis(
         small = clash & (sizes <= cap)
         rest = []
         if small.any():
-            picks, rest = solve_small(s, tree_index, w, leaf_cluster, small, by_id,
+            picks, rest = solve_small(s, tree_index, keys, leaf_cluster, small,
                                       BNB_NODE_LIMIT)
             chosen.append(picks)
         if not small[hard].all():

@@ -39,29 +39,29 @@ def solve_small(
     gives the same conflicts). Returns the chosen leaves and the members of each cluster
     whose search passed ``node_limit`` (for ``milp``)."""
     member = in_small[leaf_cluster]
-    idx = np.flatnonzero(member)
+    idx = member.nonzero()[0]
     lc = leaf_cluster[idx]
     on = member[keys[0]]
-    position = np.cumsum(member)
+    position = member.cumsum()
     position -= 1
     leaf, raw = position[keys[0][on]], keys[1][on]  # leaf: position in idx
     c = lc[leaf]
     by_key = np.lexsort((raw, c))
     c, raw, leaf = c[by_key], raw[by_key], leaf[by_key]
     first = changes(c)
-    dense = np.cumsum(first | changes(raw))
+    dense = (first | changes(raw)).cumsum()
     local = dense - np.maximum.accumulate(np.where(first, dense, 1))
     low = local < 63
     m = np.zeros(idx.size, np.uint64)
     np.bitwise_or.at(m, leaf[low], np.left_shift(np.uint64(1), local[low].astype(np.uint64)))
     masks = m.tolist()
-    if not low.all():
+    if np.count_nonzero(low) < low.size:
         for i, k in zip(leaf[~low].tolist(), local[~low].tolist(), strict=True):
             masks[i] |= 1 << k
     ti, si = tree_index[idx], s[idx]
     order = np.lexsort((-si, ti, lc))  # cluster, tree, best first; ties: index (stable)
-    t_start = np.flatnonzero(changes(ti[order]))  # a cluster's trees are consecutive
-    c_start = [*np.flatnonzero(changes(lc[order][t_start])).tolist(), t_start.size]
+    t_start = changes(ti[order]).nonzero()[0]  # a cluster's trees are consecutive
+    c_start = [*changes(lc[order][t_start]).nonzero()[0].tolist(), t_start.size]
     ordered = order.tolist()
     rows = list(zip(si[order].tolist(), [masks[j] for j in ordered], ordered, strict=True))
     bounds = [*t_start.tolist(), order.size]

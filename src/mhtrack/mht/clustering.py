@@ -49,8 +49,8 @@ def raw_plot_keys(window: np.ndarray, *, by_id: bool = False) -> tuple[np.ndarra
 def dense_index(tree: np.ndarray) -> np.ndarray:
     """``np.unique(tree, return_inverse=True)[1]`` (int64), by one pass when ``tree`` is
     already sorted (leaves are kept sorted by tree), else by ``np.unique``."""
-    if tree.size > 1 and bool((tree[1:] >= tree[:-1]).all()):
-        index = np.cumsum(changes(tree))
+    if tree.size > 1 and np.count_nonzero(tree[1:] < tree[:-1]) == 0:
+        index = changes(tree).cumsum()
         index -= 1
         return index
     return np.unique(tree, return_inverse=True)[1].reshape(-1).astype(np.int64)
@@ -89,7 +89,7 @@ def tree_clusters(tree_index: np.ndarray, leaf: np.ndarray, key: np.ndarray) -> 
     if label is not None:
         # every tree is labelled with the smallest tree of its cluster: the clusters in
         # order of their smallest tree are the labels in increasing order
-        rank = np.cumsum(label == np.arange(n_trees))
+        rank = (label == np.arange(n_trees)).cumsum()
         rank -= 1
         return rank[label]
     # pathological chain: let scipy do it
@@ -121,12 +121,12 @@ def _min_label_components(
     by_key = np.lexsort((tree, key))
     k_sorted, t_by_key = key[by_key], tree[by_key]
     k_new = changes(k_sorted)
-    k_starts = np.flatnonzero(k_new)
-    k_of_edge = np.cumsum(k_new)
+    k_starts = k_new.nonzero()[0]
+    k_of_edge = k_new.cumsum()
     k_of_edge -= 1
-    by_tree = np.argsort(t_by_key, kind="stable")
+    by_tree = t_by_key.argsort(kind="stable")
     t_sorted = t_by_key[by_tree]
-    t_starts = np.flatnonzero(changes(t_sorted))
+    t_starts = changes(t_sorted).nonzero()[0]
     t_ids = t_sorted[t_starts]
     label = np.arange(n_trees, dtype=np.int64)
     for _ in range(max_iter):
@@ -135,7 +135,7 @@ def _min_label_components(
         new = label.copy()
         new[t_ids] = np.minimum(label[t_ids], tree_min)
         new = new[new]  # pointer jumping: label[i] <= i always
-        if not (new != label).any():
+        if np.count_nonzero(new != label) == 0:
             return label
         label = new
     return None

@@ -49,10 +49,10 @@ class _Logged:
     def of(cls, scan: int, time: float, leaves: Leaves,
            rows: np.ndarray | None = None) -> _Logged:
         tentative = leaves.track < 0
-        sel = np.flatnonzero(tentative if rows is None else tentative & rows)
+        sel = (tentative if rows is None else tentative & rows).nonzero()[0]
         node = leaves.node[sel]
-        if node.size > 1 and (np.diff(node) <= 0).any():
-            sel = sel[np.argsort(node, kind="stable")]
+        if node.size > 1 and np.count_nonzero(node[1:] <= node[:-1]):
+            sel = sel[node.argsort(kind="stable")]
             node = leaves.node[sel]
         return cls(np.array([scan], np.int64), np.array([time], float), node,
                    leaves.parent[sel], leaves.x[sel], leaves.P[sel], leaves.window[sel, -1],
@@ -107,7 +107,7 @@ class TentativeHistory:
                 break  # every chain has ended
             if log.node.size == 0:
                 continue
-            j = np.minimum(np.searchsorted(log.node, cur), log.node.size - 1)
+            j = np.minimum(log.node.searchsorted(cur), log.node.size - 1)
             found = log.node[j] == cur
             # a leaf a frame did not step is logged at an older frame: look further back
             wait_cur, wait_tid = cur[~found], tid[~found]

@@ -43,13 +43,13 @@ def hand_over(leaves: Leaves, previous: Reported, *, by_id: bool = False) -> Lea
     track = leaves.track
     if previous.track.size == 0:
         return leaves
-    chosen = np.flatnonzero(leaves.chosen)
+    chosen = leaves.chosen.nonzero()[0]
     carried = track[chosen]
     cand = chosen[carried < 0]
     if cand.size == 0:
         return leaves
     lost = ~contains(carried[carried >= 0], previous.track)
-    if not lost.any():
+    if np.count_nonzero(lost) == 0:
         return leaves
     track = track.copy()
     lost_ids, lost_win = previous.track[lost], previous.window[lost]
@@ -79,7 +79,7 @@ def contains(values: np.ndarray, query: np.ndarray) -> np.ndarray:
     if values.size == 0:
         return np.zeros(query.shape, bool)
     v = np.sort(values)
-    j = np.searchsorted(v, query)
+    j = v.searchsorted(query)
     np.minimum(j, v.size - 1, out=j)
     return v[j] == query
 
@@ -88,13 +88,13 @@ def confirm(leaves: Leaves, confirms: np.ndarray, tracks: Counter) -> Leaves:
     """Every tentative tree whose chosen leaf ``confirms`` (a mask over leaves, the SPRT's
     rule) gets the next track id, in tree-id order; all its leaves carry it."""
     new = leaves.chosen & (leaves.track < 0) & confirms
-    if not new.any():
+    if np.count_nonzero(new) == 0:
         return leaves
     track = leaves.track.copy()
     trees = leaves.tree[new]  # one chosen leaf per tree, ascending
     first = tracks.take(trees.size)
     ids = np.arange(first, first + trees.size, dtype=np.int64)
-    j = np.minimum(np.searchsorted(trees, leaves.tree), trees.size - 1)
+    j = np.minimum(trees.searchsorted(leaves.tree), trees.size - 1)
     hit = trees[j] == leaves.tree
     track[hit] = ids[j[hit]]
     return replace(leaves, track=track)
@@ -103,4 +103,4 @@ def confirm(leaves: Leaves, confirms: np.ndarray, tracks: Counter) -> Leaves:
 def newly_confirmed(leaves: Leaves, first_new: int) -> np.ndarray:
     """Rows of the chosen leaves whose track id is ``first_new`` or later (given at this
     scan)."""
-    return np.flatnonzero(leaves.chosen & (leaves.track >= first_new))
+    return (leaves.chosen & (leaves.track >= first_new)).nonzero()[0]

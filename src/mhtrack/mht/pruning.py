@@ -116,14 +116,14 @@ def n_scan_keep(tree: np.ndarray, oldest: np.ndarray, chosen: np.ndarray,
         return np.ones(n, bool)
     ctree, cplot = tree[chosen], oldest[chosen]
     # rule 1: same tree as a chosen leaf, different plot at k − N
-    i = np.searchsorted(ctree, tree)  # chosen leaves are ascending, hence sorted by tree
+    i = ctree.searchsorted(tree)  # chosen leaves are ascending, hence sorted by tree
     np.minimum(i, ctree.size - 1, out=i)
     drop = (ctree[i] == tree) & (oldest != cplot[i])
     # rule 2: plot at k − N taken by the best hypothesis in another tree
     used = cplot != NO_PLOT
-    if used.any():
+    if np.count_nonzero(used):
         up, ut = cplot[used], ctree[used]
-        o = np.argsort(up, kind="stable")
+        o = up.argsort(kind="stable")
         up, ut = up[o], ut[o]
         if window is None:
             drop |= _taken(up, ut, oldest, tree)
@@ -134,7 +134,7 @@ def n_scan_keep(tree: np.ndarray, oldest: np.ndarray, chosen: np.ndarray,
         row, col = np.nonzero(cw != NO_PLOT)
         if row.size:
             up, ut = cw[row, col], ctree[row]
-            o = np.argsort(up, kind="stable")
+            o = up.argsort(kind="stable")
             drop |= _taken(up[o], ut[o], oldest, tree)
     return ~drop
 
@@ -142,7 +142,7 @@ def n_scan_keep(tree: np.ndarray, oldest: np.ndarray, chosen: np.ndarray,
 def _taken(up: np.ndarray, ut: np.ndarray, cols: np.ndarray, tree: np.ndarray) -> np.ndarray:
     """Mask like ``cols`` ((L,) or (L, C)): the plot is one of the sorted ``up`` whose
     tree ``ut`` differs from the leaf's ``tree`` (broadcast against ``cols``)."""
-    j = np.searchsorted(up, cols)
+    j = up.searchsorted(cols)
     np.minimum(j, up.size - 1, out=j)
     return (up[j] == cols) & (cols != NO_PLOT) & (ut[j] != tree)
 
@@ -218,5 +218,5 @@ def prune_after_solve(leaves: Leaves, chosen: np.ndarray, max_trees: int,
             n_kept = int(np.count_nonzero(keep))
     if n_kept == n:  # nothing pruned: the same arrays
         return replace(leaves, chosen=is_chosen)
-    rows = np.flatnonzero(keep)
+    rows = keep.nonzero()[0]
     return replace(leaves.take(rows), chosen=is_chosen[rows])

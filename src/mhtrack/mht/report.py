@@ -59,8 +59,8 @@ def report(scan: Scan, leaves: Leaves, stepped: np.ndarray | None = None) -> Tra
     rep = leaves.chosen & (leaves.track >= 0)
     if stepped is not None:
         rep &= stepped
-    sel = np.flatnonzero(rep)
-    sel = sel[np.argsort(leaves.track[sel], kind="stable")]
+    sel = rep.nonzero()[0]
+    sel = sel[leaves.track[sel].argsort(kind="stable")]
     x = leaves.x[sel]
     n = sel.size
     return TrackTable(

@@ -114,7 +114,7 @@ def segment_starts(sorted_keys: np.ndarray) -> np.ndarray:
     """Start index of each run of equal values in ``sorted_keys`` (empty for no rows)."""
     if sorted_keys.size == 0:
         return np.zeros(0, np.int64)
-    return np.flatnonzero(changes(sorted_keys))
+    return changes(sorted_keys).nonzero()[0]
 
 
 def changes(sorted_keys: np.ndarray) -> np.ndarray:

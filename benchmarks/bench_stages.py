@@ -38,7 +38,7 @@ import mhtrack.mht.tracker as T  # noqa: E402
 STAGES = ["validate_scan", "scan_config", "predict_leaves", "gate_looked",
           "plots_in_confirmed_gates", "clutter_intensity", "update_increment",
           "miss_increments", "propose_children", "prune_children", "grow_children",
-          "number_nodes", "merge_by_tree", "best_hypothesis", "solver_caps",
+          "number_nodes", "merge_by_tree", "number_and_merge", "best_hypothesis", "solver_caps",
           "removed_after_solve", "prune_after_solve", "hand_over", "confirm",
           "newly_confirmed", "report", "confirmed_windows"]
 ACC: dict[str, float] = {}
@@ -57,7 +57,8 @@ def _timed(name: str, fn: Callable[..., Any]) -> Callable[..., Any]:
 def install() -> None:
     """Wrap every stage (module docstring)."""
     for name in STAGES:
-        setattr(T, name, _timed(name, getattr(T, name)))
+        if hasattr(T, name):  # the names of the version on PYTHONPATH
+            setattr(T, name, _timed(name, getattr(T, name)))
     for cls, names in ((T.MHTTracker, ("_look", "_forget")),
                        (T.TentativeHistory, ("backfill", "record")), (T.SPRT, ("confirms",))):
         for n in names:

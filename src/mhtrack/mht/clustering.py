@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from mhtrack.mht.tree import NO_PLOT
+from mhtrack.mht.tree import NO_PLOT, changes
 
 
 def plot_keys(window: np.ndarray, *, by_id: bool = False) -> tuple[np.ndarray, np.ndarray]:
@@ -23,15 +23,37 @@ def plot_keys(window: np.ndarray, *, by_id: bool = False) -> tuple[np.ndarray, n
     integer key per distinct ``(column, plot id)`` (``by_id``: per distinct plot id),
     misses left out. Keys are dense ``0 … K−1`` in sorted ``(column, plot)`` (``plot``)
     order."""
+    leaf, raw = raw_plot_keys(window, by_id=by_id)
+    if leaf.size == 0:
+        return leaf, raw
+    _, key = np.unique(raw, return_inverse=True)
+    return leaf, key.reshape(-1).astype(np.int64)
+
+
+def raw_plot_keys(window: np.ndarray, *, by_id: bool = False) -> tuple[np.ndarray,
+                                                                       np.ndarray]:
+    """As :func:`plot_keys`, with keys not made dense: ``column·span + plot`` (``by_id``:
+    the plot id). Same order and same equalities as the dense keys (one a strictly
+    increasing function of the other), one sort less."""
     leaf, col = np.nonzero(window != NO_PLOT)
     if leaf.size == 0:
         e = np.zeros(0, np.int64)
         return e, e
     plot = window[leaf, col]
+    if by_id:
+        return leaf.astype(np.int64), plot.astype(np.int64)
     span = int(plot.max()) + 1
-    raw = plot.astype(np.int64) if by_id else col.astype(np.int64) * span + plot
-    _, key = np.unique(raw, return_inverse=True)
-    return leaf.astype(np.int64), key.reshape(-1).astype(np.int64)
+    return leaf.astype(np.int64), col.astype(np.int64) * span + plot
+
+
+def dense_index(tree: np.ndarray) -> np.ndarray:
+    """``np.unique(tree, return_inverse=True)[1]`` (int64), by one pass when ``tree`` is
+    already sorted (leaves are kept sorted by tree), else by ``np.unique``."""
+    if tree.size > 1 and np.count_nonzero(tree[1:] < tree[:-1]) == 0:
+        index = changes(tree).cumsum()
+        index -= 1
+        return index
+    return np.unique(tree, return_inverse=True)[1].reshape(-1).astype(np.int64)
 
 
 def cluster_trees(tree: np.ndarray, window: np.ndarray, *,
@@ -51,43 +73,60 @@ def cluster_trees(tree: np.ndarray, window: np.ndarray, *,
     tree_cluster : (T,) cluster label of each unique tree; labels are ``0 … C−1``
         numbered in order of each cluster's smallest tree id (deterministic).
     """
-    uniq, tree_index = np.unique(tree, return_inverse=True)
-    tree_index = tree_index.reshape(-1).astype(np.int64)
-    n_trees = uniq.size
-    leaf, key = plot_keys(window, by_id=by_id)
-    if leaf.size == 0:
-        return tree_index, np.arange(n_trees, dtype=np.int64)
-    label = _min_label_components(tree_index[leaf], key, n_trees)
-    if label is None:  # pathological chain: let scipy do it
-        from scipy.sparse import coo_matrix
-        from scipy.sparse.csgraph import connected_components
+    tree_index = dense_index(tree)
+    leaf, raw = raw_plot_keys(window, by_id=by_id)
+    return tree_index, tree_clusters(tree_index, leaf, raw)
 
-        n_keys = int(key.max()) + 1
-        n = n_trees + n_keys
-        graph = coo_matrix(
-            (np.ones(leaf.size, np.int8), (tree_index[leaf], n_trees + key)), shape=(n, n)
-        )
-        label = connected_components(graph, directed=False)[1][:n_trees]
+
+def tree_clusters(tree_index: np.ndarray, leaf: np.ndarray, key: np.ndarray) -> np.ndarray:
+    """The ``tree_cluster`` of :func:`cluster_trees` from its parts: each leaf's tree
+    index (dense, ``0 … T−1``) and the leaves' ``(leaf, key)`` plot pairs
+    (:func:`raw_plot_keys` or :func:`plot_keys`)."""
+    n_trees = int(tree_index.max()) + 1 if tree_index.size else 0
+    if leaf.size == 0:
+        return np.arange(n_trees, dtype=np.int64)
+    label = _min_label_components(tree_index[leaf], key, n_trees)
+    if label is not None:
+        # every tree is labelled with the smallest tree of its cluster: the clusters in
+        # order of their smallest tree are the labels in increasing order
+        rank = (label == np.arange(n_trees)).cumsum()
+        rank -= 1
+        return rank[label]
+    # pathological chain: let scipy do it
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    _, dense = np.unique(key, return_inverse=True)
+    dense = dense.reshape(-1)
+    n_keys = int(dense.max()) + 1
+    n = n_trees + n_keys
+    graph = coo_matrix(
+        (np.ones(leaf.size, np.int8), (tree_index[leaf], n_trees + dense)), shape=(n, n)
+    )
+    label = connected_components(graph, directed=False)[1][:n_trees]
     # number clusters by their smallest tree (first appearance in tree order)
     _, first, inv = np.unique(label, return_index=True, return_inverse=True)
     rank = np.empty(first.size, np.int64)
     rank[np.argsort(first, kind="stable")] = np.arange(first.size)
-    return tree_index, rank[inv.reshape(-1)]
+    return rank[inv.reshape(-1)]
 
 
 def _min_label_components(
     tree: np.ndarray, key: np.ndarray, n_trees: int, max_iter: int = 64
 ) -> np.ndarray | None:
     """Connected components of the bipartite tree–plot graph with edges ``(tree, key)``
-    by min-label propagation with pointer jumping: every tree ends labelled with the
-    smallest tree index of its component. ``None`` if not converged in ``max_iter``."""
+    (any integer keys: only their equalities count) by min-label propagation with pointer
+    jumping: every tree ends labelled with the smallest tree index of its component.
+    ``None`` if not converged in ``max_iter``."""
     by_key = np.lexsort((tree, key))
     k_sorted, t_by_key = key[by_key], tree[by_key]
-    k_starts = np.flatnonzero(np.r_[True, k_sorted[1:] != k_sorted[:-1]])
-    k_of_edge = np.cumsum(np.r_[True, k_sorted[1:] != k_sorted[:-1]]) - 1
-    by_tree = np.argsort(t_by_key, kind="stable")
+    k_new = changes(k_sorted)
+    k_starts = k_new.nonzero()[0]
+    k_of_edge = k_new.cumsum()
+    k_of_edge -= 1
+    by_tree = t_by_key.argsort(kind="stable")
     t_sorted = t_by_key[by_tree]
-    t_starts = np.flatnonzero(np.r_[True, t_sorted[1:] != t_sorted[:-1]])
+    t_starts = changes(t_sorted).nonzero()[0]
     t_ids = t_sorted[t_starts]
     label = np.arange(n_trees, dtype=np.int64)
     for _ in range(max_iter):
@@ -96,7 +135,7 @@ def _min_label_components(
         new = label.copy()
         new[t_ids] = np.minimum(label[t_ids], tree_min)
         new = new[new]  # pointer jumping: label[i] <= i always
-        if np.array_equal(new, label):
+        if np.count_nonzero(new != label) == 0:
             return label
         label = new
     return None

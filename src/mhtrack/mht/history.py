@@ -27,7 +27,7 @@ from dataclasses import dataclass, fields
 
 import numpy as np
 
-from mhtrack.mht.tree import Leaves
+from mhtrack.mht.tree import Leaves, changes
 from mhtrack.records import TrackTable
 
 
@@ -46,11 +46,13 @@ class _Logged:
     t: np.ndarray  # each leaf's own time
 
     @classmethod
-    def of(cls, scan: int, time: float, leaves: Leaves) -> _Logged:
-        sel = np.flatnonzero(leaves.track < 0)
+    def of(cls, scan: int, time: float, leaves: Leaves,
+           rows: np.ndarray | None = None) -> _Logged:
+        tentative = leaves.track < 0
+        sel = (tentative if rows is None else tentative & rows).nonzero()[0]
         node = leaves.node[sel]
-        if node.size > 1 and (np.diff(node) <= 0).any():
-            sel = sel[np.argsort(node, kind="stable")]
+        if node.size > 1 and np.count_nonzero(node[1:] <= node[:-1]):
+            sel = sel[node.argsort(kind="stable")]
             node = leaves.node[sel]
         return cls(np.array([scan], np.int64), np.array([time], float), node,
                    leaves.parent[sel], leaves.x[sel], leaves.P[sel], leaves.window[sel, -1],
@@ -72,13 +74,19 @@ class TentativeHistory:
         #: per logged scan, the sorted plot rows the output gives a track at that scan
         self._claimed: deque[np.ndarray] = deque(maxlen=max(self.depth, 1))
 
-    def record(self, scan: int, time: float, leaves: Leaves) -> None:
+    def record(self, scan: int, time: float, leaves: Leaves,
+               rows: np.ndarray | None = None) -> None:
         """Keep the tentative leaves (``track < 0``) of this scan, and the plots of the
-        tracks reported at it (chosen, confirmed)."""
+        tracks reported at it (chosen, confirmed); ``rows`` (mask): of those leaves only
+        (the leaves a frame stepped), as if given ``leaves.take(rows)``."""
         if self.depth:
-            self._log.append(_Logged.of(scan, time, leaves))
-            used = leaves.window[leaves.chosen & (leaves.track >= 0), -1]
-            self._claimed.append(np.unique(used[used >= 0]))
+            self._log.append(_Logged.of(scan, time, leaves, rows))
+            rep = leaves.chosen & (leaves.track >= 0)
+            if rows is not None:
+                rep &= rows
+            used = np.sort(leaves.window[rep, -1])
+            used = used[used >= 0]
+            self._claimed.append(used[changes(used)])  # np.unique, without its set-up
 
     def backfill(self, leaves: Leaves, rows: np.ndarray) -> TrackTable:
         """The ancestors of leaves ``rows`` (just confirmed, ``track >= 0``) at the logged
@@ -99,7 +107,7 @@ class TentativeHistory:
                 break  # every chain has ended
             if log.node.size == 0:
                 continue
-            j = np.minimum(np.searchsorted(log.node, cur), log.node.size - 1)
+            j = np.minimum(log.node.searchsorted(cur), log.node.size - 1)
             found = log.node[j] == cur
             # a leaf a frame did not step is logged at an older frame: look further back
             wait_cur, wait_tid = cur[~found], tid[~found]

@@ -34,7 +34,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from mhtrack.mht.clustering import cluster_trees, plot_keys
+from mhtrack.mht.bnb import search, solve_small
+from mhtrack.mht.clustering import dense_index, plot_keys, raw_plot_keys, tree_clusters
 from mhtrack.mht.murty import conflict_masks, n_best_hypotheses
 from mhtrack.mht.track_probability import leaf_probabilities
 from mhtrack.mht.tree import segment_starts
@@ -111,11 +112,14 @@ def best_hypothesis(
     Ties are broken deterministically (same input, same output).
     """
     score = np.asarray(score, float)
-    cand = np.flatnonzero(score > 0)
+    cand = (score > 0).nonzero()[0]  # the methods: no wrapper set-up (µs a call)
     if cand.size == 0:
         return _empty(score.size)
     s, w = score[cand], np.asarray(window)[cand]
-    tree_index, tree_cluster = cluster_trees(np.asarray(tree)[cand], w, by_id=by_id)
+    # clusters (as cluster_trees), the plot keys computed once for every step below
+    tree_index = dense_index(np.asarray(tree)[cand])
+    keys = raw_plot_keys(w, by_id=by_id)
+    tree_cluster = tree_clusters(tree_index, *keys)
     leaf_cluster = tree_cluster[tree_index]
     n_clusters = int(tree_cluster.max()) + 1
     sizes = np.bincount(leaf_cluster, minlength=n_clusters)
@@ -123,23 +127,33 @@ def best_hypothesis(
     # best leaf of each tree (highest score, then lowest index)
     order = np.lexsort((-s, tree_index))  # stable: ties keep index order
     best = order[segment_starts(tree_index[order])]
-    bl, bk = plot_keys(w[best], by_id=by_id)
+    is_best = np.zeros(cand.size, bool)
+    is_best[best] = True
+    on_best = is_best[keys[0]]
+    bl, bk = keys[0][on_best], keys[1][on_best]
     clash = np.zeros(n_clusters, bool)
-    if bk.size:
-        dup = np.bincount(bk)[bk] > 1
-        clash[leaf_cluster[best[bl[dup]]]] = True
+    if bk.size > 1:  # two best leaves on one plot: their (common) cluster clashes
+        by_key = bk.argsort(kind="stable")
+        dup = by_key[1:][bk[by_key[1:]] == bk[by_key[:-1]]]
+        clash[leaf_cluster[bl[dup]]] = True
     chosen = [best[~clash[leaf_cluster[best]]]]
     n_greedy = n_limited = 0
-    hard = np.flatnonzero(clash)
+    hard = clash.nonzero()[0]
     if hard.size:
-        by_cluster = np.argsort(leaf_cluster, kind="stable")
-        bounds = np.r_[0, np.cumsum(sizes)]
         # small clusters: branch-and-bound, all at once; what it cannot finish and
         # clusters over BNB_MAX_LEAVES (as solve_exact): milp; over max_cluster_size: greedy
         cap = min(BNB_MAX_LEAVES, BNB_MAX_LEAVES if max_cluster_size is None else max_cluster_size)
-        small = sizes[hard] <= cap
-        rest = _solve_small(s, tree_index, w, leaf_cluster, hard[small], by_id, chosen)
-        rest += [by_cluster[bounds[c] : bounds[c + 1]] for c in hard[~small].tolist()]
+        small = clash & (sizes <= cap)
+        rest = []
+        if np.count_nonzero(small):
+            picks, rest = solve_small(s, tree_index, keys, leaf_cluster, small,
+                                      BNB_NODE_LIMIT)
+            chosen.append(picks)
+        if not small[hard].all():
+            by_cluster = np.argsort(leaf_cluster, kind="stable")
+            bounds = np.concatenate(([0], np.cumsum(sizes)))
+            rest += [by_cluster[bounds[c] : bounds[c + 1]] for c in hard.tolist()
+                     if not small[c]]
         for members in rest:
             if max_cluster_size is not None and members.size > max_cluster_size:
                 pick = solve_greedy(s[members], tree_index[members], w[members], by_id=by_id)
@@ -157,7 +171,7 @@ def best_hypothesis(
     if n_best > 1:
         n_cut = _n_best(s, tree_index, w, leaf_cluster, sizes, n_best, max_cluster_size,
                         by_id, is_sel, probability, cand)
-    sel = np.flatnonzero(is_sel)
+    sel = is_sel.nonzero()[0]
     if n_best == 1:
         probability[cand[sel]] = 1.0
     return GlobalHypothesis(
@@ -236,89 +250,8 @@ def _branch_and_bound(
     starts = [*segment_starts(tree[pos][order]).tolist(), pos.size]
     options = [[(float(s[i]), masks[i], int(pos[i])) for i in order[a:b].tolist()]
                for a, b in itertools.pairwise(starts)]  # per tree, best first
-    best = _search(options, node_limit)
+    best = search(options, node_limit)
     return None if best is None else np.sort(np.asarray(best, np.int64))
-
-
-def _solve_small(
-    s: np.ndarray, tree_index: np.ndarray, w: np.ndarray, leaf_cluster: np.ndarray,
-    clusters: np.ndarray, by_id: bool, chosen: list,
-) -> list[np.ndarray]:
-    """:func:`_branch_and_bound` on all ``clusters`` (scores > 0), their options built
-    from one sort and one set of plot keys (bit: the key's rank in its cluster; any 1-to-1
-    numbering gives the same conflicts). Appends the choices to ``chosen``; returns the
-    members of the clusters whose search passed :data:`BNB_NODE_LIMIT` (for ``milp``)."""
-    if clusters.size == 0:
-        return []
-    idx = np.flatnonzero(np.isin(leaf_cluster, clusters))
-    leaf, key = plot_keys(w[idx], by_id=by_id)
-    c = leaf_cluster[idx][leaf]
-    by_key = np.lexsort((key, c))
-    c, key, leaf = c[by_key], key[by_key], leaf[by_key]
-    first = np.r_[True, c[1:] != c[:-1]]
-    dense = np.cumsum(first | np.r_[True, key[1:] != key[:-1]]) - 1
-    local = dense - np.maximum.accumulate(np.where(first, dense, 0))
-    low = local < 63
-    m = np.zeros(idx.size, np.uint64)
-    np.bitwise_or.at(m, leaf[low], np.left_shift(np.uint64(1), local[low].astype(np.uint64)))
-    masks = m.tolist()
-    for i, k in zip(leaf[~low].tolist(), local[~low].tolist(), strict=True):
-        masks[i] |= 1 << k
-    order = np.lexsort((idx, -s[idx], tree_index[idx], leaf_cluster[idx]))
-    t_start = segment_starts(tree_index[idx][order])  # trees of one cluster are consecutive
-    c_of_tree = leaf_cluster[idx][order][t_start]
-    c_start = [*segment_starts(c_of_tree).tolist(), t_start.size]
-    rows = list(zip(s[idx][order].tolist(), [masks[j] for j in order.tolist()],
-                    idx[order].tolist(), strict=True))
-    bounds = [*t_start.tolist(), order.size]
-    trees = [rows[a:b] for a, b in itertools.pairwise(bounds)]
-    limited, picks = [], []
-    for a, b in itertools.pairwise(c_start):
-        options = trees[a:b]
-        best = _search(options, BNB_NODE_LIMIT)
-        if best is None:
-            limited.append(np.sort(np.asarray([i for o in options for _, _, i in o])))
-        else:
-            picks.extend(best)
-    chosen.append(np.asarray(picks, np.int64))
-    return limited
-
-
-def _search(options: list[list[tuple[float, int, int]]], node_limit: int) -> list[int] | None:
-    """Branch-and-bound over trees; ``options[t]``: tree ``t``'s ``(score, plot mask,
-    leaf)``, best first (ties: lower leaf). The chosen leaves, or ``None`` after
-    ``node_limit`` nodes."""
-    options.sort(key=lambda opts: (-opts[0][0], opts[0][2]))
-    bound = [0.0] * (len(options) + 1)
-    for t in range(len(options) - 1, -1, -1):
-        bound[t] = bound[t + 1] + options[t][0][0]
-    # greedy incumbent: a lower bound that prunes early
-    best_val, best_sel, used = 0.0, [], 0
-    for opts in options:
-        for sc, m, i in opts:
-            if not m & used:
-                used |= m
-                best_val += sc
-                best_sel.append(i)
-                break
-    nodes, n_trees = 0, len(options)
-    stack: list[tuple[int, int, float, tuple[int, ...]]] = [(0, 0, 0.0, ())]
-    while stack:
-        t, used, val, sel = stack.pop()
-        nodes += 1
-        if nodes > node_limit:
-            return None
-        if val + bound[t] <= best_val:
-            continue
-        if t == n_trees:
-            best_val, best_sel = val, list(sel)
-            continue
-        # push in reverse so that the best leaf is explored first, "leave out" last
-        stack.append((t + 1, used, val, sel))
-        for sc, m, i in reversed(options[t]):
-            if not m & used:
-                stack.append((t + 1, used | m, val + sc, (*sel, i)))
-    return best_sel
 
 
 def solve_milp(

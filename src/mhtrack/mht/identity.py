@@ -41,11 +41,15 @@ def hand_over(leaves: Leaves, previous: Reported, *, by_id: bool = False) -> Lea
     then lower track id; each tree and each id at most once. A plot is shared at the same
     scan column, or (``by_id``: frames of several sensors) by its id in any column."""
     track = leaves.track
-    chosen = np.flatnonzero(leaves.chosen)
+    if previous.track.size == 0:
+        return leaves
+    chosen = leaves.chosen.nonzero()[0]
     carried = track[chosen]
-    lost = ~np.isin(previous.track, carried[carried >= 0])
     cand = chosen[carried < 0]
-    if not (lost.any() and cand.size):
+    if cand.size == 0:
+        return leaves
+    lost = ~contains(carried[carried >= 0], previous.track)
+    if np.count_nonzero(lost) == 0:
         return leaves
     track = track.copy()
     lost_ids, lost_win = previous.track[lost], previous.window[lost]
@@ -69,17 +73,28 @@ def hand_over(leaves: Leaves, previous: Reported, *, by_id: bool = False) -> Lea
     return replace(leaves, track=track)
 
 
+def contains(values: np.ndarray, query: np.ndarray) -> np.ndarray:
+    """``np.isin(query, values)`` by one sort and a binary search (no set-up cost of
+    ``np.isin`` on the few values of one scan)."""
+    if values.size == 0:
+        return np.zeros(query.shape, bool)
+    v = np.sort(values)
+    j = v.searchsorted(query)
+    np.minimum(j, v.size - 1, out=j)
+    return v[j] == query
+
+
 def confirm(leaves: Leaves, confirms: np.ndarray, tracks: Counter) -> Leaves:
     """Every tentative tree whose chosen leaf ``confirms`` (a mask over leaves, the SPRT's
     rule) gets the next track id, in tree-id order; all its leaves carry it."""
     new = leaves.chosen & (leaves.track < 0) & confirms
-    if not new.any():
+    if np.count_nonzero(new) == 0:
         return leaves
     track = leaves.track.copy()
     trees = leaves.tree[new]  # one chosen leaf per tree, ascending
     first = tracks.take(trees.size)
     ids = np.arange(first, first + trees.size, dtype=np.int64)
-    j = np.minimum(np.searchsorted(trees, leaves.tree), trees.size - 1)
+    j = np.minimum(trees.searchsorted(leaves.tree), trees.size - 1)
     hit = trees[j] == leaves.tree
     track[hit] = ids[j[hit]]
     return replace(leaves, track=track)
@@ -88,4 +103,4 @@ def confirm(leaves: Leaves, confirms: np.ndarray, tracks: Counter) -> Leaves:
 def newly_confirmed(leaves: Leaves, first_new: int) -> np.ndarray:
     """Rows of the chosen leaves whose track id is ``first_new`` or later (given at this
     scan)."""
-    return np.flatnonzero(leaves.chosen & (leaves.track >= first_new))
+    return (leaves.chosen & (leaves.track >= first_new)).nonzero()[0]

@@ -113,39 +113,39 @@ def n_scan_keep(tree: np.ndarray, oldest: np.ndarray, chosen: np.ndarray,
     (every tree steps every scan) both reduce to rule 2.
     """
     n = tree.size
-    keep = np.ones(n, bool)
     if chosen.size == 0 or n == 0:
-        return keep
+        return np.ones(n, bool)
     ctree, cplot = tree[chosen], oldest[chosen]
     # rule 1: same tree as a chosen leaf, different plot at k − N
-    i = np.searchsorted(ctree, tree)  # chosen leaves are ascending, hence sorted by tree
-    i = np.minimum(i, ctree.size - 1)
-    in_hyp = ctree[i] == tree
-    keep &= ~(in_hyp & (oldest != cplot[i]))
+    i = ctree.searchsorted(tree)  # chosen leaves are ascending, hence sorted by tree
+    np.minimum(i, ctree.size - 1, out=i)
+    drop = (ctree[i] == tree) & (oldest != cplot[i])
     # rule 2: plot at k − N taken by the best hypothesis in another tree
     used = cplot != NO_PLOT
-    if used.any():
+    if np.count_nonzero(used):
         up, ut = cplot[used], ctree[used]
-        o = np.argsort(up, kind="stable")
+        o = up.argsort(kind="stable")
         up, ut = up[o], ut[o]
-        cols = oldest[:, None] if window is None else window
-        keep &= ~_taken(up, ut, cols, tree).any(axis=1)
+        if window is None:
+            drop |= _taken(up, ut, oldest, tree)
+        else:
+            drop |= _taken(up, ut, window, tree[:, None]).any(axis=1)
     if window is not None:  # rule 2, the other way: the leaf's own k − N anywhere
         cw = window[chosen]
-        ct = np.broadcast_to(ctree[:, None], cw.shape)
-        used = cw != NO_PLOT
-        if used.any():
-            up, ut = cw[used], ct[used]
-            o = np.argsort(up, kind="stable")
-            keep &= ~_taken(up[o], ut[o], oldest[:, None], tree)[:, 0]
-    return keep
+        row, col = np.nonzero(cw != NO_PLOT)
+        if row.size:
+            up, ut = cw[row, col], ctree[row]
+            o = up.argsort(kind="stable")
+            drop |= _taken(up[o], ut[o], oldest, tree)
+    return ~drop
 
 
 def _taken(up: np.ndarray, ut: np.ndarray, cols: np.ndarray, tree: np.ndarray) -> np.ndarray:
-    """Mask like ``cols`` (L, C): the plot is one of the sorted ``up`` whose tree ``ut``
-    differs from the leaf's ``tree``."""
-    j = np.minimum(np.searchsorted(up, cols), up.size - 1)
-    return (up[j] == cols) & (cols != NO_PLOT) & (ut[j] != tree[:, None])
+    """Mask like ``cols`` ((L,) or (L, C)): the plot is one of the sorted ``up`` whose
+    tree ``ut`` differs from the leaf's ``tree`` (broadcast against ``cols``)."""
+    j = up.searchsorted(cols)
+    np.minimum(j, up.size - 1, out=j)
+    return (up[j] == cols) & (cols != NO_PLOT) & (ut[j] != tree)
 
 
 def prune_children(leaves: Leaves, children: Children, n_births: int, sprt: SPRT,
@@ -244,16 +244,23 @@ def prune_after_solve(leaves: Leaves, chosen: np.ndarray, max_trees: int,
     on trees; marks the surviving chosen leaves. ``by_id``: trees step on their own looks
     (:func:`n_scan_keep`'s ``window``). ``remove``: a mask of further leaves to drop
     (:func:`removed_after_solve`)."""
-    is_chosen = np.zeros(len(leaves), bool)
+    n = len(leaves)
+    is_chosen = np.zeros(n, bool)
     is_chosen[chosen] = True
     keep = n_scan_keep(leaves.tree, leaves.window[:, 0], chosen,
                        leaves.window if by_id else None)
     if remove is not None:
         keep &= ~remove
-    protected = is_chosen | (leaves.track >= 0)
-    keep_t, cut = cap_trees(leaves.tree[keep], leaves.score[keep], protected[keep], max_trees)
-    if cut:
-        caps["max_trees"] = cut
-        keep[np.flatnonzero(keep)[~keep_t]] = False
-    out = leaves.take(keep)
-    return replace(out, chosen=is_chosen[keep])
+    n_kept = int(np.count_nonzero(keep))
+    if n_kept > max_trees:  # else at most max_trees trees (each has a leaf): no cut
+        protected = is_chosen | (leaves.track >= 0)
+        keep_t, cut = cap_trees(leaves.tree[keep], leaves.score[keep], protected[keep],
+                                max_trees)
+        if cut:
+            caps["max_trees"] = cut
+            keep[np.flatnonzero(keep)[~keep_t]] = False
+            n_kept = int(np.count_nonzero(keep))
+    if n_kept == n:  # nothing pruned: the same arrays
+        return replace(leaves, chosen=is_chosen)
+    rows = keep.nonzero()[0]
+    return replace(leaves.take(rows), chosen=is_chosen[rows])

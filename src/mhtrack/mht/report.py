@@ -16,7 +16,8 @@ from mhtrack.records import Scan, TrackTable
 class StepStats:
     """What one :meth:`~mhtrack.mht.tracker.MHTTracker.step` did.
 
-    ``caps`` maps each hard cap that acted to how many leaves (``max_leaves_per_tree``,
+    ``caps`` maps each hard cap that acted to how many leaves (``max_leaves_per_plot``,
+    the overload rule of :mod:`mhtrack.mht.caps`; ``max_leaves_per_tree``,
     ``max_leaves``), trees (``max_trees``), plots or initiated tracks
     (``max_births_per_scan``) or clusters (``max_cluster_size``) it cut; empty when none
     acted. ``n_births`` counts the trees started at this scan. ``limits``: the caps that
@@ -42,7 +43,7 @@ class StepStats:
         return cls(scan=int(scan.index), n_plots=n_plots, n_leaves=len(leaves),
                    n_trees=leaves.n_trees, n_clusters=hyp.n_clusters,
                    largest_cluster=hyp.largest_cluster, n_confirmed=len(out), time_s=time_s,
-                   caps=caps, n_births=int(np.unique(births.tree).size),
+                   caps=caps, n_births=births.n_trees,
                    limits={} if limits is None else limits)
 
 
@@ -59,8 +60,8 @@ def report(scan: Scan, leaves: Leaves, stepped: np.ndarray | None = None) -> Tra
     rep = leaves.chosen & (leaves.track >= 0)
     if stepped is not None:
         rep &= stepped
-    sel = np.flatnonzero(rep)
-    sel = sel[np.argsort(leaves.track[sel], kind="stable")]
+    sel = rep.nonzero()[0]
+    sel = sel[leaves.track[sel].argsort(kind="stable")]
     x = leaves.x[sel]
     n = sel.size
     return TrackTable(

@@ -53,15 +53,6 @@ def split_looked(leaves: Leaves, looks: Looks) -> tuple[Leaves, Looks, Leaves]:
             leaves.take(~mask))
 
 
-def merge_by_tree(stepped: Leaves, idle: Leaves) -> Leaves:
-    """The ``stepped`` and ``idle`` leaves (disjoint trees, each sorted by tree) as one
-    store sorted by tree (``stepped`` itself when there is no idle leaf)."""
-    if len(idle) == 0:
-        return stepped
-    both = Leaves.concat(stepped, idle)
-    return both.take(np.argsort(both.tree, kind="stable"))
-
-
 def gate_looked(gate: Gate, leaves: Leaves, pred: States, pd: np.ndarray, z: np.ndarray,
                 R: np.ndarray, t: np.ndarray | None, time: float, motion: MotionModel,
                 caps: dict[str, int]) -> tuple[Gated, States | None]:

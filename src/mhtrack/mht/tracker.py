@@ -16,8 +16,8 @@ The tracking cycle, one stage per line of :meth:`MHTTracker.step`::
                                                      the (costly) update
     grow             extend.grow_children            the children's filter update
     seed births      births.Birth.seed               the new trees, with tree ids
-    number nodes     numbering.number_nodes          leaf ids for the history links
-    merge            timed.merge_by_tree             the trees the frame did not step back
+    number nodes,    numbering.number_and_merge      leaf ids for the history links; the
+    merge                                              trees the frame did not step back
     global hyp.      hypothesis.best_hypothesis      clusters → best compatible leaves
     N-scan pruning   pruning.prune_after_solve       decide scan k − N; cap on trees
     hand over        identity.hand_over              a track follows its plots
@@ -58,16 +58,16 @@ from mhtrack.mht.extend import grow_children, propose_children
 from mhtrack.mht.gating import Gate, plots_in_confirmed_gates
 from mhtrack.mht.history import TentativeHistory
 from mhtrack.mht.hypothesis import best_hypothesis
-from mhtrack.mht.identity import Reported, confirm, hand_over, newly_confirmed
+from mhtrack.mht.identity import Reported, confirm, contains, hand_over, newly_confirmed
 from mhtrack.mht.intensity import clutter_intensity
-from mhtrack.mht.numbering import Counter, number_nodes
+from mhtrack.mht.numbering import Counter, number_and_merge
 from mhtrack.mht.predict import predict_leaves
 from mhtrack.mht.pruning import prune_after_solve, prune_children, removed_after_solve
 from mhtrack.mht.report import StepStats, confirmed_windows, report
 from mhtrack.mht.scoring import miss_increments, update_increment
 from mhtrack.mht.sprt import SPRT
 from mhtrack.mht.state import load_state, located, save_state
-from mhtrack.mht.timed import gate_looked, merge_by_tree, split_looked
+from mhtrack.mht.timed import gate_looked, split_looked
 from mhtrack.mht.tree import Leaves
 from mhtrack.mht.validate import validate_scan
 from mhtrack.models.motion import MotionModel
@@ -168,7 +168,7 @@ class MHTTracker:
                               pair_pred, scan.t)
         births = self.birth.seed(scan, cand, grown.window, self.trees, caps)
         first_node = self.nodes.next
-        leaves = merge_by_tree(number_nodes(Leaves.concat(grown, births), self.nodes), idle)
+        leaves = number_and_merge(grown, births, idle, self.nodes)
         hyp = best_hypothesis(leaves.score, leaves.tree, leaves.window, cfg.max_cluster_size,
                               cfg.milp_node_limit, by_id=by_id, n_best=cfg.n_best)
         solver_caps(hyp, caps)
@@ -179,8 +179,7 @@ class MHTTracker:
         leaves = hand_over(leaves, previous, by_id=by_id)
         leaves = confirm(leaves, self.sprt.confirms(leaves), self.tracks)
         self.last_backfill = self._history.backfill(leaves, newly_confirmed(leaves, first_new))
-        self._history.record(int(scan.index), ftime,
-                             leaves if is_new is None else leaves.take(is_new))
+        self._history.record(int(scan.index), ftime, leaves, is_new)
         self._forget(leaves, rows)
         self._leaves, self._last_time, self._last_index = leaves, ftime, int(scan.index)
         out = report(scan, leaves, is_new)
@@ -201,7 +200,7 @@ class MHTTracker:
         estimator (their optional hooks)."""
         used = confirmed_windows(leaves)
         self.birth.forget_used(used)
-        self.clutter.forget(np.isin(rows, used[:, -1]))
+        self.clutter.forget(contains(used[:, -1], rows))
 
     def run(
         self, scans: Iterable[Scan] | PlotTable, stats: list[StepStats] | None = None,

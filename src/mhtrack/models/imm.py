@@ -89,11 +89,12 @@ class CVModelSet(MotionModel):
         x0 = _mix_sum(w[..., None], xm[:, :, None, :])  # (M, j, 4)
         d = xm[:, :, None, :] - x0[:, None, :, :]  # (M, i, j, 4)
         wd = w[..., None] * d
-        P0 = (_mix_sum(w[..., None, None], Pm[:, :, None])
-              + _mix_sum(wd[..., :, None], d[..., None, :]))
+        tmp = np.empty_like(Pm)  # (M, j, 4, 4) scratch of both sums
+        P0 = _mix_sum(w[..., None, None], Pm[:, :, None], tmp=tmp)
+        P0 += _mix_sum(wd[..., :, None], d[..., None, :], tmp=tmp)
         Q = (_process_noise(self.sigmas, float(dt)) if np.ndim(dt) == 0
              else np.stack([ConstantVelocity(s).Q(dt) for s in self.sigmas], axis=-3))
-        xp, Pp = kalman.predict_cv(x0, P0, dt, Q)  # every model at once
+        xp, Pp = kalman.predict_cv(x0, P0, dt, Q, overwrite=True)  # every model at once
         return xp, Pp, mubar
 
     # ------------------------------------------------------------------ MotionModel
@@ -151,12 +152,17 @@ def _process_noise(sigmas: tuple[float, ...], dt: float) -> np.ndarray:
     return q
 
 
-def _mix_sum(w: np.ndarray, a: np.ndarray) -> np.ndarray:
+def _mix_sum(w: np.ndarray, a: np.ndarray, tmp: np.ndarray | None = None) -> np.ndarray:
     """``Σ_i w_i a_i`` over axis 1, summed in model order ``((w_0 a_0 + w_1 a_1) + …)``:
-    the products and the order of ``np.einsum``'s sum, in a few whole-array operations."""
-    out = w[:, 0] * a[:, 0]
-    for i in range(1, w.shape[1]):
-        out = out + w[:, i] * a[:, i]
+    the products and the order of ``np.einsum``'s sum, in a few whole-array operations,
+    accumulated in place (the same floats as ``out = out + w_i a_i``). ``tmp``: a scratch
+    array of the result's shape to reuse (else one is allocated)."""
+    out = np.multiply(w[:, 0], a[:, 0])
+    if w.shape[1] > 1:
+        tmp = np.empty_like(out) if tmp is None else tmp
+        for i in range(1, w.shape[1]):
+            np.multiply(w[:, i], a[:, i], out=tmp)
+            out += tmp
     return out
 
 
@@ -164,9 +170,10 @@ def combine(xm: np.ndarray, Pm: np.ndarray, mu: np.ndarray) -> tuple[np.ndarray,
     """Moment-matched single Gaussian of the model mixture: ``(x, P)``, (M, 4), (M, 4, 4)."""
     x = _mix_sum(mu[..., None], xm)
     d = xm - x[:, None, :]
-    P = _mix_sum(mu[..., None, None], Pm) + _mix_sum((mu[..., None] * d)[..., None],
-                                                      d[..., None, :])
-    return x, 0.5 * (P + np.swapaxes(P, -1, -2))
+    P = _mix_sum(mu[..., None, None], Pm)
+    spread = _mix_sum((mu[..., None] * d)[..., None], d[..., None, :], tmp=np.empty_like(P))
+    P += spread
+    return x, kalman.symmetrised(P, out=spread)
 
 
 def model_logliks(xm: np.ndarray, Pm: np.ndarray, z: np.ndarray, R: np.ndarray) -> np.ndarray:

@@ -6,12 +6,11 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
+from test_numbering import _leaves
 
 from mhtrack.mht.numbering import Counter, number_and_merge
 from mhtrack.mht.pruning import prune_after_solve
 from mhtrack.mht.tree import STATE, Leaves, deferred_concat, take_deferred
-
-from test_numbering import _leaves
 
 
 def _same(got: Leaves, ref: Leaves) -> None:

@@ -107,3 +107,23 @@ def test_kalman_predict_update_bit_identical(shared_R: bool) -> None:
     z = rng.normal(size=(k, 2)) * 100
     R = np.array([[25.0, 3.0], [3.0, 36.0]]) if shared_R else _spd(rng, (k,))[:, :2, :2]
     _same(kalman.update_position(x, P, z, R), _update_ref(x, P, z, R))
+
+
+@pytest.mark.parametrize("per_row", [False, True])
+@pytest.mark.parametrize("block", [64, None])
+def test_imm_predict_in_blocks_bit_identical(per_row: bool, block: int | None,
+                                             monkeypatch: pytest.MonkeyPatch) -> None:
+    """Block by block (rows past ``BLOCK``, the last block short) or in one pass, the
+    states are those of the one-pass formulas."""
+    if block is not None:
+        monkeypatch.setattr(imm, "BLOCK", block)
+    rng = np.random.default_rng(7 + per_row)
+    m = 2 * imm.BLOCK + 37
+    model = imm.CVModelSet((1.0, 10.0), mode_time=50.0)
+    xm, Pm = rng.normal(size=(m, 2, 4)) * 100, _spd(rng, (m, 2)) * 50
+    mu = rng.dirichlet(np.ones(2), size=m)
+    dt = rng.uniform(-1, 5, m) if per_row else 4.0
+    x, P = rng.normal(size=(m, 4)), _spd(rng, (m,))
+    got = model.predict(imm.States(x, P, xm, Pm, mu), dt)
+    xp, Pp, mubar = _predict_models_ref(model, xm, Pm, mu, dt)
+    _same((got.x, got.P, got.xm, got.Pm, got.mu), (*_combine_ref(xp, Pp, mubar), xp, Pp, mubar))

@@ -78,6 +78,13 @@ class CVModelSet(MotionModel):
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Mixing and per-model prediction: ``(x⁻, P⁻, μ̄)`` (module docstring); ``dt``
         one interval or one per row."""
+        mubar, pim, Q = self._mixing(mu, dt)
+        xp, Pp = _mix_predict(xm, Pm, mu, mubar, pim, dt, Q)
+        return xp, Pp, mubar
+
+    def _mixing(self, mu: np.ndarray, dt: float | np.ndarray) -> tuple[np.ndarray, ...]:
+        """``(μ̄, π, Q)`` of :meth:`predict_models`: ``π`` (1, r, r) or (M, r, r), ``Q``
+        (r, 4, 4) or (M, r, 4, 4)."""
         pi = self.transition(dt)
         if pi.ndim == 2:
             mubar = mu @ pi  # (M, r)
@@ -85,17 +92,9 @@ class CVModelSet(MotionModel):
         else:
             mubar = np.einsum("mi,mij->mj", mu, pi)
             pim = pi
-        w = pim * mu[:, :, None] / np.maximum(mubar, 1e-300)[:, None, :]  # (M,i,j)
-        x0 = _mix_sum(w[..., None], xm[:, :, None, :])  # (M, j, 4)
-        d = xm[:, :, None, :] - x0[:, None, :, :]  # (M, i, j, 4)
-        wd = w[..., None] * d
-        tmp = np.empty_like(Pm)  # (M, j, 4, 4) scratch of both sums
-        P0 = _mix_sum(w[..., None, None], Pm[:, :, None], tmp=tmp)
-        P0 += _mix_sum(wd[..., :, None], d[..., None, :], tmp=tmp)
         Q = (_process_noise(self.sigmas, float(dt)) if np.ndim(dt) == 0
              else np.stack([ConstantVelocity(s).Q(dt) for s in self.sigmas], axis=-3))
-        xp, Pp = kalman.predict_cv(x0, P0, dt, Q, overwrite=True)  # every model at once
-        return xp, Pp, mubar
+        return mubar, pim, Q
 
     # ------------------------------------------------------------------ MotionModel
     @property
@@ -103,10 +102,26 @@ class CVModelSet(MotionModel):
         return self.r
 
     def predict(self, states: States, dt: float | np.ndarray) -> States:
-        """Mixing and prediction of every model; ``x, P`` their mixture (for gating)."""
-        xm, Pm, mubar = self.predict_models(states.xm, states.Pm, states.mu, dt)
-        xp, Pp = combine(xm, Pm, mubar)
-        return States(xp, Pp, xm, Pm, mubar)
+        """Mixing and prediction of every model; ``x, P`` their mixture (for gating).
+        Past :data:`BLOCK` rows the work goes block by block of rows, so that its
+        temporaries stay in the CPU cache: every operation is row by row, so the floats
+        are those of one pass (``tests/models/test_inplace_identity.py``)."""
+        xm, Pm, mu = states.xm, states.Pm, states.mu
+        mubar, pim, Q = self._mixing(mu, dt)
+        M = len(mu)
+        if M <= BLOCK:
+            xp, Pp = _mix_predict(xm, Pm, mu, mubar, pim, dt, Q)
+            return States(*combine(xp, Pp, mubar), xp, Pp, mubar)
+        out = States(np.empty((M, 4)), np.empty((M, 4, 4)), np.empty(xm.shape),
+                     np.empty(Pm.shape), mubar)
+        per_row = np.ndim(dt) > 0
+        for s in range(0, M, BLOCK):
+            b = slice(s, s + BLOCK)
+            xp, Pp = _mix_predict(xm[b], Pm[b], mu[b], mubar[b], pim[b] if per_row else pim,
+                                  dt[b] if per_row else dt, Q[b] if per_row else Q)
+            out.x[b], out.P[b] = combine(xp, Pp, mubar[b])
+            out.xm[b], out.Pm[b] = xp, Pp
+        return out
 
     def update(self, states: States, z: np.ndarray, R: np.ndarray) -> States:
         """Each model's update and the posterior probabilities (:func:`update`); ``x, P``
@@ -132,6 +147,26 @@ class CVModelSet(MotionModel):
         r = self.r
         return States(x, P, np.repeat(x[:, None], r, axis=1), np.repeat(P[:, None], r, axis=1),
                       self.initial_mu(len(x)))
+
+
+#: Rows per block of :meth:`CVModelSet.predict` (a block's temporaries, ~40 arrays of
+#: up to 2·16 floats a row, fit in the CPU's cache).
+BLOCK = 1024
+
+
+def _mix_predict(xm: np.ndarray, Pm: np.ndarray, mu: np.ndarray, mubar: np.ndarray,
+                 pim: np.ndarray, dt: float | np.ndarray,
+                 Q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Mixing (``μ_i|j``, ``x0_j``, ``P0_j``) and each model's prediction, row by row,
+    given ``μ̄``, ``π`` and ``Q`` (:meth:`CVModelSet._mixing`)."""
+    w = pim * mu[:, :, None] / np.maximum(mubar, 1e-300)[:, None, :]  # (M,i,j)
+    x0 = _mix_sum(w[..., None], xm[:, :, None, :])  # (M, j, 4)
+    d = xm[:, :, None, :] - x0[:, None, :, :]  # (M, i, j, 4)
+    wd = w[..., None] * d
+    tmp = np.empty_like(Pm)  # (M, j, 4, 4) scratch of both sums
+    P0 = _mix_sum(w[..., None, None], Pm[:, :, None], tmp=tmp)
+    P0 += _mix_sum(wd[..., :, None], d[..., None, :], tmp=tmp)
+    return kalman.predict_cv(x0, P0, dt, Q, overwrite=True)  # every model at once
 
 
 @functools.lru_cache(maxsize=64)

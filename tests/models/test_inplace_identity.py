@@ -127,3 +127,36 @@ def test_imm_predict_in_blocks_bit_identical(per_row: bool, block: int | None,
     got = model.predict(imm.States(x, P, xm, Pm, mu), dt)
     xp, Pp, mubar = _predict_models_ref(model, xm, Pm, mu, dt)
     _same((got.x, got.P, got.xm, got.Pm, got.mu), (*_combine_ref(xp, Pp, mubar), xp, Pp, mubar))
+
+
+def _imm_update_ref(xm, Pm, mubar, z, R):
+    """The former one-pass update: each model's Kalman update, posterior ``μ``."""
+    K, r = mubar.shape
+    ll = imm.model_logliks(xm, Pm, z, R)
+    with np.errstate(divide="ignore"):
+        a = np.log(mubar) + ll
+    a -= a.max(axis=1)[:, None]
+    mu = np.exp(a)
+    mu /= mu.sum(axis=1)[:, None]
+    Rr = R if R.ndim == 2 else np.repeat(R, r, axis=0)
+    xn, Pn = _update_ref(xm.reshape(K * r, 4), Pm.reshape(K * r, 4, 4),
+                         np.repeat(z, r, axis=0), Rr)
+    return xn.reshape(K, r, 4), Pn.reshape(K, r, 4, 4), mu
+
+
+@pytest.mark.parametrize("shared_R", [True, False])
+@pytest.mark.parametrize("block", [64, None])
+def test_imm_update_in_blocks_bit_identical(shared_R: bool, block: int | None,
+                                            monkeypatch: pytest.MonkeyPatch) -> None:
+    if block is not None:
+        monkeypatch.setattr(imm, "BLOCK", block)
+    rng = np.random.default_rng(11 + shared_R)
+    k = 2 * imm.BLOCK + 45
+    model = imm.CVModelSet((1.0, 10.0))
+    xm, Pm = rng.normal(size=(k, 2, 4)) * 100, _spd(rng, (k, 2)) * 50
+    mubar = rng.dirichlet(np.ones(2), size=k)
+    z = rng.normal(size=(k, 2)) * 100
+    R = np.array([[25.0, 3.0], [3.0, 36.0]]) if shared_R else _spd(rng, (k,))[:, :2, :2]
+    got = model.update(imm.States(np.zeros((k, 4)), np.zeros((k, 4, 4)), xm, Pm, mubar), z, R)
+    xn, Pn, mu = _imm_update_ref(xm, Pm, mubar, z, R)
+    _same((got.x, got.P, got.xm, got.Pm, got.mu), (*_combine_ref(xn, Pn, mu), xn, Pn, mu))

@@ -125,10 +125,21 @@ class CVModelSet(MotionModel):
 
     def update(self, states: States, z: np.ndarray, R: np.ndarray) -> States:
         """Each model's update and the posterior probabilities (:func:`update`); ``x, P``
-        their mixture."""
-        xm, Pm, mu = update(states.xm, states.Pm, states.mu, z, R)
-        x, P = combine(xm, Pm, mu)
-        return States(x, P, xm, Pm, mu)
+        their mixture. Block by block of rows as :meth:`predict` (the same floats)."""
+        K = len(states.mu)
+        if K <= BLOCK:
+            xm, Pm, mu = update(states.xm, states.Pm, states.mu, z, R)
+            return States(*combine(xm, Pm, mu), xm, Pm, mu)
+        R = np.asarray(R, float)
+        out = States(np.empty((K, 4)), np.empty((K, 4, 4)), np.empty(states.xm.shape),
+                     np.empty(states.Pm.shape), np.empty(states.mu.shape))
+        for s in range(0, K, BLOCK):
+            b = slice(s, s + BLOCK)
+            xm, Pm, mu = update(states.xm[b], states.Pm[b], states.mu[b], z[b],
+                                R if R.ndim == 2 else R[b])
+            out.x[b], out.P[b] = combine(xm, Pm, mu)
+            out.xm[b], out.Pm[b], out.mu[b] = xm, Pm, mu
+        return out
 
     def gating_loglik(
         self, pred: States, track: np.ndarray, plot: np.ndarray, z: np.ndarray,

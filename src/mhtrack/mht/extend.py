@@ -16,6 +16,9 @@ from mhtrack.mht.gating import Gated
 from mhtrack.mht.tree import NO_PLOT, Leaves
 from mhtrack.models.motion import MotionModel, States, row_index
 
+#: Updated children per block of :func:`grow_children`.
+UPDATE_BLOCK = 1024
+
 
 @dataclass(frozen=True, slots=True)
 class Children:
@@ -81,13 +84,16 @@ def grow_children(
     st = pred.take(par)
     child_time = np.full(len(par), float(time))
     upd = np.flatnonzero(plot >= 0)
-    if upd.size:
-        pj = plot[upd]
-        start = st.take(upd) if pair_pred is None else pair_pred.take(children.pair[upd])
-        st.put(upd, motion.update(start, z.take(pj, axis=0),
-                                  R if R.ndim == 2 else R.take(pj, axis=0)))
-        if plot_time is not None:
-            child_time[upd] = plot_time[pj]
+    # the update block by block of rows: a block's copies stay in the CPU cache (the
+    # update is row by row: the floats of one pass)
+    for s in range(0, upd.size, UPDATE_BLOCK):
+        u = upd[s:s + UPDATE_BLOCK]
+        pj = plot[u]
+        start = pred.take(par[u]) if pair_pred is None else pair_pred.take(children.pair[u])
+        st.put(u, motion.update(start, z.take(pj, axis=0),
+                                R if R.ndim == 2 else R.take(pj, axis=0)))
+    if upd.size and plot_time is not None:
+        child_time[upd] = plot_time[plot[upd]]
     new_col = np.where(plot >= 0, rows[np.maximum(plot, 0)] if rows.size else NO_PLOT, NO_PLOT)
     window = np.concatenate((leaves.window.take(par, axis=0)[:, 1:], new_col[:, None]),
                             axis=1)

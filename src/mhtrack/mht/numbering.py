@@ -6,7 +6,7 @@ from dataclasses import fields, replace
 
 import numpy as np
 
-from mhtrack.mht.tree import Leaves
+from mhtrack.mht.tree import Leaves, deferred_concat
 
 
 class Counter:
@@ -29,14 +29,19 @@ def number_nodes(leaves: Leaves, nodes: Counter) -> Leaves:
     return replace(leaves, node=np.arange(first, first + len(leaves), dtype=np.int64))
 
 
-def number_and_merge(grown: Leaves, births: Leaves, idle: Leaves, nodes: Counter) -> Leaves:
+def number_and_merge(grown: Leaves, births: Leaves, idle: Leaves, nodes: Counter,
+                     defer_states: bool = False) -> Leaves:
     """The store after a scan, built with one copy: the grown and the new trees' leaves
     get node ids (:func:`number_nodes`, in that order), then the leaves of the trees the
     frame did not step join them in tree order (stable) — the same arrays as numbering
     ``Leaves.concat(grown, births)``, concatenating ``idle`` and sorting by tree (stable),
-    without the intermediate copies (``tests/mht/test_numbering.py``)."""
+    without the intermediate copies (``tests/mht/test_numbering.py``). ``defer_states``
+    (no ``idle`` leaves): the states are not copied yet
+    (:func:`~mhtrack.mht.tree.deferred_concat`)."""
     if len(idle) == 0:
-        return number_nodes(Leaves.concat(grown, births), nodes)
+        both = (deferred_concat(grown, births) if defer_states
+                else Leaves.concat(grown, births))
+        return number_nodes(both, nodes)
     n_new = len(grown) + len(births)
     first = nodes.take(n_new)
     cols = {f.name: np.concatenate((getattr(grown, f.name), getattr(births, f.name),

@@ -24,6 +24,7 @@ from mhtrack.mht.tree import (
     segment_ids,
     segment_max,
     segment_starts,
+    take_deferred,
 )
 
 
@@ -239,11 +240,14 @@ def removed_after_solve(leaves: Leaves, hyp: GlobalHypothesis,
 
 def prune_after_solve(leaves: Leaves, chosen: np.ndarray, max_trees: int,
                       caps: dict[str, int], *, by_id: bool = False,
-                      remove: np.ndarray | None = None) -> Leaves:
+                      remove: np.ndarray | None = None,
+                      parts: tuple[Leaves, Leaves] | None = None) -> Leaves:
     """N-scan pruning around the best hypothesis (leaf indices ``chosen``), then the cap
     on trees; marks the surviving chosen leaves. ``by_id``: trees step on their own looks
     (:func:`n_scan_keep`'s ``window``). ``remove``: a mask of further leaves to drop
-    (:func:`removed_after_solve`)."""
+    (:func:`removed_after_solve`). ``parts``: ``leaves`` is their
+    :func:`~mhtrack.mht.tree.deferred_concat`, whose states are copied once for the rows
+    kept (:func:`~mhtrack.mht.tree.take_deferred`)."""
     n = len(leaves)
     is_chosen = np.zeros(n, bool)
     is_chosen[chosen] = True
@@ -260,7 +264,10 @@ def prune_after_solve(leaves: Leaves, chosen: np.ndarray, max_trees: int,
             caps["max_trees"] = cut
             keep[np.flatnonzero(keep)[~keep_t]] = False
             n_kept = int(np.count_nonzero(keep))
-    if n_kept == n:  # nothing pruned: the same arrays
+    rows = None if n_kept == n else keep.nonzero()[0]  # None: nothing pruned
+    if parts is not None:
+        return take_deferred(leaves, rows, parts,
+                             chosen=is_chosen if rows is None else is_chosen[rows])
+    if rows is None:  # the same arrays
         return replace(leaves, chosen=is_chosen)
-    rows = keep.nonzero()[0]
     return replace(leaves.take(rows), chosen=is_chosen[rows])

@@ -168,12 +168,13 @@ class MHTTracker:
                               pair_pred, scan.t)
         births = self.birth.seed(scan, cand, grown.window, self.trees, caps)
         first_node = self.nodes.next
-        leaves = number_and_merge(grown, births, idle, self.nodes)
+        parts = (grown, births) if len(idle) == 0 and len(births) else None
+        leaves = number_and_merge(grown, births, idle, self.nodes, parts is not None)
         hyp = best_hypothesis(leaves.score, leaves.tree, leaves.window, cfg.max_cluster_size,
                               cfg.milp_node_limit, by_id=by_id, n_best=cfg.n_best)
         solver_caps(hyp, caps)
         leaves = prune_after_solve(leaves, hyp.leaves, lim.max_trees, caps, by_id=by_id,
-                                   remove=removed_after_solve(leaves, hyp, cfg))
+                                   remove=removed_after_solve(leaves, hyp, cfg), parts=parts)
         is_new = None if len(idle) == 0 else leaves.node >= first_node
         first_new = self.tracks.next
         leaves = hand_over(leaves, previous, by_id=by_id)

@@ -12,7 +12,7 @@ object per leaf.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, fields
+from dataclasses import dataclass, fields, replace
 
 import numpy as np
 
@@ -115,6 +115,48 @@ class Leaves:
 
 
 _FIELDS = tuple(f.name for f in fields(Leaves))
+#: The filter-state columns: most of a leaf's bytes (an IMM's ``Pm`` alone half of them).
+STATE = ("x", "P", "xm", "Pm", "mu")
+
+
+def deferred_concat(a: Leaves, b: Leaves) -> Leaves:
+    """``Leaves.concat(a, b)`` without copying the :data:`STATE` columns: in their place
+    read-only NaN placeholders of the right shape (no memory; any use shows).
+    :func:`take_deferred` then copies the states of the rows kept once, from ``a`` and
+    ``b`` (the store after a scan: the solve and N-scan pruning read no state)."""
+    n = len(a) + len(b)
+    cols = {f: (np.broadcast_to(np.array(np.nan), (n, *getattr(a, f).shape[1:]))
+                if f in STATE else np.concatenate((getattr(a, f), getattr(b, f))))
+            for f in _FIELDS}
+    return Leaves(**cols)
+
+
+def take_deferred(leaves: Leaves, rows: np.ndarray | None, parts: tuple[Leaves, Leaves],
+                  **columns: np.ndarray) -> Leaves:
+    """Rows ``rows`` (ascending; ``None``: all) of ``leaves``, a :func:`deferred_concat`
+    of ``parts``, with their states copied from the parts and ``columns`` replacing
+    others: the same arrays as ``replace(Leaves.concat(*parts).take(rows), **columns)``
+    in one copy of each state row (``tests/mht/test_deferred.py``)."""
+    a, b = parts
+    if rows is None:
+        cols = {f: np.concatenate((getattr(a, f), getattr(b, f))) for f in STATE}
+        return replace(leaves, **cols, **columns)
+    split = int(rows.searchsorted(len(a)))
+    ra, rb = rows[:split], rows[split:] - len(a)
+    cols = {}
+    for f in _FIELDS:
+        if f in columns:
+            continue
+        if f not in STATE:
+            cols[f] = getattr(leaves, f).take(rows, axis=0)
+            continue
+        u, v = getattr(a, f), getattr(b, f)
+        out = np.empty((rows.size, *u.shape[1:]), np.result_type(u, v))
+        # mode "clip": no buffered copy (the rows are in range, nothing is clipped)
+        np.take(u, ra, axis=0, out=out[:split], mode="clip")
+        np.take(v, rb, axis=0, out=out[split:], mode="clip")
+        cols[f] = out
+    return Leaves(**cols, **columns)
 
 
 def segment_starts(sorted_keys: np.ndarray) -> np.ndarray:

@@ -78,6 +78,13 @@ class CVModelSet(MotionModel):
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Mixing and per-model prediction: ``(x⁻, P⁻, μ̄)`` (module docstring); ``dt``
         one interval or one per row."""
+        mubar, pim, Q = self._mixing(mu, dt)
+        xp, Pp = _mix_predict(xm, Pm, mu, mubar, pim, dt, Q)
+        return xp, Pp, mubar
+
+    def _mixing(self, mu: np.ndarray, dt: float | np.ndarray) -> tuple[np.ndarray, ...]:
+        """``(μ̄, π, Q)`` of :meth:`predict_models`: ``π`` (1, r, r) or (M, r, r), ``Q``
+        (r, 4, 4) or (M, r, 4, 4)."""
         pi = self.transition(dt)
         if pi.ndim == 2:
             mubar = mu @ pi  # (M, r)
@@ -85,16 +92,9 @@ class CVModelSet(MotionModel):
         else:
             mubar = np.einsum("mi,mij->mj", mu, pi)
             pim = pi
-        w = pim * mu[:, :, None] / np.maximum(mubar, 1e-300)[:, None, :]  # (M,i,j)
-        x0 = _mix_sum(w[..., None], xm[:, :, None, :])  # (M, j, 4)
-        d = xm[:, :, None, :] - x0[:, None, :, :]  # (M, i, j, 4)
-        wd = w[..., None] * d
-        P0 = (_mix_sum(w[..., None, None], Pm[:, :, None])
-              + _mix_sum(wd[..., :, None], d[..., None, :]))
         Q = (_process_noise(self.sigmas, float(dt)) if np.ndim(dt) == 0
              else np.stack([ConstantVelocity(s).Q(dt) for s in self.sigmas], axis=-3))
-        xp, Pp = kalman.predict_cv(x0, P0, dt, Q)  # every model at once
-        return xp, Pp, mubar
+        return mubar, pim, Q
 
     # ------------------------------------------------------------------ MotionModel
     @property
@@ -102,17 +102,44 @@ class CVModelSet(MotionModel):
         return self.r
 
     def predict(self, states: States, dt: float | np.ndarray) -> States:
-        """Mixing and prediction of every model; ``x, P`` their mixture (for gating)."""
-        xm, Pm, mubar = self.predict_models(states.xm, states.Pm, states.mu, dt)
-        xp, Pp = combine(xm, Pm, mubar)
-        return States(xp, Pp, xm, Pm, mubar)
+        """Mixing and prediction of every model; ``x, P`` their mixture (for gating).
+        Past :data:`BLOCK` rows the work goes block by block of rows, so that its
+        temporaries stay in the CPU cache: every operation is row by row, so the floats
+        are those of one pass (``tests/models/test_inplace_identity.py``)."""
+        xm, Pm, mu = states.xm, states.Pm, states.mu
+        mubar, pim, Q = self._mixing(mu, dt)
+        M = len(mu)
+        if M <= BLOCK:
+            xp, Pp = _mix_predict(xm, Pm, mu, mubar, pim, dt, Q)
+            return States(*combine(xp, Pp, mubar), xp, Pp, mubar)
+        out = States(np.empty((M, 4)), np.empty((M, 4, 4)), np.empty(xm.shape),
+                     np.empty(Pm.shape), mubar)
+        per_row = np.ndim(dt) > 0
+        for s in range(0, M, BLOCK):
+            b = slice(s, s + BLOCK)
+            xp, Pp = _mix_predict(xm[b], Pm[b], mu[b], mubar[b], pim[b] if per_row else pim,
+                                  dt[b] if per_row else dt, Q[b] if per_row else Q)
+            out.x[b], out.P[b] = combine(xp, Pp, mubar[b])
+            out.xm[b], out.Pm[b] = xp, Pp
+        return out
 
     def update(self, states: States, z: np.ndarray, R: np.ndarray) -> States:
         """Each model's update and the posterior probabilities (:func:`update`); ``x, P``
-        their mixture."""
-        xm, Pm, mu = update(states.xm, states.Pm, states.mu, z, R)
-        x, P = combine(xm, Pm, mu)
-        return States(x, P, xm, Pm, mu)
+        their mixture. Block by block of rows as :meth:`predict` (the same floats)."""
+        K = len(states.mu)
+        if K <= BLOCK:
+            xm, Pm, mu = update(states.xm, states.Pm, states.mu, z, R)
+            return States(*combine(xm, Pm, mu), xm, Pm, mu)
+        R = np.asarray(R, float)
+        out = States(np.empty((K, 4)), np.empty((K, 4, 4)), np.empty(states.xm.shape),
+                     np.empty(states.Pm.shape), np.empty(states.mu.shape))
+        for s in range(0, K, BLOCK):
+            b = slice(s, s + BLOCK)
+            xm, Pm, mu = update(states.xm[b], states.Pm[b], states.mu[b], z[b],
+                                R if R.ndim == 2 else R[b])
+            out.x[b], out.P[b] = combine(xm, Pm, mu)
+            out.xm[b], out.Pm[b], out.mu[b] = xm, Pm, mu
+        return out
 
     def gating_loglik(
         self, pred: States, track: np.ndarray, plot: np.ndarray, z: np.ndarray,
@@ -133,6 +160,26 @@ class CVModelSet(MotionModel):
                       self.initial_mu(len(x)))
 
 
+#: Rows per block of :meth:`CVModelSet.predict` (a block's temporaries, ~40 arrays of
+#: up to 2·16 floats a row, fit in the CPU's cache).
+BLOCK = 1024
+
+
+def _mix_predict(xm: np.ndarray, Pm: np.ndarray, mu: np.ndarray, mubar: np.ndarray,
+                 pim: np.ndarray, dt: float | np.ndarray,
+                 Q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Mixing (``μ_i|j``, ``x0_j``, ``P0_j``) and each model's prediction, row by row,
+    given ``μ̄``, ``π`` and ``Q`` (:meth:`CVModelSet._mixing`)."""
+    w = pim * mu[:, :, None] / np.maximum(mubar, 1e-300)[:, None, :]  # (M,i,j)
+    x0 = _mix_sum(w[..., None], xm[:, :, None, :])  # (M, j, 4)
+    d = xm[:, :, None, :] - x0[:, None, :, :]  # (M, i, j, 4)
+    wd = w[..., None] * d
+    tmp = np.empty_like(Pm)  # (M, j, 4, 4) scratch of both sums
+    P0 = _mix_sum(w[..., None, None], Pm[:, :, None], tmp=tmp)
+    P0 += _mix_sum(wd[..., :, None], d[..., None, :], tmp=tmp)
+    return kalman.predict_cv(x0, P0, dt, Q, overwrite=True)  # every model at once
+
+
 @functools.lru_cache(maxsize=64)
 def _transition(r: int, mode_time: float, dt: float) -> np.ndarray:
     """``π`` (r, r) for one interval (read-only; cached: synchronous scans repeat ``dt``)."""
@@ -151,12 +198,17 @@ def _process_noise(sigmas: tuple[float, ...], dt: float) -> np.ndarray:
     return q
 
 
-def _mix_sum(w: np.ndarray, a: np.ndarray) -> np.ndarray:
+def _mix_sum(w: np.ndarray, a: np.ndarray, tmp: np.ndarray | None = None) -> np.ndarray:
     """``Σ_i w_i a_i`` over axis 1, summed in model order ``((w_0 a_0 + w_1 a_1) + …)``:
-    the products and the order of ``np.einsum``'s sum, in a few whole-array operations."""
-    out = w[:, 0] * a[:, 0]
-    for i in range(1, w.shape[1]):
-        out = out + w[:, i] * a[:, i]
+    the products and the order of ``np.einsum``'s sum, in a few whole-array operations,
+    accumulated in place (the same floats as ``out = out + w_i a_i``). ``tmp``: a scratch
+    array of the result's shape to reuse (else one is allocated)."""
+    out = np.multiply(w[:, 0], a[:, 0])
+    if w.shape[1] > 1:
+        tmp = np.empty_like(out) if tmp is None else tmp
+        for i in range(1, w.shape[1]):
+            np.multiply(w[:, i], a[:, i], out=tmp)
+            out += tmp
     return out
 
 
@@ -164,9 +216,10 @@ def combine(xm: np.ndarray, Pm: np.ndarray, mu: np.ndarray) -> tuple[np.ndarray,
     """Moment-matched single Gaussian of the model mixture: ``(x, P)``, (M, 4), (M, 4, 4)."""
     x = _mix_sum(mu[..., None], xm)
     d = xm - x[:, None, :]
-    P = _mix_sum(mu[..., None, None], Pm) + _mix_sum((mu[..., None] * d)[..., None],
-                                                      d[..., None, :])
-    return x, 0.5 * (P + np.swapaxes(P, -1, -2))
+    P = _mix_sum(mu[..., None, None], Pm)
+    spread = _mix_sum((mu[..., None] * d)[..., None], d[..., None, :], tmp=np.empty_like(P))
+    P += spread
+    return x, kalman.symmetrised(P, out=spread)
 
 
 def model_logliks(xm: np.ndarray, Pm: np.ndarray, z: np.ndarray, R: np.ndarray) -> np.ndarray:

@@ -22,17 +22,27 @@ import numpy as np
 from mhtrack.models.linalg2 import sym_det2
 
 
+def symmetrised(P: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
+    """``0.5 (P + Pᵀ)`` over the last two axes, written into ``out`` (an array other than
+    ``P``) when given: the same floats as the expression, one array instead of two."""
+    out = np.add(P, np.swapaxes(P, -1, -2), out=out)
+    out *= 0.5
+    return out
+
+
 def predict_cv(
-    x: np.ndarray, P: np.ndarray, dt: float | np.ndarray, Q: np.ndarray
+    x: np.ndarray, P: np.ndarray, dt: float | np.ndarray, Q: np.ndarray,
+    overwrite: bool = False,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Prediction with the constant-velocity ``F(dt) = I + dt·E``: ``x⁻ = F x``,
     ``P⁻ = F P Fᵀ + Q`` done as two row/column updates ``P[pos] += dt·P[vel]`` on the
     whole stack. ``dt`` is one interval, or one per row (M,) with ``Q`` (M, 4, 4)
     (asynchronous plots: each track to its own plot's time). Leading axes beyond the
     first are allowed (``x`` (M, …, 4), ``P`` (M, …, 4, 4), ``Q`` broadcasting to ``P``:
-    the IMM's models at once)."""
+    the IMM's models at once). ``overwrite``: ``P`` is a scratch array of the caller's and
+    is worked on in place (no copy; the result is the same)."""
     xp = x.copy()
-    Pp = P.copy()
+    Pp = P if overwrite else P.copy()
     if np.ndim(dt) == 0:
         xp[..., 0::2] += dt * x[..., 1::2]
         Pp[..., 0::2, :] += dt * Pp[..., 1::2, :]
@@ -43,7 +53,7 @@ def predict_cv(
         Pp[..., 0::2, :] += d[..., None] * Pp[..., 1::2, :]
         Pp[..., :, 0::2] += d[..., None] * Pp[..., :, 1::2]
     Pp += Q
-    return xp, 0.5 * (Pp + np.swapaxes(Pp, -1, -2))
+    return xp, symmetrised(Pp)
 
 
 def update_position(
@@ -66,5 +76,9 @@ def update_position(
     k1 = a0 * i01[:, None] + a1 * i11[:, None]
     nu = z - x[:, 0::2]
     xn = x + k0 * nu[:, :1] + k1 * nu[:, 1:]
-    Pn = P - (k0[:, :, None] * a0[:, None, :] + k1[:, :, None] * a1[:, None, :])
-    return xn, 0.5 * (Pn + np.swapaxes(Pn, -1, -2))
+    # P − (k0 a0ᵀ + k1 a1ᵀ), in two arrays (the same operations, in the same order)
+    Pn = np.multiply(k0[:, :, None], a0[:, None, :])
+    tmp = np.multiply(k1[:, :, None], a1[:, None, :])
+    Pn += tmp
+    np.subtract(P, Pn, out=Pn)
+    return xn, symmetrised(Pn, out=tmp)

@@ -1,0 +1,54 @@
+"""The store after a scan with its states copied once (``deferred_concat`` then
+``take_deferred``, as the tracker runs it) holds bit for bit the arrays of the former
+path: concatenate every column, then take the rows N-scan pruning keeps."""
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+from test_numbering import _leaves
+
+from mhtrack.mht.numbering import Counter, number_and_merge
+from mhtrack.mht.pruning import prune_after_solve
+from mhtrack.mht.tree import STATE, Leaves, deferred_concat, take_deferred
+
+
+def _same(got: Leaves, ref: Leaves) -> None:
+    for name, a in ref.arrays().items():
+        b = got.arrays()[name]
+        assert b.dtype == a.dtype and b.shape == a.shape, name
+        np.testing.assert_array_equal(b, a, err_msg=name)
+
+
+@pytest.mark.parametrize("seed", range(12))
+def test_take_deferred_equals_concat_then_take(seed):
+    rng = np.random.default_rng(seed)
+    a = _leaves(rng, int(rng.integers(0, 40)), np.arange(20))
+    b = _leaves(rng, int(rng.integers(1, 10)), np.arange(20, 30))
+    lazy = deferred_concat(a, b)
+    assert all(np.isnan(getattr(lazy, f)).all() for f in STATE)  # placeholders, not states
+    full = Leaves.concat(a, b)
+    chosen = rng.random(len(full)) < 0.3
+    rows = np.flatnonzero(rng.random(len(full)) < 0.6)
+    _same(take_deferred(lazy, rows, (a, b), chosen=chosen[rows]),
+          replace(full.take(rows), chosen=chosen[rows]))
+    _same(take_deferred(lazy, None, (a, b), chosen=chosen), replace(full, chosen=chosen))
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_prune_after_solve_with_parts_is_the_same(seed):
+    """The tracker's path (numbering with ``defer_states``, pruning with ``parts``) against
+    numbering and pruning the concatenated store."""
+    rng = np.random.default_rng(100 + seed)
+    grown = _leaves(rng, int(rng.integers(5, 60)), np.arange(25))
+    births = _leaves(rng, int(rng.integers(1, 8)), np.arange(25, 33))
+    idle = Leaves.empty(grown.window.shape[1], grown.n_models)
+    ref = number_and_merge(grown, births, idle, Counter(9))
+    lazy = number_and_merge(grown, births, idle, Counter(9), defer_states=True)
+    chosen = np.unique(rng.choice(len(ref), 6))
+    for max_trees in (1000, 12):
+        caps_ref: dict[str, int] = {}
+        caps_got: dict[str, int] = {}
+        _same(prune_after_solve(lazy, chosen, max_trees, caps_got, parts=(grown, births)),
+              prune_after_solve(ref, chosen, max_trees, caps_ref))
+        assert caps_got == caps_ref

@@ -34,6 +34,7 @@ import math
 import sys
 import time
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -104,9 +105,13 @@ def compare(a: argparse.Namespace) -> None:
           f" = {fastest / results['mhtrack'][0]:.1f}x  (target >= 10)")
 
 
-def throughput(a: argparse.Namespace) -> dict[str, float]:
-    """An hour (``--duration``) of three rotating radars from the tests' generator; the
-    figures (also printed) as a dict."""
+#: The tracker configuration of the hour of radars (:func:`hour_scene`).
+HOUR_CONFIG = {"new_target_density": 1e-12, "imm_sigma_v": 0.0}
+
+
+def hour_scene(duration: float, targets: int = 20, seed: int = 1) -> Any:
+    """The three rotating radars (periods 4, 8, 12 s) and ``targets`` targets of the hour
+    benchmark, simulated for ``duration`` s by the tests' generator (``AsyncSim``)."""
     from async_fixture import Radar, default_targets, simulate_async
 
     radars = [
@@ -118,11 +123,16 @@ def throughput(a: argparse.Namespace) -> dict[str, float]:
         Radar(3, 0.0, -80_000.0, period=12.0, phase_deg=95.0, pd=0.8, sigma_range=80.0,
               sigma_bearing_deg=0.25, max_range=400_000.0, clutter_per_rotation=25.0),
     ]
-    x0 = default_targets(a.targets, seed=a.seed, extent=100_000.0, speeds=(30.0, 90.0))
-    sim = simulate_async(radars, x0, duration=a.duration, seed=a.seed)
+    x0 = default_targets(targets, seed=seed, extent=100_000.0, speeds=(30.0, 90.0))
+    return simulate_async(radars, x0, duration=duration, seed=seed)
+
+
+def throughput(a: argparse.Namespace) -> dict[str, float]:
+    """An hour (``--duration``) of three rotating radars from the tests' generator; the
+    figures (also printed) as a dict."""
+    sim = hour_scene(a.duration, a.targets, a.seed)
     plots = sim.plots
-    trk = make_tracker(a.tracker, MHTConfig(new_target_density=1e-12, imm_sigma_v=0.0),
-                       sensors=sim.sensors)
+    trk = make_tracker(a.tracker, MHTConfig(**HOUR_CONFIG), sensors=sim.sensors)
     t0 = time.perf_counter()
     tracks = trk.run(plots)
     wall = time.perf_counter() - t0

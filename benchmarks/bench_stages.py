@@ -77,22 +77,11 @@ def scene(a: argparse.Namespace) -> tuple[Callable[[], Any], list]:
         scans = list(simulate(sc, seed=1).plots.scans())
         return (lambda: make_tracker(a.tracker, default_config(sc))), scans
     if a.scene == "hour":
-        from async_fixture import Radar, default_targets, simulate_async
-
+        from bench_async import HOUR_CONFIG, hour_scene
         from mhtrack.mht import MHTConfig
 
-        radars = [
-            Radar(1, -60_000.0, -20_000.0, period=4.0, phase_deg=10.0, max_range=400_000.0,
-                  clutter_per_rotation=15.0),
-            Radar(2, 50_000.0, 40_000.0, period=8.0, phase_deg=200.0, pd=0.85,
-                  sigma_range=60.0, sigma_bearing_deg=0.2, max_range=400_000.0,
-                  clutter_per_rotation=20.0),
-            Radar(3, 0.0, -80_000.0, period=12.0, phase_deg=95.0, pd=0.8, sigma_range=80.0,
-                  sigma_bearing_deg=0.25, max_range=400_000.0, clutter_per_rotation=25.0),
-        ]  # as bench_async.py --hour
-        x0 = default_targets(20, seed=1, extent=100_000.0, speeds=(30.0, 90.0))
-        sim = simulate_async(radars, x0, duration=a.duration, seed=1)
-        cfg = MHTConfig(new_target_density=1e-12, imm_sigma_v=0.0)
+        sim = hour_scene(a.duration)  # as bench_async.py --hour
+        cfg = MHTConfig(**HOUR_CONFIG)
         return (lambda: make_tracker("mht-gmm", cfg, sensors=sim.sensors)), list(
             sim.plots.scans())
     import logging

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import base64
 import contextlib
+import csv
 import fcntl
 import json
 import os
@@ -219,6 +220,26 @@ def chromium() -> str:
         pytest.skip("no Chromium on PATH (apt-get install chromium, or set "
                     "MHTRACK_CHROMIUM): the HTML report is not checked in a browser")
     return exe
+
+
+def read_track_ids(path: Path) -> tuple[set[str], bool]:
+    """The track ids of a tracks CSV with a confirmed row, and whether any row is
+    tentative (before confirmation): the scene draws one trace per confirmed id and one
+    for all tentative rows."""
+    confirmed, tentative = set(), False
+    with open(path, newline="") as fh:
+        for row in csv.DictReader(fh):
+            if row.get("tentative") == "1":
+                tentative = True
+            else:
+                confirmed.add(row["track_id"])
+    return confirmed, tentative
+
+
+@pytest.fixture(scope="session")
+def track_ids():
+    """:func:`read_track_ids`, for the report tests."""
+    return read_track_ids
 
 
 # --- directories to report on, made once per session through the CLI ---------------------

@@ -25,19 +25,6 @@ def _png_size(path):
     return struct.unpack(">II", data[16:24])
 
 
-def _track_traces(path):
-    """Scene traces of a tracks file: one per id with a confirmed row, one for all rows
-    before confirmation."""
-    confirmed, tentative = set(), False
-    with open(path, newline="") as fh:
-        for row in csv.DictReader(fh):
-            if row.get("tentative") == "1":
-                tentative = True
-            else:
-                confirmed.add(row["track_id"])
-    return len(confirmed) + tentative
-
-
 def _clean(check):
     assert check.errors == [], check.errors
     assert check.requests == [], check.requests
@@ -48,13 +35,14 @@ def _clean(check):
     assert width == 1400 and height > 1000
 
 
-def test_run_report_renders(run_dir, open_in_browser):
+def test_run_report_renders(run_dir, open_in_browser, track_ids):
     check = open_in_browser(run_dir / REPORT_FILE)
     _clean(check)
     got = {f["id"]: f["drawn"] for f in check.figures}
     # scene: clutter, target plots, truth line, births, deaths, the tracks; curves: OSPA,
     # cardinality, the true number of targets (no OSPA(2) in this evaluation)
-    scene = 2 + 3 + _track_traces(run_dir / "tracks.csv")
+    confirmed, tentative = track_ids(run_dir / "tracks.csv")
+    scene = 2 + 3 + len(confirmed) + tentative
     m = json.loads((run_dir / "metrics.json").read_text())
     curves = 3 + bool([v for v in m.get("ospa2") or [] if v is not None])
     assert got == {"fig-scene": scene, "fig-curves": curves}
@@ -66,12 +54,13 @@ def test_run_report_renders(run_dir, open_in_browser):
     assert points["fig-scene"] == n_plots + 2 * n_targets  # markers: plots, births, deaths
 
 
-def test_geographic_report_renders(geo_dir, open_in_browser, tmp_path):
+def test_geographic_report_renders(geo_dir, open_in_browser, tmp_path, track_ids):
     page = write_html_report(geo_dir, tmp_path / "geo.html")
     check = open_in_browser(page)
     _clean(check)
     # scene: lat/lon grid and its labels, clutter, target plots, truth (3), tracks, sites
-    scene = 2 + 2 + 3 + _track_traces(geo_dir / "tracks.csv") + 1
+    confirmed, tentative = track_ids(geo_dir / "tracks.csv")
+    scene = 2 + 2 + 3 + len(confirmed) + tentative + 1
     assert {f["id"]: f["drawn"] for f in check.figures}["fig-scene"] == scene
 
 

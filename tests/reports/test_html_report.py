@@ -5,7 +5,6 @@ some exist. The browser checks are in test_html_browser.py."""
 
 from __future__ import annotations
 
-import csv
 import json
 import math
 import re
@@ -81,20 +80,9 @@ def test_metrics_table_shows_metrics_json(run_dir):
     assert "<td>seed</td><td>1</td>" in page
 
 
-def _track_ids(path):
-    confirmed, tentative = set(), False
-    with open(path, newline="") as fh:
-        for row in csv.DictReader(fh):
-            if row.get("tentative") == "1":
-                tentative = True
-            else:
-                confirmed.add(row["track_id"])
-    return confirmed, tentative
-
-
-def test_scene_traces_follow_the_files(run_dir):
+def test_scene_traces_follow_the_files(run_dir, track_ids):
     page = report_page(run_dir)
-    confirmed, tentative = _track_ids(run_dir / "tracks.csv")
+    confirmed, tentative = track_ids(run_dir / "tracks.csv")
     html = page.render()
     assert html.count('"legendgroup":"tracks"') == len(confirmed)  # one trace per id
     assert ('"name":"tracks before confirmation"' in html) == tentative

@@ -117,10 +117,11 @@ def targets_seen(raw_window: Sequence[Scan]) -> tuple[np.ndarray, np.ndarray]:
 
 
 def initiators(region: tuple[float, ...], *, theta_deg: float = 20.0,
-               gate_radius: float = 300.0, v_min: float = 50.0,
-               v_max: float = 400.0) -> dict[str, Any]:
+               gate_radius: float = 300.0, v_min: float = 50.0, v_max: float = 400.0,
+               extra: Mapping[str, Mapping[str, Any]] | None = None) -> dict[str, Any]:
     """Every initiator with ``mhtrack initiate``'s settings: the logic ones with the gate
-    radius, the Hough ones with accumulators over ``region``."""
+    radius, the Hough ones with accumulators over ``region``; ``extra[method]`` are more
+    constructor options of that method (a study's settings, e.g. ``accel_max``)."""
     out = {}
     for m in INITIATORS:
         p: dict[str, Any] = {"v_min": v_min, "v_max": v_max}
@@ -128,7 +129,7 @@ def initiators(region: tuple[float, ...], *, theta_deg: float = 20.0,
             p["gate_radius"] = gate_radius
         else:
             p["region"] = region
-        out[m] = make_initiator(m, theta_deg=theta_deg, **p)
+        out[m] = make_initiator(m, theta_deg=theta_deg, **p, **(extra or {}).get(m, {}))
     return out
 
 
@@ -261,17 +262,15 @@ def initiation_example(scenario: Scenario, seed: int, *, fusion: str = "adaptive
                        ) -> InitiationExample:
     """Every initiator of ``methods`` on window ``window_number`` of run ``run`` of
     ``seed``, with the CLI's settings (Hough accumulators over the scenario's region),
-    the fusion's options ``fusion_params`` and, per method, the initiator attributes
-    ``initiator_params`` (a study's settings)."""
+    the fusion's options ``fusion_params`` and, per method, the initiator options
+    ``initiator_params`` (a study's settings; :func:`initiators`' ``extra``)."""
     fr = simulate_and_fuse(scenario, run_seeds(seed, run + 1, "words")[run], fusion,
                            params=fusion_params)
     raw_win, win = list(fr.windows(4))[window_number]
     w = Window.from_scans(win)
     inits = initiators(scenario.region.as_tuple(), theta_deg=theta_deg,
-                       gate_radius=gate_radius, v_min=v_min, v_max=v_max)
-    for m, extra in (initiator_params or {}).items():
-        for k, v in extra.items():
-            setattr(inits[m], k, v)
+                       gate_radius=gate_radius, v_min=v_min, v_max=v_max,
+                       extra=initiator_params)
     tracks = {m: inits[m].initiate(w) for m in methods}
     return InitiationExample(Window.from_scans(raw_win), w, tracks,
                              fr.truth.positions[np.isin(fr.truth.scan, w.scans)])

@@ -154,11 +154,8 @@ def clustering_job(job: Mapping[str, Any]) -> dict[str, Any]:
 def _initiators(region: tuple[float, ...], settings: str = "best") -> dict[str, Any]:
     """The four initiators with the study's settings (those of ``mhtrack initiate``, plus
     :data:`~mhtrack.experiments.p2.constants.INITIATOR_PARAMS` of ``settings``)."""
-    out = initiators(region, theta_deg=THETA0, **LOGIC_PARAMS)
-    for m, extra in INITIATOR_PARAMS[settings].items():
-        for k, v in extra.items():
-            setattr(out[m], k, v)
-    return out
+    return initiators(region, theta_deg=THETA0, **LOGIC_PARAMS,
+                      extra=INITIATOR_PARAMS[settings])
 
 
 def methods_job(job: Mapping[str, Any]) -> dict[str, Any]:

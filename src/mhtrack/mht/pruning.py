@@ -34,27 +34,32 @@ def score_drop_keep(tree: np.ndarray, score: np.ndarray, drop: float) -> np.ndar
     return score >= segment_max(score, starts, seg) - drop
 
 
-def _rank_in_tree(tree: np.ndarray, score: np.ndarray) -> np.ndarray:
-    """Rank (0 = best) of each leaf within its tree by score, ties by index.
+def _rank_in_groups(group: np.ndarray, score: np.ndarray) -> np.ndarray:
+    """Rank (0 = best) of each row within its group (integers ≥ 0, in any order) by
+    score, ties by index.
 
-    One stable argsort of the key ``segment + (max − score)/(range + 1)``: cheaper than a
+    One stable argsort of the key ``group + (max − score)/(range + 1)``: cheaper than a
     two-key lexsort; scores closer than ~1e−11 of their range count as ties."""
     n = score.size
-    starts, seg = segment_ids(tree)
     hi = float(score.max())
     u = (hi - score) / (hi - float(score.min()) + 1.0)
-    order = np.argsort(seg + u, kind="stable")
+    order = np.argsort(group + u, kind="stable")
+    starts = segment_starts(group[order])
     rank = np.empty(n, np.int64)
-    rank[order] = np.arange(n) - starts[seg[order]]
+    rank[order] = np.arange(n) - np.repeat(starts, np.diff(np.r_[starts, n]))
     return rank
+
+
+def _largest_tree(tree: np.ndarray) -> int:
+    """Rows of the largest tree (``tree`` sorted; 0 for no rows)."""
+    return int(np.diff(np.r_[segment_starts(tree), tree.size]).max(initial=0))
 
 
 def cap_leaves_per_tree(tree: np.ndarray, score: np.ndarray, cap: int) -> tuple[np.ndarray, int]:
     """Keep each tree's ``cap`` best leaves (ties: lower index). Returns (keep, removed)."""
-    starts = segment_starts(tree)
-    if np.diff(np.r_[starts, score.size]).max(initial=0) <= cap:
+    if _largest_tree(tree) <= cap:
         return np.ones(score.size, bool), 0
-    keep = _rank_in_tree(tree, score) < cap
+    keep = _rank_in_groups(segment_ids(tree)[1], score) < cap
     return keep, int(score.size - keep.sum())
 
 
@@ -185,9 +190,7 @@ def prune_children(leaves: Leaves, children: Children, n_births: int, sprt: SPRT
 def leaf_caps_act(tree: np.ndarray, budget: int, per_tree: int) -> bool:
     """Whether the leaf caps would cut these children (sorted by ``tree``): more than
     ``budget`` in all, or more than ``per_tree`` in one tree."""
-    if tree.size > budget:
-        return True
-    return bool(np.diff(np.r_[segment_starts(tree), tree.size]).max(initial=0) > per_tree)
+    return tree.size > budget or _largest_tree(tree) > per_tree
 
 
 def cap_per_plot(tree: np.ndarray, plot: np.ndarray, score: np.ndarray,
@@ -195,22 +198,13 @@ def cap_per_plot(tree: np.ndarray, plot: np.ndarray, score: np.ndarray,
                  per_tree_miss: int = MISSES_PER_TREE) -> tuple[np.ndarray, int]:
     """The overload rule (``mhtrack.mht.caps``): keep the ``per_plot`` best children of
     each plot over all trees and the ``per_tree_miss`` best miss children of each tree
-    (ties: lower index). Returns (keep, removed); at most
-    ``per_plot · plots + per_tree_miss · trees`` children are kept.
-
-    One stable argsort of ``group + (max − score)/(range + 1)`` (as :func:`_rank_in_tree`;
-    scores closer than ~1e−11 of their range count as ties)."""
+    (ties: lower index; :func:`_rank_in_groups`). Returns (keep, removed); at most
+    ``per_plot · plots + per_tree_miss · trees`` children are kept."""
     if score.size == 0:
         return np.ones(0, bool), 0
     upd = plot >= 0
     key = np.where(upd, plot, -1 - tree)  # misses grouped by tree, apart from the plots
-    hi = float(score.max())
-    u = (hi - score) / (hi - float(score.min()) + 1.0)
-    order = np.argsort((key - key.min()) + u, kind="stable")
-    k = key[order]
-    new = np.r_[True, k[1:] != k[:-1]]
-    rank = np.empty(score.size, np.int64)
-    rank[order] = np.arange(score.size) - np.flatnonzero(new)[np.cumsum(new) - 1]
+    rank = _rank_in_groups(key - key.min(), score)
     keep = rank < np.where(upd, per_plot, per_tree_miss)
     return keep, int(score.size - np.count_nonzero(keep))
 

@@ -73,7 +73,7 @@ def scaled_limits(cfg: MHTConfig, n_plots: int, n_tracks: int) -> dict[str, int]
     return {
         "max_births_per_scan": max(floors["max_births_per_scan"], n),
         "max_trees": max(floors["max_trees"], TREES_PER_PLOT * n + t),
-        "max_leaves": max(floors["max_leaves"], LEAVES_PER_PLOT * n + LEAVES_PER_TRACK * t),
+        "max_leaves": max(floors["max_leaves"], _leaves_supported(n, t)),
         "max_gated_pairs": max(floors["max_gated_pairs"],
                                PAIRS_PER_PLOT * n + PAIRS_PER_TRACK * t),
     }
@@ -86,7 +86,13 @@ def scene_leaves(cfg: MHTConfig, n_plots: int, n_tracks: int) -> int | None:
     ``cfg.scale_caps`` is off."""
     if not cfg.scale_caps:
         return None
-    return LEAVES_PER_PLOT * min(int(n_plots), BURST_PLOTS) + LEAVES_PER_TRACK * int(n_tracks)
+    return _leaves_supported(min(int(n_plots), BURST_PLOTS), int(n_tracks))
+
+
+def _leaves_supported(n: int, t: int) -> int:
+    """``16·n' + 50·t`` leaves for ``n' = n`` plots (already bounded by
+    :data:`BURST_PLOTS`) and ``t`` confirmed tracks."""
+    return LEAVES_PER_PLOT * n + LEAVES_PER_TRACK * t
 
 
 def scan_config(cfg: MHTConfig, n_plots: int, n_tracks: int) -> MHTConfig:

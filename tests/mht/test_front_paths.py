@@ -6,28 +6,19 @@ import math
 
 import numpy as np
 import pytest
+from leaves_fixture import random_leaves
 
 from mhtrack.mht.scoring import miss_increment, miss_increments
 from mhtrack.mht.timed import looked_trees
-from mhtrack.mht.tree import Leaves, segment_starts
+from mhtrack.mht.tree import segment_starts
 from mhtrack.mht.validate import validate_scan
 from mhtrack.records import Scan
-
-
-def _leaves(rng, n, r=2, width=4):
-    tree = np.sort(rng.integers(0, 9, n))
-    f = rng.normal(size=n)
-    i = rng.integers(-1, 50, n)
-    return Leaves(rng.normal(size=(n, 4)), rng.normal(size=(n, 4, 4)), f, f + 1, tree, i,
-                  i + 1, i + 2, rng.integers(-1, 99, (n, width)), rng.random(n) < 0.5,
-                  rng.random((n, r)), rng.normal(size=(n, r, 4)),
-                  rng.normal(size=(n, r, 4, 4)), i + 3, i + 4, f + 2)
 
 
 @pytest.mark.parametrize("seed", range(5))
 def test_take_equals_fancy_indexing(seed):
     rng = np.random.default_rng(seed)
-    lv = _leaves(rng, 30)
+    lv = random_leaves(rng, 30)
     for idx in (rng.integers(0, 30, 50), rng.random(30) < 0.4, np.zeros(0, np.int64), [],
                 [3, -1, 0], slice(2, 9)):
         got = lv.take(idx)

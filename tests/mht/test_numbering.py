@@ -6,19 +6,10 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
+from leaves_fixture import random_leaves
 
 from mhtrack.mht.numbering import Counter, number_and_merge, number_nodes
 from mhtrack.mht.tree import Leaves
-
-
-def _leaves(rng, n, trees, width=3, r=2):
-    tree = np.sort(rng.choice(trees, n))
-    f = rng.normal(size=n)
-    i = rng.integers(-1, 50, n)
-    return Leaves(rng.normal(size=(n, 4)), rng.normal(size=(n, 4, 4)), f, f + 1, tree, i,
-                  i + 1, i + 2, rng.integers(-1, 99, (n, width)), rng.random(n) < 0.5,
-                  rng.random((n, r)), rng.normal(size=(n, r, 4)),
-                  rng.normal(size=(n, r, 4, 4)), rng.integers(0, 10**6, n), i + 4, f + 2)
 
 
 def _reference(grown, births, idle, nodes):
@@ -38,9 +29,12 @@ def test_number_and_merge_equals_the_composition(seed):
     rng = np.random.default_rng(seed)
     ids = rng.permutation(30)  # new trees take ids above every existing tree's
     stepped_trees, idle_trees, new_trees = ids[:15], ids[15:], np.arange(30, 40)
-    grown = _leaves(rng, int(rng.integers(0, 30)), stepped_trees)
-    births = _leaves(rng, int(rng.integers(0, 6)), new_trees)
-    idle = _leaves(rng, int(rng.integers(0, 30)) * int(seed % 4 != 0), idle_trees)
+    def part(n, trees):
+        return random_leaves(rng, n, np.sort(rng.choice(trees, n)))
+
+    grown = part(int(rng.integers(0, 30)), stepped_trees)
+    births = part(int(rng.integers(0, 6)), new_trees)
+    idle = part(int(rng.integers(0, 30)) * int(seed % 4 != 0), idle_trees)
     start = int(rng.integers(0, 1000))
     got = number_and_merge(grown, births, idle, Counter(start))
     ref = _reference(grown, births, idle, Counter(start))
@@ -53,9 +47,9 @@ def test_hand_worked_node_ids():
     """Two grown leaves and one new leaf get ids 7, 8, 9 in row order; the idle leaf of
     tree 1 keeps its id and lands between trees 0 and 2."""
     rng = np.random.default_rng(0)
-    grown = replace(_leaves(rng, 2, [0]), tree=np.array([0, 2]))
-    births = replace(_leaves(rng, 1, [5]), tree=np.array([5]))
-    idle = replace(_leaves(rng, 1, [1]), tree=np.array([1]), node=np.array([42]))
+    grown = replace(random_leaves(rng, 2), tree=np.array([0, 2]))
+    births = replace(random_leaves(rng, 1), tree=np.array([5]))
+    idle = replace(random_leaves(rng, 1), tree=np.array([1]), node=np.array([42]))
     out = number_and_merge(grown, births, idle, Counter(7))
     np.testing.assert_array_equal(out.tree, [0, 1, 2, 5])
     np.testing.assert_array_equal(out.node, [7, 42, 8, 9])

@@ -6,7 +6,7 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
-from test_numbering import _leaves
+from leaves_fixture import leaves_of_trees
 
 from mhtrack.mht.numbering import Counter, number_and_merge
 from mhtrack.mht.pruning import prune_after_solve
@@ -23,8 +23,8 @@ def _same(got: Leaves, ref: Leaves) -> None:
 @pytest.mark.parametrize("seed", range(12))
 def test_take_deferred_equals_concat_then_take(seed):
     rng = np.random.default_rng(seed)
-    a = _leaves(rng, int(rng.integers(0, 40)), np.arange(20))
-    b = _leaves(rng, int(rng.integers(1, 10)), np.arange(20, 30))
+    a = leaves_of_trees(rng, int(rng.integers(0, 40)), np.arange(20))
+    b = leaves_of_trees(rng, int(rng.integers(1, 10)), np.arange(20, 30))
     lazy = deferred_concat(a, b)
     assert all(np.isnan(getattr(lazy, f)).all() for f in STATE)  # placeholders, not states
     full = Leaves.concat(a, b)
@@ -40,8 +40,8 @@ def test_prune_after_solve_with_parts_is_the_same(seed):
     """The tracker's path (numbering with ``defer_states``, pruning with ``parts``) against
     numbering and pruning the concatenated store."""
     rng = np.random.default_rng(100 + seed)
-    grown = _leaves(rng, int(rng.integers(5, 60)), np.arange(25))
-    births = _leaves(rng, int(rng.integers(1, 8)), np.arange(25, 33))
+    grown = leaves_of_trees(rng, int(rng.integers(5, 60)), np.arange(25))
+    births = leaves_of_trees(rng, int(rng.integers(1, 8)), np.arange(25, 33))
     idle = Leaves.empty(grown.window.shape[1], grown.n_models)
     ref = number_and_merge(grown, births, idle, Counter(9))
     lazy = number_and_merge(grown, births, idle, Counter(9), defer_states=True)

@@ -6,7 +6,7 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
-from leaves_fixture import random_leaves
+from leaves_fixture import leaves_of_trees, random_leaves
 
 from mhtrack.mht.numbering import Counter, number_and_merge, number_nodes
 from mhtrack.mht.tree import Leaves
@@ -29,12 +29,9 @@ def test_number_and_merge_equals_the_composition(seed):
     rng = np.random.default_rng(seed)
     ids = rng.permutation(30)  # new trees take ids above every existing tree's
     stepped_trees, idle_trees, new_trees = ids[:15], ids[15:], np.arange(30, 40)
-    def part(n, trees):
-        return random_leaves(rng, n, np.sort(rng.choice(trees, n)))
-
-    grown = part(int(rng.integers(0, 30)), stepped_trees)
-    births = part(int(rng.integers(0, 6)), new_trees)
-    idle = part(int(rng.integers(0, 30)) * int(seed % 4 != 0), idle_trees)
+    grown = leaves_of_trees(rng, int(rng.integers(0, 30)), stepped_trees)
+    births = leaves_of_trees(rng, int(rng.integers(0, 6)), new_trees)
+    idle = leaves_of_trees(rng, int(rng.integers(0, 30)) * int(seed % 4 != 0), idle_trees)
     start = int(rng.integers(0, 1000))
     got = number_and_merge(grown, births, idle, Counter(start))
     ref = _reference(grown, births, idle, Counter(start))

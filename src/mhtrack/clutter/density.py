@@ -78,6 +78,10 @@ def log_pdf_t(maha_t: np.ndarray, det: np.ndarray) -> np.ndarray:
     return -LOG_2PI - 0.5 * np.log(det) - 0.5 * maha_t
 
 
+#: :meth:`Mixture.pdf` evaluates ``exp(log_pdf)`` directly up to this many plot×component
+#: pairs, and by boxes around each Gaussian above.
+PDF_DIRECT = 65_536
+
 _min, _max = np.minimum.reduce, np.maximum.reduce  # exact, without the methods' wrappers
 
 
@@ -168,7 +172,7 @@ class Mixture:
         ``exp(−½ dᵀΣ⁻¹d) < e⁻⁷⁴⁵`` underflows to 0 anyway, so the result is the same.
         """
         z = np.asarray(z, dtype=float)
-        if len(z) * max(self.n_components, 1) <= 65_536:
+        if len(z) * max(self.n_components, 1) <= PDF_DIRECT:
             return np.exp(self.log_pdf(z))
         out = self.background_weight * np.exp(self.log_background(z))
         a, b, c = self.covariances[:, 0, 0], self.covariances[:, 0, 1], self.covariances[:, 1, 1]

@@ -38,7 +38,7 @@ of the plain plot-major formulas).
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -71,7 +71,10 @@ class EMResult:
 
     ``log_likelihood`` is the mean log-likelihood ``L`` at the final parameters (what
     ``GaussianMixture.score`` returns); ``n_iter`` the EM iterations run; ``converged``
-    whether the relative-change rule stopped it; ``n_pruned`` the components deleted.
+    whether the relative-change rule stopped it; ``n_pruned`` the components deleted;
+    ``log_density`` the plots' ``log c(z_i)`` under ``mixture``, the floats of
+    ``mixture.log_pdf(z)`` (the same elementwise formulas on the same operands, and each
+    plot's sum over components taken alone).
     """
 
     mixture: Mixture
@@ -79,6 +82,7 @@ class EMResult:
     n_iter: int
     converged: bool
     n_pruned: int
+    log_density: np.ndarray | None = field(default=None, compare=False, repr=False)
 
 
 def e_step(
@@ -267,7 +271,7 @@ def fit_em(
         last = _lse_t(wlp) if norm is None else norm
     final = (_mean_ll(last, None) if sample_weight is None
              else float(np.average(last, weights=sample_weight)))
-    return EMResult(mix, final, n_iter, converged, n_pruned)
+    return EMResult(mix, final, n_iter, converged, n_pruned, last)
 
 
 def removal_gain(

@@ -27,7 +27,7 @@ from typing import Any, Literal
 import numpy as np
 
 from mhtrack.clutter.base import ClutterEstimator
-from mhtrack.clutter.density import log_pdf_t, maha_det_t, offsets_t, plots_t
+from mhtrack.clutter.density import PDF_DIRECT, log_pdf_t, maha_det_t, offsets_t, plots_t
 from mhtrack.clutter.em import Mixture, PruneRule, fit_em
 from mhtrack.clutter.seeding import kmeanspp_centres, mixture_from_centres
 from mhtrack.models.clutter import Region
@@ -169,6 +169,8 @@ class MixtureClutter(ClutterEstimator):
         self.n_pruned_ = 0
         self.n_updates_ = 0
         self.n_subsampled_ = 0
+        #: this scan's (n, 2) fed plots and their log c under the fit, from the fit itself
+        self._scan_log_c: tuple[np.ndarray, np.ndarray] | None = None
 
     # ------------------------------------------------------------------ what subclasses set
     def _prune_rule(self) -> PruneRule | None:
@@ -195,6 +197,7 @@ class MixtureClutter(ClutterEstimator):
         if in_track_gates is not None and self.source == "outside-gates":
             kept = kept[~mask]
             z = z[kept]
+        self._scan_log_c = None
         rng = _LazyRng(self.seed, self.n_updates_)
         self.n_updates_ += 1
         self._window.append(z.copy())
@@ -207,7 +210,8 @@ class MixtureClutter(ClutterEstimator):
             self.n_iter_, self.converged_, self.n_pruned_ = 0, True, 0
             self.log_likelihood_ = float("nan")
             return
-        if len(pooled) > self.max_points:
+        subsampled = len(pooled) > self.max_points
+        if subsampled:
             keep = np.sort(rng().choice(len(pooled), self.max_points, replace=False))
             self.n_subsampled_ += len(pooled) - self.max_points
             pooled = pooled[keep]
@@ -222,6 +226,9 @@ class MixtureClutter(ClutterEstimator):
             bic=self.bic, init_log_pdf=glp,
         )
         self.mixture_ = res.mixture
+        if not subsampled and len(z) and res.log_density is not None:
+            # the scan's plots are the last rows of the pool: their log c, for intensity()
+            self._scan_log_c = (self._window[-1], res.log_density[len(pooled) - len(z):])
         self.n_iter_, self.converged_ = res.n_iter, res.converged
         self.log_likelihood_, self.n_pruned_ = res.log_likelihood, res.n_pruned
 
@@ -234,6 +241,11 @@ class MixtureClutter(ClutterEstimator):
         if self.mixture_ is None or self.count_ == 0.0:
             return np.zeros(len(z))
         m = self.mixture_
+        cached = self._scan_log_c
+        if (cached is not None and len(z) * max(m.n_components, 1) <= PDF_DIRECT
+                and cached[0].shape == z.shape and cached[0].tobytes() == z.tobytes()):
+            # the scan's own plots: m.pdf(z) = exp(m.log_pdf(z)) from the fit's log c
+            return self.count_ * np.exp(cached[1])
         return self.count_ * m.pdf(z)
 
     def forget(self, used: np.ndarray) -> None:

@@ -1,0 +1,59 @@
+"""The shortcuts of a scan's update give the floats of the plain calls, bit for bit."""
+
+import numpy as np
+import pytest
+
+from mhtrack.clutter import AGMMClutter, GMMClutter
+from mhtrack.clutter.em import fit_em
+from mhtrack.clutter.seeding import kmeanspp_centres, mixture_from_centres
+from mhtrack.models.clutter import Region
+from mhtrack.records import Scan
+
+
+def same(a, b) -> bool:
+    a, b = np.asarray(a), np.asarray(b)
+    return a.shape == b.shape and a.dtype == b.dtype and a.tobytes() == b.tobytes()
+
+
+def _scan_plots(rng: np.random.Generator, k: int) -> np.ndarray:
+    n = int(rng.integers(1, 60)) if k % 3 else 1  # one-plot scans too
+    z = rng.uniform(-3000.0, 3000.0, (n, 2))
+    m = int(rng.integers(0, 15))
+    return np.concatenate((z, rng.normal((600.0, -900.0), 80.0, (m, 2))))
+
+
+@pytest.mark.parametrize("seed", range(6))
+@pytest.mark.parametrize("cls", [AGMMClutter, GMMClutter])
+def test_intensity_at_the_scan_plots_is_the_density_of_the_fit(cls: type, seed: int) -> None:
+    """κ̂ at the scan's own plots comes from the fit's ``log c``: the floats of
+    ``M̂ · mixture.pdf(z)``; other positions, or the scan's with a subsampled pool or a
+    fixed region the plots leave, still agree."""
+    rng = np.random.default_rng(seed)
+    kw = {"region": Region(-2000.0, 2000.0, -2000.0, 2000.0)} if seed == 5 else {}
+    est = cls(window=3, max_points=40 if seed == 4 else 2000, **kw)
+    shortcuts = 0
+    for k in range(12):
+        z = _scan_plots(rng, k)
+        before = est.n_subsampled_
+        est.update(Scan.from_positions(k, float(k), z), None)
+        subsampled = est.n_subsampled_ > before
+        assert (est._scan_log_c is None) == subsampled  # a subsampled pool: no shortcut
+        shortcuts += not subsampled
+        assert same(est.intensity(z), est.count_ * est.mixture_.pdf(z))
+        other = z + 1.0
+        assert same(est.intensity(other), est.count_ * est.mixture_.pdf(other))
+    assert shortcuts >= 4
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_fit_em_log_density_is_log_pdf(seed: int) -> None:
+    """``EMResult.log_density`` is ``mixture.log_pdf(z)`` bit for bit, also after
+    deletions and for a plot outside the background's box."""
+    rng = np.random.default_rng(seed)
+    z = np.concatenate((rng.uniform(-4000, 4000, (150, 2)), rng.normal(800, 150, (40, 2))))
+    box = (-4500.0, 4500.0, -4500.0, 4500.0) if seed % 4 else (-3000.0, 4500.0, -4500.0, 4500.0)
+    init = mixture_from_centres(z, kmeanspp_centres(z, 8, np.random.default_rng(seed)),
+                                reg_covar=100.0, background_box=box, background_weight=0.05)
+    res = fit_em(z, init, reg_covar=100.0, min_points=3.0, bic=seed % 2 == 0,
+                 min_contrast=5.0 if seed % 3 else 0.0)
+    assert same(res.log_density, res.mixture.log_pdf(z))

@@ -22,6 +22,10 @@ import numpy as np
 
 from mhtrack.models.linalg2 import LOG_2PI, sym_det2, sym_mahalanobis2
 
+# NumPy's reductions called directly (what ``.sum()``/``.min()``/``.max()`` call, without
+# the methods' Python wrappers): the same results
+_sum, _min, _max = np.add.reduce, np.minimum.reduce, np.maximum.reduce
+
 
 def plot_sums(a_t: np.ndarray, width: int) -> np.ndarray:
     """``a.sum(axis=0)`` of the row-major ``(n, width)`` array ``a`` given as ``a_t`` (its
@@ -32,18 +36,22 @@ def plot_sums(a_t: np.ndarray, width: int) -> np.ndarray:
     are those of ``a`` (and of several such arrays side by side). A lone column (``width``
     1) is summed as a contiguous vector (pairwise), which each row of ``a_t`` is."""
     if width < 2:
-        return a_t.sum(axis=1)
-    return np.ascontiguousarray(a_t.T).sum(axis=0)
+        return _sum(a_t, axis=1)
+    return _sum(np.ascontiguousarray(a_t.T), axis=0)
 
 
 def _lse_t(a_t: np.ndarray) -> np.ndarray:
     """``log Σ_j exp(a_ij)`` per plot of the component-major ``a_t`` (≥ 1 row); the
     maximum (exact in any order) over ``a_t``, the sum over components as
     ``.sum(axis=1)`` of the plot-major row-major array. Caller ignores log 0 warnings."""
-    m = a_t.max(axis=0)
+    m = _max(a_t, axis=0)
     m_safe = np.where(np.isfinite(m), m, 0.0)
-    e = np.exp(a_t - m_safe)
-    return np.log(np.ascontiguousarray(e.T).sum(axis=1)) + m_safe
+    e = np.subtract(a_t, m_safe)
+    np.exp(e, out=e)
+    s = _sum(np.ascontiguousarray(e.T), axis=1)
+    np.log(s, out=s)
+    s += m_safe
+    return s
 
 
 def logsumexp_rows(a: np.ndarray) -> np.ndarray:
@@ -82,7 +90,6 @@ def log_pdf_t(maha_t: np.ndarray, det: np.ndarray) -> np.ndarray:
 #: pairs, and by boxes around each Gaussian above.
 PDF_DIRECT = 65_536
 
-_min, _max = np.minimum.reduce, np.maximum.reduce  # exact, without the methods' wrappers
 
 
 def gaussian_log_pdf(z: np.ndarray, means: np.ndarray, covariances: np.ndarray) -> np.ndarray:

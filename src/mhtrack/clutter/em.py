@@ -60,6 +60,10 @@ __all__ = ["EMResult", "Mixture", "PruneRule", "e_step", "fit_em", "gaussian_log
            "logsumexp_rows", "m_step", "mahalanobis2", "removal_gain"]
 
 _EPS10 = 10.0 * np.finfo(float).eps  # sklearn adds this to n_j so that no n_j is 0
+_TWO_PI = 2.0 * np.pi
+_COV_ROWS = np.array([0, 2, 2, 1])  # rows of (Σxx, Σyy, Σxy) giving [[Σxx, Σxy], [Σxy, Σyy]]
+# NumPy's reductions called directly (what ``.sum()``/``.any()`` call): the same results
+_sum, _any = np.add.reduce, np.logical_or.reduce
 
 #: A pruning rule: normalised Gaussian weights (K,) → mask of the components to keep.
 PruneRule = Callable[[np.ndarray], np.ndarray]
@@ -128,17 +132,19 @@ def _m_step(
     sums: tuple[np.ndarray, np.ndarray] | None = None,
 ) -> tuple[Mixture, np.ndarray, np.ndarray]:
     """:func:`m_step` from the (K+1, n) responsibilities, also returning the (2, K, n) offsets
-    ``z_i − μ_j`` to the new means. ``sums``: the row-major (n, K+1) responsibilities and
-    their column sums if at hand (no sample weights). The means are the plot-major
-    ``(r[:, 1:].T @ z) / n_j``: one BLAS product on the row-major operand of the formula."""
+    ``z_i − μ_j`` to the new means. ``sums``: a row-major (n, ≥ K+1) array whose first K+1
+    columns are the responsibilities, and their column sums, if at hand (no sample
+    weights). The means are the plot-major ``(r[:, 1:].T @ z) / n_j``: one BLAS product on
+    the row-major (n, K+1) operand of the formula."""
     r_t = resp_t if sample_weight is None else resp_t * sample_weight
+    k = r_t.shape[0] - 1
     if sums is None:
         r = np.ascontiguousarray(r_t.T)
-        sums = r, r.sum(axis=0)
-    r, col = sums
-    k = r_t.shape[0] - 1
+        col = _sum(r, axis=0)
+    else:
+        r, col = np.ascontiguousarray(sums[0][:, :k + 1]), sums[1]
     nk_all = col + _EPS10
-    total = nk_all.sum()
+    total = _sum(nk_all)
     nk = nk_all[1:]
     means = (r[:, 1:].T @ z) / nk[:, None]
     d = offsets_t(z_t, means)
@@ -148,13 +154,13 @@ def _m_step(
     np.multiply(rd[0], d[1], out=prods[2 * k:])
     q = plot_sums(prods, k).reshape(3, k) / nk
     q[:2] += reg_covar
-    cov = q[[0, 2, 2, 1]].T.reshape(k, 2, 2)  # [[Σxx, Σxy], [Σxy, Σyy]]
+    cov = q.take(_COV_ROWS, axis=0).T.reshape(k, 2, 2)  # [[Σxx, Σxy], [Σxy, Σyy]]
     if box is None:
         w0 = 0.0
-        w = nk / nk.sum()
+        w = nk / _sum(nk)
     else:
         w0 = max(nk_all[0] / total, background_floor)
-        g = nk.sum()
+        g = _sum(nk)
         w = (1.0 - w0) * nk / g if g > 0 else nk * 0.0
     return Mixture(w, means, cov, float(w0), box), nk, d
 
@@ -162,7 +168,7 @@ def _m_step(
 def _drop(mix: Mixture, keep: np.ndarray) -> Mixture:
     """Keep the Gaussians in ``keep``; renormalise them to ``1 − π₀`` (P1 after eq. 12)."""
     w = mix.weights[keep]
-    s = w.sum()
+    s = _sum(w)
     if s > 0:
         w = w * (1.0 - mix.background_weight) / s
     bg = mix.background_weight if len(w) else (1.0 if mix.background_box is not None else 0.0)
@@ -237,7 +243,8 @@ def fit_em(
         for n_iter in range(1, max_iter + 1):  # noqa: B007
             if norm is None or resp is None:  # E-step (P1 eq. 9)
                 norm = _lse_t(wlp)
-                resp = np.exp(wlp - norm)
+                resp = np.subtract(wlp, norm)
+                np.exp(resp, out=resp)
             ll = _mean_ll(norm, sample_weight)
             mix, nk, dxy = _m_step(z, z_t, resp, mix.background_box, sample_weight,
                                    reg_covar, background_floor, sums)
@@ -246,17 +253,17 @@ def fit_em(
             wlp, norm, resp, sums = weighted_t(mix, glp, log_bg), None, None, None
             keep = nk >= min_points
             if min_contrast > 0 and mix.background_box is not None:
-                peak = mix.weights / (2.0 * np.pi * np.sqrt(det[:, 0]))  # det2(Σ) = |Σ|
+                peak = mix.weights / (_TWO_PI * np.sqrt(det[:, 0]))  # det2(Σ) = |Σ|
                 keep &= peak >= min_contrast * mix.background_weight / mix.background_area
             if bic and mix.background_box is not None and mix.n_components:
                 norm = _lse_t(wlp)
                 resp, gain, sums = _e_step_gain(mix, wlp, norm, log_bg, sample_weight, bg0)
                 keep &= gain >= price
-            if prune is not None and keep.any():
+            if prune is not None and _any(keep):
                 w = np.where(keep, mix.weights, 0.0)
-                keep &= prune(w / w.sum())
+                keep &= prune(w / _sum(w))
             deleted = len(keep) - int(np.count_nonzero(keep))
-            if deleted and not (keep.any() or mix.background_box is not None):
+            if deleted and not (_any(keep) or mix.background_box is not None):
                 deleted = 0  # nothing would be left: keep the components, not an empty model
             if deleted:
                 mix = _drop(mix, keep)
@@ -298,17 +305,20 @@ def _e_step_gain(
     """The (K+1, n) responsibilities ``exp(wlp − norm)``, :func:`removal_gain` and, for the
     next M-step, the row-major responsibilities with their column sums. The responsibilities
     and the terms of the gain sit side by side in one (n, 2K+1) row-major array summed once
-    (:func:`~mhtrack.clutter.density.plot_sums`: each column as alone, for K ≥ 2)."""
+    (:func:`~mhtrack.clutter.density.plot_sums`: each column as alone, for K ≥ 2); the
+    M-step copies out the responsibilities' columns only if it runs on them."""
     k = mix.n_components
     if sample_weight is not None or k < 2:
-        resp = np.exp(wlp - norm)
+        resp = np.subtract(wlp, norm)
+        np.exp(resp, out=resp)
         return resp, _removal_gain(mix, resp[1:], norm, log_bg, sample_weight, bg0), None
     both = np.empty((2 * k + 1, len(norm)))
-    resp = np.exp(wlp - norm, out=both[:k + 1])
+    resp = np.subtract(wlp, norm, out=both[:k + 1])
+    np.exp(resp, out=resp)
     _neg_log_ratio(mix, resp[1:], norm, log_bg, bg0, both[k + 1:])
     nat = np.ascontiguousarray(both.T)
-    col = nat.sum(axis=0)
-    return resp, col[k + 1:], (np.ascontiguousarray(nat[:, :k + 1]), col[:k + 1])
+    col = _sum(nat, axis=0)
+    return resp, col[k + 1:], (nat, col[:k + 1])
 
 
 def _removal_gain(
@@ -329,9 +339,11 @@ def _neg_log_ratio(mix: Mixture, resp: np.ndarray, norm: np.ndarray, log_bg: np.
     """(K, n) terms ``−log max(1 − r_ij + π_j u(z_i)/c(z_i), 1e−300)`` of the gain, in
     ``out``."""
     if bg0 is None:
-        to_bg = np.exp(np.log(mix.weights)[:, None] + log_bg - norm)
+        to_bg = np.add(np.log(mix.weights)[:, None], log_bg)
+        to_bg -= norm
     else:  # (log π_j + log u) − log c per element, as above, with log u one number
-        to_bg = np.exp((np.log(mix.weights) + bg0)[:, None] - norm)
+        to_bg = np.subtract((np.log(mix.weights) + bg0)[:, None], norm)
+    np.exp(to_bg, out=to_bg)
     np.subtract(1.0, resp, out=out)
     out += to_bg
     np.maximum(out, 1e-300, out=out)

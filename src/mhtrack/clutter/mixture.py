@@ -184,7 +184,7 @@ class MixtureClutter(ClutterEstimator):
         Raises ``ValueError`` for non-finite plots or a mask of the wrong shape.
         """
         z = np.asarray(scan.z, dtype=float).reshape(-1, 2)
-        if not np.isfinite(z).all():
+        if not _all(np.isfinite(z), axis=None):
             raise ValueError(f"scan {scan.index}: plots must be finite")
         if in_track_gates is not None:
             mask = np.asarray(in_track_gates, dtype=bool).reshape(-1)
@@ -312,12 +312,14 @@ class MixtureClutter(ClutterEstimator):
             return None
         if self.region is not None:
             return self.region.as_tuple()
-        x, y = z[:, 0], z[:, 1]  # per column: the same extremes, faster than axis=0
-        lo, hi = np.array([x.min(), y.min()]), np.array([x.max(), y.max()])
-        mid, half = 0.5 * (lo + hi), 0.5 * (hi - lo) * 1.1
-        half = np.maximum(half, 0.5 * self.min_extent)
-        return (float(mid[0] - half[0]), float(mid[0] + half[0]),
-                float(mid[1] - half[1]), float(mid[1] + half[1]))
+        # per column (the same extremes as axis=0), then per axis the same IEEE double
+        # operations on Python floats that (2,) arrays would do
+        x, y = z[:, 0], z[:, 1]
+        box: list[float] = []
+        for lo, hi in ((float(_min(x)), float(_max(x))), (float(_min(y)), float(_max(y)))):
+            mid, half = 0.5 * (lo + hi), max(0.5 * (hi - lo) * 1.1, 0.5 * self.min_extent)
+            box += (mid - half, mid + half)
+        return (box[0], box[1], box[2], box[3])
 
     def _start_weight(self) -> float:
         return max(self.background_floor, 0.05) if self.background else 0.0
@@ -341,15 +343,15 @@ class MixtureClutter(ClutterEstimator):
         if prev is None or prev.n_components == 0:
             return None, None
         bg = max(prev.background_weight, self._start_weight()) if self.background else 0.0
-        w = prev.weights * (1.0 - bg) / prev.weights.sum()
+        w = prev.weights * (1.0 - bg) / _sum(prev.weights)
         means, cov = prev.means, prev.covariances
         z_t = plots_t(z)
         maha, det = maha_det_t(*offsets_t(z_t, means), cov)
         glp = log_pdf_t(maha, det)
         free = self.n_components - prev.n_components
         if free > 0:
-            far = maha.min(axis=0) > CHI2_2_99
-            if far.sum() >= max(self.min_points, 1.0):
+            far = _min(maha, axis=0) > CHI2_2_99
+            if np.count_nonzero(far) >= max(self.min_points, 1.0):
                 novel = z[far]
                 centres = kmeanspp_centres(novel, free, rng(), existing=means)
                 if len(centres):
@@ -361,6 +363,12 @@ class MixtureClutter(ClutterEstimator):
                     glp = np.concatenate((glp, log_pdf_t(*maha_det_t(
                         *offsets_t(z_t, new.means), new.covariances))))
         return Mixture(w, means, cov, bg, box), glp
+
+
+# NumPy's reductions called directly (what ``.sum()``/``.min()``/``.max()``/``.all()``
+# call): the same results
+_sum, _min, _max = np.add.reduce, np.minimum.reduce, np.maximum.reduce
+_all = np.logical_and.reduce
 
 
 class _LazyRng:

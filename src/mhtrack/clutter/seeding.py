@@ -7,6 +7,8 @@ import numpy as np
 
 from mhtrack.clutter.em import Mixture
 
+_EYE2 = np.eye(2)
+
 
 def kmeanspp_centres(
     z: np.ndarray, k: int, rng: np.random.Generator, existing: np.ndarray | None = None
@@ -32,7 +34,8 @@ def kmeanspp_centres(
         i = int(add.accumulate(d2).searchsorted(rng.random() * total, side="right"))
         c = z[min(i, len(z) - 1)]
         chosen.append(c)
-        d2 = np.minimum(d2, add.reduce((z - c) ** 2, axis=1))
+        if len(chosen) < k:  # the last centre's distances would not be used
+            d2 = np.minimum(d2, add.reduce((z - c) ** 2, axis=1))
     return np.array(chosen, float).reshape(-1, 2)
 
 
@@ -52,8 +55,8 @@ def mixture_from_centres(
     d2 = ((z[:, None, :] - centres[None, :, :]) ** 2).sum(axis=2)
     lab = d2.argmin(axis=1)
     counts = np.bincount(lab, minlength=k).astype(float)
-    reg = reg_covar * np.eye(2)
-    means = centres.astype(float).copy()
+    reg = reg_covar * _EYE2
+    means = centres.astype(float)  # a copy
     cov = np.empty((k, 2, 2))
     if (counts < 3).any():  # some centre keeps the broad covariance
         data_cov = _cov_biased(z) if len(z) > 1 else np.zeros((2, 2))
@@ -74,7 +77,7 @@ def _cov_biased(z: np.ndarray) -> np.ndarray:
     (copy, subtract the row means, ``dot(X, Xᵀ)``, times ``1/n``), without its argument
     handling — the same floats."""
     x = np.array(z.T, ndmin=2, dtype=np.float64)
-    x -= x.mean(axis=1)[:, None]
+    x -= (np.add.reduce(x, axis=1) / x.shape[1])[:, None]  # x.mean(axis=1): its sum and division
     c = np.dot(x, x.T.conj())
     c *= np.true_divide(1, x.shape[1])
     return c

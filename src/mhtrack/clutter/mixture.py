@@ -236,16 +236,16 @@ class MixtureClutter(ClutterEstimator):
         """``κ̂_k(z) = M̂_k ĉ_k(z)`` (P1 eq. 14), plots per m² per scan, at (n, 2) ``z``;
         0 before any plot was seen. Always finite and ≥ 0."""
         z = np.asarray(z, dtype=float).reshape(-1, 2)
-        if not np.isfinite(z).all():
-            raise ValueError("intensity: positions must be finite")
-        if self.mixture_ is None or self.count_ == 0.0:
-            return np.zeros(len(z))
-        m = self.mixture_
-        cached = self._scan_log_c
-        if (cached is not None and len(z) * max(m.n_components, 1) <= PDF_DIRECT
-                and cached[0].shape == z.shape and cached[0].tobytes() == z.tobytes()):
-            # the scan's own plots: m.pdf(z) = exp(m.log_pdf(z)) from the fit's log c
+        m, cached = self.mixture_, self._scan_log_c  # cached: with a fit, finite plots, M̂ > 0
+        if (cached is not None and m is not None and cached[0].shape == z.shape
+                and cached[0].tobytes() == z.tobytes()
+                and len(z) * max(m.n_components, 1) <= PDF_DIRECT):
+            # the scan's own plots: M̂ · m.pdf(z) = M̂ · exp(m.log_pdf(z)), log c from the fit
             return self.count_ * np.exp(cached[1])
+        if not _all(np.isfinite(z), axis=None):
+            raise ValueError("intensity: positions must be finite")
+        if m is None or self.count_ == 0.0:
+            return np.zeros(len(z))
         return self.count_ * m.pdf(z)
 
     def forget(self, used: np.ndarray) -> None:

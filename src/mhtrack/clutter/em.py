@@ -166,13 +166,15 @@ def _m_step(
 
 
 def _drop(mix: Mixture, keep: np.ndarray) -> Mixture:
-    """Keep the Gaussians in ``keep``; renormalise them to ``1 − π₀`` (P1 after eq. 12)."""
-    w = mix.weights[keep]
+    """Keep the Gaussians of indices ``keep``; renormalise them to ``1 − π₀`` (P1 after
+    eq. 12)."""
+    w = mix.weights.take(keep)
     s = _sum(w)
     if s > 0:
         w = w * (1.0 - mix.background_weight) / s
     bg = mix.background_weight if len(w) else (1.0 if mix.background_box is not None else 0.0)
-    return Mixture(w, mix.means[keep], mix.covariances[keep], bg, mix.background_box)
+    return Mixture(w, mix.means.take(keep, axis=0), mix.covariances.take(keep, axis=0), bg,
+                   mix.background_box)
 
 
 def fit_em(
@@ -266,9 +268,11 @@ def fit_em(
             if deleted and not (_any(keep) or mix.background_box is not None):
                 deleted = 0  # nothing would be left: keep the components, not an empty model
             if deleted:
-                mix = _drop(mix, keep)
+                kept = np.flatnonzero(keep)
+                mix = _drop(mix, kept)
                 n_pruned += deleted
-                wlp, norm, resp, sums = weighted_t(mix, glp[keep], log_bg), None, None, None
+                wlp, norm, resp, sums = (weighted_t(mix, glp.take(kept, axis=0), log_bg), None,
+                                         None, None)
             if mix.n_components == 0:
                 break
             if not deleted and abs(ll - prev) < tol * abs(prev):

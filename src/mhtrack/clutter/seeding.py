@@ -54,21 +54,27 @@ def mixture_from_centres(
     k = len(centres)
     d2 = ((z[:, None, :] - centres[None, :, :]) ** 2).sum(axis=2)
     lab = d2.argmin(axis=1)
-    counts = np.bincount(lab, minlength=k).astype(float)
+    n_in = np.bincount(lab, minlength=k)
+    counts = n_in.astype(float)
     reg = reg_covar * _EYE2
     means = centres.astype(float)  # a copy
     cov = np.empty((k, 2, 2))
     if (counts < 3).any():  # some centre keeps the broad covariance
         data_cov = _cov_biased(z) if len(z) > 1 else np.zeros((2, 2))
         cov[:] = data_cov / k + reg
-    for j in np.flatnonzero(counts >= 1):
-        pts = z[lab == j]
-        means[j] = np.add.reduce(pts, axis=0) / len(pts)  # pts.mean(axis=0)
-        if len(pts) >= 3:
+    grouped = z.take(lab.argsort(kind="stable"), axis=0)  # centre by centre, in plot order
+    stop = 0
+    for j, m in enumerate(n_in.tolist()):
+        start, stop = stop, stop + m
+        if m == 0:
+            continue
+        pts = grouped[start:stop]  # z[lab == j]
+        means[j] = np.add.reduce(pts, axis=0) / m  # pts.mean(axis=0)
+        if m >= 3:
             d = pts - means[j]
-            cov[j] = d.T @ d / len(pts) + reg
+            cov[j] = d.T @ d / m + reg
     w = np.maximum(counts, 1e-3)
-    w = (1.0 - background_weight) * w / w.sum()
+    w = (1.0 - background_weight) * w / np.add.reduce(w)
     return Mixture(w, means, cov, float(background_weight), background_box)
 
 

@@ -350,13 +350,13 @@ class MixtureClutter(ClutterEstimator):
         glp = log_pdf_t(maha, det)
         free = self.n_components - prev.n_components
         if free > 0:
-            far = _min(maha, axis=0) > CHI2_2_99
-            if np.count_nonzero(far) >= max(self.min_points, 1.0):
-                novel = z[far]
+            far = np.flatnonzero(_min(maha, axis=0) > CHI2_2_99)
+            if len(far) >= max(self.min_points, 1.0):
+                novel = z.take(far, axis=0)
                 centres = kmeanspp_centres(novel, free, rng(), existing=means)
                 if len(centres):
                     new = mixture_from_centres(novel, centres, reg_covar=self.reg_covar)
-                    share = float(novel.shape[0]) / len(far)  # novel plots' share: mean(far)
+                    share = float(novel.shape[0]) / len(z)  # novel plots' share
                     w = np.concatenate((w * (1.0 - share), new.weights * share * (1.0 - bg)))
                     means = np.concatenate((means, new.means))
                     cov = np.concatenate((cov, new.covariances))

@@ -52,7 +52,7 @@ def mixture_from_centres(
     data's covariance divided by the number of centres (+ ``reg_covar``); a centre with no
     plot keeps its position with a tiny weight."""
     k = len(centres)
-    d2 = ((z[:, None, :] - centres[None, :, :]) ** 2).sum(axis=2)
+    d2 = np.add.reduce((z[:, None, :] - centres[None, :, :]) ** 2, axis=2)  # .sum(axis=2)
     lab = d2.argmin(axis=1)
     n_in = np.bincount(lab, minlength=k)
     counts = n_in.astype(float)

@@ -57,3 +57,19 @@ def test_fit_em_log_density_is_log_pdf(seed: int) -> None:
     res = fit_em(z, init, reg_covar=100.0, min_points=3.0, bic=seed % 2 == 0,
                  min_contrast=5.0 if seed % 3 else 0.0)
     assert same(res.log_density, res.mixture.log_pdf(z))
+
+
+@pytest.mark.parametrize("seed", range(10))
+def test_starting_mixture_of_any_centres_is_the_plain_one(seed: int) -> None:
+    """Centres with no plot, one, two or many (the grouped slices of
+    ``mixture_from_centres``): the plain code's floats (``tests/reference/plain_em.py``)."""
+    import plain_em
+
+    rng = np.random.default_rng(seed)
+    z = rng.normal(0.0, 300.0, (int(rng.integers(1, 30)), 2))
+    centres = np.concatenate((z[rng.choice(len(z), min(len(z), 3), replace=False)],
+                              rng.normal(0.0, 300.0, (2, 2)), [[1e5, 1e5]]))  # last: no plot
+    got = mixture_from_centres(z, centres, reg_covar=100.0)
+    want = plain_em.mixture_from_centres(z, centres, reg_covar=100.0)
+    for name in ("weights", "means", "covariances"):
+        assert same(getattr(got, name), getattr(want, name))

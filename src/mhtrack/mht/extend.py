@@ -73,13 +73,15 @@ def grow_children(
     time: float,
     pair_pred: States | None = None,
     plot_time: np.ndarray | None = None,
+    posterior: np.ndarray | None = None,
 ) -> Leaves:
     """Materialise ``children`` as leaves: misses keep the prediction ``pred`` (at the
     frame's ``time``), updates get the motion model's update with their plot (``R``
     shared (2, 2) or per plot (n, 2, 2); with an IMM, each model's update and ``x, P``
     their mixture). With asynchronous plots the update starts from ``pair_pred``, the
     parent predicted to its plot's own time (one row per gated pair), and the child's
-    time is the plot's, ``plot_time`` (n,)."""
+    time is the plot's, ``plot_time`` (n,). ``posterior``: per gated pair, what the
+    gate computed for the update (:attr:`~mhtrack.mht.gating.Gated.posterior`)."""
     par, plot = children.parent, children.plot
     st = pred.take(par)
     child_time = np.full(len(par), float(time))
@@ -89,9 +91,11 @@ def grow_children(
     for s in range(0, upd.size, UPDATE_BLOCK):
         u = upd[s:s + UPDATE_BLOCK]
         pj = plot[u]
-        start = pred.take(par[u]) if pair_pred is None else pair_pred.take(children.pair[u])
+        pairs = children.pair[u]
+        start = pred.take(par[u]) if pair_pred is None else pair_pred.take(pairs)
         st.put(u, motion.update(start, z.take(pj, axis=0),
-                                R if R.ndim == 2 else R.take(pj, axis=0)))
+                                R if R.ndim == 2 else R.take(pj, axis=0),
+                                None if posterior is None else posterior.take(pairs, axis=0)))
     if upd.size and plot_time is not None:
         child_time[upd] = plot_time[plot[upd]]
     new_col = np.where(plot >= 0, rows[np.maximum(plot, 0)] if rows.size else NO_PLOT, NO_PLOT)

@@ -165,7 +165,7 @@ class MHTTracker:
         children = prune_children(leaves, children, len(cand) + len(idle), self.sprt, lim,
                                   caps, scene_leaves(cfg, len(z), n_tracks))
         grown = grow_children(leaves, pred, children, z, R, rows, self.motion, ftime,
-                              pair_pred, scan.t)
+                              pair_pred, scan.t, gated.posterior)
         births = self.birth.seed(scan, cand, grown.window, self.trees, caps)
         first_node = self.nodes.next
         parts = (grown, births) if len(idle) == 0 and len(births) else None

@@ -123,12 +123,15 @@ class CVModelSet(MotionModel):
             out.xm[b], out.Pm[b] = xp, Pp
         return out
 
-    def update(self, states: States, z: np.ndarray, R: np.ndarray) -> States:
+    def update(self, states: States, z: np.ndarray, R: np.ndarray,
+               posterior: np.ndarray | None = None) -> States:
         """Each model's update and the posterior probabilities (:func:`update`); ``x, P``
-        their mixture. Block by block of rows as :meth:`predict` (the same floats)."""
+        their mixture. ``posterior``: the rows' posterior probabilities when already
+        known (:meth:`gating_scores`: the same floats). Block by block of rows as
+        :meth:`predict` (the same floats)."""
         K = len(states.mu)
         if K <= BLOCK:
-            xm, Pm, mu = update(states.xm, states.Pm, states.mu, z, R)
+            xm, Pm, mu = update(states.xm, states.Pm, states.mu, z, R, posterior)
             return States(*combine(xm, Pm, mu), xm, Pm, mu)
         R = np.asarray(R, float)
         out = States(np.empty((K, 4)), np.empty((K, 4, 4)), np.empty(states.xm.shape),
@@ -136,7 +139,8 @@ class CVModelSet(MotionModel):
         for s in range(0, K, BLOCK):
             b = slice(s, s + BLOCK)
             xm, Pm, mu = update(states.xm[b], states.Pm[b], states.mu[b], z[b],
-                                R if R.ndim == 2 else R[b])
+                                R if R.ndim == 2 else R[b],
+                                None if posterior is None else posterior[b])
             out.x[b], out.P[b] = combine(xm, Pm, mu)
             out.xm[b], out.Pm[b], out.mu[b] = xm, Pm, mu
         return out
@@ -146,12 +150,22 @@ class CVModelSet(MotionModel):
         R: np.ndarray, loglik: np.ndarray,
     ) -> np.ndarray:
         """The mixture likelihood ``ln Σ_j μ̄_j N(z; H x⁻_j, S_j)`` of the gated pairs."""
+        return self.gating_scores(pred, track, plot, z, R, loglik)[0]
+
+    def gating_scores(
+        self, pred: States, track: np.ndarray, plot: np.ndarray, z: np.ndarray,
+        R: np.ndarray, loglik: np.ndarray,
+    ) -> tuple[np.ndarray, np.ndarray | None]:
+        """:meth:`gating_loglik` and, per pair, the posterior model probabilities ``μ_j``
+        of its update (module docstring; the floats :func:`update` computes), which
+        :meth:`update` then reuses."""
         if len(track) == 0:
-            return loglik
+            return loglik, None
         # only the position terms of each pair's leaf are copied, not its whole state
         terms = [t.take(track, axis=0) for t in _position_terms(pred.xm, pred.Pm)]
         ll = _logliks(terms, z.take(plot, axis=0), R if R.ndim == 2 else R.take(plot, axis=0))
-        return mixture_loglik(pred.mu.take(track, axis=0), ll)
+        lg, mu = _mixture(pred.mu.take(track, axis=0), ll)
+        return lg, mu
 
     def new_states(self, x: np.ndarray, P: np.ndarray) -> States:
         """Every model at ``x``, ``P`` with equal probabilities."""
@@ -271,26 +285,38 @@ def _row_sum(a: np.ndarray) -> np.ndarray:
     return out
 
 
-def mixture_loglik(mubar: np.ndarray, ll: np.ndarray) -> np.ndarray:
-    """``ln Σ_j μ̄_j exp(ll_j)`` per row (log-sum-exp), ``mubar`` and ``ll`` (K, r)."""
+def _mixture(mubar: np.ndarray, ll: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``(ln Σ_j μ̄_j exp(ll_j), μ)`` per row, ``mubar`` and ``ll`` (K, r): the
+    log-sum-exp ``m + ln Σ_j exp(a_j − m)`` of ``a = ln μ̄ + ll``, ``m = max_j a_j``, and
+    the posterior model probabilities ``μ_j = exp(a_j − m) / Σ_k exp(a_k − m)``, which
+    share ``a``, ``m`` and the sum."""
     with np.errstate(divide="ignore"):
         a = np.log(mubar) + ll
     m = _row_max(a)
-    return m + np.log(_row_sum(np.exp(a - m[:, None])))
+    a -= m[:, None]
+    mu = np.exp(a)
+    total = _row_sum(mu)
+    lg = np.log(total)
+    lg += m  # m + ln Σ (a sum is the same either way round)
+    mu /= total[:, None]
+    return lg, mu
+
+
+def mixture_loglik(mubar: np.ndarray, ll: np.ndarray) -> np.ndarray:
+    """``ln Σ_j μ̄_j exp(ll_j)`` per row (log-sum-exp), ``mubar`` and ``ll`` (K, r)."""
+    return _mixture(mubar, ll)[0]
 
 
 def update(
-    xm: np.ndarray, Pm: np.ndarray, mubar: np.ndarray, z: np.ndarray, R: np.ndarray
+    xm: np.ndarray, Pm: np.ndarray, mubar: np.ndarray, z: np.ndarray, R: np.ndarray,
+    posterior: np.ndarray | None = None,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Each model's Kalman update with plot ``z`` (one plot per row) and the posterior
-    model probabilities ``μ_j ∝ μ̄_j N(z; H x⁻_j, S_j)``: ``(x, P, μ)``."""
+    model probabilities ``μ_j ∝ μ̄_j N(z; H x⁻_j, S_j)`` (:func:`_mixture`): ``(x, P, μ)``.
+    ``posterior``: those probabilities when already computed (by the gate)."""
     K, r = mubar.shape
-    ll = model_logliks(xm, Pm, z, R)
-    with np.errstate(divide="ignore"):
-        a = np.log(mubar) + ll
-    a -= _row_max(a)[:, None]
-    mu = np.exp(a)
-    mu /= _row_sum(mu)[:, None]
+    mu = (_mixture(mubar, model_logliks(xm, Pm, z, R))[1] if posterior is None
+          else posterior)
     R = np.asarray(R, float)
     Rr = R if R.ndim == 2 else np.repeat(R, r, axis=0)
     xn, Pn = kalman.update_position(xm.reshape(K * r, 4), Pm.reshape(K * r, 4, 4),

@@ -39,9 +39,10 @@ def number_and_merge(grown: Leaves, births: Leaves, idle: Leaves, nodes: Counter
     (no ``idle`` leaves): the states are not copied yet
     (:func:`~mhtrack.mht.tree.deferred_concat`)."""
     if len(idle) == 0:
-        both = (deferred_concat(grown, births) if defer_states
-                else Leaves.concat(grown, births))
-        return number_nodes(both, nodes)
+        if not defer_states:
+            return number_nodes(Leaves.concat(grown, births), nodes)
+        first = nodes.take(len(grown) + len(births))
+        return deferred_concat(grown, births, node=np.arange(first, nodes.next, dtype=np.int64))
     n_new = len(grown) + len(births)
     first = nodes.take(n_new)
     cols = {f.name: np.concatenate((getattr(grown, f.name), getattr(births, f.name),

@@ -119,16 +119,29 @@ _FIELDS = tuple(f.name for f in fields(Leaves))
 STATE = ("x", "P", "xm", "Pm", "mu")
 
 
-def deferred_concat(a: Leaves, b: Leaves) -> Leaves:
+def deferred_concat(a: Leaves, b: Leaves, **columns: np.ndarray) -> Leaves:
     """``Leaves.concat(a, b)`` without copying the :data:`STATE` columns: in their place
-    read-only NaN placeholders of the right shape (no memory; any use shows).
-    :func:`take_deferred` then copies the states of the rows kept once, from ``a`` and
-    ``b`` (the store after a scan: the solve and N-scan pruning read no state)."""
+    read-only NaN placeholders of the right shape (no memory; any use shows), and
+    ``columns`` in place of theirs. :func:`take_deferred` then copies the states of the
+    rows kept once, from ``a`` and ``b`` (the store after a scan: the solve and N-scan
+    pruning read no state)."""
     n = len(a) + len(b)
-    cols = {f: (np.broadcast_to(np.array(np.nan), (n, *getattr(a, f).shape[1:]))
-                if f in STATE else np.concatenate((getattr(a, f), getattr(b, f))))
+    cols = {f: (columns[f] if f in columns
+                else _placeholder((n, *getattr(a, f).shape[1:])) if f in STATE
+                else np.concatenate((getattr(a, f), getattr(b, f))))
             for f in _FIELDS}
     return Leaves(**cols)
+
+
+#: The one NaN behind every :func:`deferred_concat` placeholder (read-only).
+_NAN = np.array([np.nan])
+_NAN.setflags(write=False)
+
+
+def _placeholder(shape: tuple[int, ...]) -> np.ndarray:
+    """A read-only array of ``shape`` whose every element is the one NaN of :data:`_NAN`
+    (all strides 0: ``np.broadcast_to`` without its Python set-up)."""
+    return np.ndarray(shape, float, buffer=_NAN, strides=(0,) * len(shape))
 
 
 def take_deferred(leaves: Leaves, rows: np.ndarray | None, parts: tuple[Leaves, Leaves],

@@ -85,16 +85,13 @@ class CVModelSet(MotionModel):
     def _mixing(self, mu: np.ndarray, dt: float | np.ndarray) -> tuple[np.ndarray, ...]:
         """``(μ̄, π, Q)`` of :meth:`predict_models`: ``π`` (1, r, r) or (M, r, r), ``Q``
         (r, 4, 4) or (M, r, 4, 4)."""
+        if np.ndim(dt) == 0:  # one interval: π and Q are the interval's (cached) constants
+            pim, Q = _interval_constants(self.r, self.mode_time, self.sigmas, float(dt))
+            return mu @ pim[0], pim, Q  # μ̄ (M, r)
         pi = self.transition(dt)
-        if pi.ndim == 2:
-            mubar = mu @ pi  # (M, r)
-            pim = pi[None, :, :]
-        else:
-            mubar = np.einsum("mi,mij->mj", mu, pi)
-            pim = pi
-        Q = (_process_noise(self.sigmas, float(dt)) if np.ndim(dt) == 0
-             else np.stack([ConstantVelocity(s).Q(dt) for s in self.sigmas], axis=-3))
-        return mubar, pim, Q
+        mubar = np.einsum("mi,mij->mj", mu, pi)
+        Q = np.stack([ConstantVelocity(s).Q(dt) for s in self.sigmas], axis=-3)
+        return mubar, pi, Q
 
     # ------------------------------------------------------------------ MotionModel
     @property
@@ -202,6 +199,14 @@ def _transition(r: int, mode_time: float, dt: float) -> np.ndarray:
     np.fill_diagonal(pi, stay)
     pi.setflags(write=False)
     return pi
+
+
+@functools.lru_cache(maxsize=64)
+def _interval_constants(r: int, mode_time: float, sigmas: tuple[float, ...],
+                        dt: float) -> tuple[np.ndarray, np.ndarray]:
+    """``(π[None], Q)`` of one interval for :meth:`CVModelSet._mixing`: :func:`_transition`
+    as (1, r, r) and :func:`_process_noise` (read-only; one cache look-up a scan)."""
+    return _transition(r, mode_time, dt)[None, :, :], _process_noise(sigmas, dt)
 
 
 @functools.lru_cache(maxsize=64)

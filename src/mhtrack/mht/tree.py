@@ -82,15 +82,15 @@ class Leaves:
     def take(self, idx: np.ndarray | slice) -> Leaves:
         """Rows ``idx`` (an index array, boolean mask or slice), in that order."""
         if isinstance(idx, slice):
-            return Leaves(*[getattr(self, f)[idx] for f in _FIELDS])
+            return Leaves(*[getattr(self, f)[idx] for f in FIELDS])
         idx = row_index(idx)
-        return Leaves(*[getattr(self, f).take(idx, axis=0) for f in _FIELDS])
+        return Leaves(*[getattr(self, f).take(idx, axis=0) for f in FIELDS])
 
     @classmethod
     def concat(cls, a: Leaves, b: Leaves) -> Leaves:
         if len(b) == 0:  # the arrays are never written in place: share them
             return a
-        return cls(*[np.concatenate((getattr(a, f), getattr(b, f))) for f in _FIELDS])
+        return cls(*[np.concatenate((getattr(a, f), getattr(b, f))) for f in FIELDS])
 
     def arrays(self) -> dict[str, np.ndarray]:
         """The columns by name (for saving)."""
@@ -114,7 +114,8 @@ class Leaves:
         return int(segment_starts(self.tree).size)
 
 
-_FIELDS = tuple(f.name for f in fields(Leaves))
+#: The store's columns, in order.
+FIELDS = tuple(f.name for f in fields(Leaves))
 #: The filter-state columns: most of a leaf's bytes (an IMM's ``Pm`` alone half of them).
 STATE = ("x", "P", "xm", "Pm", "mu")
 
@@ -129,7 +130,7 @@ def deferred_concat(a: Leaves, b: Leaves, **columns: np.ndarray) -> Leaves:
     cols = {f: (columns[f] if f in columns
                 else _placeholder((n, *getattr(a, f).shape[1:])) if f in STATE
                 else np.concatenate((getattr(a, f), getattr(b, f))))
-            for f in _FIELDS}
+            for f in FIELDS}
     return Leaves(**cols)
 
 
@@ -157,7 +158,7 @@ def take_deferred(leaves: Leaves, rows: np.ndarray | None, parts: tuple[Leaves, 
     split = int(rows.searchsorted(len(a)))
     ra, rb = rows[:split], rows[split:] - len(a)
     cols = {}
-    for f in _FIELDS:
+    for f in FIELDS:
         if f in columns:
             continue
         if f not in STATE:

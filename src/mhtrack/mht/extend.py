@@ -9,6 +9,7 @@ Proposing is cheap (indices and scores only), so SPRT deletion and the caps act 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -73,7 +74,7 @@ def grow_children(
     time: float,
     pair_pred: States | None = None,
     plot_time: np.ndarray | None = None,
-    posterior: np.ndarray | None = None,
+    posterior: Any = None,
 ) -> Leaves:
     """Materialise ``children`` as leaves: misses keep the prediction ``pred`` (at the
     frame's ``time``), updates get the motion model's update with their plot (``R``
@@ -96,7 +97,7 @@ def grow_children(
         start = pred.take(par[u]) if pair_pred is None else pair_pred.take(pairs)
         st.put(u, motion.update(start, z.take(pj, axis=0),
                                 R if R.ndim == 2 else R.take(pj, axis=0),
-                                None if posterior is None else posterior.take(pairs, axis=0)))
+                                None if posterior is None else posterior[pairs]))
     if upd.size and plot_time is not None:
         child_time[upd] = plot_time[plot[upd]]
     new_col = filled(len(par), NO_PLOT)

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -37,15 +38,15 @@ def gate_threshold(probability: float) -> float:
 @dataclass(frozen=True, slots=True)
 class Gated:
     """Track–plot pairs inside the gate: ``track[i]`` with ``plot[i]``, their Mahalanobis
-    distance ``d2`` and log-likelihood ``loglik = ln p(z|T)``; ``posterior``: per pair,
-    what the motion model's update may reuse (its
+    distance ``d2`` and log-likelihood ``loglik = ln p(z|T)``; ``posterior``: per pair
+    (rows by ``posterior[rows]``), what the motion model's update may reuse (its
     :meth:`~mhtrack.models.motion.MotionModel.gating_scores`), or ``None``."""
 
     track: np.ndarray
     plot: np.ndarray
     d2: np.ndarray
     loglik: np.ndarray
-    posterior: np.ndarray | None = None
+    posterior: Any = None
 
     def __len__(self) -> int:
         return len(self.track)

@@ -121,10 +121,10 @@ class CVModelSet(MotionModel):
         return out
 
     def update(self, states: States, z: np.ndarray, R: np.ndarray,
-               posterior: np.ndarray | None = None) -> States:
+               posterior: Posterior | None = None) -> States:
         """Each model's update and the posterior probabilities (:func:`update`); ``x, P``
-        their mixture. ``posterior``: the rows' posterior probabilities when already
-        known (:meth:`gating_scores`: the same floats). Block by block of rows as
+        their mixture. ``posterior``: the rows' :class:`Posterior` when already known
+        (:meth:`gating_scores`: the same floats). Block by block of rows as
         :meth:`predict` (the same floats)."""
         K = len(states.mu)
         if K <= BLOCK:
@@ -152,17 +152,17 @@ class CVModelSet(MotionModel):
     def gating_scores(
         self, pred: States, track: np.ndarray, plot: np.ndarray, z: np.ndarray,
         R: np.ndarray, loglik: np.ndarray,
-    ) -> tuple[np.ndarray, np.ndarray | None]:
+    ) -> tuple[np.ndarray, Posterior | None]:
         """:meth:`gating_loglik` and, per pair, the posterior model probabilities ``μ_j``
-        of its update (module docstring; the floats :func:`update` computes), which
-        :meth:`update` then reuses."""
+        of its update (module docstring; the floats :func:`update` computes) as a
+        :class:`Posterior`, which :meth:`update` then reuses."""
         if len(track) == 0:
             return loglik, None
         # only the position terms of each pair's leaf are copied, not its whole state
         terms = [t.take(track, axis=0) for t in _position_terms(pred.xm, pred.Pm)]
         ll = _logliks(terms, z.take(plot, axis=0), R if R.ndim == 2 else R.take(plot, axis=0))
-        lg, mu = _mixture(pred.mu.take(track, axis=0), ll)
-        return lg, mu
+        lg, weight, total = _mixture(pred.mu.take(track, axis=0), ll)
+        return lg, Posterior(weight, total)
 
     def new_states(self, x: np.ndarray, P: np.ndarray) -> States:
         """Every model at ``x``, ``P`` with equal probabilities."""
@@ -290,21 +290,40 @@ def _row_sum(a: np.ndarray) -> np.ndarray:
     return out
 
 
-def _mixture(mubar: np.ndarray, ll: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """``(ln Σ_j μ̄_j exp(ll_j), μ)`` per row, ``mubar`` and ``ll`` (K, r): the
+@dataclass(frozen=True, slots=True)
+class Posterior:
+    """Posterior model probabilities of K updates as the mixture likelihood leaves them
+    (:func:`_mixture`): ``weight`` (K, r) ``exp(a_j − m)`` and ``total`` (K,) their sum;
+    ``μ_j = weight_j / total`` (:meth:`probabilities`), divided only for the rows used."""
+
+    weight: np.ndarray
+    total: np.ndarray
+
+    def __getitem__(self, rows: np.ndarray | slice) -> Posterior:
+        """Rows ``rows`` (an index array or a slice)."""
+        if isinstance(rows, slice):
+            return Posterior(self.weight[rows], self.total[rows])
+        return Posterior(self.weight.take(rows, axis=0), self.total.take(rows))
+
+    def probabilities(self) -> np.ndarray:
+        """``μ`` (K, r), ``weight / total`` (a new array)."""
+        return np.divide(self.weight, self.total[:, None])
+
+
+def _mixture(mubar: np.ndarray, ll: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(ln Σ_j μ̄_j exp(ll_j), w, Σ_j w_j)`` per row, ``mubar`` and ``ll`` (K, r): the
     log-sum-exp ``m + ln Σ_j exp(a_j − m)`` of ``a = ln μ̄ + ll``, ``m = max_j a_j``, and
-    the posterior model probabilities ``μ_j = exp(a_j − m) / Σ_k exp(a_k − m)``, which
-    share ``a``, ``m`` and the sum."""
+    the weights ``w_j = exp(a_j − m)`` of the posterior model probabilities
+    ``μ_j = w_j / Σ_k w_k``, which share ``a``, ``m`` and the sum."""
     with np.errstate(divide="ignore"):
         a = np.log(mubar) + ll
     m = _row_max(a)
     a -= m[:, None]
-    mu = np.exp(a)
-    total = _row_sum(mu)
+    w = np.exp(a)
+    total = _row_sum(w)
     lg = np.log(total)
     lg += m  # m + ln Σ (a sum is the same either way round)
-    mu /= total[:, None]
-    return lg, mu
+    return lg, w, total
 
 
 def mixture_loglik(mubar: np.ndarray, ll: np.ndarray) -> np.ndarray:
@@ -314,14 +333,17 @@ def mixture_loglik(mubar: np.ndarray, ll: np.ndarray) -> np.ndarray:
 
 def update(
     xm: np.ndarray, Pm: np.ndarray, mubar: np.ndarray, z: np.ndarray, R: np.ndarray,
-    posterior: np.ndarray | None = None,
+    posterior: Posterior | None = None,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Each model's Kalman update with plot ``z`` (one plot per row) and the posterior
     model probabilities ``μ_j ∝ μ̄_j N(z; H x⁻_j, S_j)`` (:func:`_mixture`): ``(x, P, μ)``.
     ``posterior``: those probabilities when already computed (by the gate)."""
     K, r = mubar.shape
-    mu = (_mixture(mubar, model_logliks(xm, Pm, z, R))[1] if posterior is None
-          else posterior)
+    if posterior is None:
+        _, mu, total = _mixture(mubar, model_logliks(xm, Pm, z, R))
+        mu /= total[:, None]
+    else:
+        mu = posterior.probabilities()
     R = np.asarray(R, float)
     Rr = R if R.ndim == 2 else np.repeat(R, r, axis=0)
     xn, Pn = kalman.update_position(xm.reshape(K * r, 4), Pm.reshape(K * r, 4, 4),

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 from abc import ABC, abstractmethod
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -83,10 +84,10 @@ class MotionModel(ABC):
 
     @abstractmethod
     def update(self, states: States, z: np.ndarray, R: np.ndarray,
-               posterior: np.ndarray | None = None) -> States:
+               posterior: Any = None) -> States:
         """Each predicted row updated with its plot ``z`` (K, 2); ``R`` (2, 2) or (K, 2, 2).
-        ``posterior``: the rows' part of what :meth:`gating_scores` returned for reuse
-        (``None``: compute everything)."""
+        ``posterior``: the rows (``reuse[rows]``) of what :meth:`gating_scores` returned
+        for reuse (``None``: compute everything)."""
 
     def gating_loglik(
         self, pred: States, track: np.ndarray, plot: np.ndarray, z: np.ndarray,
@@ -100,8 +101,8 @@ class MotionModel(ABC):
     def gating_scores(
         self, pred: States, track: np.ndarray, plot: np.ndarray, z: np.ndarray,
         R: np.ndarray, loglik: np.ndarray,
-    ) -> tuple[np.ndarray, np.ndarray | None]:
-        """``(gating_loglik(…), reuse)``: ``reuse`` (one row per pair, or ``None``) is what
+    ) -> tuple[np.ndarray, Any]:
+        """``(gating_loglik(…), reuse)``: ``reuse`` (rows by ``reuse[rows]``, or ``None``) is what
         :meth:`update` of the pair may take as ``posterior`` instead of recomputing it.
         Default: :meth:`gating_loglik` and ``None``."""
         return self.gating_loglik(pred, track, plot, z, R, loglik), None
@@ -158,7 +159,7 @@ class ConstantVelocity(MotionModel):
         return States(xp, Pp, states.xm, states.Pm, states.mu)
 
     def update(self, states: States, z: np.ndarray, R: np.ndarray,
-               posterior: np.ndarray | None = None) -> States:
+               posterior: Any = None) -> States:
         """Kalman update (:func:`~mhtrack.models.kalman.update_position`); nothing to
         reuse (``posterior`` is ignored)."""
         x, P = kalman.update_position(states.x, states.P, z, R)

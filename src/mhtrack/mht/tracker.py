@@ -158,8 +158,8 @@ class MHTTracker:
                                        self.motion, caps)
         in_gates = plots_in_confirmed_gates(leaves, gated, len(z))
         kappa = clutter_intensity(self.clutter, scan, z, in_gates, cfg.min_clutter_density)
-        update_dl = update_increment(gated.loglik, kappa[gated.plot],
-                                     self.coverage.plot_pd(scan), cfg.new_target_density)
+        update_dl = update_increment(gated.loglik, kappa, self.coverage.plot_pd(scan),
+                                     cfg.new_target_density, gated.plot)
         children = propose_children(leaves, gated, miss_increments(looks.miss_pd, self._miss_pg),
                                     update_dl)
         cand = self.birth.propose(scan, z, R, rows, kappa, in_gates, caps)

@@ -52,3 +52,25 @@ def test_prune_after_solve_with_parts_is_the_same(seed):
         _same(prune_after_solve(lazy, chosen, max_trees, caps_got, parts=(grown, births)),
               prune_after_solve(ref, chosen, max_trees, caps_ref))
         assert caps_got == caps_ref
+
+
+def test_placeholders_are_read_only_nans_and_columns_replace():
+    """``deferred_concat``'s placeholders: the shape of the concatenated column, every
+    element NaN, no memory (all strides 0), not writable; ``columns`` take the place of
+    the concatenated ones."""
+    rng = np.random.default_rng(0)
+    a = leaves_of_trees(rng, 7, np.arange(5))
+    b = leaves_of_trees(rng, 3, np.arange(5, 8))
+    node = np.arange(100, 100 + len(a) + len(b))
+    lazy = deferred_concat(a, b, node=node)
+    full = Leaves.concat(a, b)
+    for f in STATE:
+        p = getattr(lazy, f)
+        assert p.shape == getattr(full, f).shape and p.dtype == np.float64, f
+        assert not any(p.strides) and not p.flags.writeable, f
+        with pytest.raises(ValueError):
+            p[...] = 0.0
+    assert lazy.node is node
+    for name, v in full.arrays().items():
+        if name not in STATE and name != "node":
+            np.testing.assert_array_equal(lazy.arrays()[name], v, err_msg=name)

@@ -164,3 +164,14 @@ def test_lone_target_in_near_empty_clutter_keeps_its_plots():
     late = [r for r in rows[5:]]
     assert all(r.track_id.tolist() == [0] for r in late)
     assert all(r.plot.tolist() == [0] for r in late)
+
+
+def test_update_increment_per_plot_equals_per_pair():
+    """``kappa`` per plot with each pair's ``plot`` gives the floats of ``kappa`` taken per
+    pair first."""
+    rng = np.random.default_rng(4)
+    kappa = 10.0 ** rng.uniform(-12, -6, 30)
+    plot = rng.integers(0, 30, 500)
+    ll = rng.normal(-10, 3, 500)
+    want = update_increment(ll, kappa[plot], 0.9, 1e-7)
+    assert update_increment(ll, kappa, 0.9, 1e-7, plot).tobytes() == want.tobytes()

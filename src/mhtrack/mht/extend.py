@@ -9,11 +9,12 @@ Proposing is cheap (indices and scores only), so SPRT deletion and the caps act 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
 from mhtrack.mht.gating import Gated
-from mhtrack.mht.tree import NO_PLOT, Leaves
+from mhtrack.mht.tree import NO_PLOT, Leaves, filled
 from mhtrack.models.motion import MotionModel, States, row_index
 
 #: Updated children per block of :func:`grow_children`.
@@ -52,8 +53,8 @@ def propose_children(
     value or one per leaf (its sensor coverage's ``P_D``)."""
     n = len(leaves)
     parent = np.concatenate((np.arange(n, dtype=np.int64), gated.track))
-    plot = np.concatenate((np.full(n, NO_PLOT, np.int64), gated.plot))
-    pair = np.concatenate((np.full(n, -1, np.int64), np.arange(len(gated), dtype=np.int64)))
+    plot = np.concatenate((filled(n, NO_PLOT), gated.plot))
+    pair = np.concatenate((filled(n, -1), np.arange(len(gated), dtype=np.int64)))
     score = np.concatenate((leaves.score + miss_dl, leaves.score[gated.track] + update_dl))
     # gated pairs are sorted by (leaf, plot); a stable sort on the parent puts the miss
     # first and keeps the plot order.
@@ -73,28 +74,34 @@ def grow_children(
     time: float,
     pair_pred: States | None = None,
     plot_time: np.ndarray | None = None,
+    posterior: Any = None,
 ) -> Leaves:
     """Materialise ``children`` as leaves: misses keep the prediction ``pred`` (at the
     frame's ``time``), updates get the motion model's update with their plot (``R``
     shared (2, 2) or per plot (n, 2, 2); with an IMM, each model's update and ``x, P``
     their mixture). With asynchronous plots the update starts from ``pair_pred``, the
     parent predicted to its plot's own time (one row per gated pair), and the child's
-    time is the plot's, ``plot_time`` (n,)."""
+    time is the plot's, ``plot_time`` (n,). ``posterior``: per gated pair, what the
+    gate computed for the update (:attr:`~mhtrack.mht.gating.Gated.posterior`)."""
     par, plot = children.parent, children.plot
     st = pred.take(par)
-    child_time = np.full(len(par), float(time))
-    upd = np.flatnonzero(plot >= 0)
+    child_time = filled(len(par), float(time), float)
+    is_upd = plot >= 0
+    upd = is_upd.nonzero()[0]
     # the update block by block of rows: a block's copies stay in the CPU cache (the
     # update is row by row: the floats of one pass)
     for s in range(0, upd.size, UPDATE_BLOCK):
         u = upd[s:s + UPDATE_BLOCK]
         pj = plot[u]
-        start = pred.take(par[u]) if pair_pred is None else pair_pred.take(children.pair[u])
+        pairs = children.pair[u]
+        start = pred.take(par[u]) if pair_pred is None else pair_pred.take(pairs)
         st.put(u, motion.update(start, z.take(pj, axis=0),
-                                R if R.ndim == 2 else R.take(pj, axis=0)))
+                                R if R.ndim == 2 else R.take(pj, axis=0),
+                                None if posterior is None else posterior[pairs]))
     if upd.size and plot_time is not None:
         child_time[upd] = plot_time[plot[upd]]
-    new_col = np.where(plot >= 0, rows[np.maximum(plot, 0)] if rows.size else NO_PLOT, NO_PLOT)
+    new_col = filled(len(par), NO_PLOT)
+    new_col[upd] = rows.take(plot.take(upd))  # the plot's row id; a miss: NO_PLOT
     window = np.concatenate((leaves.window.take(par, axis=0)[:, 1:], new_col[:, None]),
                             axis=1)
     return Leaves(
@@ -105,13 +112,13 @@ def grow_children(
         tree=leaves.tree[par],
         track=leaves.track[par],
         birth=leaves.birth[par],
-        n_updates=leaves.n_updates[par] + (plot >= 0),
+        n_updates=leaves.n_updates[par] + is_upd,
         window=window,
         chosen=np.zeros(len(par), bool),
         mu=st.mu,
         xm=st.xm,
         Pm=st.Pm,
-        node=np.full(len(par), -1, np.int64),
+        node=filled(len(par), -1),
         parent=leaves.node[par],
         time=child_time,
     )

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -37,12 +38,15 @@ def gate_threshold(probability: float) -> float:
 @dataclass(frozen=True, slots=True)
 class Gated:
     """Track–plot pairs inside the gate: ``track[i]`` with ``plot[i]``, their Mahalanobis
-    distance ``d2`` and log-likelihood ``loglik = ln p(z|T)``."""
+    distance ``d2`` and log-likelihood ``loglik = ln p(z|T)``; ``posterior``: per pair
+    (rows by ``posterior[rows]``), what the motion model's update may reuse (its
+    :meth:`~mhtrack.models.motion.MotionModel.gating_scores`), or ``None``."""
 
     track: np.ndarray
     plot: np.ndarray
     d2: np.ndarray
     loglik: np.ndarray
+    posterior: Any = None
 
     def __len__(self) -> int:
         return len(self.track)
@@ -199,7 +203,7 @@ class Gate:
     burst), leaves of confirmed trees and then the best-scoring leaves are gated first
     until the budget is spent; the others only get a miss child this scan (counted in
     ``caps["max_gated_pairs"]``). The pairs' ``loglik`` is the motion model's
-    (:meth:`~mhtrack.models.motion.MotionModel.gating_loglik`: the IMM's mixture).
+    (:meth:`~mhtrack.models.motion.MotionModel.gating_scores`: the IMM's mixture).
     """
 
     def __init__(self, probability: float, max_pairs: int) -> None:
@@ -210,7 +214,7 @@ class Gate:
                  motion: MotionModel, caps: dict[str, int]) -> Gated:
         g = self.pairs(leaves, pred.x, pred.P, z, R, caps)
         return Gated(g.track, g.plot, g.d2,
-                     motion.gating_loglik(pred, g.track, g.plot, z, R, g.loglik))
+                     *motion.gating_scores(pred, g.track, g.plot, z, R, g.loglik))
 
     def pairs(self, leaves: Leaves, xp: np.ndarray, Pp: np.ndarray, z: np.ndarray,
               R: np.ndarray, caps: dict[str, int]) -> Gated:

@@ -27,10 +27,12 @@ class Reported:
     window: np.ndarray
 
     @classmethod
-    def of(cls, leaves: Leaves, *, by_id: bool = False) -> Reported:
-        """What the leaves of the last scan reported (chosen, confirmed); ``by_id``: the
-        whole windows (a tree's columns are its own looks, not the scans)."""
-        rep = leaves.chosen & (leaves.track >= 0)
+    def of(cls, leaves: Leaves, *, by_id: bool = False,
+           reported: np.ndarray | None = None) -> Reported:
+        """What the leaves of the last scan reported (chosen, confirmed; ``reported``:
+        that mask, when known); ``by_id``: the whole windows (a tree's columns are its
+        own looks, not the scans)."""
+        rep = leaves.chosen & (leaves.track >= 0) if reported is None else reported
         return cls(leaves.track[rep], leaves.window[rep] if by_id else leaves.window[rep, 1:])
 
 

@@ -2,11 +2,11 @@
 
 from __future__ import annotations
 
-from dataclasses import fields, replace
+from dataclasses import replace
 
 import numpy as np
 
-from mhtrack.mht.tree import Leaves, deferred_concat
+from mhtrack.mht.tree import FIELDS, Leaves, deferred_concat
 
 
 class Counter:
@@ -39,13 +39,14 @@ def number_and_merge(grown: Leaves, births: Leaves, idle: Leaves, nodes: Counter
     (no ``idle`` leaves): the states are not copied yet
     (:func:`~mhtrack.mht.tree.deferred_concat`)."""
     if len(idle) == 0:
-        both = (deferred_concat(grown, births) if defer_states
-                else Leaves.concat(grown, births))
-        return number_nodes(both, nodes)
+        if not defer_states:
+            return number_nodes(Leaves.concat(grown, births), nodes)
+        first = nodes.take(len(grown) + len(births))
+        return deferred_concat(grown, births, node=np.arange(first, nodes.next, dtype=np.int64))
     n_new = len(grown) + len(births)
     first = nodes.take(n_new)
-    cols = {f.name: np.concatenate((getattr(grown, f.name), getattr(births, f.name),
-                                    getattr(idle, f.name))) for f in fields(Leaves)}
+    cols = {f: np.concatenate((getattr(grown, f), getattr(births, f), getattr(idle, f)))
+            for f in FIELDS}
     cols["node"] = np.concatenate((np.arange(first, first + n_new, dtype=np.int64),
                                    idle.node))
     order = cols["tree"].argsort(kind="stable")

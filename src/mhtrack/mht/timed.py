@@ -65,7 +65,7 @@ def gate_looked(gate: Gate, leaves: Leaves, pred: States, pd: np.ndarray, z: np.
     else:
         g, pair_pred = gate_timed(gate, lv, pr, z, R, t, time, motion, caps)
     if sub is not None:
-        g = Gated(sub[g.track], g.plot, g.d2, g.loglik)
+        g = Gated(sub[g.track], g.plot, g.d2, g.loglik, g.posterior)
     return g, pair_pred
 
 
@@ -95,5 +95,5 @@ def gate_timed(gate: Gate, leaves: Leaves, pred: States, z: np.ndarray, R: np.nd
     pp = pp.take(keep)
     ti, pj, d2, det = ti[keep], pj[keep], d2[keep], det[keep]
     k = np.arange(keep.size)
-    loglik = motion.gating_loglik(pp, k, pj, z, R, gaussian_loglik2(d2, det))
-    return Gated(ti, pj, d2, loglik), pp
+    loglik, posterior = motion.gating_scores(pp, k, pj, z, R, gaussian_loglik2(d2, det))
+    return Gated(ti, pj, d2, loglik, posterior), pp

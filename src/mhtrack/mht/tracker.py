@@ -63,7 +63,7 @@ from mhtrack.mht.intensity import clutter_intensity
 from mhtrack.mht.numbering import Counter, number_and_merge
 from mhtrack.mht.predict import predict_leaves
 from mhtrack.mht.pruning import prune_after_solve, prune_children, removed_after_solve
-from mhtrack.mht.report import StepStats, confirmed_windows, report
+from mhtrack.mht.report import StepStats, confirmed_windows, report, reported
 from mhtrack.mht.scoring import miss_increments, update_increment
 from mhtrack.mht.sprt import SPRT
 from mhtrack.mht.state import load_state, located, save_state
@@ -145,27 +145,28 @@ class MHTTracker:
         cfg, ftime = self.config, float(scan.time)
         caps: dict[str, int] = {}
         z, R, rows = validate_scan(scan, self._R, self._last_time, self._last_index)
-        n_tracks = int(np.count_nonzero(self._leaves.chosen & (self._leaves.track >= 0)))
+        on_air = reported(self._leaves)  # the tracks reported at the last scan
+        n_tracks = int(np.count_nonzero(on_air))
         lim = scan_config(cfg, len(z), n_tracks)  # caps scaled to the scan
         self.gate.max_pairs = lim.max_gated_pairs
         self.birth.limit(lim.max_births_per_scan)
         by_id = self.coverage.per_tree_looks
-        previous = Reported.of(self._leaves, by_id=by_id)
+        previous = Reported.of(self._leaves, by_id=by_id, reported=on_air)
         leaves, looks, idle = self._look(scan)
         pred = predict_leaves(self.motion, leaves, ftime)
         gated, pair_pred = gate_looked(self.gate, leaves, pred, looks.pd, z, R, scan.t, ftime,
                                        self.motion, caps)
         in_gates = plots_in_confirmed_gates(leaves, gated, len(z))
         kappa = clutter_intensity(self.clutter, scan, z, in_gates, cfg.min_clutter_density)
-        update_dl = update_increment(gated.loglik, kappa[gated.plot],
-                                     self.coverage.plot_pd(scan), cfg.new_target_density)
+        update_dl = update_increment(gated.loglik, kappa, self.coverage.plot_pd(scan),
+                                     cfg.new_target_density, gated.plot)
         children = propose_children(leaves, gated, miss_increments(looks.miss_pd, self._miss_pg),
                                     update_dl)
         cand = self.birth.propose(scan, z, R, rows, kappa, in_gates, caps)
         children = prune_children(leaves, children, len(cand) + len(idle), self.sprt, lim,
                                   caps, scene_leaves(cfg, len(z), n_tracks))
         grown = grow_children(leaves, pred, children, z, R, rows, self.motion, ftime,
-                              pair_pred, scan.t)
+                              pair_pred, scan.t, gated.posterior)
         births = self.birth.seed(scan, cand, grown.window, self.trees, caps)
         first_node = self.nodes.next
         parts = (grown, births) if len(idle) == 0 and len(births) else None
@@ -181,9 +182,10 @@ class MHTTracker:
         leaves = confirm(leaves, self.sprt.confirms(leaves), self.tracks)
         self.last_backfill = self._history.backfill(leaves, newly_confirmed(leaves, first_new))
         self._history.record(int(scan.index), ftime, leaves, is_new)
-        self._forget(leaves, rows)
+        rep = reported(leaves)
+        self._forget(leaves, rows, rep)
         self._leaves, self._last_time, self._last_index = leaves, ftime, int(scan.index)
-        out = report(scan, leaves, is_new)
+        out = report(scan, leaves, is_new, rep)
         limits = {k: getattr(lim, k) for k in SCALED}
         self.last_stats = StepStats.of(scan, len(z), leaves, births, hyp, out,
                                        time.perf_counter() - t0, caps, limits)
@@ -196,10 +198,10 @@ class MHTTracker:
         lv = self._leaves
         return split_looked(lv, self.coverage.detection(scan, lv.x, lv.P, lv.time))
 
-    def _forget(self, leaves: Leaves, rows: np.ndarray) -> None:
-        """The plots the confirmed tracks used leave the birth process and the clutter
-        estimator (their optional hooks)."""
-        used = confirmed_windows(leaves)
+    def _forget(self, leaves: Leaves, rows: np.ndarray, rep: np.ndarray) -> None:
+        """The plots the confirmed tracks used (``rep``: the leaves that report them)
+        leave the birth process and the clutter estimator (their optional hooks)."""
+        used = confirmed_windows(leaves, rep)
         self.birth.forget_used(used)
         self.clutter.forget(contains(used[:, -1], rows))
 

@@ -82,15 +82,15 @@ class Leaves:
     def take(self, idx: np.ndarray | slice) -> Leaves:
         """Rows ``idx`` (an index array, boolean mask or slice), in that order."""
         if isinstance(idx, slice):
-            return Leaves(*[getattr(self, f)[idx] for f in _FIELDS])
+            return Leaves(*[getattr(self, f)[idx] for f in FIELDS])
         idx = row_index(idx)
-        return Leaves(*[getattr(self, f).take(idx, axis=0) for f in _FIELDS])
+        return Leaves(*[getattr(self, f).take(idx, axis=0) for f in FIELDS])
 
     @classmethod
     def concat(cls, a: Leaves, b: Leaves) -> Leaves:
         if len(b) == 0:  # the arrays are never written in place: share them
             return a
-        return cls(*[np.concatenate((getattr(a, f), getattr(b, f))) for f in _FIELDS])
+        return cls(*[np.concatenate((getattr(a, f), getattr(b, f))) for f in FIELDS])
 
     def arrays(self) -> dict[str, np.ndarray]:
         """The columns by name (for saving)."""
@@ -114,21 +114,35 @@ class Leaves:
         return int(segment_starts(self.tree).size)
 
 
-_FIELDS = tuple(f.name for f in fields(Leaves))
+#: The store's columns, in order.
+FIELDS = tuple(f.name for f in fields(Leaves))
 #: The filter-state columns: most of a leaf's bytes (an IMM's ``Pm`` alone half of them).
 STATE = ("x", "P", "xm", "Pm", "mu")
 
 
-def deferred_concat(a: Leaves, b: Leaves) -> Leaves:
+def deferred_concat(a: Leaves, b: Leaves, **columns: np.ndarray) -> Leaves:
     """``Leaves.concat(a, b)`` without copying the :data:`STATE` columns: in their place
-    read-only NaN placeholders of the right shape (no memory; any use shows).
-    :func:`take_deferred` then copies the states of the rows kept once, from ``a`` and
-    ``b`` (the store after a scan: the solve and N-scan pruning read no state)."""
+    read-only NaN placeholders of the right shape (no memory; any use shows), and
+    ``columns`` in place of theirs. :func:`take_deferred` then copies the states of the
+    rows kept once, from ``a`` and ``b`` (the store after a scan: the solve and N-scan
+    pruning read no state)."""
     n = len(a) + len(b)
-    cols = {f: (np.broadcast_to(np.array(np.nan), (n, *getattr(a, f).shape[1:]))
-                if f in STATE else np.concatenate((getattr(a, f), getattr(b, f))))
-            for f in _FIELDS}
+    cols = {f: (columns[f] if f in columns
+                else _placeholder((n, *getattr(a, f).shape[1:])) if f in STATE
+                else np.concatenate((getattr(a, f), getattr(b, f))))
+            for f in FIELDS}
     return Leaves(**cols)
+
+
+#: The one NaN behind every :func:`deferred_concat` placeholder (read-only).
+_NAN = np.array([np.nan])
+_NAN.setflags(write=False)
+
+
+def _placeholder(shape: tuple[int, ...]) -> np.ndarray:
+    """A read-only array of ``shape`` whose every element is the one NaN of :data:`_NAN`
+    (all strides 0: ``np.broadcast_to`` without its Python set-up)."""
+    return np.ndarray(shape, float, buffer=_NAN, strides=(0,) * len(shape))
 
 
 def take_deferred(leaves: Leaves, rows: np.ndarray | None, parts: tuple[Leaves, Leaves],
@@ -144,7 +158,7 @@ def take_deferred(leaves: Leaves, rows: np.ndarray | None, parts: tuple[Leaves, 
     split = int(rows.searchsorted(len(a)))
     ra, rb = rows[:split], rows[split:] - len(a)
     cols = {}
-    for f in _FIELDS:
+    for f in FIELDS:
         if f in columns:
             continue
         if f not in STATE:
@@ -157,6 +171,14 @@ def take_deferred(leaves: Leaves, rows: np.ndarray | None, parts: tuple[Leaves, 
         np.take(v, rb, axis=0, out=out[split:], mode="clip")
         cols[f] = out
     return Leaves(**cols, **columns)
+
+
+def filled(n: int, value: float, dtype: type = np.int64) -> np.ndarray:
+    """``np.full(n, value, dtype)`` without its Python wrapper (about half its cost on
+    the few hundred rows of a scan)."""
+    out = np.empty(n, dtype)
+    out.fill(value)
+    return out
 
 
 def segment_starts(sorted_keys: np.ndarray) -> np.ndarray:
@@ -221,15 +243,15 @@ def new_trees(
         score=score,
         peak=peak,
         tree=tree,
-        track=np.full(n, -1, np.int64),
-        birth=np.full(n, scan_index, np.int64),
+        track=filled(n, -1),
+        birth=filled(n, scan_index),
         n_updates=n_updates,
         window=window,
         chosen=np.zeros(n, bool),
         mu=states.mu,
         xm=states.xm,
         Pm=states.Pm,
-        node=np.full(n, -1, np.int64),
-        parent=np.full(n, -1, np.int64),
+        node=filled(n, -1),
+        parent=filled(n, -1),
         time=np.asarray(time, float),
     )

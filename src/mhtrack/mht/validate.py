@@ -3,6 +3,8 @@ the frame, with a unique row id and a valid covariance, and scans come in time o
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from mhtrack.models.linalg2 import det2
@@ -20,7 +22,7 @@ def validate_scan(
     rows = np.asarray(scan.rows, dtype=np.int64).reshape(-1)
     if rows.size != n:
         raise ValueError(f"scan {scan.index}: {rows.size} row ids for {n} plots")
-    if not np.isfinite(scan.time):
+    if not math.isfinite(scan.time):
         raise ValueError(f"scan {scan.index}: time {scan.time} is not finite")
     timed = scan.t is not None
     # frames of two radars may end at the same time; scans must move on

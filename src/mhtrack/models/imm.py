@@ -85,16 +85,13 @@ class CVModelSet(MotionModel):
     def _mixing(self, mu: np.ndarray, dt: float | np.ndarray) -> tuple[np.ndarray, ...]:
         """``(μ̄, π, Q)`` of :meth:`predict_models`: ``π`` (1, r, r) or (M, r, r), ``Q``
         (r, 4, 4) or (M, r, 4, 4)."""
+        if np.ndim(dt) == 0:  # one interval: π and Q are the interval's (cached) constants
+            pim, Q = _interval_constants(self.r, self.mode_time, self.sigmas, float(dt))
+            return mu @ pim[0], pim, Q  # μ̄ (M, r)
         pi = self.transition(dt)
-        if pi.ndim == 2:
-            mubar = mu @ pi  # (M, r)
-            pim = pi[None, :, :]
-        else:
-            mubar = np.einsum("mi,mij->mj", mu, pi)
-            pim = pi
-        Q = (_process_noise(self.sigmas, float(dt)) if np.ndim(dt) == 0
-             else np.stack([ConstantVelocity(s).Q(dt) for s in self.sigmas], axis=-3))
-        return mubar, pim, Q
+        mubar = np.einsum("mi,mij->mj", mu, pi)
+        Q = np.stack([ConstantVelocity(s).Q(dt) for s in self.sigmas], axis=-3)
+        return mubar, pi, Q
 
     # ------------------------------------------------------------------ MotionModel
     @property
@@ -123,12 +120,15 @@ class CVModelSet(MotionModel):
             out.xm[b], out.Pm[b] = xp, Pp
         return out
 
-    def update(self, states: States, z: np.ndarray, R: np.ndarray) -> States:
+    def update(self, states: States, z: np.ndarray, R: np.ndarray,
+               posterior: Posterior | None = None) -> States:
         """Each model's update and the posterior probabilities (:func:`update`); ``x, P``
-        their mixture. Block by block of rows as :meth:`predict` (the same floats)."""
+        their mixture. ``posterior``: the rows' :class:`Posterior` when already known
+        (:meth:`gating_scores`: the same floats). Block by block of rows as
+        :meth:`predict` (the same floats)."""
         K = len(states.mu)
         if K <= BLOCK:
-            xm, Pm, mu = update(states.xm, states.Pm, states.mu, z, R)
+            xm, Pm, mu = update(states.xm, states.Pm, states.mu, z, R, posterior)
             return States(*combine(xm, Pm, mu), xm, Pm, mu)
         R = np.asarray(R, float)
         out = States(np.empty((K, 4)), np.empty((K, 4, 4)), np.empty(states.xm.shape),
@@ -136,7 +136,8 @@ class CVModelSet(MotionModel):
         for s in range(0, K, BLOCK):
             b = slice(s, s + BLOCK)
             xm, Pm, mu = update(states.xm[b], states.Pm[b], states.mu[b], z[b],
-                                R if R.ndim == 2 else R[b])
+                                R if R.ndim == 2 else R[b],
+                                None if posterior is None else posterior[b])
             out.x[b], out.P[b] = combine(xm, Pm, mu)
             out.xm[b], out.Pm[b], out.mu[b] = xm, Pm, mu
         return out
@@ -146,12 +147,22 @@ class CVModelSet(MotionModel):
         R: np.ndarray, loglik: np.ndarray,
     ) -> np.ndarray:
         """The mixture likelihood ``ln Σ_j μ̄_j N(z; H x⁻_j, S_j)`` of the gated pairs."""
+        return self.gating_scores(pred, track, plot, z, R, loglik)[0]
+
+    def gating_scores(
+        self, pred: States, track: np.ndarray, plot: np.ndarray, z: np.ndarray,
+        R: np.ndarray, loglik: np.ndarray,
+    ) -> tuple[np.ndarray, Posterior | None]:
+        """:meth:`gating_loglik` and, per pair, the posterior model probabilities ``μ_j``
+        of its update (module docstring; the floats :func:`update` computes) as a
+        :class:`Posterior`, which :meth:`update` then reuses."""
         if len(track) == 0:
-            return loglik
+            return loglik, None
         # only the position terms of each pair's leaf are copied, not its whole state
         terms = [t.take(track, axis=0) for t in _position_terms(pred.xm, pred.Pm)]
         ll = _logliks(terms, z.take(plot, axis=0), R if R.ndim == 2 else R.take(plot, axis=0))
-        return mixture_loglik(pred.mu.take(track, axis=0), ll)
+        lg, weight, total = _mixture(pred.mu.take(track, axis=0), ll)
+        return lg, Posterior(weight, total)
 
     def new_states(self, x: np.ndarray, P: np.ndarray) -> States:
         """Every model at ``x``, ``P`` with equal probabilities."""
@@ -188,6 +199,14 @@ def _transition(r: int, mode_time: float, dt: float) -> np.ndarray:
     np.fill_diagonal(pi, stay)
     pi.setflags(write=False)
     return pi
+
+
+@functools.lru_cache(maxsize=64)
+def _interval_constants(r: int, mode_time: float, sigmas: tuple[float, ...],
+                        dt: float) -> tuple[np.ndarray, np.ndarray]:
+    """``(π[None], Q)`` of one interval for :meth:`CVModelSet._mixing`: :func:`_transition`
+    as (1, r, r) and :func:`_process_noise` (read-only; one cache look-up a scan)."""
+    return _transition(r, mode_time, dt)[None, :, :], _process_noise(sigmas, dt)
 
 
 @functools.lru_cache(maxsize=64)
@@ -271,26 +290,60 @@ def _row_sum(a: np.ndarray) -> np.ndarray:
     return out
 
 
-def mixture_loglik(mubar: np.ndarray, ll: np.ndarray) -> np.ndarray:
-    """``ln Σ_j μ̄_j exp(ll_j)`` per row (log-sum-exp), ``mubar`` and ``ll`` (K, r)."""
+@dataclass(frozen=True, slots=True)
+class Posterior:
+    """Posterior model probabilities of K updates as the mixture likelihood leaves them
+    (:func:`_mixture`): ``weight`` (K, r) ``exp(a_j − m)`` and ``total`` (K,) their sum;
+    ``μ_j = weight_j / total`` (:meth:`probabilities`), divided only for the rows used."""
+
+    weight: np.ndarray
+    total: np.ndarray
+
+    def __getitem__(self, rows: np.ndarray | slice) -> Posterior:
+        """Rows ``rows`` (an index array or a slice)."""
+        if isinstance(rows, slice):
+            return Posterior(self.weight[rows], self.total[rows])
+        return Posterior(self.weight.take(rows, axis=0), self.total.take(rows))
+
+    def probabilities(self) -> np.ndarray:
+        """``μ`` (K, r), ``weight / total`` (a new array)."""
+        return np.divide(self.weight, self.total[:, None])
+
+
+def _mixture(mubar: np.ndarray, ll: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(ln Σ_j μ̄_j exp(ll_j), w, Σ_j w_j)`` per row, ``mubar`` and ``ll`` (K, r): the
+    log-sum-exp ``m + ln Σ_j exp(a_j − m)`` of ``a = ln μ̄ + ll``, ``m = max_j a_j``, and
+    the weights ``w_j = exp(a_j − m)`` of the posterior model probabilities
+    ``μ_j = w_j / Σ_k w_k``, which share ``a``, ``m`` and the sum."""
     with np.errstate(divide="ignore"):
         a = np.log(mubar) + ll
     m = _row_max(a)
-    return m + np.log(_row_sum(np.exp(a - m[:, None])))
+    a -= m[:, None]
+    w = np.exp(a)
+    total = _row_sum(w)
+    lg = np.log(total)
+    lg += m  # m + ln Σ (a sum is the same either way round)
+    return lg, w, total
+
+
+def mixture_loglik(mubar: np.ndarray, ll: np.ndarray) -> np.ndarray:
+    """``ln Σ_j μ̄_j exp(ll_j)`` per row (log-sum-exp), ``mubar`` and ``ll`` (K, r)."""
+    return _mixture(mubar, ll)[0]
 
 
 def update(
-    xm: np.ndarray, Pm: np.ndarray, mubar: np.ndarray, z: np.ndarray, R: np.ndarray
+    xm: np.ndarray, Pm: np.ndarray, mubar: np.ndarray, z: np.ndarray, R: np.ndarray,
+    posterior: Posterior | None = None,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Each model's Kalman update with plot ``z`` (one plot per row) and the posterior
-    model probabilities ``μ_j ∝ μ̄_j N(z; H x⁻_j, S_j)``: ``(x, P, μ)``."""
+    model probabilities ``μ_j ∝ μ̄_j N(z; H x⁻_j, S_j)`` (:func:`_mixture`): ``(x, P, μ)``.
+    ``posterior``: those probabilities when already computed (by the gate)."""
     K, r = mubar.shape
-    ll = model_logliks(xm, Pm, z, R)
-    with np.errstate(divide="ignore"):
-        a = np.log(mubar) + ll
-    a -= _row_max(a)[:, None]
-    mu = np.exp(a)
-    mu /= _row_sum(mu)[:, None]
+    if posterior is None:
+        _, mu, total = _mixture(mubar, model_logliks(xm, Pm, z, R))
+        mu /= total[:, None]
+    else:
+        mu = posterior.probabilities()
     R = np.asarray(R, float)
     Rr = R if R.ndim == 2 else np.repeat(R, r, axis=0)
     xn, Pn = kalman.update_position(xm.reshape(K * r, 4), Pm.reshape(K * r, 4, 4),

@@ -25,7 +25,7 @@ from mhtrack.models.linalg2 import sym_det2
 def symmetrised(P: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
     """``0.5 (P + Pᵀ)`` over the last two axes, written into ``out`` (an array other than
     ``P``) when given: the same floats as the expression, one array instead of two."""
-    out = np.add(P, np.swapaxes(P, -1, -2), out=out)
+    out = np.add(P, P.swapaxes(-1, -2), out=out)  # the method: no wrapper set-up
     out *= 0.5
     return out
 

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 from abc import ABC, abstractmethod
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -82,8 +83,11 @@ class MotionModel(ABC):
         still adds process noise (``Q`` is a positive semi-definite function of ``dt``)."""
 
     @abstractmethod
-    def update(self, states: States, z: np.ndarray, R: np.ndarray) -> States:
-        """Each predicted row updated with its plot ``z`` (K, 2); ``R`` (2, 2) or (K, 2, 2)."""
+    def update(self, states: States, z: np.ndarray, R: np.ndarray,
+               posterior: Any = None) -> States:
+        """Each predicted row updated with its plot ``z`` (K, 2); ``R`` (2, 2) or (K, 2, 2).
+        ``posterior``: the rows (``reuse[rows]``) of what :meth:`gating_scores` returned
+        for reuse (``None``: compute everything)."""
 
     def gating_loglik(
         self, pred: States, track: np.ndarray, plot: np.ndarray, z: np.ndarray,
@@ -93,6 +97,15 @@ class MotionModel(ABC):
         Default: ``loglik``, the Gaussian innovation log-likelihood of ``x, P`` computed
         by the gate — exact for a single filter."""
         return loglik
+
+    def gating_scores(
+        self, pred: States, track: np.ndarray, plot: np.ndarray, z: np.ndarray,
+        R: np.ndarray, loglik: np.ndarray,
+    ) -> tuple[np.ndarray, Any]:
+        """``(gating_loglik(…), reuse)``: ``reuse`` (rows by ``reuse[rows]``, or ``None``) is what
+        :meth:`update` of the pair may take as ``posterior`` instead of recomputing it.
+        Default: :meth:`gating_loglik` and ``None``."""
+        return self.gating_loglik(pred, track, plot, z, R, loglik), None
 
     def new_states(self, x: np.ndarray, P: np.ndarray) -> States:
         """States of new tracks starting at ``x``, ``P``. Default: no per-model arrays."""
@@ -145,7 +158,9 @@ class ConstantVelocity(MotionModel):
         xp, Pp = kalman.predict_cv(states.x, states.P, dt, self.Q(dt))
         return States(xp, Pp, states.xm, states.Pm, states.mu)
 
-    def update(self, states: States, z: np.ndarray, R: np.ndarray) -> States:
-        """Kalman update (:func:`~mhtrack.models.kalman.update_position`)."""
+    def update(self, states: States, z: np.ndarray, R: np.ndarray,
+               posterior: Any = None) -> States:
+        """Kalman update (:func:`~mhtrack.models.kalman.update_position`); nothing to
+        reuse (``posterior`` is ignored)."""
         x, P = kalman.update_position(states.x, states.P, z, R)
         return States(x, P, states.xm, states.Pm, states.mu)

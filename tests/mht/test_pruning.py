@@ -215,3 +215,36 @@ def test_score_drop_keep_equals_the_per_tree_maximum():
         ref = np.array([score[i] >= score[tree == tree[i]].max() - 12.0
                         for i in range(tree.size)], bool)
         np.testing.assert_array_equal(score_drop_keep(tree, score, 12.0), ref)
+
+
+def test_prune_after_solve_equals_the_former_tree_cap():
+    """N-scan pruning then the cap on trees, as the former code wrote it: the cap called
+    on the kept leaves whenever they outnumber ``max_trees`` (here with trees over and
+    under the limit, and limits the kept leaves do and do not exceed)."""
+    from dataclasses import replace
+
+    from leaves_fixture import leaves_of_trees
+
+    from mhtrack.mht.pruning import cap_trees, n_scan_keep, prune_after_solve
+
+    rng = np.random.default_rng(11)
+    for _ in range(60):
+        lv = leaves_of_trees(rng, int(rng.integers(1, 80)), np.arange(30))
+        chosen = np.unique(rng.choice(len(lv), int(rng.integers(0, 6))))
+        max_trees = int(rng.integers(1, 40))
+        keep = n_scan_keep(lv.tree, lv.window[:, 0], chosen)
+        is_chosen = np.zeros(len(lv), bool)
+        is_chosen[chosen] = True
+        ref_caps: dict[str, int] = {}
+        if keep.sum() > max_trees:
+            prot = is_chosen | (lv.track >= 0)
+            kt, cut = cap_trees(lv.tree[keep], lv.score[keep], prot[keep], max_trees)
+            if cut:
+                ref_caps["max_trees"] = cut
+                keep[np.flatnonzero(keep)[~kt]] = False
+        caps: dict[str, int] = {}
+        got = prune_after_solve(lv, chosen, max_trees, caps)
+        ref = replace(lv.take(np.flatnonzero(keep)), chosen=is_chosen[keep])
+        assert caps == ref_caps
+        for name, a in ref.arrays().items():
+            np.testing.assert_array_equal(got.arrays()[name], a, err_msg=name)

@@ -21,6 +21,7 @@ from mhtrack.mht.sprt import SPRT
 from mhtrack.mht.tree import (
     NO_PLOT,
     Leaves,
+    changes,
     segment_ids,
     segment_starts,
     take_deferred,
@@ -267,12 +268,14 @@ def prune_after_solve(leaves: Leaves, chosen: np.ndarray, max_trees: int,
         keep &= ~remove
     n_kept = int(np.count_nonzero(keep))
     if n_kept > max_trees:  # else at most max_trees trees (each has a leaf): no cut
-        protected = is_chosen | (leaves.track >= 0)
-        keep_t, cut = cap_trees(leaves.tree[keep], leaves.score[keep], protected[keep],
-                                max_trees)
-        if cut:
+        kept = keep.nonzero()[0]
+        tree = leaves.tree.take(kept)
+        if np.count_nonzero(changes(tree)) > max_trees:  # the trees kept
+            protected = is_chosen | (leaves.track >= 0)
+            keep_t, cut = cap_trees(tree, leaves.score.take(kept), protected.take(kept),
+                                    max_trees)
             caps["max_trees"] = cut
-            keep[np.flatnonzero(keep)[~keep_t]] = False
+            keep[kept[~keep_t]] = False
             n_kept = int(np.count_nonzero(keep))
     rows = None if n_kept == n else keep.nonzero()[0]  # None: nothing pruned
     if parts is not None:

@@ -160,3 +160,91 @@ def test_hopeless_births_are_not_started():
     sparse = MHTTracker(MHTConfig(), KnownClutter(1e-9))
     sparse.step(scan)
     assert len(sparse.leaves) == 3
+
+
+def _tied_scores(rng, n):
+    """Scores with exact ties and near-ties (1e−13 apart) and a wide range."""
+    base = np.round(rng.normal(0, 3, n) * 2) / 2
+    return base + rng.choice([0.0, 1e-13, -1e-13, 1e6], n, p=[0.7, 0.1, 0.1, 0.1])
+
+
+def test_cap_leaves_per_tree_equals_ranking_every_tree():
+    """Ranking only the trees over the cap gives the keep mask of the former formula,
+    every leaf ranked (``_rank_in_groups`` over all rows), ties and near-ties included;
+    and what a brute force (sort by score descending, then index) keeps."""
+    from mhtrack.mht.pruning import _rank_in_groups
+    from mhtrack.mht.tree import segment_ids
+
+    rng = np.random.default_rng(7)
+    for _ in range(300):
+        n_trees = int(rng.integers(1, 12))
+        tree = np.sort(rng.integers(0, n_trees, int(rng.integers(0, 80))))
+        score = _tied_scores(rng, tree.size)
+        cap = int(rng.integers(1, 10))
+        keep, cut = cap_leaves_per_tree(tree, score, cap)
+        if tree.size:
+            former = _rank_in_groups(segment_ids(tree)[1], score) < cap
+            if np.diff(np.r_[0, np.flatnonzero(np.diff(tree)) + 1, tree.size]).max() <= cap:
+                former[:] = True
+            np.testing.assert_array_equal(keep, former)
+        assert cut == tree.size - keep.sum()
+        half = np.round(score * 2) / 2  # exact ties only: the brute force's order
+        keep, _ = cap_leaves_per_tree(tree, half, cap)
+        brute = np.zeros(tree.size, bool)
+        for t in np.unique(tree):
+            idx = np.flatnonzero(tree == t)
+            brute[sorted(idx, key=lambda i: (-half[i], i))[:cap]] = True
+        np.testing.assert_array_equal(keep, brute)
+
+
+def test_cap_leaves_per_tree_ties_as_over_all_leaves():
+    """Scores 1e−8 apart in a tree over the cap are a tie when another tree's score
+    spans 1e9 (the key's resolution is relative to the range of all leaves): the lower
+    index is kept, as when every leaf was ranked."""
+    tree = np.array([0, 1, 1, 1])
+    score = np.array([1e9, 0.0, 1e-8, -5.0])
+    keep, cut = cap_leaves_per_tree(tree, score, 1)
+    assert keep.tolist() == [True, True, False, False] and cut == 2
+
+
+def test_score_drop_keep_equals_the_per_tree_maximum():
+    rng = np.random.default_rng(3)
+    for _ in range(200):
+        tree = np.sort(rng.integers(0, 9, int(rng.integers(0, 60))))
+        score = _tied_scores(rng, tree.size)
+        ref = np.array([score[i] >= score[tree == tree[i]].max() - 12.0
+                        for i in range(tree.size)], bool)
+        np.testing.assert_array_equal(score_drop_keep(tree, score, 12.0), ref)
+
+
+def test_prune_after_solve_equals_the_former_tree_cap():
+    """N-scan pruning then the cap on trees, as the former code wrote it: the cap called
+    on the kept leaves whenever they outnumber ``max_trees`` (here with trees over and
+    under the limit, and limits the kept leaves do and do not exceed)."""
+    from dataclasses import replace
+
+    from leaves_fixture import leaves_of_trees
+
+    from mhtrack.mht.pruning import cap_trees, n_scan_keep, prune_after_solve
+
+    rng = np.random.default_rng(11)
+    for _ in range(60):
+        lv = leaves_of_trees(rng, int(rng.integers(1, 80)), np.arange(30))
+        chosen = np.unique(rng.choice(len(lv), int(rng.integers(0, 6))))
+        max_trees = int(rng.integers(1, 40))
+        keep = n_scan_keep(lv.tree, lv.window[:, 0], chosen)
+        is_chosen = np.zeros(len(lv), bool)
+        is_chosen[chosen] = True
+        ref_caps: dict[str, int] = {}
+        if keep.sum() > max_trees:
+            prot = is_chosen | (lv.track >= 0)
+            kt, cut = cap_trees(lv.tree[keep], lv.score[keep], prot[keep], max_trees)
+            if cut:
+                ref_caps["max_trees"] = cut
+                keep[np.flatnonzero(keep)[~kt]] = False
+        caps: dict[str, int] = {}
+        got = prune_after_solve(lv, chosen, max_trees, caps)
+        ref = replace(lv.take(np.flatnonzero(keep)), chosen=is_chosen[keep])
+        assert caps == ref_caps
+        for name, a in ref.arrays().items():
+            np.testing.assert_array_equal(got.arrays()[name], a, err_msg=name)

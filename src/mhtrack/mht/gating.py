@@ -188,11 +188,11 @@ def _pairs_in_boxes(
     n0 = z[:, 0].take(pj) - x[:, 0].take(ti)
     n1 = z[:, 1].take(pj) - x[:, 2].take(ti)
     d2, det = sym_mahalanobis2(n0, n1, s00, s01, s11)
-    keep = d2 <= gamma
-    ti, pj, d2, det = ti[keep], pj[keep], d2[keep], det[keep]
-    # pairs are grouped by track already; timsort on the nearly sorted key is ~linear
-    o = np.argsort(ti * N + pj, kind="stable")
-    ti, pj, d2, det = ti[o], pj[o], d2[o], det[o]
+    # the pairs in the gate, sorted by track then plot: one take of each column (the
+    # candidates are grouped by track already; timsort on the nearly sorted key is ~linear)
+    keep = (d2 <= gamma).nonzero()[0]
+    o = keep.take(np.argsort(ti.take(keep) * N + pj.take(keep), kind="stable"))
+    ti, pj, d2, det = ti.take(o), pj.take(o), d2.take(o), det.take(o)
     return Gated(ti, pj, d2, gaussian_loglik2(d2, det))
 
 

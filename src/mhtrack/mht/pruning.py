@@ -21,8 +21,8 @@ from mhtrack.mht.sprt import SPRT
 from mhtrack.mht.tree import (
     NO_PLOT,
     Leaves,
+    changes,
     segment_ids,
-    segment_max,
     segment_starts,
     take_deferred,
 )
@@ -30,19 +30,25 @@ from mhtrack.mht.tree import (
 
 def score_drop_keep(tree: np.ndarray, score: np.ndarray, drop: float) -> np.ndarray:
     """Keep leaves no more than ``drop`` below the best leaf of their tree."""
-    starts, seg = segment_ids(tree)
-    return score >= segment_max(score, starts, seg) - drop
+    if score.size == 0:
+        return np.ones(0, bool)
+    starts = segment_starts(tree)
+    best = np.maximum.reduceat(score, starts)  # each tree's, repeated over its rows
+    return score >= np.repeat(best, np.diff(np.r_[starts, score.size])) - drop
 
 
-def _rank_in_groups(group: np.ndarray, score: np.ndarray) -> np.ndarray:
+def _rank_in_groups(group: np.ndarray, score: np.ndarray,
+                    span: tuple[float, float] | None = None) -> np.ndarray:
     """Rank (0 = best) of each row within its group (integers ≥ 0, in any order) by
     score, ties by index.
 
     One stable argsort of the key ``group + (max − score)/(range + 1)``: cheaper than a
-    two-key lexsort; scores closer than ~1e−11 of their range count as ties."""
+    two-key lexsort; scores closer than ~1e−11 of their range count as ties. ``span``:
+    the ``(max, min)`` to use instead of the scores' own — those of a larger set whose
+    whole groups these rows are, which then get the ranks (and ties) they have in it."""
     n = score.size
-    hi = float(score.max())
-    u = (hi - score) / (hi - float(score.min()) + 1.0)
+    hi, lo = (float(score.max()), float(score.min())) if span is None else span
+    u = (hi - score) / (hi - lo + 1.0)
     order = np.argsort(group + u, kind="stable")
     starts = segment_starts(group[order])
     rank = np.empty(n, np.int64)
@@ -56,11 +62,22 @@ def _largest_tree(tree: np.ndarray) -> int:
 
 
 def cap_leaves_per_tree(tree: np.ndarray, score: np.ndarray, cap: int) -> tuple[np.ndarray, int]:
-    """Keep each tree's ``cap`` best leaves (ties: lower index). Returns (keep, removed)."""
-    if _largest_tree(tree) <= cap:
+    """Keep each tree's ``cap`` best leaves (ties: lower index). Returns (keep, removed).
+
+    Only the trees over the cap are ranked, with the key of all of them
+    (:func:`_rank_in_groups`' ``span``, the same segment numbers): the same ranks, ties
+    included, as ranking every leaf."""
+    starts = segment_starts(tree)
+    size = np.diff(np.r_[starts, tree.size])
+    if size.max(initial=0) <= cap:
         return np.ones(score.size, bool), 0
-    keep = _rank_in_groups(segment_ids(tree)[1], score) < cap
-    return keep, int(score.size - keep.sum())
+    big = size > cap
+    over = np.repeat(big, size).nonzero()[0]  # the rows of the trees over the cap
+    rank = _rank_in_groups(np.repeat(big.nonzero()[0], size[big]), score.take(over),
+                           (float(score.max()), float(score.min())))
+    keep = np.ones(score.size, bool)
+    keep[over[rank >= cap]] = False
+    return keep, int(score.size - np.count_nonzero(keep))
 
 
 def _top(priority_keys: tuple[np.ndarray, ...], cap: int) -> np.ndarray:
@@ -162,11 +179,11 @@ def prune_children(leaves: Leaves, children: Children, n_births: int, sprt: SPRT
     :func:`mhtrack.mht.caps.scene_leaves`; ``None``: off), then the caps on leaves per
     tree and on all leaves (``n_births`` of ``max_leaves`` and of ``scene_leaves`` are
     kept for this scan's new trees)."""
-    children = children.take(sprt.keep(children.score, children.peak,
-                                       leaves.track[children.parent] < 0))
-    tree = leaves.tree[children.parent]
-    keep = score_drop_keep(tree, children.score, cfg.prune_drop)
-    children, tree = children.take(keep), tree[keep]
+    rows = sprt.keep(children.score, children.peak,
+                     leaves.track.take(children.parent) < 0).nonzero()[0]
+    tree = leaves.tree.take(children.parent.take(rows))
+    keep = score_drop_keep(tree, children.score.take(rows), cfg.prune_drop)
+    children, tree = children.take(rows[keep]), tree[keep]  # one copy of the children
     if (scene_leaves is not None and tree.size > scene_leaves - n_births
             and leaf_caps_act(tree, max(cfg.max_leaves - n_births, 0),
                               cfg.max_leaves_per_tree)):
@@ -251,12 +268,14 @@ def prune_after_solve(leaves: Leaves, chosen: np.ndarray, max_trees: int,
         keep &= ~remove
     n_kept = int(np.count_nonzero(keep))
     if n_kept > max_trees:  # else at most max_trees trees (each has a leaf): no cut
-        protected = is_chosen | (leaves.track >= 0)
-        keep_t, cut = cap_trees(leaves.tree[keep], leaves.score[keep], protected[keep],
-                                max_trees)
-        if cut:
+        kept = keep.nonzero()[0]
+        tree = leaves.tree.take(kept)
+        if np.count_nonzero(changes(tree)) > max_trees:  # the trees kept
+            protected = is_chosen | (leaves.track >= 0)
+            keep_t, cut = cap_trees(tree, leaves.score.take(kept), protected.take(kept),
+                                    max_trees)
             caps["max_trees"] = cut
-            keep[np.flatnonzero(keep)[~keep_t]] = False
+            keep[kept[~keep_t]] = False
             n_kept = int(np.count_nonzero(keep))
     rows = None if n_kept == n else keep.nonzero()[0]  # None: nothing pruned
     if parts is not None:

@@ -6,6 +6,7 @@ from __future__ import annotations
 import dataclasses
 
 import numpy as np
+import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 from test_caps import _scene_scans
@@ -152,13 +153,74 @@ def test_scene_leaves_hand_worked():
     assert scene_leaves(MHTConfig(scale_caps=False), 44, 7) is None
 
 
-def test_a_leaf_cap_within_the_scene_budget_acts_as_before():
+def test_a_leaf_cap_within_the_scene_budget_cuts_the_tentative_trees_only():
     """A per-tree cap that acts while the children stay below 16·n + 50·t (as in the
-    1 000-target scene; here 10 clutter plots per scan): the overload rule does not
-    act, the cap cuts as it did."""
+    1 000-target scene; here 10 clutter plots per scan): the rule cuts the tentative
+    trees' children only (``max_tentative_per_plot``), never the full rule's
+    ``max_leaves_per_plot``; with ``scale_caps`` off neither acts."""
     scans = _scene_scans(10, 12, 5)
     runs = [track(MHTTracker(MHTConfig(max_leaves_per_tree=3, scale_caps=scale),
                              KnownClutter(10 / 8000.0**2)), PlotTable.from_scans(scans))
             for scale in (True, False)]
-    assert runs[0].caps == runs[1].caps and "max_leaves_per_tree" in runs[0].caps
-    _same_tracks(runs[0].tracks, runs[1].tracks)
+    assert runs[0].caps.get("max_tentative_per_plot", 0) > 0
+    assert "max_leaves_per_plot" not in runs[0].caps
+    assert set(runs[1].caps) - {"scans"} == {"max_leaves_per_tree"}
+
+
+@given(sizes=st.lists(st.integers(0, 30), min_size=0, max_size=12),
+       n_plots=st.integers(1, 8), seed=st.integers(0, 2**32 - 1),
+       per_plot=st.integers(1, 5), per_miss=st.integers(1, 3))
+def test_cap_per_plot_among_a_subset_is_the_rule_on_that_subset(sizes, n_plots, seed,
+                                                                per_plot, per_miss):
+    """``among``: the brute force on the masked children alone; the others all kept."""
+    tree, plot, score = _children(sizes, n_plots, seed)
+    among = np.random.default_rng(seed).random(tree.size) < 0.6
+    keep, cut = cap_per_plot(tree, plot, score, per_plot, per_miss, among=among)
+    sub = np.flatnonzero(among)
+    ref = np.ones(tree.size, bool)
+    ref[sub] = _reference_keep(tree[sub], plot[sub], score[sub], per_plot, per_miss)
+    np.testing.assert_array_equal(keep, ref)
+    assert cut == tree.size - keep.sum()
+
+
+def _prune_case(n_conf: int, n_tent: int, seed: int):
+    """Leaves of one confirmed tree (``n_conf`` leaves) and one tentative tree
+    (``n_tent``), each leaf with a miss and children on plots 0–2."""
+    from dataclasses import replace
+
+    from leaves_fixture import random_leaves
+
+    from mhtrack.mht.extend import Children
+
+    rng = np.random.default_rng(seed)
+    n = n_conf + n_tent
+    tree = np.r_[np.zeros(n_conf, np.int64), np.ones(n_tent, np.int64)]
+    lv = random_leaves(rng, n, tree)
+    lv = replace(lv, track=np.where(tree == 0, 7, -1), score=np.zeros(n),
+                 peak=np.zeros(n))
+    parent = np.repeat(np.arange(n), 4)
+    plot = np.tile(np.array([-1, 0, 1, 2]), n)
+    score = rng.normal(0, 0.1, parent.size)
+    return lv, Children(parent, plot, score, score, np.arange(parent.size))
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_prune_children_picks_the_rule_by_the_scene_budget(seed):
+    """Within the scene's budget the rule spares the confirmed tree; over it, it cuts
+    every tree (``scene_leaves`` the children less births must exceed)."""
+    from mhtrack.mht.pruning import prune_children
+    from mhtrack.mht.sprt import SPRT
+
+    lv, ch = _prune_case(6, 6, seed)
+    cfg = MHTConfig(max_leaves_per_tree=20)  # each tree has 24 children: the cap acts
+    sprt = SPRT.from_config(cfg)
+    for budget, name in ((10**6, "max_tentative_per_plot"), (10, "max_leaves_per_plot")):
+        caps: dict[str, int] = {}
+        out = prune_children(lv, ch, 0, sprt, cfg, caps, budget)
+        assert set(caps) == {name, "max_leaves_per_tree"} or set(caps) == {name}
+        conf = lv.track[out.parent] >= 0
+        if name == "max_tentative_per_plot":  # the confirmed tree: only the per-tree cap
+            assert conf.sum() == 20
+            assert (~conf).sum() == 3 * CHILDREN_PER_PLOT + MISSES_PER_TREE
+        else:
+            assert out.parent.size == 3 * CHILDREN_PER_PLOT + 2 * MISSES_PER_TREE

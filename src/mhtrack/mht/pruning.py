@@ -184,12 +184,17 @@ def prune_children(leaves: Leaves, children: Children, n_births: int, sprt: SPRT
     tree = leaves.tree.take(children.parent.take(rows))
     keep = score_drop_keep(tree, children.score.take(rows), cfg.prune_drop)
     children, tree = children.take(rows[keep]), tree[keep]  # one copy of the children
-    if (scene_leaves is not None and tree.size > scene_leaves - n_births
-            and leaf_caps_act(tree, max(cfg.max_leaves - n_births, 0),
-                              cfg.max_leaves_per_tree)):
-        keep, cut = cap_per_plot(tree, children.plot, children.score)
+    if scene_leaves is not None and leaf_caps_act(tree, max(cfg.max_leaves - n_births, 0),
+                                                  cfg.max_leaves_per_tree):
+        if tree.size > scene_leaves - n_births:  # over the scene's budget: every tree
+            keep, cut = cap_per_plot(tree, children.plot, children.score)
+            name = "max_leaves_per_plot"
+        else:  # within it: the tentative trees only
+            keep, cut = cap_per_plot(tree, children.plot, children.score,
+                                     among=leaves.track[children.parent] < 0)
+            name = "max_tentative_per_plot"
         if cut:
-            caps["max_leaves_per_plot"] = cut
+            caps[name] = cut
             children, tree = children.take(keep), tree[keep]
     keep, cut = cap_leaves_per_tree(tree, children.score, cfg.max_leaves_per_tree)
     if cut:
@@ -212,11 +217,21 @@ def leaf_caps_act(tree: np.ndarray, budget: int, per_tree: int) -> bool:
 
 def cap_per_plot(tree: np.ndarray, plot: np.ndarray, score: np.ndarray,
                  per_plot: int = CHILDREN_PER_PLOT,
-                 per_tree_miss: int = MISSES_PER_TREE) -> tuple[np.ndarray, int]:
+                 per_tree_miss: int = MISSES_PER_TREE,
+                 among: np.ndarray | None = None) -> tuple[np.ndarray, int]:
     """The overload rule (``mhtrack.mht.caps``): keep the ``per_plot`` best children of
     each plot over all trees and the ``per_tree_miss`` best miss children of each tree
     (ties: lower index; :func:`_rank_in_groups`). Returns (keep, removed); at most
-    ``per_plot · plots + per_tree_miss · trees`` children are kept."""
+    ``per_plot · plots + per_tree_miss · trees`` children are kept. ``among`` (mask):
+    the rule ranks and cuts these children only, as if given them alone; the others
+    are kept."""
+    if among is not None:
+        sub = among.nonzero()[0]
+        keep = np.ones(score.size, bool)
+        k, cut = cap_per_plot(tree.take(sub), plot.take(sub), score.take(sub), per_plot,
+                              per_tree_miss)
+        keep[sub[~k]] = False
+        return keep, cut
     if score.size == 0:
         return np.ones(0, bool), 0
     upd = plot >= 0

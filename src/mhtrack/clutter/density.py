@@ -103,12 +103,14 @@ def mahalanobis2(z: np.ndarray, means: np.ndarray, covariances: np.ndarray) -> n
     return np.ascontiguousarray(maha_det_t(*offsets_t(plots_t(z), means), covariances)[0].T)
 
 
-def weighted_t(mix: Mixture, glp_t: np.ndarray, log_bg: np.ndarray) -> np.ndarray:
-    """(K+1, n) ``log π_j + log f_j(z)`` from the Gaussians' (K, n) ``log N`` and the
-    background's (n,) ``log u``; row 0 the background. Caller ignores log 0 warnings."""
-    out = np.empty((mix.n_components + 1, len(log_bg)))
-    out[0] = np.log(mix.background_weight) + log_bg
-    np.add(np.log(mix.weights)[:, None], glp_t, out=out[1:])
+def weighted_t(background_weight: float, weights: np.ndarray, glp_t: np.ndarray,
+               log_bg: np.ndarray) -> np.ndarray:
+    """(K+1, n) ``log π_j + log f_j(z)`` from the weights ``π₀``, ``π_j``, the Gaussians'
+    (K, n) ``log N`` and the background's (n,) ``log u``; row 0 the background. Caller
+    ignores log 0 warnings."""
+    out = np.empty((len(weights) + 1, len(log_bg)))
+    out[0] = np.log(background_weight) + log_bg
+    np.add(np.log(weights)[:, None], glp_t, out=out[1:])
     return out
 
 
@@ -159,7 +161,8 @@ class Mixture:
         """(K+1, n) :func:`weighted_t` at ``z``; caller ignores log 0 warnings."""
         maha, det = maha_det_t(*offsets_t(plots_t(z, copy=False), self.means),
                                 self.covariances)
-        return weighted_t(self, log_pdf_t(maha, det), self.log_background(z))
+        return weighted_t(self.background_weight, self.weights, log_pdf_t(maha, det),
+                          self.log_background(z))
 
     def weighted_log_prob(self, z: np.ndarray) -> np.ndarray:
         """(n, K+1) ``log π_j + log f_j(z)``; column 0 the background (``−inf`` if none)."""

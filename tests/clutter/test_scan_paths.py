@@ -73,3 +73,21 @@ def test_starting_mixture_of_any_centres_is_the_plain_one(seed: int) -> None:
     want = plain_em.mixture_from_centres(z, centres, reg_covar=100.0)
     for name in ("weights", "means", "covariances"):
         assert same(getattr(got, name), getattr(want, name))
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_starting_mixture_sums_each_centre_in_plot_order(seed: int) -> None:
+    """The means from one pass over all plots (``np.add.at``) against the plain per-centre
+    ``mean``: large groups (hundreds to thousands of plots, where a different summation
+    order would show), magnitudes far apart and plots at ±0.0, bit for bit."""
+    import plain_em
+
+    rng = np.random.default_rng(100 + seed)
+    n = int(rng.integers(200, 3000))
+    z = rng.normal(0.0, 1.0, (n, 2)) * 10.0 ** rng.uniform(-3, 6, (n, 1)) + 1e4
+    z[rng.integers(0, n, n // 5)] = -0.0 if seed % 2 else 0.0
+    centres = np.concatenate((z[rng.choice(n, 4, replace=False)], [[-0.0, -0.0]]))
+    got = mixture_from_centres(z, centres, reg_covar=100.0)
+    want = plain_em.mixture_from_centres(z, centres, reg_covar=100.0)
+    for name in ("weights", "means", "covariances"):
+        assert same(getattr(got, name), getattr(want, name))

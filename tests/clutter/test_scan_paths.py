@@ -91,3 +91,25 @@ def test_starting_mixture_sums_each_centre_in_plot_order(seed: int) -> None:
     want = plain_em.mixture_from_centres(z, centres, reg_covar=100.0)
     for name in ("weights", "means", "covariances"):
         assert same(getattr(got, name), getattr(want, name))
+
+
+@pytest.mark.parametrize("box", [None, (-100.0, 100.0, -100.0, 100.0), (-1e4, 1e4, -1e4, 1e4),
+                                 (500.0, 900.0, 500.0, 900.0)])
+@pytest.mark.parametrize("n", [0, 1, 7])
+def test_log_background_const_is_the_one_value_of_log_background(box, n: int) -> None:
+    """``log_background_const``: ``log_background``'s array, and its value when every plot
+    has the same one (inside the box, all outside it, no box), else ``None``."""
+    from mhtrack.clutter.density import Mixture
+
+    z = np.random.default_rng(n).uniform(-300.0, 300.0, (n, 2))
+    mix = Mixture(np.ones(1), np.zeros((1, 2)), np.eye(2)[None], 0.1 if box else 0.0, box)
+    with np.errstate(divide="ignore"):
+        want = np.where(
+            (z[:, 0] >= box[0]) & (z[:, 0] <= box[1]) & (z[:, 1] >= box[2]) & (z[:, 1] <= box[3]),
+            -np.log((box[1] - box[0]) * (box[3] - box[2])), -np.inf) if box else np.full(n, -np.inf)
+        out, const = mix.log_background_const(z)
+    assert same(out, want) and same(mix.log_background(z), want)
+    if n and (want == want[0]).all():
+        assert same(const, want[0])
+    else:
+        assert const is None

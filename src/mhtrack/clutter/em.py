@@ -223,9 +223,10 @@ def fit_em(
     box = init.background_box
     area = init.background_area
     with np.errstate(divide="ignore"):
-        log_bg = init.log_background(z)  # the box is fixed
-        # inside the box log u is one number (the usual case: the box holds the data)
-        bg0 = log_bg[0] if len(log_bg) and (log_bg == log_bg[0]).all() else None
+        # the box is fixed; inside it log u is one number, bg0 (the usual case: the box
+        # holds the data)
+        log_bg, bg0 = init.log_background_const(z)
+        log_u = log_bg if bg0 is None else bg0  # row 0 of weighted_t: one number, or per plot
         price = 3.0 * np.log(max(float(len(z) if sample_weight is None
                                        else sample_weight.sum()), 1.0)) if bic else 0.0
         w, means, w0 = init.weights, init.means, init.background_weight
@@ -233,7 +234,7 @@ def fit_em(
         glp = init_log_pdf
         if glp is None:
             glp = log_pdf_t(*maha_det_t(*offsets_t(z_t, means), init.covariances))
-        wlp = weighted_t(w0, w, glp, log_bg)
+        wlp = weighted_t(w0, w, glp, log_u)
         norm: np.ndarray | None = None
         resp: np.ndarray | None = None
         sums: tuple[np.ndarray, np.ndarray] | None = None
@@ -251,7 +252,7 @@ def fit_em(
                                                background_floor, sums)
             maha, det = sym_mahalanobis2(*dxy, q[0, :, None], q[2, :, None], q[1, :, None])
             glp = log_pdf_t(maha, det)
-            wlp, norm, resp, sums = weighted_t(w0, w, glp, log_bg), None, None, None
+            wlp, norm, resp, sums = weighted_t(w0, w, glp, log_u), None, None, None
             keep = nk >= min_points
             k = len(w)
             if min_contrast > 0 and box is not None:
@@ -277,7 +278,7 @@ def fit_em(
                     w0 = 1.0 if box is not None else 0.0
                 means, q = means.take(kept, axis=0), q.take(kept, axis=1)
                 n_pruned += deleted
-                wlp, norm, resp, sums = (weighted_t(w0, w, glp.take(kept, axis=0), log_bg), None,
+                wlp, norm, resp, sums = (weighted_t(w0, w, glp.take(kept, axis=0), log_u), None,
                                          None, None)
             if not len(w):
                 break

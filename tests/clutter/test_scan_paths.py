@@ -113,3 +113,15 @@ def test_log_background_const_is_the_one_value_of_log_background(box, n: int) ->
         assert same(const, want[0])
     else:
         assert const is None
+
+
+def test_scan_rngs_hand_out_fresh_generators_of_seed_and_scan() -> None:
+    """``ScanRngs.take(seed, u)`` draws as ``default_rng(SeedSequence(seed, spawn_key=(u,)))``
+    made then, in any order of scans and seeds, a scan taken twice included."""
+    from mhtrack.clutter.seeding import RNG_BATCH, ScanRngs
+
+    rngs = ScanRngs()
+    for seed, u in [(0, 0), (0, 3), (0, 1), (0, RNG_BATCH + 2), (0, 3), (7, 3), (0, 2), (7, 3)]:
+        got = rngs.take(seed, u).random(4)
+        want = np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(u,))).random(4)
+        assert same(got, want)

@@ -8,6 +8,29 @@ import numpy as np
 from mhtrack.clutter.em import Mixture
 
 _EYE2 = np.eye(2)
+#: Scans whose generators :class:`ScanRngs` makes together. Setting one up is mostly
+#: cold-cache time when made alone in a tracker's cycle (~47 µs), ~14 µs each made in a row
+#: (docs/performance.md).
+RNG_BATCH = 8
+
+
+class ScanRngs:
+    """Scan ``u``'s generator ``default_rng(SeedSequence(seed, spawn_key=(u,)))``, made
+    ``RNG_BATCH`` scans ahead and handed out once each: a generator is a function of
+    ``(seed, u)`` alone and none is drawn from before it is handed out, so the draws are
+    those of one made when needed."""
+
+    def __init__(self) -> None:
+        self._ahead: dict[tuple[int, int], np.random.Generator] = {}
+
+    def take(self, seed: int, u: int) -> np.random.Generator:
+        """The fresh generator of scan ``u`` (``seed``)."""
+        g = self._ahead.pop((seed, u), None)
+        if g is None:
+            self._ahead = {(seed, v): np.random.default_rng(np.random.SeedSequence(
+                seed, spawn_key=(v,))) for v in range(u, u + RNG_BATCH)}
+            g = self._ahead.pop((seed, u))
+        return g
 
 
 def kmeanspp_centres(

@@ -269,7 +269,7 @@ def fit_em(
             if deleted and not (_any(keep) or box is not None):
                 deleted = 0  # nothing would be left: keep the components, not an empty model
             if deleted:  # keep the Gaussians kept; renormalise them to 1 − π₀ (P1 after eq. 12)
-                kept = np.flatnonzero(keep)
+                kept = keep.nonzero()[0]  # np.flatnonzero's indices
                 w = w.take(kept)
                 s = _sum(w)
                 if s > 0:

@@ -204,7 +204,7 @@ class MixtureClutter(ClutterEstimator):
         self._window.append(z.copy())
         self._kept = kept
         # Poisson ML: the mean count (integer sum, exact as np.mean's float sum)
-        self.count_ = float(sum(len(w) for w in self._window)) / len(self._window)
+        self.count_ = float(sum(map(len, self._window))) / len(self._window)
         pooled = np.concatenate(self._window) if len(self._window) > 1 else self._window[0]
         if len(pooled) == 0:
             self.mixture_ = None
@@ -351,7 +351,7 @@ class MixtureClutter(ClutterEstimator):
         glp = log_pdf_t(maha, det)
         free = self.n_components - prev.n_components
         if free > 0:
-            far = np.flatnonzero(_min(maha, axis=0) > CHI2_2_99)
+            far = (_min(maha, axis=0) > CHI2_2_99).nonzero()[0]  # np.flatnonzero's indices
             if len(far) >= max(self.min_points, 1.0):
                 novel = z.take(far, axis=0)
                 centres = kmeanspp_centres(novel, free, rng(), existing=means)

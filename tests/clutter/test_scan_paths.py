@@ -73,3 +73,55 @@ def test_starting_mixture_of_any_centres_is_the_plain_one(seed: int) -> None:
     want = plain_em.mixture_from_centres(z, centres, reg_covar=100.0)
     for name in ("weights", "means", "covariances"):
         assert same(getattr(got, name), getattr(want, name))
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_starting_mixture_sums_each_centre_in_plot_order(seed: int) -> None:
+    """The means from one pass over all plots (``np.add.at``) against the plain per-centre
+    ``mean``: large groups (hundreds to thousands of plots, where a different summation
+    order would show), magnitudes far apart and plots at ±0.0, bit for bit."""
+    import plain_em
+
+    rng = np.random.default_rng(100 + seed)
+    n = int(rng.integers(200, 3000))
+    z = rng.normal(0.0, 1.0, (n, 2)) * 10.0 ** rng.uniform(-3, 6, (n, 1)) + 1e4
+    z[rng.integers(0, n, n // 5)] = -0.0 if seed % 2 else 0.0
+    centres = np.concatenate((z[rng.choice(n, 4, replace=False)], [[-0.0, -0.0]]))
+    got = mixture_from_centres(z, centres, reg_covar=100.0)
+    want = plain_em.mixture_from_centres(z, centres, reg_covar=100.0)
+    for name in ("weights", "means", "covariances"):
+        assert same(getattr(got, name), getattr(want, name))
+
+
+@pytest.mark.parametrize("box", [None, (-100.0, 100.0, -100.0, 100.0), (-1e4, 1e4, -1e4, 1e4),
+                                 (500.0, 900.0, 500.0, 900.0)])
+@pytest.mark.parametrize("n", [0, 1, 7])
+def test_log_background_const_is_the_one_value_of_log_background(box, n: int) -> None:
+    """``log_background_const``: ``log_background``'s array, and its value when every plot
+    has the same one (inside the box, all outside it, no box), else ``None``."""
+    from mhtrack.clutter.density import Mixture
+
+    z = np.random.default_rng(n).uniform(-300.0, 300.0, (n, 2))
+    mix = Mixture(np.ones(1), np.zeros((1, 2)), np.eye(2)[None], 0.1 if box else 0.0, box)
+    with np.errstate(divide="ignore"):
+        want = np.where(
+            (z[:, 0] >= box[0]) & (z[:, 0] <= box[1]) & (z[:, 1] >= box[2]) & (z[:, 1] <= box[3]),
+            -np.log((box[1] - box[0]) * (box[3] - box[2])), -np.inf) if box else np.full(n, -np.inf)
+        out, const = mix.log_background_const(z)
+    assert same(out, want) and same(mix.log_background(z), want)
+    if n and (want == want[0]).all():
+        assert same(const, want[0])
+    else:
+        assert const is None
+
+
+def test_scan_rngs_hand_out_fresh_generators_of_seed_and_scan() -> None:
+    """``ScanRngs.take(seed, u)`` draws as ``default_rng(SeedSequence(seed, spawn_key=(u,)))``
+    made then, in any order of scans and seeds, a scan taken twice included."""
+    from mhtrack.clutter.seeding import RNG_BATCH, ScanRngs
+
+    rngs = ScanRngs()
+    for seed, u in [(0, 0), (0, 3), (0, 1), (0, RNG_BATCH + 2), (0, 3), (7, 3), (0, 2), (7, 3)]:
+        got = rngs.take(seed, u).random(4)
+        want = np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(u,))).random(4)
+        assert same(got, want)

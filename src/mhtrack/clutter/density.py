@@ -103,12 +103,14 @@ def mahalanobis2(z: np.ndarray, means: np.ndarray, covariances: np.ndarray) -> n
     return np.ascontiguousarray(maha_det_t(*offsets_t(plots_t(z), means), covariances)[0].T)
 
 
-def weighted_t(mix: Mixture, glp_t: np.ndarray, log_bg: np.ndarray) -> np.ndarray:
-    """(K+1, n) ``log π_j + log f_j(z)`` from the Gaussians' (K, n) ``log N`` and the
-    background's (n,) ``log u``; row 0 the background. Caller ignores log 0 warnings."""
-    out = np.empty((mix.n_components + 1, len(log_bg)))
-    out[0] = np.log(mix.background_weight) + log_bg
-    np.add(np.log(mix.weights)[:, None], glp_t, out=out[1:])
+def weighted_t(background_weight: float, weights: np.ndarray, glp_t: np.ndarray,
+               log_bg: np.ndarray | np.floating) -> np.ndarray:
+    """(K+1, n) ``log π_j + log f_j(z)`` from the weights ``π₀``, ``π_j``, the Gaussians'
+    (K, n) ``log N`` and the background's (n,) ``log u`` (or its one value at every plot);
+    row 0 the background. Caller ignores log 0 warnings."""
+    out = np.empty((len(weights) + 1, glp_t.shape[1]))
+    out[0] = np.log(background_weight) + log_bg
+    np.add(np.log(weights)[:, None], glp_t, out=out[1:])
     return out
 
 
@@ -146,20 +148,29 @@ class Mixture:
 
     def log_background(self, z: np.ndarray) -> np.ndarray:
         """``log u(z)``: ``−log A`` inside the box, ``−inf`` outside (or without a box)."""
+        return self.log_background_const(z)[0]
+
+    def log_background_const(self, z: np.ndarray) -> tuple[np.ndarray, np.floating | None]:
+        """:meth:`log_background` at (n ≥ 0, 2) ``z`` and its value when it is the same at
+        every plot (``None`` otherwise)."""
         if self.background_box is None:
-            return np.full(len(z), -np.inf)
+            out = np.full(len(z), -np.inf)
+            return out, (out[0] if len(z) else None)
         x0, x1, y0, y1 = self.background_box
         x, y = z[:, 0], z[:, 1]
         if len(z) and (_min(x) >= x0 and _max(x) <= x1 and _min(y) >= y0 and _max(y) <= y1):
-            return np.full(len(z), -np.log(self.background_area))  # all inside the box
+            out = np.full(len(z), -np.log(self.background_area))  # all inside the box
+            return out, out[0]
         inside = (x >= x0) & (x <= x1) & (y >= y0) & (y <= y1)
-        return np.where(inside, -np.log(self.background_area), -np.inf)
+        out = np.where(inside, -np.log(self.background_area), -np.inf)
+        return out, (out[0] if len(out) and (out == out[0]).all() else None)
 
     def _weighted_t(self, z: np.ndarray) -> np.ndarray:
         """(K+1, n) :func:`weighted_t` at ``z``; caller ignores log 0 warnings."""
         maha, det = maha_det_t(*offsets_t(plots_t(z, copy=False), self.means),
                                 self.covariances)
-        return weighted_t(self, log_pdf_t(maha, det), self.log_background(z))
+        return weighted_t(self.background_weight, self.weights, log_pdf_t(maha, det),
+                          self.log_background(z))
 
     def weighted_log_prob(self, z: np.ndarray) -> np.ndarray:
         """(n, K+1) ``log π_j + log f_j(z)``; column 0 the background (``−inf`` if none)."""

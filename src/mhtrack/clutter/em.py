@@ -55,6 +55,7 @@ from mhtrack.clutter.density import (
     plots_t,
     weighted_t,
 )
+from mhtrack.models.linalg2 import sym_mahalanobis2
 
 __all__ = ["EMResult", "Mixture", "PruneRule", "e_step", "fit_em", "gaussian_log_pdf",
            "logsumexp_rows", "m_step", "mahalanobis2", "removal_gain"]
@@ -120,9 +121,9 @@ def m_step(
 
     Returns the new mixture and the effective counts ``n_j`` of the Gaussians.
     """
-    mix, nk, _ = _m_step(z, plots_t(z), resp.T, background_box, sample_weight, reg_covar,
-                         background_floor)
-    return mix, nk
+    w, means, q, w0, nk, _ = _m_step(z, plots_t(z), resp.T, background_box, sample_weight,
+                                     reg_covar, background_floor)
+    return Mixture(w, means, _cov(q), w0, background_box), nk
 
 
 def _m_step(
@@ -130,12 +131,14 @@ def _m_step(
     box: tuple[float, float, float, float] | None, sample_weight: np.ndarray | None,
     reg_covar: float, background_floor: float,
     sums: tuple[np.ndarray, np.ndarray] | None = None,
-) -> tuple[Mixture, np.ndarray, np.ndarray]:
-    """:func:`m_step` from the (K+1, n) responsibilities, also returning the (2, K, n) offsets
-    ``z_i − μ_j`` to the new means. ``sums``: a row-major (n, ≥ K+1) array whose first K+1
-    columns are the responsibilities, and their column sums, if at hand (no sample
-    weights). The means are the plot-major ``(r[:, 1:].T @ z) / n_j``: one BLAS product on
-    the row-major (n, K+1) operand of the formula."""
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, float, np.ndarray, np.ndarray]:
+    """:func:`m_step` from the (K+1, n) responsibilities: the new weights, means, (3, K)
+    covariance entries ``Σxx, Σyy, Σxy`` (:func:`_cov`), background weight, the counts
+    ``n_j`` and the (2, K, n) offsets ``z_i − μ_j`` to the new means. ``sums``: a row-major
+    (n, ≥ K+1) array whose first K+1 columns are the responsibilities, and their column
+    sums, if at hand (no sample weights). The means are the plot-major
+    ``(r[:, 1:].T @ z) / n_j``: one BLAS product on the row-major (n, K+1) operand of the
+    formula."""
     r_t = resp_t if sample_weight is None else resp_t * sample_weight
     k = r_t.shape[0] - 1
     if sums is None:
@@ -154,27 +157,19 @@ def _m_step(
     np.multiply(rd[0], d[1], out=prods[2 * k:])
     q = plot_sums(prods, k).reshape(3, k) / nk
     q[:2] += reg_covar
-    cov = q.take(_COV_ROWS, axis=0).T.reshape(k, 2, 2)  # [[Σxx, Σxy], [Σxy, Σyy]]
     if box is None:
         w0 = 0.0
         w = nk / _sum(nk)
     else:
-        w0 = max(nk_all[0] / total, background_floor)
+        w0 = float(max(nk_all[0] / total, background_floor))
         g = _sum(nk)
         w = (1.0 - w0) * nk / g if g > 0 else nk * 0.0
-    return Mixture(w, means, cov, float(w0), box), nk, d
+    return w, means, q, w0, nk, d
 
 
-def _drop(mix: Mixture, keep: np.ndarray) -> Mixture:
-    """Keep the Gaussians of indices ``keep``; renormalise them to ``1 − π₀`` (P1 after
-    eq. 12)."""
-    w = mix.weights.take(keep)
-    s = _sum(w)
-    if s > 0:
-        w = w * (1.0 - mix.background_weight) / s
-    bg = mix.background_weight if len(w) else (1.0 if mix.background_box is not None else 0.0)
-    return Mixture(w, mix.means.take(keep, axis=0), mix.covariances.take(keep, axis=0), bg,
-                   mix.background_box)
+def _cov(q: np.ndarray) -> np.ndarray:
+    """(K, 2, 2) ``[[Σxx, Σxy], [Σxy, Σyy]]`` from the (3, K) rows ``Σxx, Σyy, Σxy``."""
+    return q.take(_COV_ROWS, axis=0).T.reshape(q.shape[1], 2, 2)
 
 
 def fit_em(
@@ -221,20 +216,25 @@ def fit_em(
     # iteration, the BIC test and the final L reuse them, and a deletion keeps the
     # surviving rows (elementwise formulas: the same floats as recomputing them). The
     # M-step's offsets z − μ and the determinants serve the densities and the contrast
-    # test. Every float is the one the plain loop over e_step/m_step gives
-    # (tests/clutter/test_em.py).
+    # test. The mixture is held as its arrays (covariances as the M-step's (3, K) rows)
+    # and assembled once at the end. Every float is the one the plain loop over
+    # e_step/m_step gives (tests/clutter/test_em.py).
     z_t = plots_t(z)
+    box = init.background_box
+    area = init.background_area
     with np.errstate(divide="ignore"):
-        log_bg = init.log_background(z)  # the box is fixed
-        # inside the box log u is one number (the usual case: the box holds the data)
-        bg0 = log_bg[0] if len(log_bg) and (log_bg == log_bg[0]).all() else None
+        # the box is fixed; inside it log u is one number, bg0 (the usual case: the box
+        # holds the data)
+        log_bg, bg0 = init.log_background_const(z)
+        log_u = log_bg if bg0 is None else bg0  # row 0 of weighted_t: one number, or per plot
         price = 3.0 * np.log(max(float(len(z) if sample_weight is None
                                        else sample_weight.sum()), 1.0)) if bic else 0.0
-        mix = init
+        w, means, w0 = init.weights, init.means, init.background_weight
+        q: np.ndarray | None = None  # None: the covariances are init's
         glp = init_log_pdf
         if glp is None:
-            glp = log_pdf_t(*maha_det_t(*offsets_t(z_t, mix.means), mix.covariances))
-        wlp = weighted_t(mix, glp, log_bg)
+            glp = log_pdf_t(*maha_det_t(*offsets_t(z_t, means), init.covariances))
+        wlp = weighted_t(w0, w, glp, log_u)
         norm: np.ndarray | None = None
         resp: np.ndarray | None = None
         sums: tuple[np.ndarray, np.ndarray] | None = None
@@ -248,32 +248,39 @@ def fit_em(
                 resp = np.subtract(wlp, norm)
                 np.exp(resp, out=resp)
             ll = _mean_ll(norm, sample_weight)
-            mix, nk, dxy = _m_step(z, z_t, resp, mix.background_box, sample_weight,
-                                   reg_covar, background_floor, sums)
-            maha, det = maha_det_t(*dxy, mix.covariances)
+            w, means, q, w0, nk, dxy = _m_step(z, z_t, resp, box, sample_weight, reg_covar,
+                                               background_floor, sums)
+            maha, det = sym_mahalanobis2(*dxy, q[0, :, None], q[2, :, None], q[1, :, None])
             glp = log_pdf_t(maha, det)
-            wlp, norm, resp, sums = weighted_t(mix, glp, log_bg), None, None, None
+            wlp, norm, resp, sums = weighted_t(w0, w, glp, log_u), None, None, None
             keep = nk >= min_points
-            if min_contrast > 0 and mix.background_box is not None:
-                peak = mix.weights / (_TWO_PI * np.sqrt(det[:, 0]))  # det2(Σ) = |Σ|
-                keep &= peak >= min_contrast * mix.background_weight / mix.background_area
-            if bic and mix.background_box is not None and mix.n_components:
+            k = len(w)
+            if min_contrast > 0 and box is not None:
+                peak = w / (_TWO_PI * np.sqrt(det[:, 0]))  # det2(Σ) = |Σ|
+                keep &= peak >= min_contrast * w0 / area
+            if bic and box is not None and k:
                 norm = _lse_t(wlp)
-                resp, gain, sums = _e_step_gain(mix, wlp, norm, log_bg, sample_weight, bg0)
+                resp, gain, sums = _e_step_gain(w, wlp, norm, log_bg, sample_weight, bg0)
                 keep &= gain >= price
             if prune is not None and _any(keep):
-                w = np.where(keep, mix.weights, 0.0)
-                keep &= prune(w / _sum(w))
-            deleted = len(keep) - int(np.count_nonzero(keep))
-            if deleted and not (_any(keep) or mix.background_box is not None):
+                wk = np.where(keep, w, 0.0)
+                keep &= prune(wk / _sum(wk))
+            deleted = k - int(np.count_nonzero(keep))
+            if deleted and not (_any(keep) or box is not None):
                 deleted = 0  # nothing would be left: keep the components, not an empty model
-            if deleted:
-                kept = np.flatnonzero(keep)
-                mix = _drop(mix, kept)
+            if deleted:  # keep the Gaussians kept; renormalise them to 1 − π₀ (P1 after eq. 12)
+                kept = keep.nonzero()[0]  # np.flatnonzero's indices
+                w = w.take(kept)
+                s = _sum(w)
+                if s > 0:
+                    w = w * (1.0 - w0) / s
+                if not len(w):
+                    w0 = 1.0 if box is not None else 0.0
+                means, q = means.take(kept, axis=0), q.take(kept, axis=1)
                 n_pruned += deleted
-                wlp, norm, resp, sums = (weighted_t(mix, glp.take(kept, axis=0), log_bg), None,
+                wlp, norm, resp, sums = (weighted_t(w0, w, glp.take(kept, axis=0), log_u), None,
                                          None, None)
-            if mix.n_components == 0:
+            if not len(w):
                 break
             if not deleted and abs(ll - prev) < tol * abs(prev):
                 converged = True
@@ -282,6 +289,7 @@ def fit_em(
         last = _lse_t(wlp) if norm is None else norm
     final = (_mean_ll(last, None) if sample_weight is None
              else float(np.average(last, weights=sample_weight)))
+    mix = init if q is None else Mixture(w, means, _cov(q), w0, box)
     return EMResult(mix, final, n_iter, converged, n_pruned, last)
 
 
@@ -298,12 +306,12 @@ def removal_gain(
     wlp = mix.weighted_log_prob(z)
     norm = logsumexp_rows(wlp)
     with np.errstate(divide="ignore"):
-        return _removal_gain(mix, np.exp(wlp[:, 1:] - norm[:, None]).T, norm,
+        return _removal_gain(mix.weights, np.exp(wlp[:, 1:] - norm[:, None]).T, norm,
                              mix.log_background(z), sample_weight)
 
 
 def _e_step_gain(
-    mix: Mixture, wlp: np.ndarray, norm: np.ndarray, log_bg: np.ndarray,
+    weights: np.ndarray, wlp: np.ndarray, norm: np.ndarray, log_bg: np.ndarray,
     sample_weight: np.ndarray | None, bg0: float | None,
 ) -> tuple[np.ndarray, np.ndarray, tuple[np.ndarray, np.ndarray] | None]:
     """The (K+1, n) responsibilities ``exp(wlp − norm)``, :func:`removal_gain` and, for the
@@ -311,42 +319,42 @@ def _e_step_gain(
     and the terms of the gain sit side by side in one (n, 2K+1) row-major array summed once
     (:func:`~mhtrack.clutter.density.plot_sums`: each column as alone, for K ≥ 2); the
     M-step copies out the responsibilities' columns only if it runs on them."""
-    k = mix.n_components
+    k = len(weights)
     if sample_weight is not None or k < 2:
         resp = np.subtract(wlp, norm)
         np.exp(resp, out=resp)
-        return resp, _removal_gain(mix, resp[1:], norm, log_bg, sample_weight, bg0), None
+        return resp, _removal_gain(weights, resp[1:], norm, log_bg, sample_weight, bg0), None
     both = np.empty((2 * k + 1, len(norm)))
     resp = np.subtract(wlp, norm, out=both[:k + 1])
     np.exp(resp, out=resp)
-    _neg_log_ratio(mix, resp[1:], norm, log_bg, bg0, both[k + 1:])
+    _neg_log_ratio(weights, resp[1:], norm, log_bg, bg0, both[k + 1:])
     nat = np.ascontiguousarray(both.T)
     col = _sum(nat, axis=0)
     return resp, col[k + 1:], (nat, col[:k + 1])
 
 
 def _removal_gain(
-    mix: Mixture, resp: np.ndarray, norm: np.ndarray, log_bg: np.ndarray,
+    weights: np.ndarray, resp: np.ndarray, norm: np.ndarray, log_bg: np.ndarray,
     sample_weight: np.ndarray | None, bg0: float | None = None,
 ) -> np.ndarray:
     """:func:`removal_gain` from the Gaussians' (K, n) responsibilities, the plots'
     ``log c(z_i)`` and the background's ``log u(z_i)`` (``bg0``: its value if the same for
     every plot). The caller ignores divide-by-zero warnings (``log π_j = −∞``)."""
-    per = _neg_log_ratio(mix, resp, norm, log_bg, bg0, np.empty(resp.shape))
+    per = _neg_log_ratio(weights, resp, norm, log_bg, bg0, np.empty(resp.shape))
     if sample_weight is None:
         return plot_sums(per, len(per))
     return sample_weight @ np.ascontiguousarray(per.T)
 
 
-def _neg_log_ratio(mix: Mixture, resp: np.ndarray, norm: np.ndarray, log_bg: np.ndarray,
+def _neg_log_ratio(weights: np.ndarray, resp: np.ndarray, norm: np.ndarray, log_bg: np.ndarray,
                    bg0: float | None, out: np.ndarray) -> np.ndarray:
     """(K, n) terms ``−log max(1 − r_ij + π_j u(z_i)/c(z_i), 1e−300)`` of the gain, in
     ``out``."""
     if bg0 is None:
-        to_bg = np.add(np.log(mix.weights)[:, None], log_bg)
+        to_bg = np.add(np.log(weights)[:, None], log_bg)
         to_bg -= norm
     else:  # (log π_j + log u) − log c per element, as above, with log u one number
-        to_bg = np.subtract((np.log(mix.weights) + bg0)[:, None], norm)
+        to_bg = np.subtract((np.log(weights) + bg0)[:, None], norm)
     np.exp(to_bg, out=to_bg)
     np.subtract(1.0, resp, out=out)
     out += to_bg

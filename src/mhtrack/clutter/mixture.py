@@ -29,7 +29,7 @@ import numpy as np
 from mhtrack.clutter.base import ClutterEstimator
 from mhtrack.clutter.density import PDF_DIRECT, log_pdf_t, maha_det_t, offsets_t, plots_t
 from mhtrack.clutter.em import Mixture, PruneRule, fit_em
-from mhtrack.clutter.seeding import kmeanspp_centres, mixture_from_centres
+from mhtrack.clutter.seeding import ScanRngs, kmeanspp_centres, mixture_from_centres
 from mhtrack.models.clutter import Region
 from mhtrack.records import Scan
 
@@ -171,6 +171,7 @@ class MixtureClutter(ClutterEstimator):
         self.n_subsampled_ = 0
         #: this scan's (n, 2) fed plots and their log c under the fit, from the fit itself
         self._scan_log_c: tuple[np.ndarray, np.ndarray] | None = None
+        self._rngs = ScanRngs()  # the scans' generators, made a few scans ahead
 
     # ------------------------------------------------------------------ what subclasses set
     def _prune_rule(self) -> PruneRule | None:
@@ -198,12 +199,12 @@ class MixtureClutter(ClutterEstimator):
             kept = kept[~mask]
             z = z[kept]
         self._scan_log_c = None
-        rng = _LazyRng(self.seed, self.n_updates_)
+        rng = _LazyRng(self._rngs, self.seed, self.n_updates_)
         self.n_updates_ += 1
         self._window.append(z.copy())
         self._kept = kept
         # Poisson ML: the mean count (integer sum, exact as np.mean's float sum)
-        self.count_ = float(sum(len(w) for w in self._window)) / len(self._window)
+        self.count_ = float(sum(map(len, self._window))) / len(self._window)
         pooled = np.concatenate(self._window) if len(self._window) > 1 else self._window[0]
         if len(pooled) == 0:
             self.mixture_ = None
@@ -350,7 +351,7 @@ class MixtureClutter(ClutterEstimator):
         glp = log_pdf_t(maha, det)
         free = self.n_components - prev.n_components
         if free > 0:
-            far = np.flatnonzero(_min(maha, axis=0) > CHI2_2_99)
+            far = (_min(maha, axis=0) > CHI2_2_99).nonzero()[0]  # np.flatnonzero's indices
             if len(far) >= max(self.min_points, 1.0):
                 novel = z.take(far, axis=0)
                 centres = kmeanspp_centres(novel, free, rng(), existing=means)
@@ -372,15 +373,14 @@ _all = np.logical_and.reduce
 
 
 class _LazyRng:
-    """The scan's generator ``default_rng(SeedSequence(seed, spawn_key=(u,)))``, made on
-    first call (most warm-started scans draw nothing) and the same one after."""
+    """The scan's generator ``default_rng(SeedSequence(seed, spawn_key=(u,)))``, taken from
+    ``rngs`` on first call (some scans draw nothing) and the same one after."""
 
-    def __init__(self, seed: int, u: int) -> None:
-        self._key = (seed, u)
+    def __init__(self, rngs: ScanRngs, seed: int, u: int) -> None:
+        self._from, self._key = rngs, (seed, u)
         self._rng: np.random.Generator | None = None
 
     def __call__(self) -> np.random.Generator:
         if self._rng is None:
-            seed, u = self._key
-            self._rng = np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(u,)))
+            self._rng = self._from.take(*self._key)
         return self._rng

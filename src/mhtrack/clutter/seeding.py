@@ -8,6 +8,29 @@ import numpy as np
 from mhtrack.clutter.em import Mixture
 
 _EYE2 = np.eye(2)
+#: Scans whose generators :class:`ScanRngs` makes together. Setting one up is mostly
+#: cold-cache time when made alone in a tracker's cycle (~47 µs), ~14 µs each made in a row
+#: (docs/performance.md).
+RNG_BATCH = 8
+
+
+class ScanRngs:
+    """Scan ``u``'s generator ``default_rng(SeedSequence(seed, spawn_key=(u,)))``, made
+    ``RNG_BATCH`` scans ahead and handed out once each: a generator is a function of
+    ``(seed, u)`` alone and none is drawn from before it is handed out, so the draws are
+    those of one made when needed."""
+
+    def __init__(self) -> None:
+        self._ahead: dict[tuple[int, int], np.random.Generator] = {}
+
+    def take(self, seed: int, u: int) -> np.random.Generator:
+        """The fresh generator of scan ``u`` (``seed``)."""
+        g = self._ahead.pop((seed, u), None)
+        if g is None:
+            self._ahead = {(seed, v): np.random.default_rng(np.random.SeedSequence(
+                seed, spawn_key=(v,))) for v in range(u, u + RNG_BATCH)}
+            g = self._ahead.pop((seed, u))
+        return g
 
 
 def kmeanspp_centres(
@@ -55,24 +78,27 @@ def mixture_from_centres(
     d2 = np.add.reduce((z[:, None, :] - centres[None, :, :]) ** 2, axis=2)  # .sum(axis=2)
     lab = d2.argmin(axis=1)
     n_in = np.bincount(lab, minlength=k)
+    sizes = n_in.tolist()
     counts = n_in.astype(float)
     reg = reg_covar * _EYE2
-    means = centres.astype(float)  # a copy
+    # each centre's plots summed in plot order from 0.0: the additions of
+    # np.add.reduce(z[lab == j], axis=0), all centres in one pass; a mean is that sum / m
+    sums = np.zeros((k, 2))
+    np.add.at(sums, lab, z)
+    means = centres.astype(float)  # a copy; a centre with no plot keeps its position
+    np.divide(sums, counts[:, None], out=means, where=n_in[:, None] > 0)
     cov = np.empty((k, 2, 2))
-    if (counts < 3).any():  # some centre keeps the broad covariance
+    if min(sizes) < 3:  # some centre keeps the broad covariance
         data_cov = _cov_biased(z) if len(z) > 1 else np.zeros((2, 2))
         cov[:] = data_cov / k + reg
-    grouped = z.take(lab.argsort(kind="stable"), axis=0)  # centre by centre, in plot order
-    stop = 0
-    for j, m in enumerate(n_in.tolist()):
-        start, stop = stop, stop + m
-        if m == 0:
-            continue
-        pts = grouped[start:stop]  # z[lab == j]
-        means[j] = np.add.reduce(pts, axis=0) / m  # pts.mean(axis=0)
-        if m >= 3:
-            d = pts - means[j]
-            cov[j] = d.T @ d / m + reg
+    if max(sizes) >= 3:
+        grouped = z.take(lab.argsort(kind="stable"), axis=0)  # centre by centre, in plot order
+        stop = 0
+        for j, m in enumerate(sizes):
+            start, stop = stop, stop + m
+            if m >= 3:
+                d = grouped[start:stop] - means[j]  # z[lab == j] − μ_j
+                cov[j] = d.T @ d / m + reg
     w = np.maximum(counts, 1e-3)
     w = (1.0 - background_weight) * w / np.add.reduce(w)
     return Mixture(w, means, cov, float(background_weight), background_box)

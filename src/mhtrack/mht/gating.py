@@ -38,7 +38,8 @@ def gate_threshold(probability: float) -> float:
 @dataclass(frozen=True, slots=True)
 class Gated:
     """Track–plot pairs inside the gate: ``track[i]`` with ``plot[i]``, their Mahalanobis
-    distance ``d2`` and log-likelihood ``loglik = ln p(z|T)``; ``posterior``: per pair
+    distance ``d2`` and log-likelihood ``loglik = ln p(z|T)`` (``None`` from a gate asked
+    for the pairs only, ``loglik=False``); ``posterior``: per pair
     (rows by ``posterior[rows]``), what the motion model's update may reuse (its
     :meth:`~mhtrack.models.motion.MotionModel.gating_scores`), or ``None``."""
 
@@ -117,7 +118,8 @@ def gate_candidate_counts(
 
 
 def gate_sweep(
-    x: np.ndarray, P: np.ndarray, z: np.ndarray, R: np.ndarray, gamma: float
+    x: np.ndarray, P: np.ndarray, z: np.ndarray, R: np.ndarray, gamma: float,
+    loglik: bool = True,
 ) -> Gated:
     """Every track–plot pair with ``d² ≤ γ`` and its innovation log-likelihood, ordered by
     track then plot; ``x`` (M, 4), ``P`` (M, 4, 4) predicted, ``z`` (N, 2), ``R`` (2, 2)
@@ -127,21 +129,24 @@ def gate_sweep(
     ``|νy| ≤ √(γ S_yy)``. Plots are bucketed into vertical strips and sorted by ``y``
     within each; every track looks up, in each strip its box overlaps, the plots in its
     ``y`` range with one vectorised ``searchsorted``. Work and memory are
-    O(M·strips-per-box + pairs in boxes), whatever M × N is.
+    O(M·strips-per-box + pairs in boxes), whatever M × N is. ``loglik=False``: the
+    pairs and ``d2`` only (``loglik`` ``None``).
     """
     x = np.asarray(x, float).reshape(-1, 4)
     z = np.asarray(z, float).reshape(-1, 2)
     R, shared = plot_covariances(R, len(z))
     if len(x) == 0 or len(z) == 0:
         e = np.zeros(0, np.int64)
-        return Gated(e, e, np.zeros(0), np.zeros(0))
+        return Gated(e, e, np.zeros(0), np.zeros(0) if loglik else None)
     if len(x) * len(z) <= DENSE_MAX_PAIRS:
-        return _dense_pairs(x, P, z, R, shared, gamma)
-    return _pairs_in_boxes(x, P, z, R, shared, gamma, _sweep_boxes(x, P, z, R, shared, gamma))
+        return _dense_pairs(x, P, z, R, shared, gamma, loglik)
+    return _pairs_in_boxes(x, P, z, R, shared, gamma, _sweep_boxes(x, P, z, R, shared, gamma),
+                           loglik)
 
 
 def _dense_pairs(
-    x: np.ndarray, P: np.ndarray, z: np.ndarray, R: np.ndarray, shared: bool, gamma: float
+    x: np.ndarray, P: np.ndarray, z: np.ndarray, R: np.ndarray, shared: bool, gamma: float,
+    loglik: bool = True,
 ) -> Gated:
     """The exact test of :func:`gate_sweep` on every (track, plot) pair as an (M, N)
     matrix: the same elementwise operations on the same operands as
@@ -158,13 +163,15 @@ def _dense_pairs(
     ti = flat // len(z)
     pj = flat - ti * len(z)
     d2 = d2.ravel().take(flat)
+    if not loglik:
+        return Gated(ti, pj, d2, None)
     det = det.ravel().take(ti if shared else flat)  # (M, 1) when R is shared
     return Gated(ti, pj, d2, gaussian_loglik2(d2, det))
 
 
 def _pairs_in_boxes(
     x: np.ndarray, P: np.ndarray, z: np.ndarray, R: np.ndarray, shared: bool, gamma: float,
-    boxes: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray],
+    boxes: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray], loglik: bool = True,
 ) -> Gated:
     """The exact test of :func:`gate_sweep` on the candidates of :func:`_sweep_boxes`
     (any boxes holding every gated pair give the same result: the test is per pair and
@@ -176,7 +183,7 @@ def _pairs_in_boxes(
     ti = np.repeat(tq, cnt)
     pj = order[np.repeat(lo - np.cumsum(cnt) + cnt, cnt) + np.arange(int(cnt.sum()))]
     if ti.size == 0:
-        return Gated(e, e, np.zeros(0), np.zeros(0))
+        return Gated(e, e, np.zeros(0), np.zeros(0) if loglik else None)
     if shared:
         s00 = P[:, 0, 0].take(ti) + R[0, 0]
         s01 = P[:, 0, 2].take(ti) + R[0, 1]
@@ -192,8 +199,8 @@ def _pairs_in_boxes(
     # candidates are grouped by track already; timsort on the nearly sorted key is ~linear)
     keep = (d2 <= gamma).nonzero()[0]
     o = keep.take(np.argsort(ti.take(keep) * N + pj.take(keep), kind="stable"))
-    ti, pj, d2, det = ti.take(o), pj.take(o), d2.take(o), det.take(o)
-    return Gated(ti, pj, d2, gaussian_loglik2(d2, det))
+    ti, pj, d2 = ti.take(o), pj.take(o), d2.take(o)
+    return Gated(ti, pj, d2, gaussian_loglik2(d2, det.take(o)) if loglik else None)
 
 
 class Gate:
@@ -203,7 +210,9 @@ class Gate:
     burst), leaves of confirmed trees and then the best-scoring leaves are gated first
     until the budget is spent; the others only get a miss child this scan (counted in
     ``caps["max_gated_pairs"]``). The pairs' ``loglik`` is the motion model's
-    (:meth:`~mhtrack.models.motion.MotionModel.gating_scores`: the IMM's mixture).
+    (:meth:`~mhtrack.models.motion.MotionModel.gating_scores`: the IMM's mixture; the
+    single Gaussian's of ``x, P`` is computed only for a model that reads it,
+    :attr:`~mhtrack.models.motion.MotionModel.reads_gate_loglik`).
     """
 
     def __init__(self, probability: float, max_pairs: int) -> None:
@@ -212,24 +221,25 @@ class Gate:
 
     def __call__(self, leaves: Leaves, pred: States, z: np.ndarray, R: np.ndarray,
                  motion: MotionModel, caps: dict[str, int]) -> Gated:
-        g = self.pairs(leaves, pred.x, pred.P, z, R, caps)
+        g = self.pairs(leaves, pred.x, pred.P, z, R, caps, motion.reads_gate_loglik)
         return Gated(g.track, g.plot, g.d2,
                      *motion.gating_scores(pred, g.track, g.plot, z, R, g.loglik))
 
     def pairs(self, leaves: Leaves, xp: np.ndarray, Pp: np.ndarray, z: np.ndarray,
-              R: np.ndarray, caps: dict[str, int]) -> Gated:
+              R: np.ndarray, caps: dict[str, int], loglik: bool = True) -> Gated:
         """The pairs of :func:`gate_sweep` of states ``xp``, ``Pp`` within the work budget
-        (class docstring), with the Gaussian ``loglik`` of ``xp, Pp``."""
+        (class docstring), with the Gaussian ``loglik`` of ``xp, Pp`` (``loglik=False``:
+        ``None``)."""
         budget = self.max_pairs
         if len(leaves) * len(z) <= budget or len(leaves) == 0 or len(z) == 0:
-            return gate_sweep(xp, Pp, z, R, self.gamma)
+            return gate_sweep(xp, Pp, z, R, self.gamma, loglik)
         # the candidate boxes are found once: counted against the budget, then tested
         R, shared = plot_covariances(R, len(z))
         boxes = _sweep_boxes(xp, Pp, z, R, shared, self.gamma)
         tq, lo, hi, plot_order = boxes
         counts = np.bincount(tq, weights=hi - lo, minlength=len(leaves)).astype(np.int64)
         if counts.sum() <= budget:
-            return _pairs_in_boxes(xp, Pp, z, R, shared, self.gamma, boxes)
+            return _pairs_in_boxes(xp, Pp, z, R, shared, self.gamma, boxes, loglik)
         order = np.lexsort((-leaves.score, leaves.track < 0))
         sel = np.sort(order[np.cumsum(counts[order]) <= budget])
         caps["max_gated_pairs"] = len(leaves) - sel.size
@@ -237,7 +247,7 @@ class Gate:
         new_index[sel] = np.arange(sel.size)
         q = new_index[tq] >= 0
         g = _pairs_in_boxes(xp[sel], Pp[sel], z, R, shared, self.gamma,
-                            (new_index[tq[q]], lo[q], hi[q], plot_order))
+                            (new_index[tq[q]], lo[q], hi[q], plot_order), loglik)
         return Gated(sel[g.track], g.plot, g.d2, g.loglik)
 
 

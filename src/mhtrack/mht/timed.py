@@ -84,7 +84,7 @@ def gate_timed(gate: Gate, leaves: Leaves, pred: States, z: np.ndarray, R: np.nd
     Pc = 2.0 * P
     Pc[:, 0, 0] += extra
     Pc[:, 2, 2] += extra
-    coarse = gate.pairs(leaves, pred.x, Pc, z, 2.0 * R, caps)
+    coarse = gate.pairs(leaves, pred.x, Pc, z, 2.0 * R, caps, loglik=False)
     ti, pj = coarse.track, coarse.plot
     pp = motion.predict(leaves.states().take(ti), t[pj] - leaves.time[ti])
     Rp = R if R.ndim == 2 else R.take(pj, axis=0)
@@ -95,5 +95,6 @@ def gate_timed(gate: Gate, leaves: Leaves, pred: States, z: np.ndarray, R: np.nd
     pp = pp.take(keep)
     ti, pj, d2, det = ti[keep], pj[keep], d2[keep], det[keep]
     k = np.arange(keep.size)
-    loglik, posterior = motion.gating_scores(pp, k, pj, z, R, gaussian_loglik2(d2, det))
+    loglik, posterior = motion.gating_scores(
+        pp, k, pj, z, R, gaussian_loglik2(d2, det) if motion.reads_gate_loglik else None)
     return Gated(ti, pj, d2, loglik, posterior), pp

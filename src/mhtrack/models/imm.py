@@ -24,6 +24,7 @@ from __future__ import annotations
 import functools
 import math
 from dataclasses import dataclass
+from typing import ClassVar
 
 import numpy as np
 
@@ -43,6 +44,8 @@ class CVModelSet(MotionModel):
 
     sigmas: tuple[float, ...]
     mode_time: float = 100.0
+    #: The score is the models' mixture: the gate's single-Gaussian likelihood is not read.
+    reads_gate_loglik: ClassVar[bool] = False
 
     def __post_init__(self) -> None:
         if len(self.sigmas) < 2:
@@ -157,7 +160,7 @@ class CVModelSet(MotionModel):
         of its update (module docstring; the floats :func:`update` computes) as a
         :class:`Posterior`, which :meth:`update` then reuses."""
         if len(track) == 0:
-            return loglik, None
+            return np.zeros(0), None
         # only the position terms of each pair's leaf are copied, not its whole state
         terms = [t.take(track, axis=0) for t in _position_terms(pred.xm, pred.Pm)]
         ll = _logliks(terms, z.take(plot, axis=0), R if R.ndim == 2 else R.take(plot, axis=0))

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 from abc import ABC, abstractmethod
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 
@@ -68,6 +68,10 @@ class MotionModel(ABC):
     Required: :attr:`n_models`, :meth:`predict`, :meth:`update`. Optional hooks (defaults
     for a single Gaussian filter): :meth:`gating_loglik`, :meth:`new_states`.
     """
+
+    #: Whether :meth:`gating_scores` reads its ``loglik`` argument (the single Gaussian's
+    #: of ``x, P``); a model that does not gets ``None`` there, not computed by the gate.
+    reads_gate_loglik: ClassVar[bool] = True
 
     @property
     @abstractmethod

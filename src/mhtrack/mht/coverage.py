@@ -39,10 +39,13 @@ class Looks:
     at; gating and the update use it) and ``certain`` (L,) whether the look is sure enough
     to score a miss — a leaf on the edge of the swept sector may be seen by this frame or
     by the sensor's next one, so its miss costs nothing (``ln(1 − 0)``) while a plot may
-    still update it."""
+    still update it. ``uniform``: not ``None`` when every leaf was looked at, with
+    certainty and this one ``P_D`` (``pd`` all that value, ``certain`` all true; P1's
+    scans, :class:`Everywhere`), so the stages may skip their per-leaf tests."""
 
     pd: np.ndarray
     certain: np.ndarray
+    uniform: float | None = None
 
     @property
     def miss_pd(self) -> np.ndarray:
@@ -95,7 +98,8 @@ class Everywhere(Coverage):
 
     def detection(self, scan: Scan, x: np.ndarray, P: np.ndarray,
                   time: np.ndarray) -> Looks:
-        return Looks(np.full(len(x), self.p_detection), np.ones(len(x), bool))
+        return Looks(np.full(len(x), self.p_detection), np.ones(len(x), bool),
+                     self.p_detection)
 
     def plot_pd(self, scan: Scan) -> float:
         return self.p_detection

@@ -26,7 +26,7 @@ import numpy as np
 
 from mhtrack.mht.coverage import Looks
 from mhtrack.mht.gating import Gate, Gated
-from mhtrack.mht.tree import Leaves
+from mhtrack.mht.tree import FIELDS, Leaves
 from mhtrack.models.linalg2 import gaussian_loglik2, sym_mahalanobis2
 from mhtrack.models.motion import MotionModel, States
 
@@ -43,22 +43,38 @@ def looked_trees(tree: np.ndarray, pd: np.ndarray) -> np.ndarray:
 def split_looked(leaves: Leaves, looks: Looks) -> tuple[Leaves, Looks, Leaves]:
     """``(looked, their looks, idle)``: the leaves of the trees the frame looked at
     (``P_D > 0`` at one of their leaves) and the others (the same objects when every tree
-    was looked at)."""
-    if (looks.pd > 0).all():  # every leaf looked at: no tree is carried
-        return leaves, looks, leaves.take(slice(0, 0))
+    was looked at, with no idle leaves)."""
+    if looks.uniform is not None or (looks.pd > 0).all():  # no tree is carried
+        return leaves, looks, _no_leaves(leaves)
     mask = looked_trees(leaves.tree, looks.pd)
     if mask.all():
-        return leaves, looks, leaves.take(slice(0, 0))
+        return leaves, looks, _no_leaves(leaves)
     return (leaves.take(mask), Looks(looks.pd[mask], looks.certain[mask]),
             leaves.take(~mask))
 
 
-def gate_looked(gate: Gate, leaves: Leaves, pred: States, pd: np.ndarray, z: np.ndarray,
-                R: np.ndarray, t: np.ndarray | None, time: float, motion: MotionModel,
-                caps: dict[str, int]) -> tuple[Gated, States | None]:
-    """Gated pairs of the leaves with ``pd > 0`` (indices into ``leaves``) and, for timed
-    plots (``t`` not all ``time``), each pair's state predicted to its plot's time."""
-    sub = None if (pd > 0).all() else np.flatnonzero(pd > 0)
+#: Stores of no leaves by (window width, IMM models): the idle part of a scan that
+#: stepped every tree (its arrays are never written).
+_EMPTY: dict[tuple[int, int], Leaves] = {}
+
+
+def _no_leaves(leaves: Leaves) -> Leaves:
+    """An empty store shaped as ``leaves`` (one per shape, reused)."""
+    key = (leaves.window.shape[1], leaves.mu.shape[1])
+    empty = _EMPTY.get(key)
+    if empty is None:
+        # copies: a view would keep the whole store it was sliced from alive
+        empty = _EMPTY[key] = Leaves(*[getattr(leaves, f)[:0].copy() for f in FIELDS])
+    return empty
+
+
+def gate_looked(gate: Gate, leaves: Leaves, pred: States, pd: np.ndarray | None,
+                z: np.ndarray, R: np.ndarray, t: np.ndarray | None, time: float,
+                motion: MotionModel, caps: dict[str, int]) -> tuple[Gated, States | None]:
+    """Gated pairs of the leaves with ``pd > 0`` (indices into ``leaves``; ``pd`` ``None``:
+    every leaf) and, for timed plots (``t`` not all ``time``), each pair's state predicted
+    to its plot's time."""
+    sub = None if pd is None or (pd > 0).all() else np.flatnonzero(pd > 0)
     lv, pr = (leaves, pred) if sub is None else (leaves.take(sub), pred.take(sub))
     if t is None or (t == time).all():
         g, pair_pred = gate(lv, pr, z, R, motion, caps), None

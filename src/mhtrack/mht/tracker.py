@@ -64,7 +64,7 @@ from mhtrack.mht.numbering import Counter, number_and_merge
 from mhtrack.mht.predict import predict_leaves
 from mhtrack.mht.pruning import prune_after_solve, prune_children, removed_after_solve
 from mhtrack.mht.report import StepStats, confirmed_windows, report, reported
-from mhtrack.mht.scoring import miss_increments, update_increment
+from mhtrack.mht.scoring import miss_increment, miss_increments, update_increment
 from mhtrack.mht.sprt import SPRT
 from mhtrack.mht.state import load_state, located, save_state
 from mhtrack.mht.timed import gate_looked, split_looked
@@ -154,14 +154,14 @@ class MHTTracker:
         previous = Reported.of(self._leaves, by_id=by_id, reported=on_air)
         leaves, looks, idle = self._look(scan)
         pred = predict_leaves(self.motion, leaves, ftime)
-        gated, pair_pred = gate_looked(self.gate, leaves, pred, looks.pd, z, R, scan.t, ftime,
-                                       self.motion, caps)
+        gated, pair_pred = gate_looked(self.gate, leaves, pred,
+                                       None if looks.uniform is not None else looks.pd,
+                                       z, R, scan.t, ftime, self.motion, caps)
         in_gates = plots_in_confirmed_gates(leaves, gated, len(z))
         kappa = clutter_intensity(self.clutter, scan, z, in_gates, cfg.min_clutter_density)
         update_dl = update_increment(gated.loglik, kappa, self.coverage.plot_pd(scan),
                                      cfg.new_target_density, gated.plot)
-        children = propose_children(leaves, gated, miss_increments(looks.miss_pd, self._miss_pg),
-                                    update_dl)
+        children = propose_children(leaves, gated, self._miss(looks), update_dl)
         cand = self.birth.propose(scan, z, R, rows, kappa, in_gates, caps)
         children = prune_children(leaves, children, len(cand) + len(idle), self.sprt, lim,
                                   caps, scene_leaves(cfg, len(z), n_tracks))
@@ -197,6 +197,13 @@ class MHTTracker:
         at are set aside (``idle``) and carried unchanged."""
         lv = self._leaves
         return split_looked(lv, self.coverage.detection(scan, lv.x, lv.P, lv.time))
+
+    def _miss(self, looks: Looks) -> float | np.ndarray:
+        """The miss increments of the looked-at leaves: one value when every leaf was
+        looked at alike (what :func:`miss_increments` then fills every row with)."""
+        if looks.uniform is not None:
+            return miss_increment(looks.uniform, self._miss_pg)
+        return miss_increments(looks.miss_pd, self._miss_pg)
 
     def _forget(self, leaves: Leaves, rows: np.ndarray, rep: np.ndarray) -> None:
         """The plots the confirmed tracks used (``rep``: the leaves that report them)

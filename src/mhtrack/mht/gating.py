@@ -159,7 +159,7 @@ def _dense_pairs(
     n0 = z[:, 0] - x[:, 0][:, None]
     n1 = z[:, 1] - x[:, 2][:, None]
     d2, det = sym_mahalanobis2(n0, n1, s00, s01, s11)
-    flat = np.flatnonzero(d2 <= gamma)  # row-major: by track, then plot
+    flat = (d2 <= gamma).ravel().nonzero()[0]  # row-major: by track, then plot
     ti = flat // len(z)
     pj = flat - ti * len(z)
     d2 = d2.ravel().take(flat)

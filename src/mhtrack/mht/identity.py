@@ -33,7 +33,9 @@ class Reported:
         that mask, when known); ``by_id``: the whole windows (a tree's columns are its
         own looks, not the scans)."""
         rep = leaves.chosen & (leaves.track >= 0) if reported is None else reported
-        return cls(leaves.track[rep], leaves.window[rep] if by_id else leaves.window[rep, 1:])
+        rows = rep.nonzero()[0]
+        window = leaves.window.take(rows, axis=0)
+        return cls(leaves.track.take(rows), window if by_id else window[:, 1:])
 
 
 def hand_over(leaves: Leaves, previous: Reported, *, by_id: bool = False) -> Leaves:

@@ -8,7 +8,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from mhtrack.mht.hypothesis import GlobalHypothesis
-from mhtrack.mht.tree import Leaves
+from mhtrack.mht.tree import Leaves, filled
 from mhtrack.records import Scan, TrackTable
 
 
@@ -68,19 +68,20 @@ def report(scan: Scan, leaves: Leaves, stepped: np.ndarray | None = None,
     if stepped is not None:
         rep = rep & stepped
     sel = rep.nonzero()[0]
-    sel = sel[leaves.track[sel].argsort(kind="stable")]
+    sel = sel.take(leaves.track.take(sel).argsort(kind="stable"))
     x = leaves.x.take(sel, axis=0)
     n = sel.size
+    # ``take``: a copy of the rows, without fancy indexing's set-up
     return TrackTable(
-        scan=np.full(n, int(scan.index), np.int64),
-        time=leaves.time[sel].copy(),
-        track_id=leaves.track[sel],
+        scan=filled(n, int(scan.index)),
+        time=leaves.time.take(sel),
+        track_id=leaves.track.take(sel),
         x=x[:, 0].copy(),
         y=x[:, 2].copy(),
         vx=x[:, 1].copy(),
         vy=x[:, 3].copy(),
-        plot=leaves.window[sel, -1].copy(),
-        score=leaves.score[sel].copy(),
-        P=leaves.P[sel].copy(),
+        plot=leaves.window[:, -1].take(sel),
+        score=leaves.score.take(sel),
+        P=leaves.P.take(sel, axis=0),
         tentative=np.zeros(n, bool),
     )

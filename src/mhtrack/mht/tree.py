@@ -166,9 +166,10 @@ def take_deferred(leaves: Leaves, rows: np.ndarray | None, parts: tuple[Leaves, 
             continue
         u, v = getattr(a, f), getattr(b, f)
         out = np.empty((rows.size, *u.shape[1:]), np.result_type(u, v))
-        # mode "clip": no buffered copy (the rows are in range, nothing is clipped)
-        np.take(u, ra, axis=0, out=out[:split], mode="clip")
-        np.take(v, rb, axis=0, out=out[split:], mode="clip")
+        # mode "clip": no buffered copy (the rows are in range, nothing is clipped); the
+        # ndarray method: no wrapper set-up
+        u.take(ra, axis=0, out=out[:split], mode="clip")
+        v.take(rb, axis=0, out=out[split:], mode="clip")
         cols[f] = out
     return Leaves(**cols, **columns)
 

@@ -40,10 +40,11 @@ def raw_plot_keys(window: np.ndarray, *, by_id: bool = False) -> tuple[np.ndarra
         e = np.zeros(0, np.int64)
         return e, e
     plot = window[leaf, col]
+    leaf = leaf.astype(np.int64, copy=False)  # no copy when already int64 (nonzero's)
     if by_id:
-        return leaf.astype(np.int64), plot.astype(np.int64)
+        return leaf, plot.astype(np.int64)
     span = int(plot.max()) + 1
-    return leaf.astype(np.int64), col.astype(np.int64) * span + plot
+    return leaf, col.astype(np.int64, copy=False) * span + plot
 
 
 def dense_index(tree: np.ndarray) -> np.ndarray:

@@ -23,6 +23,7 @@ from mhtrack.mht.tree import (
     Leaves,
     changes,
     segment_ids,
+    segment_sizes,
     segment_starts,
     take_deferred,
 )
@@ -34,7 +35,7 @@ def score_drop_keep(tree: np.ndarray, score: np.ndarray, drop: float) -> np.ndar
         return np.ones(0, bool)
     starts = segment_starts(tree)
     best = np.maximum.reduceat(score, starts)  # each tree's, repeated over its rows
-    return score >= np.repeat(best, np.diff(np.r_[starts, score.size])) - drop
+    return score >= np.repeat(best, segment_sizes(starts, score.size)) - drop
 
 
 def _rank_in_groups(group: np.ndarray, score: np.ndarray,
@@ -52,13 +53,13 @@ def _rank_in_groups(group: np.ndarray, score: np.ndarray,
     order = np.argsort(group + u, kind="stable")
     starts = segment_starts(group[order])
     rank = np.empty(n, np.int64)
-    rank[order] = np.arange(n) - np.repeat(starts, np.diff(np.r_[starts, n]))
+    rank[order] = np.arange(n) - np.repeat(starts, segment_sizes(starts, n))
     return rank
 
 
 def _largest_tree(tree: np.ndarray) -> int:
     """Rows of the largest tree (``tree`` sorted; 0 for no rows)."""
-    return int(np.diff(np.r_[segment_starts(tree), tree.size]).max(initial=0))
+    return int(segment_sizes(segment_starts(tree), tree.size).max(initial=0))
 
 
 def cap_leaves_per_tree(tree: np.ndarray, score: np.ndarray, cap: int) -> tuple[np.ndarray, int]:
@@ -68,7 +69,7 @@ def cap_leaves_per_tree(tree: np.ndarray, score: np.ndarray, cap: int) -> tuple[
     (:func:`_rank_in_groups`' ``span``, the same segment numbers): the same ranks, ties
     included, as ranking every leaf."""
     starts = segment_starts(tree)
-    size = np.diff(np.r_[starts, tree.size])
+    size = segment_sizes(starts, tree.size)
     if size.max(initial=0) <= cap:
         return np.ones(score.size, bool), 0
     big = size > cap
@@ -201,7 +202,7 @@ def prune_children(leaves: Leaves, children: Children, n_births: int, sprt: SPRT
         caps["max_leaves_per_tree"] = cut
         children, tree = children.take(keep), tree[keep]
     budget = max(cfg.max_leaves - n_births, 0)
-    confirmed = leaves.track[children.parent] >= 0
+    confirmed = leaves.track.take(children.parent) >= 0
     keep, cut = cap_leaves(children.score, confirmed, budget)
     if cut:
         caps["max_leaves"] = cut

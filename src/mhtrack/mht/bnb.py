@@ -54,16 +54,19 @@ def solve_small(
     low = local < 63
     m = np.zeros(idx.size, np.uint64)
     np.bitwise_or.at(m, leaf[low], np.left_shift(np.uint64(1), local[low].astype(np.uint64)))
-    masks = m.tolist()
-    if np.count_nonzero(low) < low.size:
-        for i, k in zip(leaf[~low].tolist(), local[~low].tolist(), strict=True):
-            masks[i] |= 1 << k
     ti, si = tree_index[idx], s[idx]
     order = np.lexsort((-si, ti, lc))  # cluster, tree, best first; ties: index (stable)
     t_start = changes(ti[order]).nonzero()[0]  # a cluster's trees are consecutive
     c_start = [*changes(lc[order][t_start]).nonzero()[0].tolist(), t_start.size]
     ordered = order.tolist()
-    rows = list(zip(si[order].tolist(), [masks[j] for j in ordered], ordered, strict=True))
+    if np.count_nonzero(low) == low.size:
+        masks = m.take(order).tolist()  # in the options' order
+    else:  # bits past 62: Python integers
+        by_leaf = m.tolist()
+        for i, k in zip(leaf[~low].tolist(), local[~low].tolist(), strict=True):
+            by_leaf[i] |= 1 << k
+        masks = [by_leaf[j] for j in ordered]
+    rows = list(zip(si.take(order).tolist(), masks, ordered, strict=True))
     bounds = [*t_start.tolist(), order.size]
     trees = [rows[a:b] for a, b in itertools.pairwise(bounds)]
     limited, picks = [], []

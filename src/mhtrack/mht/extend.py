@@ -55,12 +55,13 @@ def propose_children(
     parent = np.concatenate((np.arange(n, dtype=np.int64), gated.track))
     plot = np.concatenate((filled(n, NO_PLOT), gated.plot))
     pair = np.concatenate((filled(n, -1), np.arange(len(gated), dtype=np.int64)))
-    score = np.concatenate((leaves.score + miss_dl, leaves.score[gated.track] + update_dl))
+    score = np.concatenate((leaves.score + miss_dl, leaves.score.take(gated.track) + update_dl))
     # gated pairs are sorted by (leaf, plot); a stable sort on the parent puts the miss
     # first and keeps the plot order.
-    order = np.argsort(parent, kind="stable")
-    parent, plot, score, pair = parent[order], plot[order], score[order], pair[order]
-    return Children(parent, plot, score, np.maximum(leaves.peak[parent], score), pair)
+    order = parent.argsort(kind="stable")
+    parent, plot, pair = parent.take(order), plot.take(order), pair.take(order)
+    score = score.take(order)
+    return Children(parent, plot, score, np.maximum(leaves.peak.take(parent), score), pair)
 
 
 def grow_children(

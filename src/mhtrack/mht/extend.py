@@ -55,13 +55,12 @@ def propose_children(
     parent = np.concatenate((np.arange(n, dtype=np.int64), gated.track))
     plot = np.concatenate((filled(n, NO_PLOT), gated.plot))
     pair = np.concatenate((filled(n, -1), np.arange(len(gated), dtype=np.int64)))
-    score = np.concatenate((leaves.score + miss_dl, leaves.score.take(gated.track) + update_dl))
+    score = np.concatenate((leaves.score + miss_dl, leaves.score[gated.track] + update_dl))
     # gated pairs are sorted by (leaf, plot); a stable sort on the parent puts the miss
     # first and keeps the plot order.
-    order = parent.argsort(kind="stable")
-    parent, plot, pair = parent.take(order), plot.take(order), pair.take(order)
-    score = score.take(order)
-    return Children(parent, plot, score, np.maximum(leaves.peak.take(parent), score), pair)
+    order = np.argsort(parent, kind="stable")
+    parent, plot, score, pair = parent[order], plot[order], score[order], pair[order]
+    return Children(parent, plot, score, np.maximum(leaves.peak[parent], score), pair)
 
 
 def grow_children(
@@ -110,16 +109,16 @@ def grow_children(
         P=st.P,
         score=children.score,
         peak=children.peak,
-        tree=leaves.tree.take(par),
-        track=leaves.track.take(par),
-        birth=leaves.birth.take(par),
-        n_updates=leaves.n_updates.take(par) + is_upd,
+        tree=leaves.tree[par],
+        track=leaves.track[par],
+        birth=leaves.birth[par],
+        n_updates=leaves.n_updates[par] + is_upd,
         window=window,
         chosen=np.zeros(len(par), bool),
         mu=st.mu,
         xm=st.xm,
         Pm=st.Pm,
         node=filled(len(par), -1),
-        parent=leaves.node.take(par),
+        parent=leaves.node[par],
         time=child_time,
     )

@@ -115,9 +115,9 @@ def best_hypothesis(
     cand = (score > 0).nonzero()[0]  # the methods: no wrapper set-up (µs a call)
     if cand.size == 0:
         return _empty(score.size)
-    s, w = score.take(cand), np.asarray(window).take(cand, axis=0)
+    s, w = score[cand], np.asarray(window).take(cand, axis=0)
     # clusters (as cluster_trees), the plot keys computed once for every step below
-    tree_index = dense_index(np.asarray(tree).take(cand))
+    tree_index = dense_index(np.asarray(tree)[cand])
     keys = raw_plot_keys(w, by_id=by_id)
     tree_cluster = tree_clusters(tree_index, *keys)
     leaf_cluster = tree_cluster[tree_index]

@@ -54,9 +54,10 @@ class _Logged:
         if node.size > 1 and np.count_nonzero(node[1:] <= node[:-1]):
             sel = sel[node.argsort(kind="stable")]
             node = leaves.node[sel]
+        # 2-D and wider rows by take (a copy without fancy indexing's set-up)
         return cls(np.array([scan], np.int64), np.array([time], float), node,
-                   leaves.parent[sel], leaves.x[sel], leaves.P[sel], leaves.window[sel, -1],
-                   leaves.score[sel], leaves.time[sel])
+                   leaves.parent[sel], leaves.x.take(sel, axis=0), leaves.P.take(sel, axis=0),
+                   leaves.window[:, -1][sel], leaves.score[sel], leaves.time[sel])
 
 
 class TentativeHistory:
@@ -84,7 +85,7 @@ class TentativeHistory:
             rep = leaves.chosen & (leaves.track >= 0)
             if rows is not None:
                 rep &= rows
-            used = np.sort(leaves.window[rep, -1])
+            used = np.sort(leaves.window[:, -1][rep])
             used = used[used >= 0]
             self._claimed.append(used[changes(used)])  # np.unique, without its set-up
 
@@ -121,12 +122,12 @@ class TentativeHistory:
             ok &= ~dup
             j, tid, plot = j[ok], tid[ok], plot[ok]
             self._claimed[i] = np.union1d(self._claimed[i], plot[plot >= 0])
-            x = log.x[j]
+            x = log.x.take(j, axis=0)
             n = j.size
             parts.append(TrackTable(
                 scan=np.repeat(log.scan, n), time=log.t[j], track_id=tid,
                 x=x[:, 0].copy(), y=x[:, 2].copy(), vx=x[:, 1].copy(), vy=x[:, 3].copy(),
-                plot=plot, score=log.score[j], P=log.P[j],
+                plot=plot, score=log.score[j], P=log.P.take(j, axis=0),
                 tentative=np.ones(n, bool)))
             cur = log.parent[j]
             live = cur >= 0

@@ -26,7 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from mhtrack.mht.numbering import Counter
-from mhtrack.mht.tree import Leaves, new_trees
+from mhtrack.mht.tree import Leaves, filled, new_trees
 from mhtrack.models.motion import MotionModel, row_index
 from mhtrack.records import Scan
 
@@ -90,7 +90,7 @@ class Birth(ABC):
         """The new trees' leaves: :meth:`select`, then consecutive tree ids from ``trees``."""
         cand, group = self.select(cand, leaf_window, caps)
         first = trees.take(int(group.max()) + 1 if len(cand) else 0)
-        time = np.full(len(cand), float(scan.time)) if cand.time is None else cand.time
+        time = filled(len(cand), float(scan.time), float) if cand.time is None else cand.time
         return new_trees(self.motion.new_states(cand.x, cand.P), cand.score, cand.peak,
                          first + group, int(scan.index), cand.n_updates, cand.window, time)
 

@@ -88,11 +88,6 @@ class EMResult:
     converged: bool
     n_pruned: int
     log_density: np.ndarray | None = field(default=None, compare=False, repr=False)
-    #: the (K, n) ``log N(z_i; μ_j, Σ_j)`` and ``dᵀΣ_j⁻¹d`` of ``mixture``'s Gaussians at
-    #: the plots, as :func:`~mhtrack.clutter.density.log_pdf_t` and ``maha_det_t`` give
-    #: them (``None`` when no M-step ran)
-    gauss: tuple[np.ndarray, np.ndarray] | None = field(default=None, compare=False,
-                                                        repr=False)
 
 
 def e_step(
@@ -237,7 +232,6 @@ def fit_em(
         w, means, w0 = init.weights, init.means, init.background_weight
         q: np.ndarray | None = None  # None: the covariances are init's
         glp = init_log_pdf
-        maha = None
         if glp is None:
             glp = log_pdf_t(*maha_det_t(*offsets_t(z_t, means), init.covariances))
         wlp = weighted_t(w0, w, glp, log_u)
@@ -284,9 +278,9 @@ def fit_em(
                 if not len(w):
                     w0 = 1.0 if box is not None else 0.0
                 means, q = means.take(kept, axis=0), q.take(kept, axis=1)
-                maha, glp = maha.take(kept, axis=0), glp.take(kept, axis=0)
                 n_pruned += deleted
-                wlp, norm, resp, sums = weighted_t(w0, w, glp, log_u), None, None, None
+                wlp, norm, resp, sums = (weighted_t(w0, w, glp.take(kept, axis=0), log_u), None,
+                                         None, None)
             if not len(w):
                 break
             if not deleted and abs(ll - prev) < tol * abs(prev):
@@ -297,8 +291,7 @@ def fit_em(
     final = (_mean_ll(last, None) if sample_weight is None
              else float(np.average(last, weights=sample_weight)))
     mix = init if q is None else Mixture(w, means, _cov(q), w0, box)
-    gauss = None if q is None or maha is None else (glp, maha)
-    return EMResult(mix, final, n_iter, converged, n_pruned, last, gauss)
+    return EMResult(mix, final, n_iter, converged, n_pruned, last)
 
 
 def removal_gain(

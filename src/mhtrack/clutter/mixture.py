@@ -27,7 +27,6 @@ from typing import Any, Literal
 import numpy as np
 
 from mhtrack.clutter.base import ClutterEstimator
-from mhtrack.clutter.carry import Carried, FitColumns, gauss_at
 from mhtrack.clutter.density import PDF_DIRECT, log_pdf_t, maha_det_t, offsets_t, plots_t
 from mhtrack.clutter.em import Mixture, PruneRule, fit_em
 from mhtrack.clutter.seeding import ScanRngs, kmeanspp_centres, mixture_from_centres
@@ -173,7 +172,6 @@ class MixtureClutter(ClutterEstimator):
         #: this scan's (n, 2) fed plots and their log c under the fit, from the fit itself
         self._scan_log_c: tuple[np.ndarray, np.ndarray] | None = None
         self._rngs = ScanRngs()  # the scans' generators, made a few scans ahead
-        self._fit_cols = FitColumns()  # the last fit's densities, for the next warm start
 
     # ------------------------------------------------------------------ what subclasses set
     def _prune_rule(self) -> PruneRule | None:
@@ -201,8 +199,6 @@ class MixtureClutter(ClutterEstimator):
             kept = kept[~mask]
             z = z[kept]
         self._scan_log_c = None
-        carried = self._fit_cols.carried(self.window)  # before the window moves
-        self._fit_cols.clear()
         rng = _LazyRng(self._rngs, self.seed, self.n_updates_)
         self.n_updates_ += 1
         self._window.append(z.copy())
@@ -220,12 +216,8 @@ class MixtureClutter(ClutterEstimator):
             keep = np.sort(rng().choice(len(pooled), self.max_points, replace=False))
             self.n_subsampled_ += len(pooled) - self.max_points
             pooled = pooled[keep]
-            carried = None
-        elif carried is not None and len(carried[0]) + len(z) != len(pooled):
-            carried = None  # not the window the columns were counted for
         box = self._box(pooled)
-        init, glp = (self._warm_init(pooled, box, rng, carried) if self.warm_start
-                     else (None, None))
+        init, glp = self._warm_init(pooled, box, rng) if self.warm_start else (None, None)
         if init is None:
             init = self._cold_init(pooled, box, rng())
         res = fit_em(
@@ -235,8 +227,6 @@ class MixtureClutter(ClutterEstimator):
             bic=self.bic, init_log_pdf=glp,
         )
         self.mixture_ = res.mixture
-        if not subsampled and res.gauss is not None:
-            self._fit_cols.record(*res.gauss, list(map(len, self._window)))
         if not subsampled and len(z) and res.log_density is not None:
             # the scan's plots are the last rows of the pool: their log c, for intensity()
             self._scan_log_c = (self._window[-1], res.log_density[len(pooled) - len(z):])
@@ -278,7 +268,6 @@ class MixtureClutter(ClutterEstimator):
         if drop.any():
             self._window[-1] = self._window[-1][~drop]
             self._kept = self._kept[~drop]
-            self._fit_cols.drop_last((~drop).nonzero()[0])
 
     def density(self, z: np.ndarray) -> np.ndarray:
         """``ĉ_k(z)`` (P1 eq. 13), per m²; 0 before any plot was seen."""
@@ -347,11 +336,10 @@ class MixtureClutter(ClutterEstimator):
 
     def _warm_init(
         self, z: np.ndarray, box: tuple[float, float, float, float] | None,
-        rng: _LazyRng, carried: Carried | None = None,
+        rng: _LazyRng,
     ) -> tuple[Mixture | None, np.ndarray | None]:
         """Previous Gaussians + new ones seeded among unexplained plots (``None``: cold),
-        with the (K, n) log-densities of its Gaussians at ``z`` (for :func:`fit_em`);
-        ``carried``: the last fit's columns of the first plots of ``z`` (:mod:`.carry`)."""
+        with the (K, n) log-densities of its Gaussians at ``z`` (for :func:`fit_em`)."""
         prev = self.mixture_
         if prev is None or prev.n_components == 0:
             return None, None
@@ -359,10 +347,11 @@ class MixtureClutter(ClutterEstimator):
         w = prev.weights * (1.0 - bg) / _sum(prev.weights)
         means, cov = prev.means, prev.covariances
         z_t = plots_t(z)
+        maha, det = maha_det_t(*offsets_t(z_t, means), cov)
+        glp = log_pdf_t(maha, det)
         free = self.n_components - prev.n_components
-        near, glp = gauss_at(z_t, means, cov, carried, free > 0)
-        if near is not None:
-            far = (near > CHI2_2_99).nonzero()[0]  # np.flatnonzero's indices
+        if free > 0:
+            far = (_min(maha, axis=0) > CHI2_2_99).nonzero()[0]  # np.flatnonzero's indices
             if len(far) >= max(self.min_points, 1.0):
                 novel = z.take(far, axis=0)
                 centres = kmeanspp_centres(novel, free, rng(), existing=means)

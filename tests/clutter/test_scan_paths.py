@@ -125,3 +125,23 @@ def test_scan_rngs_hand_out_fresh_generators_of_seed_and_scan() -> None:
         got = rngs.take(seed, u).random(4)
         want = np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(u,))).random(4)
         assert same(got, want)
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_lse_t_is_the_plain_formula_with_non_finite_and_huge_maxima(seed: int) -> None:
+    """``_lse_t`` skips ``np.where`` when the maxima sum to a finite number: the same floats
+    as the plain formula, with columns of −inf, +inf, NaN, and maxima whose sum overflows."""
+    from mhtrack.clutter.density import _lse_t
+    rng = np.random.default_rng(seed)
+    a = rng.normal(0.0, 50.0, (int(rng.integers(1, 10)), 40))
+    if seed % 3 == 1:
+        a[:, 3] = -np.inf
+        a[0, 5], a[-1, 7] = np.inf, np.nan
+    elif seed % 3 == 2:
+        a[0] = 1e308  # finite maxima, infinite sum
+    m = a.max(axis=0)
+    m_safe = np.where(np.isfinite(m), m, 0.0)
+    with np.errstate(all="ignore"):
+        want = np.log(np.exp(a - m_safe).T.copy().sum(axis=1)) + m_safe
+        got = _lse_t(a)
+    assert same(got, want)

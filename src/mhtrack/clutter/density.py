@@ -17,6 +17,7 @@ floats are those of the plot-major code, bit for bit (``tests/clutter/test_em.py
 from __future__ import annotations
 
 from dataclasses import dataclass
+from math import isfinite
 
 import numpy as np
 
@@ -45,7 +46,8 @@ def _lse_t(a_t: np.ndarray) -> np.ndarray:
     maximum (exact in any order) over ``a_t``, the sum over components as
     ``.sum(axis=1)`` of the plot-major row-major array. Caller ignores log 0 warnings."""
     m = _max(a_t, axis=0)
-    m_safe = np.where(np.isfinite(m), m, 0.0)
+    # a finite sum: every maximum is finite, and np.where would copy m as it is
+    m_safe = m if isfinite(_sum(m)) else np.where(np.isfinite(m), m, 0.0)
     e = np.subtract(a_t, m_safe)
     np.exp(e, out=e)
     s = _sum(np.ascontiguousarray(e.T), axis=1)

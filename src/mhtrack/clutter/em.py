@@ -262,10 +262,11 @@ def fit_em(
                 norm = _lse_t(wlp)
                 resp, gain, sums = _e_step_gain(w, wlp, norm, log_bg, sample_weight, bg0)
                 keep &= gain >= price
-            if prune is not None and _any(keep):
-                wk = np.where(keep, w, 0.0)
-                keep &= prune(wk / _sum(wk))
             deleted = k - int(np.count_nonzero(keep))
+            if prune is not None and deleted < k:
+                wk = np.where(keep, w, 0.0) if deleted else w  # the same floats as where's
+                keep &= prune(wk / _sum(wk))
+                deleted = k - int(np.count_nonzero(keep))
             if deleted and not (_any(keep) or box is not None):
                 deleted = 0  # nothing would be left: keep the components, not an empty model
             if deleted:  # keep the Gaussians kept; renormalise them to 1 − π₀ (P1 after eq. 12)

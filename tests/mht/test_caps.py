@@ -14,7 +14,15 @@ from hypothesis import strategies as st
 from mhtrack.clutter import KnownClutter
 from mhtrack.experiments import track
 from mhtrack.mht import MHTConfig, MHTTracker
-from mhtrack.mht.caps import BURST_PLOTS, SCALED, describe, scaled_limits, scan_config
+from mhtrack.mht.caps import (
+    BURST_PLOTS,
+    SCALED,
+    ScanLimits,
+    describe,
+    scaled_limits,
+    scan_config,
+    scene_leaves,
+)
 from mhtrack.records import PlotTable, Scan
 
 DEFAULT = MHTConfig()
@@ -110,3 +118,20 @@ def test_a_burst_is_bounded_and_says_what_it_capped(caplog):
     assert f"MHT scan 5 ({n} plots)" in lines[0]
     assert f"max_births_per_scan {n - BURST_PLOTS} (limit {BURST_PLOTS})" in lines[0]
     assert peak < 1.5 * 2**30
+
+
+def test_scan_limits_remembers_what_scan_config_and_scene_leaves_give():
+    """The tracker's cache gives, for each (plots, tracks), the values of the functions
+    it remembers — with and without scaling, before and after it starts afresh — and a
+    fresh limits dict each call (a step's StepStats.limits is its own)."""
+
+    for cfg in (MHTConfig(), MHTConfig(scale_caps=False)):
+        memo = ScanLimits(cfg, size=3)
+        for n, t in [(5, 0), (5000, 3), (5, 0), (30_000, 200), (900, 1), (5000, 3)] * 2:
+            lim, limits, supported = memo(n, t)
+            assert lim == scan_config(cfg, n, t)
+            assert limits == {k: getattr(lim, k) for k in SCALED}
+            assert supported == scene_leaves(cfg, n, t)
+            limits["max_trees"] = -1
+            assert memo(n, t)[1]["max_trees"] == lim.max_trees
+        assert len(memo._seen) <= 3

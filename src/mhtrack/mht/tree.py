@@ -111,7 +111,8 @@ class Leaves:
 
     @property
     def n_trees(self) -> int:
-        return int(segment_starts(self.tree).size)
+        tree = self.tree  # the runs of equal tree ids (leaves are sorted by tree)
+        return int(np.count_nonzero(changes(tree))) if tree.size else 0
 
 
 #: The store's columns, in order.

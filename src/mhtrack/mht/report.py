@@ -16,8 +16,9 @@ from mhtrack.records import Scan, TrackTable
 class StepStats:
     """What one :meth:`~mhtrack.mht.tracker.MHTTracker.step` did.
 
-    ``caps`` maps each hard cap that acted to how many leaves (``max_leaves_per_plot``,
-    the overload rule of :mod:`mhtrack.mht.caps`; ``max_leaves_per_tree``,
+    ``caps`` maps each hard cap that acted to how many leaves (``max_leaves_per_plot``
+    and ``max_tentative_per_plot``, the overload rules of :mod:`mhtrack.mht.caps`;
+    ``max_leaves_per_tree``,
     ``max_leaves``), trees (``max_trees``), plots or initiated tracks
     (``max_births_per_scan``) or clusters (``max_cluster_size``) it cut; empty when none
     acted. ``n_births`` counts the trees started at this scan. ``limits``: the caps that

@@ -135,3 +135,15 @@ def test_scan_limits_remembers_what_scan_config_and_scene_leaves_give():
             limits["max_trees"] = -1
             assert memo(n, t)[1]["max_trees"] == lim.max_trees
         assert len(memo._seen) <= 3
+
+
+def test_scan_limits_follow_a_new_configuration():
+    """A tracker whose ``config`` is replaced gets the new configuration's limits, not
+    the remembered ones of the old."""
+    old, new = MHTConfig(), MHTConfig(max_trees=7, scale_caps=False)
+    memo = ScanLimits(old)
+    assert memo(5000, 3)[0] == scan_config(old, 5000, 3)
+    lim, limits, supported = memo(5000, 3, new)
+    assert lim == scan_config(new, 5000, 3) and limits["max_trees"] == 7
+    assert supported == scene_leaves(new, 5000, 3)
+    assert memo(5000, 3, new)[0] == scan_config(new, 5000, 3)

@@ -148,7 +148,7 @@ class MHTTracker:
         z, R, rows = validate_scan(scan, self._R, self._last_time, self._last_index)
         on_air = reported(self._leaves)  # the tracks reported at the last scan
         n_tracks = int(np.count_nonzero(on_air))
-        lim, limits, supported = self._limits(len(z), n_tracks)  # caps scaled to the scan
+        lim, limits, supported = self._limits(len(z), n_tracks, cfg)  # scaled to the scan
         self.gate.max_pairs = lim.max_gated_pairs
         self.birth.limit(lim.max_births_per_scan)
         by_id = self.coverage.per_tree_looks

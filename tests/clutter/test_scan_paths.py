@@ -45,6 +45,21 @@ def test_intensity_at_the_scan_plots_is_the_density_of_the_fit(cls: type, seed: 
     assert shortcuts >= 4
 
 
+def test_intensity_follows_a_mixture_set_by_hand() -> None:
+    """A ``mixture_`` replaced after the fit (another estimator's) is the one ``κ̂``
+    reads, also at the scan's own plots: the fit's cached ``log c`` is not its."""
+    rng = np.random.default_rng(3)
+    a, b = AGMMClutter(window=3), AGMMClutter(window=3)
+    for k in range(4):
+        a.update(Scan.from_positions(k, float(k), _scan_plots(rng, k)), None)
+    z = _scan_plots(rng, 9)
+    b.update(Scan.from_positions(0, 0.0, z), None)
+    assert b._scan_log_c is not None  # the shortcut would otherwise answer
+    b.mixture_ = a.mixture_
+    assert same(b.intensity(z), b.count_ * a.mixture_.pdf(z))
+    assert not same(b.intensity(z), b.count_ * np.exp(b._scan_log_c[1]))
+
+
 @pytest.mark.parametrize("seed", range(8))
 def test_fit_em_log_density_is_log_pdf(seed: int) -> None:
     """``EMResult.log_density`` is ``mixture.log_pdf(z)`` bit for bit, also after

@@ -137,3 +137,19 @@ def test_the_motion_model_is_a_part() -> None:
     assert _branch_scores(trk) == pytest.approx([L_MISS, L_UPDATE], abs=1e-6)
     assert trk.leaves.n_models == 0
     assert MHTTracker(MHTConfig(), KnownClutter(1e-8)).leaves.n_models == 2
+
+
+class _ThreeArgumentCV(ConstantVelocity):
+    """A user's model written against ``update(states, z, R)`` (no ``posterior``)."""
+
+    def update(self, states, z, R):  # type: ignore[override]
+        return super().update(states, z, R)
+
+
+def test_a_motion_model_with_the_three_argument_update_runs() -> None:
+    """A model whose ``update`` takes no ``posterior`` (its ``gating_scores`` reuses
+    nothing) runs the cycle and scores as the CV model it wraps."""
+    trk = MHTTracker(MHTConfig(), KnownClutter(1e-8), motion=_ThreeArgumentCV(10.0))
+    trk.step(SCAN1)
+    trk.step(SCAN2)
+    assert _branch_scores(trk) == pytest.approx([L_MISS, L_UPDATE], abs=1e-6)

@@ -169,8 +169,9 @@ class MixtureClutter(ClutterEstimator):
         self.n_pruned_ = 0
         self.n_updates_ = 0
         self.n_subsampled_ = 0
-        #: this scan's (n, 2) fed plots and their log c under the fit, from the fit itself
-        self._scan_log_c: tuple[np.ndarray, np.ndarray] | None = None
+        #: this scan's (n, 2) fed plots and their log c under the fit (the Mixture it was
+        #: computed with, so that a mixture_ set by hand is not answered from it)
+        self._scan_log_c: tuple[np.ndarray, np.ndarray, Mixture] | None = None
         self._rngs = ScanRngs()  # the scans' generators, made a few scans ahead
 
     # ------------------------------------------------------------------ what subclasses set
@@ -229,7 +230,8 @@ class MixtureClutter(ClutterEstimator):
         self.mixture_ = res.mixture
         if not subsampled and len(z) and res.log_density is not None:
             # the scan's plots are the last rows of the pool: their log c, for intensity()
-            self._scan_log_c = (self._window[-1], res.log_density[len(pooled) - len(z):])
+            self._scan_log_c = (self._window[-1], res.log_density[len(pooled) - len(z):],
+                                res.mixture)
         self.n_iter_, self.converged_ = res.n_iter, res.converged
         self.log_likelihood_, self.n_pruned_ = res.log_likelihood, res.n_pruned
 
@@ -238,7 +240,7 @@ class MixtureClutter(ClutterEstimator):
         0 before any plot was seen. Always finite and ≥ 0."""
         z = np.asarray(z, dtype=float).reshape(-1, 2)
         m, cached = self.mixture_, self._scan_log_c  # cached: with a fit, finite plots, M̂ > 0
-        if (cached is not None and m is not None and cached[0].shape == z.shape
+        if (cached is not None and m is cached[2] and cached[0].shape == z.shape
                 and cached[0].tobytes() == z.tobytes()
                 and len(z) * max(m.n_components, 1) <= PDF_DIRECT):
             # the scan's own plots: M̂ · m.pdf(z) = M̂ · exp(m.log_pdf(z)), log c from the fit

@@ -87,9 +87,10 @@ class MHTConfig:
         ``max_gated_pairs`` grow with the scan's plots and confirmed tracks, the values
         below being their floors (:func:`mhtrack.mht.caps.scaled_limits`; unchanged up to
         900 plots and 100 tracks per scan, bounded in a burst of over 20 000), and the
-        overload rule cuts the children to 4 per plot and 2 misses per tree where a leaf
-        cap would act on more children than the scan supports (:mod:`mhtrack.mht.caps`).
-        Default True; False: the values below at every scan, no overload rule.
+        overload rules cut the children to 4 per plot and 2 misses per tree where a leaf
+        cap would act — those of every tree when the children exceed what the scan
+        supports, else those of the tentative trees only (:mod:`mhtrack.mht.caps`).
+        Default True; False: the values below at every scan, neither overload rule.
     max_leaves_per_tree : hard cap on the leaves of one tree (best scores kept).
         Default 300 (above the largest trees, ~290 leaves, of the crossing scenario with
         40 uniform clutter plots per scan and the true κ).

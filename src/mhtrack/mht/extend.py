@@ -95,9 +95,11 @@ def grow_children(
         pj = plot[u]
         pairs = children.pair[u]
         start = pred.take(par[u]) if pair_pred is None else pair_pred.take(pairs)
-        st.put(u, motion.update(start, z.take(pj, axis=0),
-                                R if R.ndim == 2 else R.take(pj, axis=0),
-                                None if posterior is None else posterior[pairs]))
+        zu, Ru = z.take(pj, axis=0), R if R.ndim == 2 else R.take(pj, axis=0)
+        # posterior only when the model's gating_scores gave one: a model written against
+        # update(states, z, R) keeps working
+        st.put(u, motion.update(start, zu, Ru) if posterior is None
+               else motion.update(start, zu, Ru, posterior=posterior[pairs]))
     if upd.size and plot_time is not None:
         child_time[upd] = plot_time[plot[upd]]
     new_col = filled(len(par), NO_PLOT)

@@ -46,7 +46,7 @@ class Gated:
     track: np.ndarray
     plot: np.ndarray
     d2: np.ndarray
-    loglik: np.ndarray
+    loglik: np.ndarray | None  # None for a model that does not read it (reads_gate_loglik)
     posterior: Any = None
 
     def __len__(self) -> int:

@@ -219,13 +219,6 @@ def segment_ids(sorted_keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return starts, seg
 
 
-def segment_max(values: np.ndarray, starts: np.ndarray, seg: np.ndarray) -> np.ndarray:
-    """Per row, the maximum of ``values`` over its segment."""
-    if values.size == 0:
-        return values.copy()
-    return np.maximum.reduceat(values, starts)[seg]
-
-
 def one_point_state(z: np.ndarray, R: np.ndarray, v_max: float) -> tuple[np.ndarray,
                                                                           np.ndarray]:
     """One-point initialisation of plots ``z`` (n, 2): ``x = [zx, 0, zy, 0]``, position

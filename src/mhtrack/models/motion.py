@@ -66,7 +66,9 @@ class MotionModel(ABC):
     """What the MHT needs of a motion model: predict, score a plot, update, start a track.
 
     Required: :attr:`n_models`, :meth:`predict`, :meth:`update`. Optional hooks (defaults
-    for a single Gaussian filter): :meth:`gating_loglik`, :meth:`new_states`.
+    for a single Gaussian filter): :meth:`gating_loglik`, :meth:`gating_scores` (the score
+    and what :meth:`update` may reuse; ``update`` is given ``posterior=`` only when it
+    returns one), :attr:`reads_gate_loglik`, :meth:`new_states`.
     """
 
     #: Whether :meth:`gating_scores` reads its ``loglik`` argument (the single Gaussian's

@@ -7,7 +7,7 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 
 from mhtrack.metrics import evaluate
@@ -112,8 +112,19 @@ def _naive(tracks, times, scans, max_age):
     return rows
 
 
+def test_a_query_max_age_after_a_row_in_floats_is_kept():
+    """``0.9 − 0.2 ≤ 0.7`` in floats although ``0.2 + 0.7 < 0.9``: the row at 0.2 is no
+    older than 0.7 s at 0.9 and is reported there (found by the naive-loop test)."""
+    assert 0.9 - 0.2 <= 0.7 and 0.2 + 0.7 < 0.9
+    tracks = TrackTable(np.arange(1), np.array([0.2]), np.array([2]), np.zeros(1),
+                        np.zeros(1), np.ones(1), np.zeros(1), np.full(1, -1))
+    out = tracks_at_times(tracks, np.array([0.9]), np.array([4]), 0.7)
+    assert out.scan.tolist() == [4] and out.track_id.tolist() == [2]
+
+
 @settings(max_examples=60, deadline=None)
 @given(seed=st.integers(0, 2**32 - 1), max_age=st.sampled_from([0.0, 0.7, 2.0, 5.0]))
+@example(seed=1131481, max_age=0.7)  # the boundary case above, among random tracks
 def test_agrees_with_a_naive_loop(seed, max_age):
     rng = np.random.default_rng(seed)
     n = int(rng.integers(0, 40))

@@ -125,14 +125,19 @@ def tracks_at_times(tracks: TrackTable, times: npt.ArrayLike, scans: npt.ArrayLi
     q_order = np.argsort(q_time, kind="stable")
     qt = q_time[q_order]
 
-    # Candidate queries of each track: times in [its first time, its last time + max_age].
+    # Candidate queries of each track: times in [its first time, its last time + max_age],
+    # the upper end widened by a few ulps: a query whose rounded t − t_k is ≤ max_age can
+    # lie just above the rounded t_k + max_age; the test on dt below decides exactly.
     t_first = np.full(len(uid), np.inf)
     t_last = np.full(len(uid), -np.inf)
     np.minimum.at(t_first, r_tid, r_time)
     np.maximum.at(t_last, r_tid, r_time)
     lo = np.searchsorted(qt, t_first, side="left")
-    hi = np.searchsorted(qt, t_last + max_age, side="right") if math.isfinite(max_age) \
-        else np.full(len(uid), len(qt))
+    if math.isfinite(max_age):
+        slack = 4.0 * np.spacing(np.abs(t_last) + max_age)
+        hi = np.searchsorted(qt, t_last + max_age + slack, side="right")
+    else:
+        hi = np.full(len(uid), len(qt))
     count = np.maximum(hi - lo, 0)
     c_tid = np.repeat(np.arange(len(uid)), count)
     c_q = np.arange(count.sum()) - np.repeat(np.cumsum(count) - count - lo, count)

@@ -17,11 +17,9 @@ from mhtrack.mht import MHTConfig, MHTTracker
 from mhtrack.mht.caps import (
     BURST_PLOTS,
     SCALED,
-    ScanLimits,
     describe,
     scaled_limits,
     scan_config,
-    scene_leaves,
 )
 from mhtrack.records import PlotTable, Scan
 
@@ -120,30 +118,13 @@ def test_a_burst_is_bounded_and_says_what_it_capped(caplog):
     assert peak < 1.5 * 2**30
 
 
-def test_scan_limits_remembers_what_scan_config_and_scene_leaves_give():
-    """The tracker's cache gives, for each (plots, tracks), the values of the functions
-    it remembers — with and without scaling, before and after it starts afresh — and a
-    fresh limits dict each call (a step's StepStats.limits is its own)."""
-
-    for cfg in (MHTConfig(), MHTConfig(scale_caps=False)):
-        memo = ScanLimits(cfg, size=3)
-        for n, t in [(5, 0), (5000, 3), (5, 0), (30_000, 200), (900, 1), (5000, 3)] * 2:
-            lim, limits, supported = memo(n, t)
-            assert lim == scan_config(cfg, n, t)
-            assert limits == {k: getattr(lim, k) for k in SCALED}
-            assert supported == scene_leaves(cfg, n, t)
-            limits["max_trees"] = -1
-            assert memo(n, t)[1]["max_trees"] == lim.max_trees
-        assert len(memo._seen) <= 3
-
-
-def test_scan_limits_follow_a_new_configuration():
-    """A tracker whose ``config`` is replaced gets the new configuration's limits, not
-    the remembered ones of the old."""
-    old, new = MHTConfig(), MHTConfig(max_trees=7, scale_caps=False)
-    memo = ScanLimits(old)
-    assert memo(5000, 3)[0] == scan_config(old, 5000, 3)
-    lim, limits, supported = memo(5000, 3, new)
-    assert lim == scan_config(new, 5000, 3) and limits["max_trees"] == 7
-    assert supported == scene_leaves(new, 5000, 3)
-    assert memo(5000, 3, new)[0] == scan_config(new, 5000, 3)
+def test_a_replaced_config_gives_its_own_limits():
+    """A tracker whose ``config`` is replaced scales the new configuration's caps."""
+    trk = MHTTracker(MHTConfig(), KnownClutter(1e-8))
+    z = np.array([[0.0, 0.0], [500.0, 500.0]])
+    trk.step(Scan.from_positions(0, 0.0, z))
+    assert trk.last_stats.limits == {k: getattr(scan_config(MHTConfig(), 2, 0), k)
+                                     for k in SCALED}
+    trk.config = MHTConfig(max_trees=7, scale_caps=False)
+    trk.step(Scan.from_positions(1, 1.0, z))
+    assert trk.last_stats.limits["max_trees"] == 7

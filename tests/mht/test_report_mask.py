@@ -9,7 +9,7 @@ import pytest
 from leaves_fixture import random_leaves
 
 from mhtrack.mht.identity import Reported
-from mhtrack.mht.report import confirmed_windows, report, reported
+from mhtrack.mht.report import confirmed_windows, report
 from mhtrack.records import Scan
 
 
@@ -20,7 +20,7 @@ def test_report_with_the_mask_equals_report_without(seed, stepped):
     lv = random_leaves(rng, 40)
     scan = Scan(7, 3.0, np.zeros((0, 2)), np.zeros(0, np.int64), np.zeros(0, np.int64))
     rows = rng.random(40) < 0.5 if stepped else None
-    rep = reported(lv)
+    rep = lv.reported()
     assert np.array_equal(rep, lv.chosen & (lv.track >= 0)) and 0 < rep.sum() < 40
     kept = rep.copy()
     a, b = report(scan, lv, rows, rep), report(scan, lv, rows)

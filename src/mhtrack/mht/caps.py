@@ -112,34 +112,6 @@ def scan_config(cfg: MHTConfig, n_plots: int, n_tracks: int) -> MHTConfig:
     return dataclasses.replace(cfg, **lim)
 
 
-class ScanLimits:
-    """A tracker's per-scan limits, remembered by ``(n_plots, n_tracks)``: what
-    :func:`scan_config` and :func:`scene_leaves` give for ``cfg`` (which they depend on
-    alone besides the two counts), and the scaled limits as a dict (``StepStats.limits``;
-    a fresh dict each call). At most ``size`` pairs are kept (then it starts afresh); a
-    call with another configuration than the remembered one starts afresh too."""
-
-    def __init__(self, cfg: MHTConfig, size: int = 4096) -> None:
-        self.cfg, self.size = cfg, size
-        self._seen: dict[tuple[int, int], tuple[MHTConfig, dict[str, int], int | None]] = {}
-
-    def __call__(self, n_plots: int, n_tracks: int, cfg: MHTConfig | None = None
-                 ) -> tuple[MHTConfig, dict[str, int], int | None]:
-        """``(scan_config(cfg, n_plots, n_tracks), its SCALED limits, scene_leaves(...))``;
-        ``cfg`` (default: the one given at construction) is the tracker's current one."""
-        if cfg is not None and cfg is not self.cfg:
-            self.cfg, self._seen = cfg, {}
-        key = (n_plots, n_tracks)
-        got = self._seen.get(key)
-        if got is None:
-            if len(self._seen) >= self.size:
-                self._seen.clear()
-            lim = scan_config(self.cfg, n_plots, n_tracks)
-            got = self._seen[key] = (lim, {k: getattr(lim, k) for k in SCALED},
-                                     scene_leaves(self.cfg, n_plots, n_tracks))
-        return got[0], dict(got[1]), got[2]
-
-
 def solver_caps(hyp: GlobalHypothesis, caps: dict[str, int]) -> None:
     """Record the clusters solved greedily (too large) or stopped by the MILP node limit."""
     if hyp.n_greedy:

@@ -254,7 +254,7 @@ class Gate:
 def plots_in_confirmed_gates(leaves: Leaves, gated: Gated, n_plots: int) -> np.ndarray | None:
     """Mask of plots inside the gate of a confirmed track reported at the last scan, or
     ``None`` when there is none (the clutter estimator's ``in_track_gates``)."""
-    reported = leaves.chosen & (leaves.track >= 0)
+    reported = leaves.reported()
     if not reported.any():
         return None
     mask = np.zeros(n_plots, bool)

@@ -76,15 +76,16 @@ class TentativeHistory:
         self._claimed: deque[np.ndarray] = deque(maxlen=max(self.depth, 1))
 
     def record(self, scan: int, time: float, leaves: Leaves,
-               rows: np.ndarray | None = None) -> None:
+               rows: np.ndarray | None = None, rep: np.ndarray | None = None) -> None:
         """Keep the tentative leaves (``track < 0``) of this scan, and the plots of the
-        tracks reported at it (chosen, confirmed); ``rows`` (mask): of those leaves only
-        (the leaves a frame stepped), as if given ``leaves.take(rows)``."""
+        tracks reported at it (:meth:`Leaves.reported`; ``rep``: that mask, when known,
+        not modified); ``rows`` (mask): of those leaves only (the leaves a frame
+        stepped), as if given ``leaves.take(rows)``."""
         if self.depth:
             self._log.append(_Logged.of(scan, time, leaves, rows))
-            rep = leaves.chosen & (leaves.track >= 0)
+            rep = leaves.reported() if rep is None else rep
             if rows is not None:
-                rep &= rows
+                rep = rep & rows
             used = np.sort(leaves.window[:, -1][rep])
             used = used[used >= 0]
             self._claimed.append(used[changes(used)])  # np.unique, without its set-up

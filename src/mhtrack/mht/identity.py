@@ -15,7 +15,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from mhtrack.mht.numbering import Counter
-from mhtrack.mht.tree import Leaves
+from mhtrack.mht.tree import Leaves, contains
 
 
 @dataclass(frozen=True, slots=True)
@@ -32,7 +32,7 @@ class Reported:
         """What the leaves of the last scan reported (chosen, confirmed; ``reported``:
         that mask, when known); ``by_id``: the whole windows (a tree's columns are its
         own looks, not the scans)."""
-        rep = leaves.chosen & (leaves.track >= 0) if reported is None else reported
+        rep = leaves.reported() if reported is None else reported
         rows = rep.nonzero()[0]
         window = leaves.window.take(rows, axis=0)
         return cls(leaves.track.take(rows), window if by_id else window[:, 1:])
@@ -75,17 +75,6 @@ def hand_over(leaves: Leaves, previous: Reported, *, by_id: bool = False) -> Lea
         track[track == tid] = -1  # the old tree gives the id up
         track[leaves.tree == leaves.tree[cand[c]]] = tid
     return replace(leaves, track=track)
-
-
-def contains(values: np.ndarray, query: np.ndarray) -> np.ndarray:
-    """``np.isin(query, values)`` by one sort and a binary search (no set-up cost of
-    ``np.isin`` on the few values of one scan)."""
-    if values.size == 0:
-        return np.zeros(query.shape, bool)
-    v = np.sort(values)
-    j = v.searchsorted(query)
-    np.minimum(j, v.size - 1, out=j)
-    return v[j] == query
 
 
 def confirm(leaves: Leaves, confirms: np.ndarray, tracks: Counter) -> Leaves:

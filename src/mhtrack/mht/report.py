@@ -48,15 +48,10 @@ class StepStats:
                    limits={} if limits is None else limits)
 
 
-def reported(leaves: Leaves) -> np.ndarray:
-    """Mask of the leaves that report a track: chosen (best hypothesis) and confirmed."""
-    return leaves.chosen & (leaves.track >= 0)
-
-
 def confirmed_windows(leaves: Leaves, rep: np.ndarray | None = None) -> np.ndarray:
     """Leaf windows (m, N+1) of the confirmed tracks in the best hypothesis: the plots
-    they used at scans ``k−N … k`` (``rep``: :func:`reported`, when known)."""
-    return leaves.window[reported(leaves) if rep is None else rep]
+    they used at scans ``k−N … k`` (``rep``: :meth:`Leaves.reported`, when known)."""
+    return leaves.window[leaves.reported() if rep is None else rep]
 
 
 def report(scan: Scan, leaves: Leaves, stepped: np.ndarray | None = None,
@@ -64,8 +59,8 @@ def report(scan: Scan, leaves: Leaves, stepped: np.ndarray | None = None,
     """Confirmed tracks of the best hypothesis at ``scan``, ordered by track id; each row
     at its state's own time (``Leaves.time``). ``stepped`` (mask): only the leaves this
     frame stepped (a frame of one radar's sector reports the tracks it looked at).
-    ``rep``: :func:`reported`, when known (not modified)."""
-    rep = reported(leaves) if rep is None else rep
+    ``rep``: :meth:`Leaves.reported`, when known (not modified)."""
+    rep = leaves.reported() if rep is None else rep
     if stepped is not None:
         rep = rep & stepped
     sel = rep.nonzero()[0]

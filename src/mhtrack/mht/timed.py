@@ -26,18 +26,14 @@ import numpy as np
 
 from mhtrack.mht.coverage import Looks
 from mhtrack.mht.gating import Gate, Gated
-from mhtrack.mht.tree import FIELDS, Leaves
+from mhtrack.mht.tree import FIELDS, Leaves, contains
 from mhtrack.models.linalg2 import gaussian_loglik2, sym_mahalanobis2
 from mhtrack.models.motion import MotionModel, States
 
 
 def looked_trees(tree: np.ndarray, pd: np.ndarray) -> np.ndarray:
     """Mask over leaves (sorted by ``tree``): the leaf's tree has a leaf with ``pd > 0``."""
-    looked = tree[pd > 0]  # sorted, as ``tree``
-    if looked.size == 0:
-        return np.zeros(tree.size, bool)
-    at = np.minimum(np.searchsorted(looked, tree), looked.size - 1)
-    return looked.take(at) == tree
+    return contains(tree[pd > 0], tree)
 
 
 def split_looked(leaves: Leaves, looks: Looks) -> tuple[Leaves, Looks, Leaves]:

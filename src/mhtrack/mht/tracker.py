@@ -27,7 +27,7 @@ The tracking cycle, one stage per line of :meth:`MHTTracker.step`::
     forget           Birth.forget_used,              the confirmed tracks' plots leave the
                      ClutterEstimator.forget           birth window and the estimator's
     report           report.report, StepStats        confirmed tracks of the best hypothesis
-    caps             caps.ScanLimits, CapWarnings    limits scaled to the scan's plots and
+    caps             caps.scan_config, CapWarnings   limits scaled to the scan's plots and
                                                      tracks; log the hard caps that acted
 
 The motion model (:class:`~mhtrack.models.motion.MotionModel`: CV or IMM), the clutter
@@ -51,24 +51,24 @@ import numpy as np
 from mhtrack.clutter.base import ClutterEstimator
 from mhtrack.clutter.known import KnownClutter
 from mhtrack.mht.births import Birth, make_birth
-from mhtrack.mht.caps import CapWarnings, ScanLimits, solver_caps
+from mhtrack.mht.caps import SCALED, CapWarnings, scan_config, scene_leaves, solver_caps
 from mhtrack.mht.config import MHTConfig
 from mhtrack.mht.coverage import Coverage, Everywhere, Looks
 from mhtrack.mht.extend import grow_children, propose_children
 from mhtrack.mht.gating import Gate, plots_in_confirmed_gates
 from mhtrack.mht.history import TentativeHistory
 from mhtrack.mht.hypothesis import best_hypothesis
-from mhtrack.mht.identity import Reported, confirm, contains, hand_over, newly_confirmed
+from mhtrack.mht.identity import Reported, confirm, hand_over, newly_confirmed
 from mhtrack.mht.intensity import clutter_intensity
 from mhtrack.mht.numbering import Counter, number_and_merge
 from mhtrack.mht.predict import predict_leaves
 from mhtrack.mht.pruning import prune_after_solve, prune_children, removed_after_solve
-from mhtrack.mht.report import StepStats, confirmed_windows, report, reported
+from mhtrack.mht.report import StepStats, confirmed_windows, report
 from mhtrack.mht.scoring import miss_increment, miss_increments, update_increment
 from mhtrack.mht.sprt import SPRT
 from mhtrack.mht.state import load_state, located, save_state
 from mhtrack.mht.timed import gate_looked, split_looked
-from mhtrack.mht.tree import Leaves
+from mhtrack.mht.tree import Leaves, contains
 from mhtrack.mht.validate import validate_scan
 from mhtrack.models.motion import MotionModel
 from mhtrack.records import PlotTable, Scan, TrackTable
@@ -122,7 +122,6 @@ class MHTTracker:
         self.trees, self.tracks, self.nodes = Counter(), Counter(), Counter()
         self._history = TentativeHistory(cfg.history_scans)
         self._cap_warnings = CapWarnings()
-        self._limits = ScanLimits(cfg)  # caps scaled to a scan's plots and tracks
         self.last_stats: StepStats | None = None
         #: Rows, at earlier scans, of the tracks confirmed by the last :meth:`step`: their
         #: tentative past (``tentative`` true; :mod:`mhtrack.mht.history`).
@@ -146,9 +145,9 @@ class MHTTracker:
         cfg, ftime = self.config, float(scan.time)
         caps: dict[str, int] = {}
         z, R, rows = validate_scan(scan, self._R, self._last_time, self._last_index)
-        on_air = reported(self._leaves)  # the tracks reported at the last scan
+        on_air = self._leaves.reported()  # the tracks reported at the last scan
         n_tracks = int(np.count_nonzero(on_air))
-        lim, limits, supported = self._limits(len(z), n_tracks, cfg)  # scaled to the scan
+        lim = scan_config(cfg, len(z), n_tracks)  # caps scaled to the scan
         self.gate.max_pairs = lim.max_gated_pairs
         self.birth.limit(lim.max_births_per_scan)
         by_id = self.coverage.per_tree_looks
@@ -165,7 +164,7 @@ class MHTTracker:
         children = propose_children(leaves, gated, self._miss(looks), update_dl)
         cand = self.birth.propose(scan, z, R, rows, kappa, in_gates, caps)
         children = prune_children(leaves, children, len(cand) + len(idle), self.sprt, lim,
-                                  caps, supported)
+                                  caps, scene_leaves(cfg, len(z), n_tracks))
         grown = grow_children(leaves, pred, children, z, R, rows, self.motion, ftime,
                               pair_pred, scan.t, gated.posterior)
         births = self.birth.seed(scan, cand, grown.window, self.trees, caps)
@@ -182,11 +181,12 @@ class MHTTracker:
         leaves = hand_over(leaves, previous, by_id=by_id)
         leaves = confirm(leaves, self.sprt.confirms(leaves), self.tracks)
         self.last_backfill = self._history.backfill(leaves, newly_confirmed(leaves, first_new))
-        self._history.record(int(scan.index), ftime, leaves, is_new)
-        rep = reported(leaves)
+        rep = leaves.reported()
+        self._history.record(int(scan.index), ftime, leaves, is_new, rep)
         self._forget(leaves, rows, rep)
         self._leaves, self._last_time, self._last_index = leaves, ftime, int(scan.index)
         out = report(scan, leaves, is_new, rep)
+        limits = {k: getattr(lim, k) for k in SCALED}
         self.last_stats = StepStats.of(scan, len(z), leaves, births, hyp, out,
                                        time.perf_counter() - t0, caps, limits)
         self._cap_warnings(int(scan.index), caps, len(z), limits)

@@ -109,6 +109,11 @@ class Leaves:
         """IMM models per leaf (0: single constant-velocity model)."""
         return int(self.mu.shape[1])
 
+    def reported(self) -> np.ndarray:
+        """Mask of the leaves that report a track: chosen (best hypothesis) and
+        confirmed."""
+        return self.chosen & (self.track >= 0)
+
     @property
     def n_trees(self) -> int:
         tree = self.tree  # the runs of equal tree ids (leaves are sorted by tree)
@@ -173,6 +178,17 @@ def take_deferred(leaves: Leaves, rows: np.ndarray | None, parts: tuple[Leaves, 
         v.take(rb, axis=0, out=out[split:], mode="clip")
         cols[f] = out
     return Leaves(**cols, **columns)
+
+
+def contains(values: np.ndarray, query: np.ndarray) -> np.ndarray:
+    """``np.isin(query, values)`` by one sort and a binary search (no set-up cost of
+    ``np.isin`` on the few values of one scan)."""
+    if values.size == 0:
+        return np.zeros(query.shape, bool)
+    v = np.sort(values)
+    j = v.searchsorted(query)
+    np.minimum(j, v.size - 1, out=j)
+    return v[j] == query
 
 
 def filled(n: int, value: float, dtype: type = np.int64) -> np.ndarray:

@@ -11,7 +11,9 @@ compares two such directories file by file, ignoring only timing fields (keys su
 
 The commands: ``run crossing|opensky|multiradar|crossing-changing --seed 1 --json``,
 ``montecarlo crossing --runs 5``, ``reproduce p2 --runs 2`` and the whole
-``opensky-radars`` simulate → track → evaluate (its ``tracks.csv`` compared byte for byte).
+``opensky-radars`` simulate → track → evaluate (its ``tracks.csv`` compared byte for byte),
+and the same plots exported as an ASTERIX recording, tracked from it (history and online)
+and the tracks exported as CAT062 (each file compared byte for byte).
 """
 
 from __future__ import annotations
@@ -35,6 +37,16 @@ COMMANDS: list[tuple[str, list[str]]] = [
     ("", ["track", "b_or/plots.csv", "--sensors", "b_or/sensors.toml", "--out",
           "b_or/tracks.csv"]),
     ("or_eval.json", ["evaluate", "b_or/tracks.csv", "b_or/truth.csv", "--json"]),
+    ("", ["track", "b_or/plots.csv", "--sensors", "b_or/sensors.toml", "--output", "online",
+          "--out", "b_or/tracks_online.csv"]),
+    ("", ["export", "b_or/plots.csv", "--sensors", "b_or/sensors.toml", "--out",
+          "b_or/radar.pcap"]),
+    ("", ["track", "b_or/radar.pcap", "--sensors", "b_or/sensors.toml", "--out",
+          "b_or/tracks_rec.csv"]),
+    ("", ["track", "b_or/radar.pcap", "--sensors", "b_or/sensors.toml", "--output", "online",
+          "--out", "b_or/tracks_rec_online.parquet"]),
+    ("", ["export", "b_or/tracks_rec.csv", "--sensors", "b_or/sensors.toml", "--category",
+          "062", "--out", "b_or/tracks_rec062.ast"]),
 ]
 
 #: Keys of JSON objects and Parquet rows that hold times (ignored).

@@ -14,7 +14,7 @@ LAYER = {
     "records": 1, "names": 1, "errors": 1, "bounds": 1,
     "models": 2, "frames": 2,
     "io": 3, "clutter": 3, "initiation": 3,
-    "scenario": 4, "mht": 4,
+    "scenario": 4, "mht": 4, "sources": 4,
     "build": 5, "metrics": 5,
     "experiments": 6,
     "plotting": 7, "stonesoup": 7,

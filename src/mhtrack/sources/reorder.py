@@ -16,8 +16,8 @@ batch), never the whole input.
 from __future__ import annotations
 
 import heapq
-from collections.abc import Mapping
-from dataclasses import dataclass
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -29,27 +29,28 @@ Columns = Mapping[str, np.ndarray]
 @dataclass
 class Late:
     """Plots dropped for arriving too late: how many, the largest lateness (s), and the
-    input position (0-based plot number in arrival order) and lateness of the first."""
+    first one's lateness and 1-d column values (e.g. its file row, for the warning)."""
 
     n: int = 0
     max_late_s: float = 0.0
-    first_at: int = -1
     first_late_s: float = 0.0
+    first: dict[str, object] = field(default_factory=dict)
 
-    def add(self, at: int, late_s: float) -> None:
+    def add(self, late_s: float, first: Callable[[], dict[str, object]]) -> None:
         if self.n == 0:
-            self.first_at, self.first_late_s = at, late_s
+            self.first_late_s, self.first = late_s, first()
         self.n += 1
         self.max_late_s = max(self.max_late_s, late_s)
 
-    def line(self, name: str) -> str:
-        """The one warning line: ``NAME: 1 plot dropped, late by 40 s (...)``."""
+    def line(self, name: str, where: str) -> str:
+        """The one warning line: ``NAME: 1 plot dropped, late by 40 s (...)``; ``where``
+        names the first dropped plot's place in the input."""
         plural = "plot" if self.n == 1 else "plots"
         by = (f"late by {self.max_late_s:.3g} s" if self.n == 1
               else f"late by up to {self.max_late_s:.3g} s")
-        return (f"{name}: {self.n} {plural} dropped, {by} (arrived after later plots had "
-                "gone to the tracker, beyond the reorder window; the first is input plot "
-                f"{self.first_at}, late by {self.first_late_s:.3g} s)")
+        first = "" if self.n == 1 else f", the first late by {self.first_late_s:.3g} s"
+        return (f"{name}: {self.n} {plural} dropped, {by} (after later plots had gone to "
+                f"the tracker, beyond the reorder window; first at {where}{first})")
 
 
 class ReorderBuffer:
@@ -82,7 +83,9 @@ class ReorderBuffer:
         latest, released = self.latest, self.released
         for i, ti in enumerate(t.tolist()):
             if ti < released:
-                self.late.add(seq0 + i, latest - ti)
+                self.late.add(latest - ti, lambda i=i: {  # type: ignore[misc]
+                    k: np.asarray(v)[i].item() for k, v in cols.items()
+                    if np.ndim(v) == 1})
                 continue
             if ti < latest:
                 self.reordered += 1

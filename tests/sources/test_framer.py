@@ -4,6 +4,8 @@ each frame out without waiting for the end of the stream."""
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
@@ -18,7 +20,7 @@ def _frames(t: np.ndarray, s: np.ndarray, lengths: dict[int, float] | float,
     fr = Framer(lengths)
     bounds = [0, *sorted(set(c for c in cuts if 0 < c < t.size)), t.size]
     out = []
-    for k, (a, b) in enumerate(zip(bounds[:-1], bounds[1:], strict=True)):
+    for k, (a, b) in enumerate(itertools.pairwise(bounds)):
         for f in fr.push({"time": t[a:b], "sensor": s[a:b], "pos": np.arange(a, b)}):
             out.append((f.index, f.sensor, f.time, f.cols["pos"].tolist(), k + 1))
     for f in fr.flush():

@@ -16,18 +16,18 @@ import pytest
 
 pytest.importorskip("asterix.generated", reason="libasterix not installed")
 
-from mhtrack.errors import InputError  # noqa: E402
-from mhtrack.io.asterix import export  # noqa: E402
-from mhtrack.io.asterix.container import datagrams  # noqa: E402
-from mhtrack.io.asterix.problems import Problems  # noqa: E402
-from mhtrack.io.plots import read_plots  # noqa: E402
-from mhtrack.io.sensors import read_sensors, write_sensors  # noqa: E402
-from mhtrack.records import Scan  # noqa: E402
-from mhtrack.sources import open_source  # noqa: E402
-from mhtrack.sources.datagrams import DatagramSource  # noqa: E402
-from mhtrack.sources.recording import AsterixSource  # noqa: E402
+from mhtrack.errors import InputError
+from mhtrack.io.asterix import export
+from mhtrack.io.asterix.container import datagrams
+from mhtrack.io.asterix.problems import Problems
+from mhtrack.io.plots import read_plots
+from mhtrack.io.sensors import read_sensors, write_sensors
+from mhtrack.records import Scan
+from mhtrack.sources import open_source
+from mhtrack.sources.datagrams import DatagramSource
+from mhtrack.sources.recording import AsterixSource
 
-from .conftest import differences  # noqa: E402
+from .conftest import differences
 
 PCAP_HEAD = 24
 #: Offset of the ASTERIX data in a packet record: its header, Ethernet, IPv4, UDP.
@@ -134,7 +134,7 @@ def test_packet_40_s_late(recs: dict[str, Path], opensky2: Path, tmp_path: Path,
     offset = PCAP_HEAD + sum(len(r) for r in late[:to - 1]) + UDP_DATA
     assert f"first at byte {offset} (plot " in lines[0] and "mhtrack-asterix" not in lines[0]
     # today's path refuses it, naming a file the user never made
-    with pytest.raises(InputError, match="mhtrack-asterix-.*plots.parquet"):
+    with pytest.raises(InputError, match=r"mhtrack-asterix-.*plots\.parquet"):
         _today(tmp_path / "late.pcap", opensky2 / "sensors.toml")
 
 

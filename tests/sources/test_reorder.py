@@ -3,6 +3,8 @@ rule (a list sorted at every step), and the properties the rule promises."""
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
@@ -17,7 +19,7 @@ def _run(times: list[float], window: float, cuts: list[int] | None = None
     t = np.asarray(times, float)
     bounds = [0, *sorted(set(c for c in (cuts or []) if 0 < c < t.size)), t.size]
     out: list[int] = []
-    for a, b in zip(bounds[:-1], bounds[1:], strict=True):
+    for a, b in itertools.pairwise(bounds):
         got = buf.push({"time": t[a:b], "tag": np.arange(a, b)})
         if got:
             assert got["seq"].tolist() == got["tag"].tolist()  # columns travel together

@@ -59,7 +59,7 @@ def read_timed_plots(
     """
     if not reorder_window_s >= 0:
         raise ValueError(f"reorder_window_s must be >= 0, got {reorder_window_s!r}")
-    f, c = read_timed_columns(path, sensors, order=lambda f, time: _check_order(
+    _f, c = read_timed_columns(path, sensors, order=lambda f, time: _check_order(
         f, time, reorder_window_s))
     periods = {s: sensors.sensor(s).period if sensors is not None else None
                for s in np.unique(c.sensor).tolist()}

@@ -21,8 +21,8 @@ import mhtrack.io.asterix._lib as _lib
 from mhtrack.io.asterix.container import blocks, container, datagrams
 from mhtrack.io.asterix.fast import reader034, reader048
 from mhtrack.io.asterix.problems import Problems
-from mhtrack.io.asterix.timeaxis import DAY_S, TimeAxis
-from mhtrack.io.asterix.timeaxis import unwrap_days as unwrap_days  # the former home
+from mhtrack.io.asterix.timeaxis import TimeAxis
+
 #: One nautical mile (m), the unit of I048/040 RHO.
 NM_M = 1852.0
 #: One flight level (m): 100 ft of 0.3048 m.

@@ -78,19 +78,18 @@ class DatagramSource(Source):
         offset``), in decoding order; sweep marks (time on the axis) go to ``sweeps``."""
         decoder, axis = Decoder(fast=self.fast), TimeAxis()
         rows: list[tuple[Any, ...]] = []
-        times: list[np.ndarray] = []
+        times: list[float] = []
         at_rows: list[int] = []
         n = 0
         for offset, payload, when in self._datagrams(problems):
             for at, cat, found in decoder.blocks(payload, offset, problems):
-                t = axis.times([r[0] for r in found], when)
+                t = axis.times_list([r[0] for r in found], when)
                 if cat == 34:
                     if sweeps is not None:
-                        sweeps.extend((ti, *r[1:]) for ti, r in zip(t.tolist(), found,
-                                                                    strict=True))
+                        sweeps.extend((ti, *r[1:]) for ti, r in zip(t, found, strict=True))
                     continue
                 rows.extend(found)
-                times.append(t)
+                times.extend(t)
                 at_rows.extend([at] * len(found))
                 if len(rows) >= CHUNK:
                     yield self._convert(rows, times, at_rows, n)
@@ -99,7 +98,7 @@ class DatagramSource(Source):
         if rows:
             yield self._convert(rows, times, at_rows, n)
 
-    def _convert(self, rows: list[tuple[Any, ...]], times: list[np.ndarray],
+    def _convert(self, rows: list[tuple[Any, ...]], times: list[float],
                  at: list[int], n0: int) -> dict[str, np.ndarray]:
         p = plot_columns(rows)
         sensor, offset = p["sensor"], np.asarray(at, np.int64)
@@ -111,7 +110,7 @@ class DatagramSource(Source):
             mine = sensor == sid
             x[mine], y[mine], R[mine] = polar_plots(self.sensors, sid, rng[mine],
                                                     p["bearing"][mine])
-        return {"time": np.concatenate(times), "sensor": sensor, "x": x, "y": y, "R": R,
+        return {"time": np.array(times, float), "sensor": sensor, "x": x, "y": y, "R": R,
                 "file_row": np.arange(n0, n0 + sensor.size, dtype=np.int64),
                 "offset": offset}
 

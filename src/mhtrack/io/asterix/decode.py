@@ -70,16 +70,16 @@ def read_recording(path: str | Path, *, fast: bool = True) -> Recording:
     rows: list[tuple[Any, ...]] = []
     marks: list[tuple[Any, ...]] = []
     is_plot: list[bool] = []
-    times: list[np.ndarray] = []
+    times: list[float] = []
     axis = TimeAxis()
     for offset, payload, when in datagrams(data, kind, name, problems):
         for _, cat, found in decoder.blocks(payload, offset, problems):
             into = rows if cat == 48 else marks
             into.extend(found)
             is_plot.extend([cat == 48] * len(found))
-            times.append(axis.times([r[0] for r in found], when))
+            times.extend(axis.times_list([r[0] for r in found], when))
     plots, sweeps = _columns(rows, marks, np.array(is_plot, bool),
-                             np.concatenate(times) if times else np.zeros(0))
+                             np.array(times, float))
     return Recording(name, kind, plots, sweeps, problems)
 
 

@@ -18,6 +18,8 @@ with ``d`` the day of the message counted from that first day. The day ``d`` of 
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 #: Seconds in a day: times of day are modulo this.
@@ -32,45 +34,50 @@ class TimeAxis:
     """Maps times of day, in arrival order, to the monotonic axis (module docstring)."""
 
     def __init__(self) -> None:
-        self.day0: float | None = None  # capture day of the axis' first day
+        self.day0: int | float | None = None  # capture day of the axis' first day
         self.latest: float | None = None  # largest time on the axis so far
 
-    def times(self, tod: np.ndarray, capture: float | None = None) -> np.ndarray:
+    def times(self, tod: np.ndarray | list[float], capture: float | None = None
+              ) -> np.ndarray:
         """Times on the axis of the times of day ``tod`` (arrival order), all captured at
         ``capture`` (POSIX s) or without a capture time (``None``)."""
-        tod = np.asarray(tod, float).reshape(-1)
-        if tod.size == 0:
-            return tod.copy()
+        return np.array(self.times_list(np.asarray(tod, float).reshape(-1).tolist(),
+                                        capture), float)
+
+    def times_list(self, tod: list[float], capture: float | None = None) -> list[float]:
+        """:meth:`times` of a list of floats, as a list (a data block's few records: plain
+        Python is faster than NumPy there)."""
+        out = []
+        latest = self.latest
         if capture is not None:
-            day = np.round((float(capture) - tod) / DAY_S)
-            if self.day0 is None:
-                self.day0 = float(day[0]) if self.latest is None else float(
-                    day[0]) - self._day_without(float(tod[0]))
-            out = tod + DAY_S * (day - self.day0)
+            c = float(capture)
+            for x in tod:
+                day = round((c - x) / DAY_S)  # half to even, as numpy.round
+                if self.day0 is None:
+                    self.day0 = day if latest is None else day - self._day_without(x)
+                y = x + DAY_S * (day - self.day0)
+                out.append(y)
+                if latest is None or y > latest:
+                    latest = self.latest = y
         else:
-            out = np.empty(tod.size)
-            for i, x in enumerate(tod.tolist()):
-                d = 0.0 if self.latest is None else self._day_without(x)
-                out[i] = y = x + DAY_S * d
-                if self.latest is None or y > self.latest:
-                    self.latest = y
-            if self.day0 is None:
-                return out
-        top = float(out.max())
-        if self.latest is None or top > self.latest:
-            self.latest = top
+            for x in tod:
+                d = 0.0 if latest is None else self._day_without(x)
+                y = x + DAY_S * d
+                out.append(y)
+                if latest is None or y > latest:
+                    latest = self.latest = y
         return out
 
-    def _day_without(self, x: float) -> float:
+    def _day_without(self, x: float) -> int:
         """Day of time of day ``x`` by the rule without capture times."""
         assert self.latest is not None
-        k = np.floor(self.latest / DAY_S)
+        k = math.floor(self.latest / DAY_S)
         step = x - (self.latest - k * DAY_S)
         if step < -_HALF:
-            return float(k + 1)
+            return k + 1
         if step > DAY_S - MAX_LATE_S:
-            return float(k - 1)
-        return float(k)
+            return k - 1
+        return k
 
 
 def unwrap_days(tod: np.ndarray) -> np.ndarray:

@@ -12,6 +12,9 @@ one-sensor frames with :func:`mhtrack.frames.make_frames` and returns a timed
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from dataclasses import dataclass
+
 import numpy as np
 
 from mhtrack.frames import frame_lengths, make_frames
@@ -47,19 +50,60 @@ def read_timed_plots(
     own σ applies) and ``range``/``bearing`` are only carried along. With ``sensors``:
     a polar sensor's rows need ``range, bearing`` (``z, R`` by
     :func:`~mhtrack.models.geodesy.polar_to_local`), a Cartesian sensor's rows ``x, y`` or
-    ``lat, lon`` (``LocalFrame.to_local``) with ``R = σ² I``.
+    ``lat, lon`` (``LocalFrame.to_local``) with ``R = σ² I``. Rows out of time order by
+    more than ``reorder_window_s`` are refused (:mod:`mhtrack.sources` re-orders and drops
+    instead).
 
     Returns a ``PlotTable(timed=True)`` sorted by frame, then time; ``file_row[i]`` is the
     0-based file row of table row ``i``.
     """
     if not reorder_window_s >= 0:
         raise ValueError(f"reorder_window_s must be >= 0, got {reorder_window_s!r}")
+    _f, c = read_timed_columns(path, sensors, order=lambda f, time: _check_order(
+        f, time, reorder_window_s))
+    periods = {s: sensors.sensor(s).period if sensors is not None else None
+               for s in np.unique(c.sensor).tolist()}
+    frame, order = make_frames(c.time, c.sensor, frame_lengths(periods))
+
+    def take(v: np.ndarray | None) -> np.ndarray | None:
+        return None if v is None else np.ascontiguousarray(v[order])
+
+    return PlotTable(
+        scan=frame[order], time=c.time[order], sensor=c.sensor[order], x=take(c.x),
+        y=take(c.y), range=take(c.range), bearing=take(c.bearing), origin=take(c.origin),
+        R=take(c.R), timed=True, file_row=order.astype(np.int64),
+    )  # type: ignore[arg-type]
+
+
+@dataclass(frozen=True)
+class TimedColumns:
+    """The validated rows of a timed plots file, in file order, positions in the local
+    frame (``R`` ``None`` without a sensors file)."""
+
+    time: np.ndarray
+    sensor: np.ndarray
+    x: np.ndarray
+    y: np.ndarray
+    range: np.ndarray | None
+    bearing: np.ndarray | None
+    origin: np.ndarray | None
+    R: np.ndarray | None
+
+
+def read_timed_columns(
+    path: PathArg, sensors: SensorSet | None = None, *,
+    order: Callable[[Frame, np.ndarray], None] | None = None,
+) -> tuple[Frame, TimedColumns]:
+    """Read, check and convert a timed plots file (as :func:`read_timed_plots`, without
+    cutting frames): the file (for located errors) and its rows in file order. ``order``
+    checks the times before anything else is read (``read_timed_plots``: the window)."""
     f = read_frame(path, COLUMNS, REQUIRED, "timed plots")
     if f.n == 0:
         f.fail("no rows (a plots file needs at least one plot)")
     _check_pairs(f)
     time = seconds(f)
-    _check_order(f, time, reorder_window_s)
+    if order is not None:
+        order(f, time)
     sensor = f.ints("sensor")
     origin = None
     if f.has("origin"):
@@ -76,18 +120,21 @@ def read_timed_plots(
         f.check(np.abs(v) > MAX_COORDINATE, name if f.has(name) else None,
                 lambda r, v=v, name=name: f"{name} = {num(v[r])} m is beyond "
                 f"±{MAX_COORDINATE:g} m of the frame's origin (a unit or parsing error?)")
-    periods = {s: sensors.sensor(s).period if sensors is not None else None
-               for s in np.unique(sensor).tolist()}
-    frame, order = make_frames(time, sensor, frame_lengths(periods))
+    return f, TimedColumns(time, sensor, x, y, rng, bearing, origin, R)
 
-    def take(v: np.ndarray | None) -> np.ndarray | None:
-        return None if v is None else np.ascontiguousarray(v[order])
 
-    return PlotTable(
-        scan=frame[order], time=time[order], sensor=sensor[order], x=take(x), y=take(y),
-        range=take(rng), bearing=take(bearing), origin=take(origin), R=take(R),
-        timed=True, file_row=order.astype(np.int64),
-    )  # type: ignore[arg-type]
+def polar_plots(sensors: SensorSet, sensor_id: int, rng: np.ndarray, bearing: np.ndarray
+                ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``x, y, R`` in the sensors' local frame of polar radar ``sensor_id``'s plots at
+    ground ``rng`` (m) and ``bearing`` (deg), by
+    :func:`~mhtrack.models.geodesy.polar_to_local` with the radar's σ. Element-wise: a
+    plot's result does not depend on the others (the sources convert chunk by chunk)."""
+    from mhtrack.models.geodesy import polar_to_local  # pyproj only when converting
+
+    s = sensors.sensor(sensor_id)
+    z, R = polar_to_local(sensors.frame(), *sensors.site_latlon(sensor_id), rng, bearing,
+                          s.sigma_range, s.sigma_bearing_deg)
+    return z[:, 0], z[:, 1], R
 
 
 def _check_pairs(f: Frame) -> None:
@@ -174,8 +221,6 @@ def _convert(
     lat: np.ndarray | None, lon: np.ndarray | None, sensors: SensorSet,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Positions and covariances of every row in the sensors' local frame."""
-    from mhtrack.models.geodesy import polar_to_local  # pyproj only when converting
-
     ids = sensors.ids
     listed = ", ".join(str(i) for i in ids)
     f.check(~np.isin(sensor, np.asarray(ids, np.int64)), "sensor", lambda r: (
@@ -203,10 +248,8 @@ def _convert(
         if rows.size == 0:
             continue
         if s.kind == "polar":
-            z, R[rows] = polar_to_local(sensors.frame(), *sensors.site_latlon(s.id),
-                                        rng[rows], bearing[rows],  # type: ignore[index]
-                                        s.sigma_range, s.sigma_bearing_deg)
-            x[rows], y[rows] = z[:, 0], z[:, 1]
+            x[rows], y[rows], R[rows] = polar_plots(sensors, s.id, rng[rows],  # type: ignore[index]
+                                                    bearing[rows])  # type: ignore[index]
         else:
             x[rows], y[rows] = _cartesian(f, sensors, rows, s.id, lat, lon)
             R[rows] = np.eye(2) * float(s.sigma) ** 2  # type: ignore[arg-type]

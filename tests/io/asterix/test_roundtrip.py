@@ -10,8 +10,8 @@ import pyarrow.csv as pacsv
 import pytest
 
 from mhtrack.io.asterix import convert, export, read_recording
-from mhtrack.io.asterix.decode import unwrap_days
 from mhtrack.io.asterix.encode import lsb
+from mhtrack.io.asterix.timeaxis import unwrap_days
 from mhtrack.io.sensors import read_sensors
 
 

@@ -62,21 +62,28 @@ def _blocks_chain(head: bytes, size: int) -> bool:
 
 
 def add_ground_range(rec: Recording, sensors: SensorSet) -> np.ndarray:
-    """The ``range`` column (m) of a recording's plots: ground range from slant range,
-    flight level and the site's ``alt`` (:mod:`~mhtrack.io.asterix.earth`; ``alt``
-    absent = 0 m, flight level absent = the site's height); NaN for a sensor the file
-    does not list or that has no geodetic site."""
+    """The ``range`` column (m) of a recording's plots (:func:`ground_ranges`)."""
     p = rec.plots
-    out = np.full(len(rec), np.nan)
-    for sid in np.unique(p["sensor"]).tolist():
+    return ground_ranges(sensors, p["sensor"], p["slant_range"], p["bearing"],
+                         p["flight_level"])
+
+
+def ground_ranges(sensors: SensorSet, sensor: np.ndarray, slant: np.ndarray,
+                  bearing: np.ndarray, flight_level: np.ndarray) -> np.ndarray:
+    """Ground range (m) of plots: from slant range, flight level and the site's ``alt``
+    (:mod:`~mhtrack.io.asterix.earth`; ``alt`` absent = 0 m, flight level absent = the
+    site's height); NaN for a sensor the file does not list or that has no geodetic
+    site. Element-wise (the sources convert chunk by chunk)."""
+    out = np.full(sensor.size, np.nan)
+    for sid in np.unique(sensor).tolist():
         if sid not in sensors.ids or sensors.sensor(sid).lat is None:
             continue
         s = sensors.sensor(sid)
-        rows = p["sensor"] == sid
+        rows = sensor == sid
         alt = float(s.alt or 0.0)
-        h = np.where(np.isnan(p["flight_level"][rows]), alt, p["flight_level"][rows] * FL_M)
-        out[rows] = ground_range(p["slant_range"][rows], p["bearing"][rows], h,
-                                 float(s.lat), alt)  # type: ignore[arg-type]
+        h = np.where(np.isnan(flight_level[rows]), alt, flight_level[rows] * FL_M)
+        out[rows] = ground_range(slant[rows], bearing[rows], h, float(s.lat),
+                                 alt)  # type: ignore[arg-type]
     return out
 
 
@@ -117,10 +124,12 @@ def convert(source: str | Path, out: str | Path, sensors: SensorSet | None = Non
     return Converted(len(rec), rec)
 
 
-def sensors_with_periods(sensors: SensorSet, rec: Recording) -> SensorSet:
-    """``sensors`` with the rotation periods the recording's CAT034 messages give filled
-    in where the file has none (they set the length of the tracker's frames)."""
-    found = rec.periods()
+def sensors_with_periods(sensors: SensorSet, rec: Recording | dict[int, float]
+                         ) -> SensorSet:
+    """``sensors`` with the rotation periods the recording's CAT034 messages give (a
+    :class:`Recording`, or its periods) filled in where the file has none (they set the
+    length of the tracker's frames)."""
+    found = rec.periods() if isinstance(rec, Recording) else rec
     radars = tuple(replace(s, period=found[s.id]) if s.period is None and s.id in found
                    else s for s in sensors.sensors)
     return replace(sensors, sensors=radars)

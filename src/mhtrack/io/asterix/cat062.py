@@ -18,9 +18,9 @@ from mhtrack.errors import InputError
 from mhtrack.io._frame import FLOAT, INT, TIME, read_frame
 from mhtrack.io._times import seconds
 from mhtrack.io.asterix.container import blocks, container, payloads
-from mhtrack.io.asterix.decode import unwrap_days
 from mhtrack.io.asterix.encode import Message, encode_blocks, raw_tod
 from mhtrack.io.asterix.problems import Problems
+from mhtrack.io.asterix.timeaxis import unwrap_days
 from mhtrack.io.asterix.writer import write_blocks
 from mhtrack.models.radars import SensorSet
 

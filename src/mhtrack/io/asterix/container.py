@@ -55,15 +55,26 @@ def container(data: bytes, name: str, known_categories: set[int]) -> str:
 def payloads(data: bytes, kind: str, name: str, problems: Problems
              ) -> Iterator[tuple[int, bytes]]:
     """``(offset in the file, ASTERIX bytes)`` of each datagram (raw: the whole file)."""
+    for offset, payload, _ in datagrams(data, kind, name, problems):
+        yield offset, payload
+
+
+def datagrams(data: bytes, kind: str, name: str, problems: Problems
+              ) -> Iterator[tuple[int, bytes, float | None]]:
+    """``(offset in the file, ASTERIX bytes, capture time)`` of each datagram; the
+    capture time is POSIX seconds (pcap, pcapng), ``None`` where the container has none
+    (raw: the whole file, pcapng simple packet blocks). ``data`` may be a ``bytes`` or
+    an ``mmap`` of the file."""
     if kind == "raw":
-        yield 0, data
+        yield 0, data, None
     elif kind == "pcap":
         yield from _pcap(data, name, problems)
     else:
         yield from _pcapng(data, name, problems)
 
 
-def _pcap(data: bytes, name: str, problems: Problems) -> Iterator[tuple[int, bytes]]:
+def _pcap(data: bytes, name: str, problems: Problems
+          ) -> Iterator[tuple[int, bytes, float | None]]:
     if len(data) < 24:
         raise InputError(f"{name}: byte 0: pcap global header cut short ({len(data)} of "
                          "24 octets)", file=name)
@@ -71,12 +82,13 @@ def _pcap(data: bytes, name: str, problems: Problems) -> Iterator[tuple[int, byt
     link = struct.unpack_from(e + "I", data, 20)[0] & 0xFFFF
     _check_link(link, name, 20)
     rec = struct.Struct(e + "IIII")
+    frac = 1e-9 if data[:4] in (b"\x4d\x3c\xb2\xa1", b"\xa1\xb2\x3c\x4d") else 1e-6
     pos = 24
     while pos < len(data):
         if pos + 16 > len(data):
             problems.add("truncated_packet", pos)
             return
-        _, _, incl, _ = rec.unpack_from(data, pos)
+        sec, sub, incl, _ = rec.unpack_from(data, pos)
         start = pos + 16
         if start + incl > len(data):
             problems.add("truncated_packet", pos)
@@ -85,13 +97,15 @@ def _pcap(data: bytes, name: str, problems: Problems) -> Iterator[tuple[int, byt
         if found is None:
             problems.add("non_udp", pos)
         else:
-            yield found
+            yield (*found, sec + sub * frac)
         pos = start + incl
 
 
-def _pcapng(data: bytes, name: str, problems: Problems) -> Iterator[tuple[int, bytes]]:
+def _pcapng(data: bytes, name: str, problems: Problems
+            ) -> Iterator[tuple[int, bytes, float | None]]:
     e = "<"
     links: list[int] = []
+    clocks: list[tuple[float, float]] = []  # per interface: (seconds per unit, offset s)
     pos = 0
     while pos < len(data):
         if pos + 12 > len(data):
@@ -105,7 +119,7 @@ def _pcapng(data: bytes, name: str, problems: Problems) -> Iterator[tuple[int, b
             if not e:
                 raise InputError(f"{name}: byte {pos + 8}: pcapng section header without "
                                  "its byte-order magic 1a2b3c4d", file=name)
-            links = []
+            links, clocks = [], []
         total = struct.unpack_from(e + "I", data, pos + 4)[0]
         if total < 12 or pos + total > len(data):
             problems.add("truncated_packet", pos)
@@ -114,7 +128,9 @@ def _pcapng(data: bytes, name: str, problems: Problems) -> Iterator[tuple[int, b
             link = struct.unpack_from(e + "H", data, pos + 8)[0]
             _check_link(link, name, pos + 8)
             links.append(link)
+            clocks.append(_clock(data, e, pos + 16, pos + total - 4))
         elif btype in (6, 3, 2):  # enhanced, simple, obsolete packet blocks
+            stamped = btype != 3
             if btype == 6:
                 iface, cap = struct.unpack_from(e + "I", data, pos + 8)[0], \
                     struct.unpack_from(e + "I", data, pos + 20)[0]
@@ -133,8 +149,31 @@ def _pcapng(data: bytes, name: str, problems: Problems) -> Iterator[tuple[int, b
             if found is None:
                 problems.add("non_udp", pos)
             else:
-                yield found
+                when = None
+                if stamped:
+                    hi, lo = struct.unpack_from(e + "II", data, pos + 12)
+                    unit, offset = clocks[iface]
+                    when = ((hi << 32) | lo) * unit + offset
+                yield (*found, when)
         pos += total
+
+
+def _clock(data: bytes, e: str, pos: int, end: int) -> tuple[float, float]:
+    """``(seconds per timestamp unit, offset s)`` of a pcapng interface from its options
+    ``if_tsresol`` (9: 10^-v, or 2^-v with the top bit set; default 10^-6) and
+    ``if_tsoffset`` (14: seconds added)."""
+    unit, offset = 1e-6, 0.0
+    while pos + 4 <= end:
+        code, length = struct.unpack_from(e + "HH", data, pos)
+        if code == 0:
+            break
+        if code == 9 and length >= 1:
+            v = data[pos + 4]
+            unit = 2.0 ** -(v & 0x7F) if v & 0x80 else 10.0 ** -v
+        elif code == 14 and length >= 8:
+            offset = float(struct.unpack_from(e + "q", data, pos + 4)[0])
+        pos += 4 + (length + 3) // 4 * 4
+    return unit, offset
 
 
 def _check_link(link: int, name: str, offset: int) -> None:

@@ -10,6 +10,7 @@ and skipped (libasterix's strict parsing: the records must fill the block).
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -17,12 +18,11 @@ from typing import Any
 import numpy as np
 
 import mhtrack.io.asterix._lib as _lib
-from mhtrack.io.asterix.container import blocks, container, payloads
+from mhtrack.io.asterix.container import blocks, container, datagrams
 from mhtrack.io.asterix.fast import reader034, reader048
 from mhtrack.io.asterix.problems import Problems
+from mhtrack.io.asterix.timeaxis import TimeAxis
 
-#: Seconds in a day: I048/140 and I034/030 are times of day (UTC), modulo this.
-DAY_S = 86400.0
 #: One nautical mile (m), the unit of I048/040 RHO.
 NM_M = 1852.0
 #: One flight level (m): 100 ft of 0.3048 m.
@@ -50,20 +50,9 @@ class Recording:
         return int(self.plots["time"].size)
 
     def periods(self) -> dict[int, float]:
-        """Each radar's rotation period (s) from its CAT034 messages: the median I034/041
-        if sent, else the median interval between its north markers; radars with fewer
-        than two north markers and no I034/041 are left out."""
-        out: dict[int, float] = {}
-        s = self.sweeps
-        for sensor in np.unique(s["sensor"]).tolist():
-            mine = s["sensor"] == sensor
-            ars = s["period"][mine & np.isfinite(s["period"])]
-            north = np.sort(s["time"][mine & (s["kind"] == 1)])
-            if ars.size:
-                out[int(sensor)] = float(np.median(ars))
-            elif north.size >= 2:
-                out[int(sensor)] = float(np.median(np.diff(north)))
-        return out
+        """Each radar's rotation period (s) from its CAT034 messages
+        (:func:`sweep_periods`)."""
+        return sweep_periods(self.sweeps)
 
 
 def read_recording(path: str | Path, *, fast: bool = True) -> Recording:
@@ -71,52 +60,85 @@ def read_recording(path: str | Path, *, fast: bool = True) -> Recording:
     file (recognised by content). Malformed parts are counted in ``problems`` (the caller
     warns); a file that is no recording raises :class:`~mhtrack.errors.InputError`.
     ``fast=False`` decodes every record with libasterix alone (the reference path of
-    :mod:`~mhtrack.io.asterix.fast`)."""
+    :mod:`~mhtrack.io.asterix.fast`). Times are on one monotonic axis
+    (:mod:`~mhtrack.io.asterix.timeaxis`, capture times where the container has them)."""
     name = str(path)
     data = Path(path).read_bytes()
-    base, gen = _lib.modules()
-    c48, c34 = _lib.cat048(), _lib.cat034()
-    kind = container(data, name, {int(c) for c in gen.manifest["CATS"]} | {34, 48})
+    decoder = Decoder(fast=fast)
+    kind = container(data, name, decoder.categories)
     problems = Problems()
     rows: list[tuple[Any, ...]] = []
     marks: list[tuple[Any, ...]] = []
-    order: list[tuple[int, int]] = []  # (0 plot / 1 mark, index) in file order
-    bits = base.Bits.from_bytes
-    readers = {48: reader048(plot_row), 34: reader034(mark_row)} if fast else {}
-    for offset, payload in payloads(data, kind, name, problems):
+    is_plot: list[bool] = []
+    times: list[float] = []
+    axis = TimeAxis()
+    for offset, payload, when in datagrams(data, kind, name, problems):
+        for _, cat, found in decoder.blocks(payload, offset, problems):
+            into = rows if cat == 48 else marks
+            into.extend(found)
+            is_plot.extend([cat == 48] * len(found))
+            times.extend(axis.times_list([r[0] for r in found], when))
+    plots, sweeps = _columns(rows, marks, np.array(is_plot, bool),
+                             np.array(times, float))
+    return Recording(name, kind, plots, sweeps, problems)
+
+
+class Decoder:
+    """Decodes the CAT048 plots and CAT034 sweep marks of data blocks, block by block
+    (through :mod:`~mhtrack.io.asterix.fast` unless ``fast=False``)."""
+
+    def __init__(self, *, fast: bool = True) -> None:
+        base, gen = _lib.modules()
+        self.bits = base.Bits.from_bytes
+        self.specs = {48: _lib.cat048(), 34: _lib.cat034()}
+        self.categories = {int(c) for c in gen.manifest["CATS"]} | {34, 48}
+        self.readers = {48: reader048(plot_row), 34: reader034(mark_row)} if fast else {}
+
+    def blocks(self, payload: bytes, offset: int, problems: Problems
+               ) -> Iterator[tuple[int, int, list[tuple[Any, ...]]]]:
+        """``(file offset, category, rows)`` of each CAT048 or CAT034 block of one
+        datagram: plot rows (:func:`plot_row`) or sweep marks (:func:`mark_row`), in
+        record order; other blocks are counted in ``problems`` and skipped."""
         for at, cat, raw in blocks(payload, offset, problems):
             if cat not in (48, 34):
                 problems.add("unknown_category", at, detail=f"category {cat}")
                 continue
-            if cat in readers:
-                found = readers[cat].block(raw, at, problems)
+            if cat in self.readers:
+                found = self.readers[cat].block(raw, at, problems)
                 if found is None:
                     problems.add("undecodable", at, detail=f"category {cat}: records do "
                                  "not fill the block")
                     continue
-                into = rows if cat == 48 else marks
-                for row in found:
-                    order.append((0 if cat == 48 else 1, len(into)))
-                    into.append(row)
+                yield at, cat, found
                 continue
-            spec = c48 if cat == 48 else c34
-            records = spec.cv_uap.parse(bits(raw))
+            records = self.specs[cat].cv_uap.parse(self.bits(raw))
             if isinstance(records, ValueError):
                 problems.add("undecodable", at, detail=f"category {cat}: {records}")
                 continue
+            out = []
             for rec in records:
-                if cat == 48:
-                    row = plot_row(rec, at, problems)
-                    if row is not None:
-                        order.append((0, len(rows)))
-                        rows.append(row)
-                else:
-                    mark = mark_row(rec)
-                    if mark is not None:
-                        order.append((1, len(marks)))
-                        marks.append(mark)
-    plots, sweeps = _columns(rows, marks, order)
-    return Recording(name, kind, plots, sweeps, problems)
+                row = plot_row(rec, at, problems) if cat == 48 else mark_row(rec)
+                if row is not None:
+                    out.append(row)
+            yield at, cat, out
+
+
+def sweep_periods(sweeps: dict[str, np.ndarray]) -> dict[int, float]:
+    """Each radar's rotation period (s) from its CAT034 sweep marks (``time, sensor,
+    kind, period`` columns): the median I034/041 if sent, else the median interval
+    between its north markers; radars with fewer than two north markers and no I034/041
+    are left out."""
+    out: dict[int, float] = {}
+    s = sweeps
+    for sensor in np.unique(s["sensor"]).tolist():
+        mine = s["sensor"] == sensor
+        ars = s["period"][mine & np.isfinite(s["period"])]
+        north = np.sort(s["time"][mine & (s["kind"] == 1)])
+        if ars.size:
+            out[int(sensor)] = float(np.median(ars))
+        elif north.size >= 2:
+            out[int(sensor)] = float(np.median(np.diff(north)))
+    return out
 
 
 def _q(item: Any, unit: str) -> float:
@@ -173,27 +195,12 @@ def mark_row(rec: Any) -> tuple[Any, ...] | None:
     return _q(i030, "s"), sac * 256 + sic, kind, azimuth, period
 
 
-def unwrap_days(tod: np.ndarray) -> np.ndarray:
-    """Times of day (s, file order) made continuous across midnight: each step back by
-    more than half a day adds a day (``numpy.unwrap`` with period 86 400 s), so a
-    recording from 23:59 to 00:01 runs on past 86 400 s; small steps back (jitter between
-    radars) stay as they are."""
-    if tod.size == 0:
-        return tod.astype(float)
-    return np.unwrap(np.asarray(tod, float), period=DAY_S)
-
-
 def _columns(rows: list[tuple[Any, ...]], marks: list[tuple[Any, ...]],
-             order: list[tuple[int, int]]) -> tuple[dict[str, np.ndarray],
-                                                     dict[str, np.ndarray]]:
-    tod = np.array([(rows[i] if k == 0 else marks[i])[0] for k, i in order], float)
-    t = unwrap_days(tod)
-    is_plot = np.array([k == 0 for k, _ in order], bool)
-    kinds = (float, np.int64, np.int64, np.int64, float, float, float, object, object,
-             object, np.int64, np.int64)
-    cols = list(zip(*rows, strict=True)) if rows else [()] * len(PLOT_COLUMNS)
-    plots = {name: np.array(c, dtype=k) for name, c, k in zip(PLOT_COLUMNS, cols, kinds,
-                                                                strict=True)}
+             is_plot: np.ndarray, t: np.ndarray) -> tuple[dict[str, np.ndarray],
+                                                          dict[str, np.ndarray]]:
+    """Plot and sweep columns; ``t``: the axis time of every row and mark, in file order
+    (``is_plot`` telling which is which)."""
+    plots = plot_columns(rows)
     plots["time"] = t[is_plot] if t.size else np.zeros(0)
     mcols = list(zip(*marks, strict=True)) if marks else [()] * 5
     sweeps = {name: np.array(c, dtype=k) for name, c, k in zip(
@@ -201,3 +208,12 @@ def _columns(rows: list[tuple[Any, ...]], marks: list[tuple[Any, ...]],
         (float, np.int64, np.int64, float, float), strict=True)}
     sweeps["time"] = t[~is_plot] if t.size else np.zeros(0)
     return plots, sweeps
+
+
+def plot_columns(rows: list[tuple[Any, ...]]) -> dict[str, np.ndarray]:
+    """:data:`PLOT_COLUMNS` of plot rows (:func:`plot_row`); ``time`` is the time of day."""
+    kinds = (float, np.int64, np.int64, np.int64, float, float, float, object, object,
+             object, np.int64, np.int64)
+    cols = list(zip(*rows, strict=True)) if rows else [()] * len(PLOT_COLUMNS)
+    return {name: np.array(c, dtype=k) for name, c, k in zip(PLOT_COLUMNS, cols, kinds,
+                                                             strict=True)}

@@ -17,7 +17,8 @@ from typing import Any
 import numpy as np
 
 import mhtrack.io.asterix._lib as _lib
-from mhtrack.io.asterix.decode import DAY_S, NM_M
+from mhtrack.io.asterix.decode import NM_M
+from mhtrack.io.asterix.timeaxis import DAY_S
 
 #: Records per data block at most (CAT048 reports of up to ~30 octets each).
 MAX_RECORDS = 40

@@ -1,0 +1,146 @@
+"""Frames cut as the plots arrive: the same frames as :func:`mhtrack.frames.make_frames`,
+each given out as soon as no later plot can change it.
+
+Input: plots in time order (ties in input order), as batches of columns (``time``,
+``sensor`` and any others). A sensor's frame starts at its first plot and takes the
+sensor's plots while ``t − start ≤ frame_s``; it is *closed* once a plot of that sensor
+falls beyond (it starts the next frame) or the stream's time ``T`` passes
+``start + frame_s`` (every later plot has ``t ≥ T``). :func:`~mhtrack.frames.make_frames`
+numbers frames by (latest plot time ``end``, sensor id); a closed frame ``F`` therefore
+goes out once
+
+* ``end_F < T`` (a frame not yet started ends at ``≥ T``), and
+* every open frame ``G`` has ``(end_G, sensor_G) > (end_F, sensor_F)`` (an open frame's
+  end only grows),
+
+and closed frames go out in ``(end, sensor)`` order. Frames of one sensor have distinct
+ends, so make_frames' last tie-break (first row) never decides. Within a frame plots keep
+their input order, which is time order.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator, Mapping
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from mhtrack.frames import DEFAULT_FRAME_S
+
+
+@dataclass
+class _Open:
+    """A sensor's frame being filled: its start, end and the plots' positions."""
+
+    start: float
+    end: float
+    parts: list[tuple[int, np.ndarray]] = field(default_factory=list)  # (batch id, rows)
+
+
+@dataclass(frozen=True)
+class Frame:
+    """A finished frame: its number, sensor, reference time (its latest plot's) and the
+    columns of its plots in time order."""
+
+    index: int
+    sensor: int
+    time: float
+    cols: dict[str, np.ndarray]
+
+
+class Framer:
+    """Cuts time-ordered batches of plots into one-sensor frames (module docstring).
+
+    ``frame_s`` gives the longest frame per sensor id (s) or one length for all; a sensor
+    missing from the mapping gets :data:`~mhtrack.frames.DEFAULT_FRAME_S`."""
+
+    def __init__(self, frame_s: Mapping[int, float] | float = DEFAULT_FRAME_S) -> None:
+        self.frame_s = frame_s
+        self.now = -np.inf
+        self.n_frames = 0
+        self._open: dict[int, _Open] = {}
+        self._closed: list[tuple[float, int, _Open]] = []
+        self._batches: dict[int, dict[str, np.ndarray]] = {}
+        self._uses: dict[int, int] = {}
+        self._next_batch = 0
+
+    def _length(self, sensor: int) -> float:
+        f = self.frame_s
+        length = f if isinstance(f, int | float) else f.get(sensor, DEFAULT_FRAME_S)
+        if not length > 0:
+            raise ValueError(f"sensor {sensor}: frame length must be > 0, got {length!r}")
+        return float(length)
+
+    def push(self, cols: Mapping[str, np.ndarray]) -> Iterator[Frame]:
+        """Add a batch (time order, after every earlier batch); the frames it completes."""
+        t = np.asarray(cols["time"], float)
+        if t.size == 0:
+            return
+        if t[0] < self.now or (t.size > 1 and np.any(np.diff(t) < 0)):
+            raise ValueError("plots must reach the framer in time order")
+        b = self._next_batch
+        self._next_batch += 1
+        self._batches[b] = {k: np.asarray(v) for k, v in cols.items()}
+        sensor = np.asarray(cols["sensor"], np.int64)
+        uses = 0
+        for s in np.unique(sensor).tolist():
+            rows = np.flatnonzero(sensor == s)
+            ts = t[rows]
+            fr = self._open.get(s)
+            length = self._length(s)
+            cut = 0
+            while cut < rows.size:
+                if fr is None:
+                    fr = self._open[s] = _Open(float(ts[cut]), float(ts[cut]))
+                # plots of this frame: t − start ≤ length, computed as make_frames does
+                # (the difference of sorted times is sorted)
+                stop = cut + int(np.searchsorted(ts[cut:] - fr.start, length, side="right"))
+                if stop > cut:
+                    fr.parts.append((b, rows[cut:stop]))
+                    fr.end = float(ts[stop - 1])
+                    uses += 1
+                if stop < rows.size:  # a later plot starts the next frame
+                    self._close(s)
+                    fr = None
+                cut = stop
+        self._uses[b] = uses
+        self.now = float(t[-1])
+        yield from self._ready(final=False)
+
+    def flush(self) -> Iterator[Frame]:
+        """Every remaining frame (the input has ended)."""
+        for s in list(self._open):
+            self._close(s)
+        yield from self._ready(final=True)
+
+    def _close(self, sensor: int) -> None:
+        fr = self._open.pop(sensor)
+        self._closed.append((fr.end, sensor, fr))
+
+    def _ready(self, final: bool) -> Iterator[Frame]:
+        for s, fr in list(self._open.items()):  # closed by the stream's time
+            if self.now - fr.start > self._length(s):
+                self._close(s)
+        self._closed.sort(key=lambda c: (c[0], c[1]))
+        while self._closed:
+            end, s, fr = self._closed[0]
+            if not final:
+                if not end < self.now:
+                    break
+                if any((g.end, gs) < (end, s) for gs, g in self._open.items()):
+                    break
+            self._closed.pop(0)
+            yield self._emit(s, fr)
+
+    def _emit(self, sensor: int, fr: _Open) -> Frame:
+        pieces: dict[str, list[np.ndarray]] = {}
+        for b, rows in fr.parts:
+            for k, v in self._batches[b].items():
+                pieces.setdefault(k, []).append(v[rows])
+            self._uses[b] -= 1
+            if self._uses[b] == 0:
+                del self._batches[b], self._uses[b]
+        cols = {k: v[0] if len(v) == 1 else np.concatenate(v) for k, v in pieces.items()}
+        out = Frame(self.n_frames, sensor, fr.end, cols)
+        self.n_frames += 1
+        return out

@@ -1,0 +1,44 @@
+"""Which source reads a file: :func:`open_source` looks at the content, as ``mhtrack
+track`` does — an ASTERIX recording (:func:`mhtrack.io.asterix.api.is_recording`), else a
+plots table, timed or with scans (:func:`mhtrack.io.plots.is_timed`)."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+from mhtrack.errors import InputError
+from mhtrack.io._source import PathArg
+from mhtrack.sources.base import Source
+
+if TYPE_CHECKING:
+    from mhtrack.models.radars import SensorSet
+    from mhtrack.scenario import Scenario
+
+
+def open_source(path: PathArg, *, sensors: SensorSet | None = None,
+                scenario: Scenario | None = None,
+                reorder_window_s: float | None = None) -> Source:
+    """The :class:`Source` of a plots table or an ASTERIX recording at ``path``.
+
+    ``sensors``: the radars of timed plots and recordings (a recording needs them);
+    ``scenario``: the sensors and scan times of a scan table; ``reorder_window_s``: the
+    re-order window of timed plots (default
+    :data:`~mhtrack.io.timed_plots.DEFAULT_REORDER_WINDOW_S`). Nothing else is guessed:
+    a sensors file beside the plots is the caller's choice."""
+    from mhtrack.io.asterix.api import is_recording
+
+    if is_recording(path):
+        if sensors is None:
+            raise InputError(f"{path} is an ASTERIX recording: give its radars with a "
+                             "sensors file (id = SAC·256 + SIC, lat, lon, alt)",
+                             file=str(path))
+        if scenario is not None:
+            raise ValueError(f"{path} is an ASTERIX recording: its radars come from a "
+                             "sensors file, not a scenario")
+        from mhtrack.sources.recording import AsterixSource
+
+        return AsterixSource(path, sensors=sensors, reorder_window_s=reorder_window_s)
+    from mhtrack.sources.tables import TableSource
+
+    return TableSource(path, sensors=sensors, scenario=scenario,
+                       reorder_window_s=reorder_window_s)

@@ -1,0 +1,76 @@
+"""An ASTERIX recording file (pcap, pcapng or raw data blocks) as a source: the container
+is read through an ``mmap`` of the file (:func:`mhtrack.io.asterix.container.datagrams`,
+with each packet's capture time) and its datagrams fed to
+:class:`~mhtrack.sources.datagrams.DatagramSource` — decoded in memory, chunk by chunk,
+never through a temporary file.
+
+Before the frames, one pass over the recording (:meth:`AsterixSource.survey`, done once)
+finds every radar (a radar the sensors file does not list is an error, as before any
+tracking), the rotation periods its CAT034 messages give (filled into the sensors where
+the file has none: they set the frame lengths, as
+:func:`~mhtrack.io.asterix.api.sensors_with_periods` does) and every plot's ``x, y``.
+"""
+
+from __future__ import annotations
+
+import mmap
+from collections.abc import Iterator
+from contextlib import contextmanager
+from pathlib import Path
+from typing import Any
+
+from mhtrack.errors import InputError
+from mhtrack.io.asterix.api import sensors_with_periods
+from mhtrack.io.asterix.container import container, datagrams
+from mhtrack.io.asterix.decode import Decoder
+from mhtrack.io.asterix.problems import Problems
+from mhtrack.io.paths import check_input_file
+from mhtrack.models.radars import SensorSet
+from mhtrack.records import Scan
+from mhtrack.sources.base import Survey
+from mhtrack.sources.datagrams import DatagramSource
+
+
+class AsterixSource(DatagramSource):
+    """Frames from a recording file; errors name the file and the byte offset there.
+    ``container`` is ``"pcap"``, ``"pcapng"`` or ``"raw"`` (by content)."""
+
+    def __init__(self, path: str | Path, *, sensors: SensorSet,
+                 reorder_window_s: float | None = None, fast: bool = True) -> None:
+        super().__init__((), sensors=sensors, name=str(path),
+                         reorder_window_s=reorder_window_s, fast=fast)
+        self.path = check_input_file(Path(path))
+        self.given = sensors
+        with self._mapped() as data:
+            self.container = container(data, self.name, Decoder(fast=fast).categories)
+        self._survey: Survey | None = None
+
+    @contextmanager
+    def _mapped(self) -> Iterator[Any]:
+        """The file's bytes, memory-mapped (an empty file as ``b""``)."""
+        with self.path.open("rb") as fh:
+            if self.path.stat().st_size == 0:
+                yield b""
+                return
+            with mmap.mmap(fh.fileno(), 0, access=mmap.ACCESS_READ) as data:
+                yield data
+
+    def _datagrams(self, problems: Problems) -> Iterator[tuple[int, Any, float | None]]:
+        with self._mapped() as data:
+            yield from datagrams(data, self.container, self.name, problems)
+
+    def survey(self) -> Survey:
+        """The recording's radars, plots' ``x, y`` and periods (one pass, kept)."""
+        if self._survey is None:
+            periods, survey = self.periods_and_survey()
+            if survey.n_plots == 0:
+                raise InputError(f"{self.name}: no CAT048 plot with a measured position "
+                                 f"(I048/040) in this {self.container} recording",
+                                 file=self.name)
+            self.sensors = sensors_with_periods(self.given, periods)
+            self._survey = survey
+        return self._survey
+
+    def __iter__(self) -> Iterator[Scan]:
+        self.survey()
+        yield from super().__iter__()

@@ -1,0 +1,135 @@
+"""A bounded re-order buffer: plots that arrive slightly out of time order leave in time
+order; plots that arrive too late to be put in order are dropped and counted.
+
+Rule (``docs/sources.md``, *Ordering*): with ``M`` the latest plot time seen so far and
+``W`` the window (s), a plot is held until ``M − t > W``, then released; held plots leave
+in time order, ties in arrival order. A plot whose time is before the last time already
+released cannot be put in order: it is dropped, counted, and its lateness ``M − t``
+recorded. A plot at most ``W`` older than ``M`` is therefore never dropped — the same
+rows that :func:`mhtrack.io.timed_plots.read_timed_plots` accepts (a row's time ≥ the
+largest time above it − ``W``) all come through, sorted.
+
+The buffer holds the plots of the last ``W`` seconds of the stream (plus the current
+batch), never the whole input.
+"""
+
+from __future__ import annotations
+
+import heapq
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from mhtrack.io.timed_plots import DEFAULT_REORDER_WINDOW_S
+
+Columns = Mapping[str, np.ndarray]
+
+
+@dataclass
+class Late:
+    """Plots dropped for arriving too late: how many, the largest lateness (s), and the
+    first one's lateness and 1-d column values (e.g. its file row, for the warning)."""
+
+    n: int = 0
+    max_late_s: float = 0.0
+    first_late_s: float = 0.0
+    first: dict[str, object] = field(default_factory=dict)
+
+    def add(self, late_s: float, first: Callable[[], dict[str, object]]) -> None:
+        if self.n == 0:
+            self.first_late_s, self.first = late_s, first()
+        self.n += 1
+        self.max_late_s = max(self.max_late_s, late_s)
+
+    def line(self, name: str, where: str) -> str:
+        """The one warning line: ``NAME: 1 plot dropped, late by 40 s (...)``; ``where``
+        names the first dropped plot's place in the input."""
+        plural = "plot" if self.n == 1 else "plots"
+        by = (f"late by {self.max_late_s:.3g} s" if self.n == 1
+              else f"late by up to {self.max_late_s:.3g} s")
+        first = "" if self.n == 1 else f", the first late by {self.first_late_s:.3g} s"
+        return (f"{name}: {self.n} {plural} dropped, {by} (after later plots had gone to "
+                f"the tracker, beyond the reorder window; first at {where}{first})")
+
+
+class ReorderBuffer:
+    """Re-orders batches of plots (columns of equal length, one of them ``time``).
+
+    :meth:`push` takes a batch in arrival order and returns the columns of the plots it
+    releases, in time order, plus ``seq`` (each plot's 0-based arrival number);
+    :meth:`flush` releases the rest at the end of the input."""
+
+    def __init__(self, window_s: float = DEFAULT_REORDER_WINDOW_S) -> None:
+        if not window_s >= 0:
+            raise ValueError(f"reorder window must be >= 0 s, got {window_s!r}")
+        self.window_s = float(window_s)
+        self.latest = -np.inf
+        self.released = -np.inf
+        self.late = Late()
+        self.n_in = 0
+        self.reordered = 0
+        self._heap: list[tuple[float, int]] = []  # (time, seq) of the held plots
+        self._held: dict[str, np.ndarray] | None = None  # columns of held plots, by seq
+        self._held_seq = np.zeros(0, np.int64)
+
+    def push(self, cols: Columns) -> dict[str, np.ndarray]:
+        """Add a batch (arrival order); the released plots' columns, time order."""
+        t = np.asarray(cols["time"], float)
+        seq0 = self.n_in
+        self.n_in += t.size
+        out: list[int] = []
+        heap, window = self._heap, self.window_s
+        latest, released = self.latest, self.released
+        for i, ti in enumerate(t.tolist()):
+            if ti < released:
+                self.late.add(latest - ti, lambda i=i: {  # type: ignore[misc]
+                    k: np.asarray(v)[i].item() for k, v in cols.items()
+                    if np.ndim(v) == 1})
+                continue
+            if ti < latest:
+                self.reordered += 1
+            else:
+                latest = ti
+            heapq.heappush(heap, (ti, seq0 + i))
+            edge = latest - window
+            while heap and heap[0][0] < edge:
+                released, s = heapq.heappop(heap)
+                out.append(s)
+        self.latest, self.released = latest, released
+        return self._move(cols, seq0, out)
+
+    def flush(self) -> dict[str, np.ndarray]:
+        """Release every held plot (the input has ended)."""
+        out = [s for _, s in sorted(self._heap)]
+        self._heap = []
+        if out:
+            self.released = max(self.released, self._time_of(out[-1]))
+        return self._move(None, self.n_in, out)
+
+    def _time_of(self, seq: int) -> float:
+        assert self._held is not None
+        return float(self._held["time"][np.searchsorted(self._held_seq, seq)])
+
+    def _move(self, cols: Columns | None, seq0: int, out: list[int]) -> dict[str, np.ndarray]:
+        """Gather the released plots (by ``seq``) from the held ones and the batch; keep
+        the rest held."""
+        if cols is not None and len(cols["time"]):
+            new_seq = np.arange(seq0, seq0 + len(cols["time"]), dtype=np.int64)
+            batch = {k: np.asarray(v) for k, v in cols.items()}
+            if self._held is None:
+                self._held, self._held_seq = batch, new_seq
+            else:
+                self._held = {k: np.concatenate((self._held[k], batch[k])) for k in batch}
+                self._held_seq = np.concatenate((self._held_seq, new_seq))
+        if self._held is None:
+            return {}
+        seq = np.asarray(out, np.int64)
+        pos = np.searchsorted(self._held_seq, seq)
+        result = {k: v[pos] for k, v in self._held.items()}
+        result["seq"] = seq
+        keep = np.sort(np.fromiter((s for _, s in self._heap), np.int64, len(self._heap)))
+        kpos = np.searchsorted(self._held_seq, keep)
+        self._held = {k: v[kpos] for k, v in self._held.items()}
+        self._held_seq = keep
+        return result

@@ -1,0 +1,84 @@
+"""Timed plots in arrival order → frames in processing order: the re-order buffer
+(:mod:`~mhtrack.sources.reorder`), then the framer (:mod:`~mhtrack.sources.framer`),
+then :class:`~mhtrack.records.Scan` frames with running row numbers. Shared by every
+source of timed plots (tables, recordings, datagrams)."""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import Callable, Iterator, Mapping
+
+import numpy as np
+
+from mhtrack.records import Scan
+from mhtrack.sources.base import SourceStats
+from mhtrack.sources.framer import Frame, Framer
+from mhtrack.sources.reorder import ReorderBuffer
+
+
+class TimedStream:
+    """Batches of plots (columns ``time, sensor, x, y, file_row`` and optionally ``R``,
+    ``origin``; arrival order) in, :class:`Scan` frames out.
+
+    ``Scan.rows`` number the plots 0, 1, … in the order they are yielded;
+    :meth:`file_rows` maps them to the batches' ``file_row``. ``stats`` is updated as
+    plots pass; :meth:`finish` logs one warning line if plots were dropped, naming the
+    first by ``where(its column values)``."""
+
+    def __init__(self, name: str, stats: SourceStats, frame_s: Mapping[int, float] | float,
+                 window_s: float, where: Callable[[dict[str, object]], str]) -> None:
+        self.name = name
+        self.stats = stats
+        self.where = where
+        self.buffer = ReorderBuffer(window_s)
+        self.framer = Framer(frame_s)
+        self._file_rows: list[np.ndarray] = []
+        self._rows = np.zeros(0, np.int64)
+        self._n_out = 0
+
+    def push(self, cols: Mapping[str, np.ndarray]) -> Iterator[Scan]:
+        """Frames completed by one more batch of plots."""
+        self.stats.plots_in += len(cols["time"])
+        released = self.buffer.push(cols)
+        self._count()
+        if released and len(released["time"]):
+            yield from map(self._scan, self.framer.push(released))
+
+    def finish(self) -> Iterator[Scan]:
+        """The remaining frames (end of input); warns about dropped plots."""
+        released = self.buffer.flush()
+        if released and len(released["time"]):
+            yield from map(self._scan, self.framer.push(released))
+        yield from map(self._scan, self.framer.flush())
+        self._count()
+        late = self.buffer.late
+        if late.n:
+            logging.getLogger("mhtrack").warning("%s", late.line(self.name,
+                                                                 self.where(late.first)))
+
+    def _count(self) -> None:
+        b, s = self.buffer, self.stats
+        s.reordered, s.late_dropped, s.max_late_s = b.reordered, b.late.n, b.late.max_late_s
+
+    def _scan(self, fr: Frame) -> Scan:
+        c = fr.cols
+        n = len(c["time"])
+        rows = np.arange(self._n_out, self._n_out + n, dtype=np.int64)
+        self._n_out += n
+        self._file_rows.append(np.asarray(c["file_row"], np.int64))
+        self.stats.plots_out += n
+        self.stats.frames += 1
+        return Scan(index=fr.index, time=fr.time, z=np.column_stack((c["x"], c["y"])),
+                    sensor=np.asarray(c["sensor"], np.int64), rows=rows, R=c.get("R"),
+                    origin=c.get("origin"), t=np.asarray(c["time"], float))
+
+    def file_rows(self, rows: np.ndarray) -> np.ndarray:
+        """The ``file_row`` of each running row number (``-1`` stays ``-1``)."""
+        if self._file_rows:
+            self._rows = np.concatenate((self._rows, *self._file_rows))
+            self._file_rows = []
+        rows = np.asarray(rows, np.int64)
+        out = np.full(rows.shape, -1, np.int64)
+        ok = rows >= 0
+        out[ok] = self._rows[rows[ok]]
+        return out

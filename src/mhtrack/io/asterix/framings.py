@@ -24,10 +24,15 @@ Layouts (octets; multi-octet fields big-endian unless said):
 Layouts of ORADIS, GPS and Final as the Croatia Control ``asterix`` decoder reads them
 (``asterixgpssubformat``, ``asterixfinalsubformat``; facts only).
 
-Damage (a length beyond the data, a missing trailer, a time beyond a day) is skipped at the
-level of one record: the reader moves on to the next offset where a record is valid and the
-one after it too (or ends the file), counts one ``resync`` and the octets skipped, and never
-raises past the first octets (a file that is no recording: :class:`InputError`).
+Damage (a length beyond the data, a missing trailer, a time beyond a day; a pcap packet
+empty, more than a day from the one before, or whose captured length is neither its
+length nor the snap length) is skipped at the level of one record: the reader moves on to
+the next offset where :data:`CONFIRM` records in a row are valid (or valid ones end the
+file), counts one ``resync`` and the octets skipped (:func:`_walk`). It raises only on the
+file's own headers: a file that is no recording, a capture link type not read
+(:class:`InputError`, naming the byte). A raw stream has no framing of its own: a damaged
+block length that still fits takes the blocks it covers with it (the decoder then finds
+that block undecodable).
 """
 
 from __future__ import annotations
@@ -51,6 +56,10 @@ DAY_S = 86400.0
 STREAMS = ("final", "oradis", "gps", "raw")
 #: Records checked from the start to recognise a stream framing.
 PROBE = 16
+#: Records in a row that confirm where reading resumes after damage.
+CONFIRM = 3
+#: Octets searched for the first valid record of a file whose first records are damaged.
+SEARCH = 4096
 #: pcap packets longer than this are damage (the largest snap length tcpdump uses).
 MAX_PACKET = 262144
 
@@ -116,10 +125,10 @@ _AT: dict[str, Callable[[bytes, int, set[int]], int]] = {
 _START = {"final": 0, "oradis": 0, "gps": GPS_HEADER, "raw": 0}
 
 
-def _probe(data: bytes, kind: str, cats: set[int]) -> int:
-    """Records that chain from the start (at most :data:`PROBE`; :data:`PROBE` when the
+def _chain(data: bytes, kind: str, p: int, cats: set[int]) -> int:
+    """Records that chain from offset ``p`` (at most :data:`PROBE`; :data:`PROBE` when the
     chain reaches the end of the file)."""
-    at, p = _AT[kind], _START[kind]
+    at = _AT[kind]
     for k in range(PROBE):
         if p == len(data):
             return PROBE if k else 0
@@ -130,20 +139,37 @@ def _probe(data: bytes, kind: str, cats: set[int]) -> int:
     return PROBE
 
 
+def _probe(data: bytes, kind: str, cats: set[int], fallback: bool) -> int:
+    """How well the file reads as ``kind``: the records chained from its start; with
+    ``fallback``, when fewer than two do, :data:`PROBE` − 1 if a full chain (:data:`PROBE`
+    records, or two or more to the end of the file) starts within the next :data:`SEARCH`
+    octets (the first records damaged)."""
+    start = _START[kind]
+    score = _chain(data, kind, start, cats)
+    if score >= 2 or len(data) <= start or not fallback:
+        return score
+    for q in range(start + 1, min(len(data), start + SEARCH)):
+        if _AT[kind](data, q, cats) and _chain(data, kind, q, cats) == PROBE:
+            return PROBE - 1
+    return score
+
+
 def recognise(data: bytes, name: str, cats: set[int]) -> str:
     """``"pcap"``, ``"pcapng"``, ``"final"``, ``"oradis"``, ``"gps"`` or ``"raw"`` by the
     file's content (stream framings: the one whose records chain furthest from the start,
-    :data:`STREAMS` order at a tie), else an :class:`InputError` naming byte 0."""
+    :data:`STREAMS` order at a tie; when none chains two, the one whose full chain starts
+    within :data:`SEARCH` octets), else an :class:`InputError` naming byte 0."""
     if data[:4] in PCAP_MAGICS:
         return "pcap"
     if data[:4] == PCAPNG_MAGIC:
         return "pcapng"
-    best, kind = 0, ""
-    for k in STREAMS:
-        if (score := _probe(data, k, cats)) > best:
-            best, kind = score, k
-    if kind:
-        return kind
+    for fallback in (False, True):  # records chained from the start first
+        best, kind = 0, ""
+        for k in STREAMS:
+            if (score := _probe(data, k, cats, fallback)) > best:
+                best, kind = score, k
+        if best >= 2 or (kind and fallback):
+            return kind
     shown = f"starts with {data[:8].hex(' ')}" if data else "the file is empty"
     raise InputError(f"{name}: byte 0: not an ASTERIX recording ({shown}; expected pcap, "
                      "pcapng, ORADIS, GPS or Final records, or ASTERIX data blocks)",
@@ -178,26 +204,44 @@ def unwrap(offset: int, time: float | None, octets: bytes, cats: set[int]
     return out if out and p == len(octets) else [(offset, time, octets)]
 
 
-def _walk(data: bytes, start: int, at: Callable[[int], int], problems: Problems, *,
-          align: int = 1) -> Iterator[tuple[int, int]]:
-    """``(offset, length)`` of each valid record from ``start``; after damage, the next
-    offset (a multiple of ``align`` from ``start``) where a record is valid and is followed
-    by another valid one or by the end of the file."""
-    p, n = start, len(data)
+def _confirmed(data: bytes, q: int, at: Callable[[int], int]) -> bool:
+    """:data:`CONFIRM` valid records in a row from ``q``, or valid ones to the end."""
+    for _ in range(CONFIRM):
+        if q == len(data):
+            return True
+        s = at(q)
+        if not s:
+            return False
+        q += s
+    return True
+
+
+def _walk(data: bytes, start: int, at: Callable[[int], int], problems: Problems
+          ) -> Iterator[tuple[int, int]]:
+    """``(offset, length)`` of each valid record from ``start``. A record is taken when the
+    one after it is valid too (or the file ends there), or else when no record confirmed
+    by :data:`CONFIRM` valid records in a row (or by the end of the file) starts inside it
+    (it is the last good record before damage, not a false length swallowing good
+    records). After damage, reading resumes at the next confirmed record, searched octet
+    by octet (damage may add or remove octets, so no alignment is assumed)."""
+    n = len(data)
+
+    def confirmed(q: int) -> bool:
+        return _confirmed(data, q, at)
+
+    p = start
     while p < n:
         step = at(p)
-        if step:
+        if step and (p + step == n or at(p + step)
+                     or not any(confirmed(q) for q in range(p + 1, p + step))):
             yield p, step
             p += step
             continue
-        q = p + align
-        while q < n:
-            s = at(q)
-            if s and (q + s == n or at(q + s)):
-                break
-            q += align
+        q = p + 1
+        while q < n and not confirmed(q):
+            q += 1
         problems.add("resync", p)
-        problems.add("skipped_octets", p, min(q, n) - p)
+        problems.add("skipped_octets", p, q - p)
         p = q
 
 
@@ -240,15 +284,27 @@ def _pcap(data: bytes, name: str, problems: Problems) -> Iterator[Unit]:
     rec = struct.Struct(e + "IIII")
     frac_max = round(1 / unit)
 
+    last = [-1]  # the seconds of the last packet taken (-1: none yet)
+
     def at(p: int) -> int:
         if len(data) - p < 16:
             return 0
-        _, frac, incl, orig = rec.unpack_from(data, p)
-        ok = incl <= limit and orig >= incl and frac < frac_max and p + 16 + incl <= len(data)
+        sec, frac, incl, orig = rec.unpack_from(data, p)
+        ok = 0 < incl <= limit and (orig == incl or incl == snap < orig) and frac < frac_max \
+            and p + 16 + incl <= len(data) and (last[0] < 0 or abs(sec - last[0]) <= DAY_S)
         return 16 + incl if ok else 0
 
+    secs, q = [], 24  # to begin with, the median time of the first packets chained
+    while len(secs) < 5 and (step := at(q)):
+        secs.append(rec.unpack_from(data, q)[0])
+        q += step
+    if secs:
+        last[0] = sorted(secs)[len(secs) // 2]
     for p, step in _walk(data, 24, at, problems):
         sec, frac, _, _ = rec.unpack_from(data, p)
+        nxt = p + step
+        if nxt + 16 > len(data) or abs(rec.unpack_from(data, nxt)[0] - sec) <= DAY_S:
+            last[0] = sec  # the reference moves on only where the next packet agrees
         found = payload(data, p + 16, p + step, link)
         if found is None:
             problems.add("non_udp", p)
@@ -291,7 +347,7 @@ def _pcapng(data: bytes, name: str, problems: Problems) -> Iterator[Unit]:
             return 0
         return total
 
-    for p, total in _walk(data, 0, at, problems, align=4):
+    for p, total in _walk(data, 0, at, problems):
         if data[p:p + 4] == PCAPNG_MAGIC:
             state["e"] = "<" if data[p + 8] == 0x4D else ">"
             links = []

@@ -5,15 +5,18 @@ decoded by libasterix (CAT001 edition 1.4, CAT002 1.2) into the columns of CAT04
 
 A CAT001 record is a plot or a track by I001/020 TYP (each record's own UAP: plot first,
 then the track UAP when TYP = 1). Its time is I001/141, the time of day truncated to
-2¹⁶ × 1/128 s = 512 s; :class:`TimeRestorer` restores the full time of day from a
-reference ``r`` known to lie within 256 s of it — the radar's last CAT002 message
-(I002/030, full time of day), else its last restored plot, else the capture time of day —
-as ``t = r + ((t₁₄₁ − r + 256) mod 512) − 256``. A plot with no reference is counted
-(``no_time``) and dropped. A restored time of day beyond a day is impossible and refused.
+2¹⁶ × 1/128 s = 512 s. :class:`TimeRestorer` restores the full time of day from a
+reference ``r`` — the radar's last CAT002 message (I002/030, full time of day), else its
+last restored plot, else the capture time of day — as
+``t = r + ((t₁₄₁ − r + 256) mod 512) − 256``, across midnight (:func:`nearest_tod`). It is
+exact when ``r`` lies within 192 s of the plot's time (256 s, half the cycle, but the
+day's last cycle is only 384 s long: 86 400 = 168 × 512 + 384). A plot with no reference
+is counted (``no_time``) and dropped.
 """
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import numpy as np
@@ -125,6 +128,19 @@ def records002(raw: bytes) -> list[Any] | ValueError:
     return specs()[1].cv_uap.parse(base.Bits.from_bytes(raw))
 
 
+def nearest_tod(truncated: float, ref: float) -> float:
+    """The time of day in [0, 86 400) whose value modulo 512 s is ``truncated`` and which
+    is nearest to ``ref`` across midnight (exact when ``ref`` is within 192 s of it):
+    ``c = r + ((t₁₄₁ − r + 256) mod 512) − 256`` for ``r`` = ref and ref ∓ 1 day, the
+    nearest ``c`` inside the day."""
+    best, gap = ref, math.inf
+    for r in (ref, ref - DAY_S, ref + DAY_S):
+        c = r + (truncated - r + TRUNC_S / 2) % TRUNC_S - TRUNC_S / 2
+        if 0.0 <= c < DAY_S and abs(c - r) < gap:
+            best, gap = c, abs(c - r)
+    return best
+
+
 class TimeRestorer:
     """Full times of day of CAT001 plots from their truncated I001/141, per radar, in the
     order the reports arrive (streaming: O(radars) memory). Feed each radar's CAT002
@@ -153,8 +169,7 @@ class TimeRestorer:
                              "message of its radar, and no capture time")
                 return None
             ref = capture % DAY_S
-        t = ref + (truncated - ref + TRUNC_S / 2) % TRUNC_S - TRUNC_S / 2
-        t %= DAY_S
+        t = nearest_tod(truncated, ref)
         self.reference[sensor] = t
         return t
 

@@ -34,7 +34,7 @@ def plot001(time: float, sensor: int, slant: float, bearing: float, *, typ: int 
                 (("TST", tst), 0, 0, 0, 0, None)),
         "040": (("RHO", round(slant / NM_M * 128)),
                 ("THETA", round(bearing / 360.0 * 65536) % 65536)),
-        "141": round(time * 128) % 65536,
+        "141": round(time % 86400.0 * 128) % 65536,
     }
     if mode_3a:
         items["070"] = (0, 0, 0, 0, ("MODE3A", mode_3a))
@@ -47,7 +47,7 @@ def mark002(time: float, sensor: int, kind: int, azimuth: float = 0.0,
             period: float | None = None) -> Any:
     """A CAT002 north marker (``kind`` 1) or sector crossing (2, sector 360/2⁸ °)."""
     items: dict[str, Any] = {"000": kind, "010": _sid(sensor),
-                             "030": round(time * 128) % (86400 * 128)}
+                             "030": round(time % 86400.0 * 128) % (86400 * 128)}
     if kind == 2:
         items["020"] = round(azimuth / 360.0 * 256) % 256
     if period is not None:
@@ -65,7 +65,7 @@ def report021(time: float, sensor: int, lat: float, lon: float, *, nacp: int = 9
         "010": _sid(sensor),
         "040": ((0, 0, 0, ("RAB", rab), None),
                 (0, 0, ("SIM", sim), ("TST", tst), 0, 0, None)),
-        "071": round(time * 128) % (1 << 24),
+        "071": round(time % 86400.0 * 128) % (86400 * 128),
         "131": (("LAT", round(lat / step)), ("LON", round(lon / step))),
         "090": ((0, ("NUCPNIC", nucp), None), (0, 0, ("NACP", nacp), None)),
         "210": (0, ("VNS", 0), ("VN", version), ("LTT", 2)),

@@ -60,6 +60,15 @@ def flags048(rec: Any) -> tuple[int, int, int, int]:
     return _sub(v, "TYP"), _sub(v, "SIM"), _sub(v, "RAB"), _sub(v, "TST")
 
 
+def flags048_octets(octets: bytes) -> tuple[int, int, int, int]:
+    """``(typ, sim, rab, tst)`` from the raw octets of I048/020 (for byte-level readers):
+    first octet TYP bits 8–6, SIM bit 5, RAB bit 2, FX bit 1; TST bit 8 of the first
+    extension, 0 when the FX bit does not announce it."""
+    first = octets[0]
+    tst = octets[1] >> 7 if first & 1 and len(octets) > 1 else 0
+    return first >> 5, (first >> 4) & 1, (first >> 1) & 1, tst
+
+
 def real_plots(typ: np.ndarray, sim: np.ndarray, rab: np.ndarray, tst: np.ndarray, *,
                track: np.ndarray | None = None) -> tuple[np.ndarray, dict[str, int]]:
     """The mask of reports that are plots of real targets, and the count of the others

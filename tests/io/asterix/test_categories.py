@@ -238,3 +238,18 @@ def test_nearest_tod_is_ambiguous_at_192_s_before_midnight() -> None:
     assert 86400 - 168 * 512 == 384
     assert cat001.nearest_tod(0.0, 86400.0 - 150.0) == 0.0
     assert cat001.nearest_tod(0.0, 86400.0 - 250.0) == 86016.0
+
+
+def test_rows_as_columns_in_the_plot_layout() -> None:
+    from mhtrack.io.asterix.columns import columns
+    from mhtrack.io.asterix.decode import PLOT_COLUMNS
+
+    assert cat001.COLUMNS[:len(PLOT_COLUMNS)] == PLOT_COLUMNS
+    assert cat021.COLUMNS[:len(PLOT_COLUMNS)] == PLOT_COLUMNS
+    empty = columns([], cat021.COLUMNS)
+    assert all(v.size == 0 for v in empty.values()) and empty["sigma"].dtype == float
+    row = encode_other.report021(10.0, 258, 1.0, 2.0, address="ABCDEF")
+    cols = columns(cat021.block021(encode_other.blocks([(10.0, 258, 21, row)])[0][2][3:],
+                                   0, Problems()) or [], cat021.COLUMNS)
+    assert cols["address"].tolist() == ["ABCDEF"] and cols["sensor"].dtype == np.int64
+    assert np.isnan(cols["slant_range"][0]) and cols["plot_type"][0] == cat021.ADSB

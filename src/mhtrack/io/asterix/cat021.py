@@ -16,6 +16,8 @@ whose Estimated Position Uncertainty EPU bounds the horizontal error with 95 % p
 With VN 0 (DO-260): the Navigation Uncertainty Category NUCp, whose HFOM is the 95 %
 horizontal accuracy bound (RTCA DO-260, NUCp table): 9 < 3 m, 8 < 10 m, 7 < 0.05 NM,
 6 < 0.1 NM, 5 < 0.25 NM, 4 < 0.5 NM, 3 < 1 NM, 2 < 5 NM, 1 < 10 NM, 0 unknown.
+(Both tables as summarised in Airbus, "Getting to grips with surveillance", appendix E,
+and RTCA DO-242A's NUCp/NACp definitions: HFOM = EPU, the 95 % horizontal radius.)
 The bound R is taken as the 95 % radius of a circular Gaussian: P(r < R) = 1 − exp(−R²/2σ²)
 = 0.95, so σ = R / √(−2 ln 0.05) = R / 2.4477 per axis. Category 0 (unknown) gives NaN.
 """

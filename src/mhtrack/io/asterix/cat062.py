@@ -17,10 +17,11 @@ import mhtrack.io.asterix._lib as _lib
 from mhtrack.errors import InputError
 from mhtrack.io._frame import FLOAT, INT, TIME, read_frame
 from mhtrack.io._times import seconds
-from mhtrack.io.asterix.container import blocks, container, payloads
+from mhtrack.io.asterix.container import blocks
 from mhtrack.io.asterix.encode import Message, encode_blocks, raw_tod
+from mhtrack.io.asterix.framings import recognise, units
 from mhtrack.io.asterix.problems import Problems
-from mhtrack.io.asterix.timeaxis import unwrap_days
+from mhtrack.io.asterix.timeaxis import DAY_S, unwrap_days
 from mhtrack.io.asterix.writer import write_blocks
 from mhtrack.models.radars import SensorSet
 
@@ -100,25 +101,29 @@ def export_tracks(tracks: str | Path, sensors: SensorSet | None, out: str | Path
 
 
 def read_system_tracks(path: str | Path) -> tuple[dict[str, np.ndarray], Problems]:
-    """CAT062 records of a recording (pcap, pcapng or raw) as columns
-    :data:`TRACK_COLUMNS`, with the parts skipped; times continued across midnight."""
-    base, gen = _lib.modules()
-    spec = _lib.cat062()
+    """CAT062 records of a recording (any framing of :mod:`~mhtrack.io.asterix.framings`)
+    as columns :data:`TRACK_COLUMNS`, with the parts skipped; times continued across
+    midnight. A reference system's tracks for ``evaluate``: physically impossible records
+    (|lat| > 90°, |lon| > 180°, time of day ≥ 86 400 s) are refused and counted
+    (``impossible``), never passed on."""
+    gen = _lib.modules()[1]
     name = str(path)
     data = Path(path).read_bytes()
-    kind = container(data, name, {int(c) for c in gen.manifest["CATS"]} | {62})
+    cats = {int(c) for c in gen.manifest["CATS"]} | {62}
+    kind = recognise(data, name, cats)
     problems = Problems()
     rows: list[tuple[Any, ...]] = []
-    for offset, payload in payloads(data, kind, name, problems):
+    for offset, _, payload in units(data, kind, name, cats, problems):
         for at, cat, raw in blocks(payload, offset, problems):
             if cat != 62:
                 problems.add("unknown_category", at, detail=f"category {cat}")
                 continue
-            records = spec.cv_uap.parse(base.Bits.from_bytes(raw))
-            if isinstance(records, ValueError):
-                problems.add("undecodable", at, detail=f"category 62: {records}")
+            found = block062(raw, at, problems)
+            if found is None:
+                problems.add("undecodable", at, detail="category 62: records do not fill "
+                             "the block")
                 continue
-            rows += [r for r in map(_track_row, records) if r is not None]
+            rows += found
     if not rows:
         raise InputError(f"{name}: no CAT062 track with I062/010, 040, 070 and 105",
                          file=name)
@@ -126,6 +131,26 @@ def read_system_tracks(path: str | Path) -> tuple[dict[str, np.ndarray], Problem
                                              strict=True)}
     cols["time"] = unwrap_days(cols["time"].astype(float))
     return cols, problems
+
+
+def block062(raw: bytes, at: int, problems: Problems) -> list[tuple[Any, ...]] | None:
+    """The track rows (:data:`TRACK_COLUMNS`, time of day) of one CAT062 data block, the
+    impossible ones refused and counted; ``None`` when its records do not fill it."""
+    base = _lib.modules()[0]
+    records = _lib.cat062().cv_uap.parse(base.Bits.from_bytes(raw))
+    if isinstance(records, ValueError):
+        return None
+    out = []
+    for row in map(_track_row, records):
+        if row is None:
+            continue
+        t, lat, lon = row[0], row[4], row[5]
+        if abs(lat) > 90.0 or abs(lon) > 180.0 or not 0.0 <= t < DAY_S:
+            problems.add("impossible", at, detail=f"CAT062 track {row[3]}: lat {lat:g}, "
+                         f"lon {lon:g}, time {t:g} s")
+            continue
+        out.append(row)
+    return out
 
 
 def _track_row(rec: Any) -> tuple[Any, ...] | None:

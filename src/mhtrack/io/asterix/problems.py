@@ -20,6 +20,15 @@ KINDS = {
     "no_time": "{n} CAT048 report(s) without time of day (I048/140) or data source "
                "(I048/010) skipped",
     "trailing": "{n} stray byte(s) after the last data block skipped",
+    "resync": "{n} damaged framing record(s) or packet(s): reading went on at the next "
+              "valid one",
+    "skipped_octets": "{n} octet(s) of damaged framing skipped",
+    "duplicate": "{n} data block(s) received twice within the duplicate window (redundant "
+                 "LANs, re-sent packets) dropped",
+    "impossible": "{n} report(s) with a physically impossible value (latitude beyond "
+                  "±90°, time of day beyond a day, ...) refused",
+    "not_plot": "{n} report(s) that are not plots (no detection, test target, field "
+                "monitor, simulated) left out",
 }
 
 

@@ -1,0 +1,60 @@
+"""The same data block received twice — on the two LANs of a redundant network, or a
+re-sent packet — kept once (docs/file-formats.md, "ASTERIX recordings").
+
+Two data blocks are the same when their octets are equal (category, length and records,
+so the same SAC/SIC, times and plots); the second is dropped when it arrives within
+``window`` s of capture time of the first, or, for a recording without capture times,
+within the last ``span`` data blocks. A radar that sends an identical block again later
+(the same plots a rotation later cannot be: its time of day differs) is not affected.
+
+Streaming: one :meth:`DuplicateFilter.keep` call per data block, in file order; memory
+is bounded by ``span`` digests (16-octet BLAKE2b of each block) whatever the window.
+"""
+
+from __future__ import annotations
+
+import hashlib
+from collections import OrderedDict
+
+#: Default window (s): redundant LANs deliver both copies within milliseconds; a radar's
+#: next identical block would be a rotation (≥ 1 s) later.
+WINDOW_S = 0.5
+#: Default number of recent blocks remembered.
+SPAN = 4096
+
+
+class DuplicateFilter:
+    """``keep(block, time)`` is ``False`` for a block seen within the window; counts in
+    :attr:`dropped`."""
+
+    def __init__(self, window: float = WINDOW_S, span: int = SPAN) -> None:
+        if not window >= 0.0 or span < 1:
+            raise ValueError(f"duplicate window {window} s and span {span} blocks: the "
+                             "window must be ≥ 0 and the span ≥ 1")
+        self.window, self.span = float(window), int(span)
+        self.seen: OrderedDict[bytes, tuple[float | None, int]] = OrderedDict()
+        self.count = 0
+        self.dropped = 0
+
+    def keep(self, block: bytes, time: float | None = None) -> bool:
+        """Whether this data block (its whole octets, header included) is new: not seen
+        within ``window`` s (with capture times) or within the last ``span`` blocks."""
+        self.count += 1
+        key = hashlib.blake2b(block, digest_size=16).digest()
+        prev = self.seen.get(key)
+        if prev is not None:
+            if abs(time - prev[0]) <= self.window if time is not None and prev[0] is not None \
+                    else self.count - prev[1] <= self.span:
+                self.dropped += 1
+                return False
+            del self.seen[key]
+        self.seen[key] = (time, self.count)
+        while len(self.seen) > self.span:
+            self.seen.popitem(last=False)
+        if time is not None:
+            while self.seen:
+                first_t = next(iter(self.seen.values()))[0]
+                if first_t is None or time - first_t <= self.window:
+                    break
+                self.seen.popitem(last=False)
+        return True

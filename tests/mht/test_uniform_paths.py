@@ -6,6 +6,7 @@ import dataclasses
 
 import numpy as np
 import pytest
+from frame_fixture import frame
 from leaves_fixture import random_leaves
 from test_gate_dense import _problem
 
@@ -76,9 +77,9 @@ def test_gate_without_loglik_gives_the_same_pairs(seed):
     assert swept.loglik is None and np.array_equal(swept.d2, full.d2)
     # the budget path of the stage, too
     lv = random_leaves(rng, M)
-    caps: dict = {}
-    g = Gate(0.999, max(1, M * N // 3)).pairs(lv, x, P, z, R, caps, loglik=False)
-    h = Gate(0.999, max(1, M * N // 3)).pairs(lv, x, P, z, R, {})
+    f = frame(z, R, max_gated_pairs=max(1, M * N // 3))
+    g = Gate(0.999).pairs(f, lv, x, P, loglik=False)
+    h = Gate(0.999).pairs(f, lv, x, P)
     assert g.loglik is None and np.array_equal(g.track, h.track) and np.array_equal(g.d2, h.d2)
 
 

@@ -13,6 +13,7 @@ from typing import Any
 
 import numpy as np
 
+from mhtrack.mht.context import FrameContext
 from mhtrack.mht.gating import Gated
 from mhtrack.mht.tree import NO_PLOT, Leaves, filled
 from mhtrack.models.motion import MotionModel, States, row_index
@@ -63,26 +64,19 @@ def propose_children(
     return Children(parent, plot, score, np.maximum(leaves.peak[parent], score), pair)
 
 
-def grow_children(
-    leaves: Leaves,
-    pred: States,
-    children: Children,
-    z: np.ndarray,
-    R: np.ndarray,
-    rows: np.ndarray,
-    motion: MotionModel,
-    time: float,
-    pair_pred: States | None = None,
-    plot_time: np.ndarray | None = None,
-    posterior: Any = None,
-) -> Leaves:
+def grow_children(frame: FrameContext, leaves: Leaves, pred: States, children: Children, *,
+                  motion: MotionModel, pair_pred: States | None = None,
+                  posterior: Any = None) -> Leaves:
     """Materialise ``children`` as leaves: misses keep the prediction ``pred`` (at the
-    frame's ``time``), updates get the motion model's update with their plot (``R``
-    shared (2, 2) or per plot (n, 2, 2); with an IMM, each model's update and ``x, P``
-    their mixture). With asynchronous plots the update starts from ``pair_pred``, the
-    parent predicted to its plot's own time (one row per gated pair), and the child's
-    time is the plot's, ``plot_time`` (n,). ``posterior``: per gated pair, what the
-    gate computed for the update (:attr:`~mhtrack.mht.gating.Gated.posterior`)."""
+    frame's time), updates get the motion model's update with their plot of the frame
+    (``frame.R`` shared (2, 2) or per plot (n, 2, 2); with an IMM, each model's update and
+    ``x, P`` their mixture). With asynchronous plots the update starts from
+    ``pair_pred``, the parent predicted to its plot's own time (one row per gated pair),
+    and the child's time is the plot's (``frame.t``, when the frame has plot times).
+    ``posterior``: per gated pair, what the gate computed for the update
+    (:attr:`~mhtrack.mht.gating.Gated.posterior`)."""
+    z, R, rows, time = frame.z, frame.R, frame.rows, frame.time
+    plot_time = frame.t
     par, plot = children.parent, children.plot
     st = pred.take(par)
     child_time = filled(len(par), float(time), float)

@@ -63,8 +63,6 @@ __all__ = ["EMResult", "Mixture", "PruneRule", "e_step", "fit_em", "gaussian_log
 _EPS10 = 10.0 * np.finfo(float).eps  # sklearn adds this to n_j so that no n_j is 0
 _TWO_PI = 2.0 * np.pi
 _COV_ROWS = np.array([0, 2, 2, 1])  # rows of (Σxx, Σyy, Σxy) giving [[Σxx, Σxy], [Σxy, Σyy]]
-# NumPy's reductions called directly (what ``.sum()``/``.any()`` call): the same results
-_sum, _any = np.add.reduce, np.logical_or.reduce
 
 #: A pruning rule: normalised Gaussian weights (K,) → mask of the components to keep.
 PruneRule = Callable[[np.ndarray], np.ndarray]
@@ -102,9 +100,9 @@ def e_step(
 
 def _mean_ll(norm: np.ndarray, sample_weight: np.ndarray | None) -> float:
     """``L = (1/Σs) Σ_i s_i log c(z_i)`` from the plots' ``log c`` (unweighted: ``mean``'s
-    own sum and division, without its wrapper)."""
+    own sum and division)."""
     if sample_weight is None:
-        return float(np.add.reduce(norm) / len(norm))
+        return float(norm.mean())
     return float(sample_weight @ norm / sample_weight.sum())
 
 
@@ -143,11 +141,11 @@ def _m_step(
     k = r_t.shape[0] - 1
     if sums is None:
         r = np.ascontiguousarray(r_t.T)
-        col = _sum(r, axis=0)
+        col = r.sum(axis=0)
     else:
         r, col = np.ascontiguousarray(sums[0][:, :k + 1]), sums[1]
     nk_all = col + _EPS10
-    total = _sum(nk_all)
+    total = nk_all.sum()
     nk = nk_all[1:]
     means = (r[:, 1:].T @ z) / nk[:, None]
     d = offsets_t(z_t, means)
@@ -159,10 +157,10 @@ def _m_step(
     q[:2] += reg_covar
     if box is None:
         w0 = 0.0
-        w = nk / _sum(nk)
+        w = nk / nk.sum()
     else:
         w0 = float(max(nk_all[0] / total, background_floor))
-        g = _sum(nk)
+        g = nk.sum()
         w = (1.0 - w0) * nk / g if g > 0 else nk * 0.0
     return w, means, q, w0, nk, d
 
@@ -265,14 +263,14 @@ def fit_em(
             deleted = k - int(np.count_nonzero(keep))
             if prune is not None and deleted < k:
                 wk = np.where(keep, w, 0.0) if deleted else w  # the same floats as where's
-                keep &= prune(wk / _sum(wk))
+                keep &= prune(wk / wk.sum())
                 deleted = k - int(np.count_nonzero(keep))
-            if deleted and not (_any(keep) or box is not None):
+            if deleted and not (keep.any() or box is not None):
                 deleted = 0  # nothing would be left: keep the components, not an empty model
             if deleted:  # keep the Gaussians kept; renormalise them to 1 − π₀ (P1 after eq. 12)
                 kept = keep.nonzero()[0]  # np.flatnonzero's indices
                 w = w.take(kept)
-                s = _sum(w)
+                s = w.sum()
                 if s > 0:
                     w = w * (1.0 - w0) / s
                 if not len(w):
@@ -330,7 +328,7 @@ def _e_step_gain(
     np.exp(resp, out=resp)
     _neg_log_ratio(weights, resp[1:], norm, log_bg, bg0, both[k + 1:])
     nat = np.ascontiguousarray(both.T)
-    col = _sum(nat, axis=0)
+    col = nat.sum(axis=0)
     return resp, col[k + 1:], (nat, col[:k + 1])
 
 

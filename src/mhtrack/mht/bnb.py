@@ -22,7 +22,7 @@ import itertools
 
 import numpy as np
 
-from mhtrack.mht.tree import changes
+from mhtrack.kernels import changes
 
 #: One tree's options, best first: ``(score, plot mask, leaf)``.
 Option = tuple[float, int, int]

@@ -12,6 +12,7 @@ from dataclasses import replace
 
 import numpy as np
 
+from mhtrack.kernels import changes
 from mhtrack.mht.caps import CHILDREN_PER_PLOT, MISSES_PER_TREE
 from mhtrack.mht.config import MHTConfig
 from mhtrack.mht.context import FrameContext
@@ -22,7 +23,6 @@ from mhtrack.mht.sprt import SPRT
 from mhtrack.mht.tree import (
     NO_PLOT,
     Leaves,
-    changes,
     segment_ids,
     segment_sizes,
     segment_starts,

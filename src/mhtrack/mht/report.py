@@ -9,7 +9,7 @@ import numpy as np
 
 from mhtrack.mht.context import FrameContext
 from mhtrack.mht.hypothesis import GlobalHypothesis
-from mhtrack.mht.tree import Leaves, filled
+from mhtrack.mht.tree import Leaves
 from mhtrack.records import Scan, TrackTable
 
 
@@ -71,7 +71,7 @@ def report(scan: Scan, leaves: Leaves, stepped: np.ndarray | None = None,
     n = sel.size
     # ``take``: a copy of the rows, without fancy indexing's set-up
     return TrackTable(
-        scan=filled(n, int(scan.index)),
+        scan=np.full(n, int(scan.index), np.int64),
         time=leaves.time.take(sel),
         track_id=leaves.track.take(sel),
         x=x[:, 0].copy(),

@@ -27,7 +27,7 @@ import numpy as np
 from mhtrack.mht.context import FrameContext
 from mhtrack.mht.coverage import Looks
 from mhtrack.mht.gating import Gate, Gated
-from mhtrack.mht.tree import FIELDS, Leaves, contains
+from mhtrack.mht.tree import Leaves, contains
 from mhtrack.models.linalg2 import gaussian_loglik2, sym_mahalanobis2
 from mhtrack.models.motion import MotionModel, States
 
@@ -50,19 +50,9 @@ def split_looked(leaves: Leaves, looks: Looks) -> tuple[Leaves, Looks, Leaves]:
             leaves.take(~mask))
 
 
-#: Stores of no leaves by (window width, IMM models): the idle part of a scan that
-#: stepped every tree (its arrays are never written).
-_EMPTY: dict[tuple[int, int], Leaves] = {}
-
-
 def _no_leaves(leaves: Leaves) -> Leaves:
-    """An empty store shaped as ``leaves`` (one per shape, reused)."""
-    key = (leaves.window.shape[1], leaves.mu.shape[1])
-    empty = _EMPTY.get(key)
-    if empty is None:
-        # copies: a view would keep the whole store it was sliced from alive
-        empty = _EMPTY[key] = Leaves(*[getattr(leaves, f)[:0].copy() for f in FIELDS])
-    return empty
+    """An empty store shaped as ``leaves``."""
+    return leaves.take(np.zeros(0, np.int64))
 
 
 def gate_looked(frame: FrameContext, gate: Gate, leaves: Leaves, pred: States, *,

@@ -1,34 +1,34 @@
 """The track-oriented MHT (P1 §1.3, Fig. 1): one call of :meth:`MHTTracker.step` per scan.
 
-The tracking cycle, one stage per line of :meth:`MHTTracker.step`::
+The tracking cycle, one stage per line of :meth:`MHTTracker.step`, each given the frame's
+context (:class:`~mhtrack.mht.context.FrameContext`: validated plots, scaled limits, the
+tracks on air, the caps' counters) where it needs more than its own arrays::
 
-    validate         validate.validate_scan          the scan at the library boundary
-    coverage         coverage.Coverage               P_D of each leaf (0: sensor did not look)
-    looked-at trees  timed.split_looked              trees the frame steps; others carried
-    predict          predict.predict_leaves          all leaves to the scan time (motion model)
-    gate             timed.gate_looked               every leaf against every plot (each at
-                                                       its plot's own time), ln p(z|T)
-    clutter          intensity.clutter_intensity     κ̂(z) of the scan's plots (estimator)
-    score            scoring.update_increment        ΔL of every gated pair
-    extend trees     extend.propose_children         miss + one child per gated plot
-    propose births   births.Birth.propose            new trees' first leaves (birth process)
-    prune children   pruning.prune_children          SPRT deletion, score drop, caps — before
-                                                     the (costly) update
-    grow             extend.grow_children            the children's filter update
-    seed births      births.Birth.seed               the new trees, with tree ids
-    number nodes,    numbering.number_and_merge      leaf ids for the history links; the
-    merge                                              trees the frame did not step back
-    global hyp.      hypothesis.best_hypothesis      clusters → best compatible leaves
-    N-scan pruning   pruning.prune_after_solve       decide scan k − N; cap on trees
-    hand over        identity.hand_over              a track follows its plots
-    confirm          sprt.SPRT.confirms,             SPRT (or M-of-N) confirmation → new
-                     identity.confirm                  track ids
-    backfill         history.TentativeHistory        the tentative past of new tracks
-    forget           Birth.forget_used,              the confirmed tracks' plots leave the
-                     ClutterEstimator.forget           birth window and the estimator's
-    report           report.report, StepStats        confirmed tracks of the best hypothesis
-    caps             caps.scan_config, CapWarnings   limits scaled to the scan's plots and
-                                                     tracks; log the hard caps that acted
+    validate    validate.validate_scan,         the scan at the library boundary; limits
+                context.FrameContext.of           scaled to its plots and tracks (caps)
+    look        coverage.Coverage,              P_D of each leaf (0: sensor did not look);
+                timed.split_looked                trees the frame steps, others carried
+    predict     predict.predict_leaves          all leaves to the scan time (motion model)
+    gate        timed.gate_looked               every leaf against every plot (each at
+                                                  its plot's own time), ln p(z|T)
+    clutter     intensity.clutter_intensity     κ̂(z) of the scan's plots (estimator)
+    score       scoring.update_increment        ΔL of every gated pair
+    propose     extend.propose_children,        miss + one child per gated plot; new
+                births.Birth.propose              trees' first leaves (birth process)
+    prune       pruning.prune_children          SPRT deletion, score drop, caps — before
+                                                  the (costly) update
+    grow        extend.grow_children            the children's filter update
+    births      births.Birth.seed,              the new trees, with tree ids; leaf ids for
+                numbering.number_and_merge        the history links; idle trees merged back
+    hypothesis  hypothesis.best_hypothesis      clusters → best compatible leaves
+    prune       pruning.prune_after_solve       N-scan: decide scan k − N; cap on trees
+    confirm     identity.hand_over,             a track follows its plots; SPRT (or
+                sprt.SPRT.confirms,               M-of-N) confirmation → new track ids;
+                history.TentativeHistory          the tentative past of new tracks
+    report      report.report, StepStats,       the confirmed tracks' plots leave the
+                Birth.forget_used,                birth window and the estimator's; the
+                ClutterEstimator.forget,          confirmed tracks of the best hypothesis;
+                caps.CapWarnings                  log the hard caps that acted
 
 The motion model (:class:`~mhtrack.models.motion.MotionModel`: CV or IMM), the clutter
 estimator (:class:`~mhtrack.clutter.base.ClutterEstimator`), the birth process

@@ -30,7 +30,7 @@ import numpy as np
 
 from mhtrack.mht.context import FrameContext
 from mhtrack.mht.numbering import Counter
-from mhtrack.mht.tree import Leaves, filled, new_trees
+from mhtrack.mht.tree import Leaves, new_trees
 from mhtrack.models.motion import MotionModel, row_index
 
 
@@ -94,7 +94,7 @@ class Birth(ABC):
         cand, group = self.select(frame, cand, leaf_window)
         first = trees.take(int(group.max()) + 1 if len(cand) else 0)
         scan = frame.scan
-        time = filled(len(cand), float(scan.time), float) if cand.time is None else cand.time
+        time = np.full(len(cand), float(scan.time), float) if cand.time is None else cand.time
         return new_trees(self.motion.new_states(cand.x, cand.P), cand.score, cand.peak,
                          first + group, int(scan.index), cand.n_updates, cand.window, time)
 

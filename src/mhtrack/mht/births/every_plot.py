@@ -56,7 +56,7 @@ class EveryPlotBirth(Birth):
         scan, z, R, rows = frame.scan, frame.z, frame.R, frame.rows
         pd = self.p_detection if self.plot_pd is None else self.plot_pd(scan)
         score = birth_score(kappa, pd, self.new_target_density)
-        sel = (score > self.floor).nonzero()[0]  # np.flatnonzero without its wrapper
+        sel = np.flatnonzero(score > self.floor)
         if sel.size > self.max_per_scan:
             gated_first = np.zeros(len(z), bool) if in_gates is None else in_gates
             order = sel[np.lexsort((-score[sel], gated_first[sel]))]
@@ -65,8 +65,7 @@ class EveryPlotBirth(Birth):
         n = sel.size
         x, P = one_point_state(z.take(sel, axis=0), R if R.ndim == 2 else R.take(sel, axis=0),
                                self.v_max)
-        window = np.empty((n, self.width), np.int64)  # np.full without its wrapper
-        window.fill(NO_PLOT)
+        window = np.full((n, self.width), NO_PLOT, np.int64)
         window[:, -1] = rows.take(sel)
         start = np.asarray(score.take(sel), float)
         return BirthCandidates(x, P, start, start.copy(), window, np.ones(n, np.int64),

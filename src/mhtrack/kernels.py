@@ -9,6 +9,20 @@ from __future__ import annotations
 
 import numpy as np
 
+#: ``a.sum(axis)`` and ``a.max(axis)``: NumPy's reductions called directly, without the
+#: methods' Python wrappers — the same results. ``sum_(w)`` of a mixture's few weights
+#: 0.65 against 1.43 µs, of a (9, 300) array 1.85 against 2.07 µs; ~35 calls a scan in EM
+#: (:mod:`mhtrack.clutter.em`, :mod:`mhtrack.clutter.density`), ~1.2 % of a scan.
+sum_, max_ = np.add.reduce, np.maximum.reduce
+
+
+def mean(a: np.ndarray) -> float:
+    """``a.mean()`` of a 1-D float array: its sum divided by its length, ndarray.mean's own
+    formula, without the method's dispatch.
+
+    1.0 against 3.1 µs on 300 plots; ~6 calls a scan (EM's log-likelihood), ~1 %."""
+    return sum_(a) / len(a)
+
 
 def changes(sorted_keys: np.ndarray) -> np.ndarray:
     """Mask over the rows of ``sorted_keys``: the row starts a run of equal values (the
@@ -20,6 +34,31 @@ def changes(sorted_keys: np.ndarray) -> np.ndarray:
     flag[:1] = True
     np.not_equal(sorted_keys[1:], sorted_keys[:-1], out=flag[1:])
     return flag
+
+
+def segment_sizes(starts: np.ndarray, n: int) -> np.ndarray:
+    """Rows of each segment from its ``starts`` over ``n`` rows: ``np.diff(np.r_[starts,
+    n])``.
+
+    2.6 against 7.9 µs on 15 segments (no index-trick set-up); ~3 calls a scan, ~1.2 %."""
+    sizes = np.empty(starts.size, np.int64)
+    np.subtract(starts[1:], starts[:-1], out=sizes[:-1])
+    sizes[-1:] = n - starts[-1:]
+    return sizes
+
+
+def cov_biased(z: np.ndarray) -> np.ndarray:
+    """``np.cov(z.T, bias=True)`` of (n ≥ 2, 2) points: NumPy's own steps for this case
+    (copy, subtract the row means, ``dot(X, Xᵀ)``, times ``1/n``) without its argument
+    handling — the same floats.
+
+    11.6 against 25.7 µs on 30 points; ~0.9 calls a scan (a k-means++ start of new
+    clutter components), ~1 %."""
+    x = np.array(z.T, ndmin=2, dtype=np.float64)
+    x -= (sum_(x, axis=1) / x.shape[1])[:, None]
+    c = np.dot(x, x.T.conj())
+    c *= np.true_divide(1, x.shape[1])
+    return c
 
 
 def same_floats(a: np.ndarray, b: np.ndarray) -> bool:

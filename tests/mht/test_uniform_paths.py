@@ -11,12 +11,13 @@ from leaves_fixture import random_leaves
 from test_gate_dense import _problem
 
 from mhtrack.build import default_config, make_tracker
+from mhtrack.kernels import segment_sizes
 from mhtrack.mht import gating
 from mhtrack.mht.coverage import Everywhere, Looks
 from mhtrack.mht.gating import Gate, gate_sweep, gate_threshold
 from mhtrack.mht.identity import Reported
 from mhtrack.mht.timed import split_looked
-from mhtrack.mht.tree import FIELDS, segment_sizes, segment_starts
+from mhtrack.mht.tree import FIELDS, segment_starts
 from mhtrack.models.imm import CVModelSet
 from mhtrack.models.motion import ConstantVelocity
 from mhtrack.scenario import preset, simulate

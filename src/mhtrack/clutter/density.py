@@ -21,6 +21,7 @@ from math import isfinite
 
 import numpy as np
 
+from mhtrack.kernels import max_, sum_
 from mhtrack.models.linalg2 import LOG_2PI, sym_det2, sym_mahalanobis2
 
 
@@ -33,20 +34,20 @@ def plot_sums(a_t: np.ndarray, width: int) -> np.ndarray:
     are those of ``a`` (and of several such arrays side by side). A lone column (``width``
     1) is summed as a contiguous vector (pairwise), which each row of ``a_t`` is."""
     if width < 2:
-        return a_t.sum(axis=1)
-    return np.ascontiguousarray(a_t.T).sum(axis=0)
+        return sum_(a_t, axis=1)
+    return sum_(np.ascontiguousarray(a_t.T), axis=0)
 
 
 def _lse_t(a_t: np.ndarray) -> np.ndarray:
     """``log Σ_j exp(a_ij)`` per plot of the component-major ``a_t`` (≥ 1 row); the
     maximum (exact in any order) over ``a_t``, the sum over components as
     ``.sum(axis=1)`` of the plot-major row-major array. Caller ignores log 0 warnings."""
-    m = a_t.max(axis=0)
+    m = max_(a_t, axis=0)
     # a finite sum: every maximum is finite, and np.where would copy m as it is
-    m_safe = m if isfinite(m.sum()) else np.where(np.isfinite(m), m, 0.0)
+    m_safe = m if isfinite(sum_(m)) else np.where(np.isfinite(m), m, 0.0)
     e = np.subtract(a_t, m_safe)
     np.exp(e, out=e)
-    s = np.ascontiguousarray(e.T).sum(axis=1)
+    s = sum_(np.ascontiguousarray(e.T), axis=1)
     np.log(s, out=s)
     s += m_safe
     return s

@@ -55,6 +55,7 @@ from mhtrack.clutter.density import (
     plots_t,
     weighted_t,
 )
+from mhtrack.kernels import mean, sum_
 from mhtrack.models.linalg2 import sym_mahalanobis2
 
 __all__ = ["EMResult", "Mixture", "PruneRule", "e_step", "fit_em", "gaussian_log_pdf",
@@ -100,9 +101,9 @@ def e_step(
 
 def _mean_ll(norm: np.ndarray, sample_weight: np.ndarray | None) -> float:
     """``L = (1/Σs) Σ_i s_i log c(z_i)`` from the plots' ``log c`` (unweighted: ``mean``'s
-    own sum and division)."""
+    own sum and division, :func:`mhtrack.kernels.mean`)."""
     if sample_weight is None:
-        return float(norm.mean())
+        return float(mean(norm))
     return float(sample_weight @ norm / sample_weight.sum())
 
 
@@ -141,11 +142,11 @@ def _m_step(
     k = r_t.shape[0] - 1
     if sums is None:
         r = np.ascontiguousarray(r_t.T)
-        col = r.sum(axis=0)
+        col = sum_(r, axis=0)
     else:
         r, col = np.ascontiguousarray(sums[0][:, :k + 1]), sums[1]
     nk_all = col + _EPS10
-    total = nk_all.sum()
+    total = sum_(nk_all)
     nk = nk_all[1:]
     means = (r[:, 1:].T @ z) / nk[:, None]
     d = offsets_t(z_t, means)
@@ -157,10 +158,10 @@ def _m_step(
     q[:2] += reg_covar
     if box is None:
         w0 = 0.0
-        w = nk / nk.sum()
+        w = nk / sum_(nk)
     else:
         w0 = float(max(nk_all[0] / total, background_floor))
-        g = nk.sum()
+        g = sum_(nk)
         w = (1.0 - w0) * nk / g if g > 0 else nk * 0.0
     return w, means, q, w0, nk, d
 
@@ -263,14 +264,14 @@ def fit_em(
             deleted = k - int(np.count_nonzero(keep))
             if prune is not None and deleted < k:
                 wk = np.where(keep, w, 0.0) if deleted else w  # the same floats as where's
-                keep &= prune(wk / wk.sum())
+                keep &= prune(wk / sum_(wk))
                 deleted = k - int(np.count_nonzero(keep))
             if deleted and not (keep.any() or box is not None):
                 deleted = 0  # nothing would be left: keep the components, not an empty model
             if deleted:  # keep the Gaussians kept; renormalise them to 1 − π₀ (P1 after eq. 12)
                 kept = keep.nonzero()[0]  # np.flatnonzero's indices
                 w = w.take(kept)
-                s = w.sum()
+                s = sum_(w)
                 if s > 0:
                     w = w * (1.0 - w0) / s
                 if not len(w):
@@ -328,7 +329,7 @@ def _e_step_gain(
     np.exp(resp, out=resp)
     _neg_log_ratio(weights, resp[1:], norm, log_bg, bg0, both[k + 1:])
     nat = np.ascontiguousarray(both.T)
-    col = nat.sum(axis=0)
+    col = sum_(nat, axis=0)
     return resp, col[k + 1:], (nat, col[:k + 1])
 
 

@@ -353,7 +353,7 @@ class MixtureClutter(ClutterEstimator):
         glp = log_pdf_t(maha, det)
         free = self.n_components - prev.n_components
         if free > 0:
-            far = np.flatnonzero(maha.min(axis=0) > CHI2_2_99)
+            far = (maha.min(axis=0) > CHI2_2_99).nonzero()[0]
             if len(far) >= max(self.min_points, 1.0):
                 novel = z.take(far, axis=0)
                 centres = kmeanspp_centres(novel, free, rng(), existing=means)

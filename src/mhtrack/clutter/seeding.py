@@ -6,6 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from mhtrack.clutter.em import Mixture
+from mhtrack.kernels import cov_biased
 
 _EYE2 = np.eye(2)
 #: Scans whose generators :class:`ScanRngs` makes together. Setting one up is mostly
@@ -86,7 +87,7 @@ def mixture_from_centres(
     np.divide(sums, counts[:, None], out=means, where=n_in[:, None] > 0)
     cov = np.empty((k, 2, 2))
     if min(sizes) < 3:  # some centre keeps the broad covariance
-        data_cov = np.cov(z.T, bias=True) if len(z) > 1 else np.zeros((2, 2))
+        data_cov = cov_biased(z) if len(z) > 1 else np.zeros((2, 2))
         cov[:] = data_cov / k + reg
     if max(sizes) >= 3:
         grouped = z.take(lab.argsort(kind="stable"), axis=0)  # centre by centre, in plot order

@@ -12,7 +12,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from mhtrack.kernels import changes
+from mhtrack.kernels import changes, segment_sizes
 from mhtrack.mht.caps import CHILDREN_PER_PLOT, MISSES_PER_TREE
 from mhtrack.mht.config import MHTConfig
 from mhtrack.mht.context import FrameContext
@@ -24,7 +24,6 @@ from mhtrack.mht.tree import (
     NO_PLOT,
     Leaves,
     segment_ids,
-    segment_sizes,
     segment_starts,
     take_deferred,
 )

@@ -52,7 +52,7 @@ def split_looked(leaves: Leaves, looks: Looks) -> tuple[Leaves, Looks, Leaves]:
 
 def _no_leaves(leaves: Leaves) -> Leaves:
     """An empty store shaped as ``leaves``."""
-    return leaves.take(np.zeros(0, np.int64))
+    return Leaves.empty(leaves.window.shape[1], leaves.n_models)
 
 
 def gate_looked(frame: FrameContext, gate: Gate, leaves: Leaves, pred: States, *,

@@ -169,7 +169,7 @@ class MHTTracker:
         out = self._report(f, leaves, stepped)
         self.last_stats = StepStats.of(f, leaves, births=births, hyp=hyp, out=out,
                                        time_s=time.perf_counter() - t0)
-        self._cap_warnings(f.index, f.caps, f.n_plots, f.scaled_limits())
+        self._cap_warnings(f.index, f.caps, f.n_plots, self.last_stats.limits)
         return out
 
     # ------------------------------------------------------------------ stages

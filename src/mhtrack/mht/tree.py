@@ -199,11 +199,6 @@ def segment_starts(sorted_keys: np.ndarray) -> np.ndarray:
     return changes(sorted_keys).nonzero()[0]
 
 
-def segment_sizes(starts: np.ndarray, n: int) -> np.ndarray:
-    """Rows of each segment from its ``starts`` over ``n`` rows."""
-    return np.diff(np.r_[starts, n])
-
-
 def segment_ids(sorted_keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """``(starts, seg)``: segment starts and, per row, the index of its segment."""
     starts = segment_starts(sorted_keys)

@@ -56,7 +56,7 @@ class EveryPlotBirth(Birth):
         scan, z, R, rows = frame.scan, frame.z, frame.R, frame.rows
         pd = self.p_detection if self.plot_pd is None else self.plot_pd(scan)
         score = birth_score(kappa, pd, self.new_target_density)
-        sel = np.flatnonzero(score > self.floor)
+        sel = (score > self.floor).nonzero()[0]
         if sel.size > self.max_per_scan:
             gated_first = np.zeros(len(z), bool) if in_gates is None else in_gates
             order = sel[np.lexsort((-score[sel], gated_first[sel]))]

@@ -21,7 +21,7 @@ from math import isfinite
 
 import numpy as np
 
-from mhtrack.kernels import max_, sum_
+from mhtrack.kernels import max_, min_, sum_
 from mhtrack.models.linalg2 import LOG_2PI, sym_det2, sym_mahalanobis2
 
 
@@ -157,7 +157,7 @@ class Mixture:
             return out, (out[0] if len(z) else None)
         x0, x1, y0, y1 = self.background_box
         x, y = z[:, 0], z[:, 1]
-        if len(z) and (x.min() >= x0 and x.max() <= x1 and y.min() >= y0 and y.max() <= y1):
+        if len(z) and (min_(x) >= x0 and max_(x) <= x1 and min_(y) >= y0 and max_(y) <= y1):
             out = np.full(len(z), -np.log(self.background_area))  # all inside the box
             return out, out[0]
         inside = (x >= x0) & (x <= x1) & (y >= y0) & (y <= y1)

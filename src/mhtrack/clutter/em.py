@@ -55,7 +55,7 @@ from mhtrack.clutter.density import (
     plots_t,
     weighted_t,
 )
-from mhtrack.kernels import mean, sum_
+from mhtrack.kernels import any_, mean, sum_
 from mhtrack.models.linalg2 import sym_mahalanobis2
 
 __all__ = ["EMResult", "Mixture", "PruneRule", "e_step", "fit_em", "gaussian_log_pdf",
@@ -266,7 +266,7 @@ def fit_em(
                 wk = np.where(keep, w, 0.0) if deleted else w  # the same floats as where's
                 keep &= prune(wk / sum_(wk))
                 deleted = k - int(np.count_nonzero(keep))
-            if deleted and not (keep.any() or box is not None):
+            if deleted and not (any_(keep) or box is not None):
                 deleted = 0  # nothing would be left: keep the components, not an empty model
             if deleted:  # keep the Gaussians kept; renormalise them to 1 − π₀ (P1 after eq. 12)
                 kept = keep.nonzero()[0]  # np.flatnonzero's indices

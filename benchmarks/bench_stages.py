@@ -35,10 +35,10 @@ sys.path.insert(0, str(HERE.parent / "tests" / "mht"))
 import mhtrack.mht.tracker as T  # noqa: E402
 
 #: The tracker module's names, in the order of the cycle, and the stage they time.
-STAGES = ["validate_scan", "scan_config", "predict_leaves", "gate_looked",
+STAGES = ["validate_scan", "predict_leaves", "gate_looked",
           "plots_in_confirmed_gates", "clutter_intensity", "update_increment",
           "miss_increments", "propose_children", "prune_children", "grow_children",
-          "number_nodes", "merge_by_tree", "number_and_merge", "best_hypothesis", "solver_caps",
+          "number_nodes", "merge_by_tree", "number_and_merge", "best_hypothesis",
           "removed_after_solve", "prune_after_solve", "hand_over", "confirm",
           "newly_confirmed", "report", "confirmed_windows"]
 ACC: dict[str, float] = {}

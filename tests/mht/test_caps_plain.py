@@ -208,6 +208,8 @@ def _prune_case(n_conf: int, n_tent: int, seed: int):
 def test_prune_children_picks_the_rule_by_the_scene_budget(seed):
     """Within the scene's budget the rule spares the confirmed tree; over it, it cuts
     every tree (``scene_leaves`` the children less births must exceed)."""
+    from frame_fixture import frame
+
     from mhtrack.mht.pruning import prune_children
     from mhtrack.mht.sprt import SPRT
 
@@ -215,8 +217,9 @@ def test_prune_children_picks_the_rule_by_the_scene_budget(seed):
     cfg = MHTConfig(max_leaves_per_tree=20)  # each tree has 24 children: the cap acts
     sprt = SPRT.from_config(cfg)
     for budget, name in ((10**6, "max_tentative_per_plot"), (10, "max_leaves_per_plot")):
-        caps: dict[str, int] = {}
-        out = prune_children(lv, ch, 0, sprt, cfg, caps, budget)
+        f = frame(max_leaves_per_tree=20, scene_leaves=budget)
+        out = prune_children(f, lv, ch, sprt, n_births=0)
+        caps = f.caps
         assert set(caps) == {name, "max_leaves_per_tree"} or set(caps) == {name}
         conf = lv.track[out.parent] >= 0
         if name == "max_tentative_per_plot":  # the confirmed tree: only the per-tree cap

@@ -6,6 +6,7 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
+from frame_fixture import frame
 from leaves_fixture import leaves_of_trees
 
 from mhtrack.mht.numbering import Counter, number_and_merge
@@ -47,11 +48,10 @@ def test_prune_after_solve_with_parts_is_the_same(seed):
     lazy = number_and_merge(grown, births, idle, Counter(9), defer_states=True)
     chosen = np.unique(rng.choice(len(ref), 6))
     for max_trees in (1000, 12):
-        caps_ref: dict[str, int] = {}
-        caps_got: dict[str, int] = {}
-        _same(prune_after_solve(lazy, chosen, max_trees, caps_got, parts=(grown, births)),
-              prune_after_solve(ref, chosen, max_trees, caps_ref))
-        assert caps_got == caps_ref
+        f_ref, f_got = frame(max_trees=max_trees), frame(max_trees=max_trees)
+        _same(prune_after_solve(f_got, lazy, chosen, parts=(grown, births)),
+              prune_after_solve(f_ref, ref, chosen))
+        assert f_got.caps == f_ref.caps
 
 
 def test_placeholders_are_read_only_nans_and_columns_replace():

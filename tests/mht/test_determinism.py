@@ -5,7 +5,6 @@ import numpy as np
 
 from mhtrack.experiments.pipeline import TrackingRun
 from mhtrack.mht import MHTConfig, MHTTracker
-from mhtrack.mht.caps import solver_caps
 from mhtrack.mht.hypothesis import GlobalHypothesis
 from mhtrack.mht.report import StepStats
 from mhtrack.records import Scan, TrackTable
@@ -23,10 +22,17 @@ def test_run_caps_sum_each_cap_and_count_the_scans_where_any_acted():
     assert TrackingRun("mht", TrackTable.empty(), (_stats(0, {}),)).caps == {}
 
 
-def test_the_node_limit_is_reported_as_a_cap():
-    caps: dict[str, int] = {}
-    solver_caps(GlobalHypothesis(np.zeros(0, np.int64), 0.0, n_node_limited=2), caps)
-    assert caps == {"milp_node_limit": 2}
+def test_the_node_limit_is_reported_as_a_cap(monkeypatch):
+    """The tracker's hypothesis stage counts the clusters the node limit stopped."""
+    from mhtrack.mht import tracker
+
+    def stopped(*a, **k):
+        return GlobalHypothesis(np.zeros(0, np.int64), 0.0, n_node_limited=2)
+
+    monkeypatch.setattr(tracker, "best_hypothesis", stopped)
+    trk = MHTTracker(MHTConfig(imm_sigma_v=0.0))
+    trk.step(Scan.from_positions(0, 0.0, np.zeros((0, 2))))
+    assert trk.last_stats is not None and trk.last_stats.caps == {"milp_node_limit": 2}
 
 
 def test_the_config_has_no_time_limit():

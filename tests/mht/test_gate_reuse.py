@@ -5,8 +5,10 @@ per-plot ``R``, scans and timed plots, one block and several)."""
 
 import numpy as np
 import pytest
+from frame_fixture import frame
 
 from mhtrack.mht import extend
+from mhtrack.mht.coverage import Looks
 from mhtrack.mht.gating import Gate
 from mhtrack.mht.timed import gate_looked
 from mhtrack.mht.tree import Leaves, one_point_state
@@ -43,8 +45,9 @@ def test_grow_with_the_gates_posterior_equals_grow_without(motion, timed, shared
     R = (np.array([[900.0, 40.0], [40.0, 1600.0]]) if shared_R
          else np.array([[900.0, 40.0], [40.0, 1600.0]]) * rng.uniform(0.5, 2, (m, 1, 1)))
     t = rng.uniform(3.0, 4.0, m) if timed else None
-    gated, pair_pred = gate_looked(Gate(0.9999, 10**6), leaves, pred, np.ones(n), z, R, t,
-                                   4.0, motion, {})
+    f = frame(z, R, rows=np.arange(100, 100 + m), t=t, time=4.0, max_gated_pairs=10**6)
+    gated, pair_pred = gate_looked(f, Gate(0.9999), leaves, pred,
+                                   looks=Looks(np.ones(n), np.ones(n, bool)), motion=motion)
     assert len(gated) > 30
     assert (gated.posterior is None) == (motion.n_models == 0)
     children = extend.propose_children(leaves, gated, -1.0, rng.normal(size=len(gated)))
@@ -52,9 +55,9 @@ def test_grow_with_the_gates_posterior_equals_grow_without(motion, timed, shared
     children = children.take(keep)  # pruned: the pairs left are not all, nor in a row
     if block is not None:
         monkeypatch.setattr(extend, "UPDATE_BLOCK", block)
-    args = (leaves, pred, children, z, R, np.arange(100, 100 + m), motion, 4.0, pair_pred, t)
-    plain = extend.grow_children(*args)
-    reused = extend.grow_children(*args, gated.posterior)
+    plain = extend.grow_children(f, leaves, pred, children, motion=motion, pair_pred=pair_pred)
+    reused = extend.grow_children(f, leaves, pred, children, motion=motion, pair_pred=pair_pred,
+                                  posterior=gated.posterior)
     for name, a in plain.arrays().items():
         assert a.tobytes() == reused.arrays()[name].tobytes(), name
 

@@ -4,6 +4,7 @@ the single constant-velocity model, with scans and with timed plots (``pair_pred
 
 import numpy as np
 import pytest
+from frame_fixture import frame
 
 from mhtrack.mht import extend
 from mhtrack.mht.gating import Gated
@@ -33,9 +34,10 @@ def test_blocks_give_the_leaves_of_one_pass(motion, timed, monkeypatch):
     t = rng.uniform(3.0, 4.0, m) if timed else None
     pair_pred = (motion.predict(leaves.states().take(gated.track), t[gated.plot])
                  if timed else None)
-    one = extend.grow_children(leaves, pred, children, z, R, rows, motion, 4.0, pair_pred, t)
+    f = frame(z, R, rows=rows, t=t, time=4.0)
+    one = extend.grow_children(f, leaves, pred, children, motion=motion, pair_pred=pair_pred)
     monkeypatch.setattr(extend, "UPDATE_BLOCK", 7)
-    got = extend.grow_children(leaves, pred, children, z, R, rows, motion, 4.0, pair_pred, t)
+    got = extend.grow_children(f, leaves, pred, children, motion=motion, pair_pred=pair_pred)
     assert np.count_nonzero(children.plot >= 0) > 3 * 7  # several blocks, the last short
     for name, a in one.arrays().items():
         assert np.array_equal(got.arrays()[name], a), name

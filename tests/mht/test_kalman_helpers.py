@@ -3,6 +3,7 @@ with the general matrix forms they shortcut (``tests/reference/kalman_reference.
 
 import kalman_reference as ref
 import numpy as np
+from frame_fixture import frame
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -108,14 +109,13 @@ def test_gate_within_budget_gates_confirmed_then_best_leaves():
     leaves = _Leaves(rng.normal(size=M), np.where(rng.random(M) < 0.2, 7, -1))
     counts = gate_candidate_counts(x, P, z, R, gate_threshold(0.999))
     for budget in (10**9, int(counts.sum()), int(counts.sum()) // 3):
-        gate = Gate(0.999, budget)
-        gate.max_pairs = budget
-        caps: dict[str, int] = {}
-        g = gate.pairs(leaves, x, P, z, R, caps)
+        gate = Gate(0.999)
+        f = frame(z, R, max_gated_pairs=budget)
+        g = gate.pairs(f, leaves, x, P)
         order = np.lexsort((-leaves.score, leaves.track < 0))
         sel = np.sort(order[np.cumsum(counts[order]) <= budget])
         want = ref.gate(x[sel], P[sel], z, R, gate.gamma)
         assert np.array_equal(g.track, sel[want.track]) and np.array_equal(g.plot, want.plot)
         np.testing.assert_allclose(g.loglik, want.loglik, rtol=1e-12, atol=1e-12)
-        assert caps.get("max_gated_pairs", 0) == M - sel.size
+        assert f.caps.get("max_gated_pairs", 0) == M - sel.size
         assert (sel.size < M) == (budget < counts.sum())

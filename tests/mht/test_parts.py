@@ -16,6 +16,7 @@ from mhtrack.clutter import KnownClutter
 from mhtrack.clutter.base import ClutterEstimator
 from mhtrack.mht import MHTConfig, MHTTracker
 from mhtrack.mht.births.base import Birth, BirthCandidates
+from mhtrack.mht.context import FrameContext
 from mhtrack.mht.tree import NO_PLOT, one_point_state
 from mhtrack.models.motion import ConstantVelocity, MotionModel
 from mhtrack.records import Scan
@@ -56,13 +57,13 @@ class FirstScanBirth(Birth):
         super().__init__(motion)
         self.score, self.width, self.done = score, width, False
 
-    def propose(self, scan: Scan, z: np.ndarray, R: np.ndarray, rows: np.ndarray,
-                kappa: np.ndarray, in_gates: np.ndarray | None,
-                caps: dict[str, int]) -> BirthCandidates:
+    def propose(self, frame: FrameContext, kappa: np.ndarray,
+                in_gates: np.ndarray | None) -> BirthCandidates:
         if self.done:
             return BirthCandidates.empty(self.width)
         self.done = True
-        x, P = one_point_state(z, R, 300.0)
+        z, rows = frame.z, frame.rows
+        x, P = one_point_state(z, frame.R, 300.0)
         window = np.full((len(z), self.width), NO_PLOT, np.int64)
         window[:, -1] = rows
         s = np.full(len(z), self.score)

@@ -223,6 +223,7 @@ def test_prune_after_solve_equals_the_former_tree_cap():
     under the limit, and limits the kept leaves do and do not exceed)."""
     from dataclasses import replace
 
+    from frame_fixture import frame
     from leaves_fixture import leaves_of_trees
 
     from mhtrack.mht.pruning import cap_trees, n_scan_keep, prune_after_solve
@@ -242,9 +243,9 @@ def test_prune_after_solve_equals_the_former_tree_cap():
             if cut:
                 ref_caps["max_trees"] = cut
                 keep[np.flatnonzero(keep)[~kt]] = False
-        caps: dict[str, int] = {}
-        got = prune_after_solve(lv, chosen, max_trees, caps)
+        f = frame(max_trees=max_trees)
+        got = prune_after_solve(f, lv, chosen)
         ref = replace(lv.take(np.flatnonzero(keep)), chosen=is_chosen[keep])
-        assert caps == ref_caps
+        assert f.caps == ref_caps
         for name, a in ref.arrays().items():
             np.testing.assert_array_equal(got.arrays()[name], a, err_msg=name)

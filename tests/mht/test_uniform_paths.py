@@ -6,16 +6,18 @@ import dataclasses
 
 import numpy as np
 import pytest
+from frame_fixture import frame
 from leaves_fixture import random_leaves
 from test_gate_dense import _problem
 
 from mhtrack.build import default_config, make_tracker
+from mhtrack.kernels import segment_sizes
 from mhtrack.mht import gating
 from mhtrack.mht.coverage import Everywhere, Looks
 from mhtrack.mht.gating import Gate, gate_sweep, gate_threshold
 from mhtrack.mht.identity import Reported
 from mhtrack.mht.timed import split_looked
-from mhtrack.mht.tree import FIELDS, segment_sizes, segment_starts
+from mhtrack.mht.tree import FIELDS, segment_starts
 from mhtrack.models.imm import CVModelSet
 from mhtrack.models.motion import ConstantVelocity
 from mhtrack.scenario import preset, simulate
@@ -46,7 +48,7 @@ def test_uniform_looks_give_the_per_leaf_paths_stores(tracker):
     assert len(fast.leaves) > 0
 
 
-def test_split_looked_every_leaf_returns_one_unattached_empty_store():
+def test_split_looked_every_leaf_returns_an_unattached_empty_store():
     lv = random_leaves(np.random.default_rng(1), 30)
     looks = Everywhere(0.9).detection(None, lv.x, lv.P, lv.time)
     assert looks.uniform == 0.9
@@ -55,9 +57,6 @@ def test_split_looked_every_leaf_returns_one_unattached_empty_store():
     for f in FIELDS:  # the shapes and types of the store's rows, not a view of it
         a, b = getattr(idle, f), getattr(lv, f)
         assert a.shape[1:] == b.shape[1:] and a.dtype == b.dtype and a.base is None
-    other = random_leaves(np.random.default_rng(2), 5)  # same shapes: the same store
-    assert split_looked(other, Everywhere(0.5).detection(None, other.x, other.P,
-                                                          other.time))[2] is idle
 
 
 @pytest.mark.parametrize("seed", range(12))
@@ -76,9 +75,9 @@ def test_gate_without_loglik_gives_the_same_pairs(seed):
     assert swept.loglik is None and np.array_equal(swept.d2, full.d2)
     # the budget path of the stage, too
     lv = random_leaves(rng, M)
-    caps: dict = {}
-    g = Gate(0.999, max(1, M * N // 3)).pairs(lv, x, P, z, R, caps, loglik=False)
-    h = Gate(0.999, max(1, M * N // 3)).pairs(lv, x, P, z, R, {})
+    f = frame(z, R, max_gated_pairs=max(1, M * N // 3))
+    g = Gate(0.999).pairs(f, lv, x, P, loglik=False)
+    h = Gate(0.999).pairs(f, lv, x, P)
     assert g.loglik is None and np.array_equal(g.track, h.track) and np.array_equal(g.d2, h.d2)
 
 

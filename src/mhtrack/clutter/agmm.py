@@ -46,7 +46,7 @@ def keep_mass(weights: np.ndarray, mass: float = P1_MASS) -> np.ndarray:
     keep = np.zeros(w.size, bool)
     if w.size == 0:
         return keep
-    order = (-w).argsort(kind="stable")  # np.argsort's own call, without its wrapper
+    order = (-w).argsort(kind="stable")
     m, csum = w.size, 0.0
     for i, v in enumerate(w[order].tolist()):  # np.cumsum's additions, in its order
         csum += v

@@ -21,11 +21,8 @@ from math import isfinite
 
 import numpy as np
 
+from mhtrack.kernels import max_, min_, sum_
 from mhtrack.models.linalg2 import LOG_2PI, sym_det2, sym_mahalanobis2
-
-# NumPy's reductions called directly (what ``.sum()``/``.min()``/``.max()`` call, without
-# the methods' Python wrappers): the same results
-_sum, _min, _max = np.add.reduce, np.minimum.reduce, np.maximum.reduce
 
 
 def plot_sums(a_t: np.ndarray, width: int) -> np.ndarray:
@@ -37,20 +34,20 @@ def plot_sums(a_t: np.ndarray, width: int) -> np.ndarray:
     are those of ``a`` (and of several such arrays side by side). A lone column (``width``
     1) is summed as a contiguous vector (pairwise), which each row of ``a_t`` is."""
     if width < 2:
-        return _sum(a_t, axis=1)
-    return _sum(np.ascontiguousarray(a_t.T), axis=0)
+        return sum_(a_t, axis=1)
+    return sum_(np.ascontiguousarray(a_t.T), axis=0)
 
 
 def _lse_t(a_t: np.ndarray) -> np.ndarray:
     """``log Σ_j exp(a_ij)`` per plot of the component-major ``a_t`` (≥ 1 row); the
     maximum (exact in any order) over ``a_t``, the sum over components as
     ``.sum(axis=1)`` of the plot-major row-major array. Caller ignores log 0 warnings."""
-    m = _max(a_t, axis=0)
+    m = max_(a_t, axis=0)
     # a finite sum: every maximum is finite, and np.where would copy m as it is
-    m_safe = m if isfinite(_sum(m)) else np.where(np.isfinite(m), m, 0.0)
+    m_safe = m if isfinite(sum_(m)) else np.where(np.isfinite(m), m, 0.0)
     e = np.subtract(a_t, m_safe)
     np.exp(e, out=e)
-    s = _sum(np.ascontiguousarray(e.T), axis=1)
+    s = sum_(np.ascontiguousarray(e.T), axis=1)
     np.log(s, out=s)
     s += m_safe
     return s
@@ -160,7 +157,7 @@ class Mixture:
             return out, (out[0] if len(z) else None)
         x0, x1, y0, y1 = self.background_box
         x, y = z[:, 0], z[:, 1]
-        if len(z) and (_min(x) >= x0 and _max(x) <= x1 and _min(y) >= y0 and _max(y) <= y1):
+        if len(z) and (min_(x) >= x0 and max_(x) <= x1 and min_(y) >= y0 and max_(y) <= y1):
             out = np.full(len(z), -np.log(self.background_area))  # all inside the box
             return out, out[0]
         inside = (x >= x0) & (x <= x1) & (y >= y0) & (y <= y1)

@@ -55,6 +55,7 @@ from mhtrack.clutter.density import (
     plots_t,
     weighted_t,
 )
+from mhtrack.kernels import any_, mean, sum_
 from mhtrack.models.linalg2 import sym_mahalanobis2
 
 __all__ = ["EMResult", "Mixture", "PruneRule", "e_step", "fit_em", "gaussian_log_pdf",
@@ -63,8 +64,6 @@ __all__ = ["EMResult", "Mixture", "PruneRule", "e_step", "fit_em", "gaussian_log
 _EPS10 = 10.0 * np.finfo(float).eps  # sklearn adds this to n_j so that no n_j is 0
 _TWO_PI = 2.0 * np.pi
 _COV_ROWS = np.array([0, 2, 2, 1])  # rows of (Σxx, Σyy, Σxy) giving [[Σxx, Σxy], [Σxy, Σyy]]
-# NumPy's reductions called directly (what ``.sum()``/``.any()`` call): the same results
-_sum, _any = np.add.reduce, np.logical_or.reduce
 
 #: A pruning rule: normalised Gaussian weights (K,) → mask of the components to keep.
 PruneRule = Callable[[np.ndarray], np.ndarray]
@@ -102,9 +101,9 @@ def e_step(
 
 def _mean_ll(norm: np.ndarray, sample_weight: np.ndarray | None) -> float:
     """``L = (1/Σs) Σ_i s_i log c(z_i)`` from the plots' ``log c`` (unweighted: ``mean``'s
-    own sum and division, without its wrapper)."""
+    own sum and division, :func:`mhtrack.kernels.mean`)."""
     if sample_weight is None:
-        return float(np.add.reduce(norm) / len(norm))
+        return float(mean(norm))
     return float(sample_weight @ norm / sample_weight.sum())
 
 
@@ -143,11 +142,11 @@ def _m_step(
     k = r_t.shape[0] - 1
     if sums is None:
         r = np.ascontiguousarray(r_t.T)
-        col = _sum(r, axis=0)
+        col = sum_(r, axis=0)
     else:
         r, col = np.ascontiguousarray(sums[0][:, :k + 1]), sums[1]
     nk_all = col + _EPS10
-    total = _sum(nk_all)
+    total = sum_(nk_all)
     nk = nk_all[1:]
     means = (r[:, 1:].T @ z) / nk[:, None]
     d = offsets_t(z_t, means)
@@ -159,10 +158,10 @@ def _m_step(
     q[:2] += reg_covar
     if box is None:
         w0 = 0.0
-        w = nk / _sum(nk)
+        w = nk / sum_(nk)
     else:
         w0 = float(max(nk_all[0] / total, background_floor))
-        g = _sum(nk)
+        g = sum_(nk)
         w = (1.0 - w0) * nk / g if g > 0 else nk * 0.0
     return w, means, q, w0, nk, d
 
@@ -265,14 +264,14 @@ def fit_em(
             deleted = k - int(np.count_nonzero(keep))
             if prune is not None and deleted < k:
                 wk = np.where(keep, w, 0.0) if deleted else w  # the same floats as where's
-                keep &= prune(wk / _sum(wk))
+                keep &= prune(wk / sum_(wk))
                 deleted = k - int(np.count_nonzero(keep))
-            if deleted and not (_any(keep) or box is not None):
+            if deleted and not (any_(keep) or box is not None):
                 deleted = 0  # nothing would be left: keep the components, not an empty model
             if deleted:  # keep the Gaussians kept; renormalise them to 1 − π₀ (P1 after eq. 12)
                 kept = keep.nonzero()[0]  # np.flatnonzero's indices
                 w = w.take(kept)
-                s = _sum(w)
+                s = sum_(w)
                 if s > 0:
                     w = w * (1.0 - w0) / s
                 if not len(w):
@@ -330,7 +329,7 @@ def _e_step_gain(
     np.exp(resp, out=resp)
     _neg_log_ratio(weights, resp[1:], norm, log_bg, bg0, both[k + 1:])
     nat = np.ascontiguousarray(both.T)
-    col = _sum(nat, axis=0)
+    col = sum_(nat, axis=0)
     return resp, col[k + 1:], (nat, col[:k + 1])
 
 

@@ -30,6 +30,7 @@ from mhtrack.clutter.base import ClutterEstimator
 from mhtrack.clutter.density import PDF_DIRECT, log_pdf_t, maha_det_t, offsets_t, plots_t
 from mhtrack.clutter.em import Mixture, PruneRule, fit_em
 from mhtrack.clutter.seeding import ScanRngs, kmeanspp_centres, mixture_from_centres
+from mhtrack.kernels import all_, max_, min_, same_floats, sum_
 from mhtrack.models.clutter import Region
 from mhtrack.records import Scan
 
@@ -186,7 +187,7 @@ class MixtureClutter(ClutterEstimator):
         Raises ``ValueError`` for non-finite plots or a mask of the wrong shape.
         """
         z = np.asarray(scan.z, dtype=float).reshape(-1, 2)
-        if not _all(np.isfinite(z), axis=None):
+        if not all_(np.isfinite(z), axis=None):
             raise ValueError(f"scan {scan.index}: plots must be finite")
         if in_track_gates is not None:
             mask = np.asarray(in_track_gates, dtype=bool).reshape(-1)
@@ -240,12 +241,11 @@ class MixtureClutter(ClutterEstimator):
         0 before any plot was seen. Always finite and ≥ 0."""
         z = np.asarray(z, dtype=float).reshape(-1, 2)
         m, cached = self.mixture_, self._scan_log_c  # cached: with a fit, finite plots, M̂ > 0
-        if (cached is not None and m is cached[2] and cached[0].shape == z.shape
-                and cached[0].tobytes() == z.tobytes()
+        if (cached is not None and m is cached[2] and same_floats(cached[0], z)
                 and len(z) * max(m.n_components, 1) <= PDF_DIRECT):
             # the scan's own plots: M̂ · m.pdf(z) = M̂ · exp(m.log_pdf(z)), log c from the fit
             return self.count_ * np.exp(cached[1])
-        if not _all(np.isfinite(z), axis=None):
+        if not all_(np.isfinite(z), axis=None):
             raise ValueError("intensity: positions must be finite")
         if m is None or self.count_ == 0.0:
             return np.zeros(len(z))
@@ -319,7 +319,7 @@ class MixtureClutter(ClutterEstimator):
         # operations on Python floats that (2,) arrays would do
         x, y = z[:, 0], z[:, 1]
         box: list[float] = []
-        for lo, hi in ((float(_min(x)), float(_max(x))), (float(_min(y)), float(_max(y)))):
+        for lo, hi in ((float(min_(x)), float(max_(x))), (float(min_(y)), float(max_(y)))):
             mid, half = 0.5 * (lo + hi), max(0.5 * (hi - lo) * 1.1, 0.5 * self.min_extent)
             box += (mid - half, mid + half)
         return (box[0], box[1], box[2], box[3])
@@ -346,14 +346,14 @@ class MixtureClutter(ClutterEstimator):
         if prev is None or prev.n_components == 0:
             return None, None
         bg = max(prev.background_weight, self._start_weight()) if self.background else 0.0
-        w = prev.weights * (1.0 - bg) / _sum(prev.weights)
+        w = prev.weights * (1.0 - bg) / sum_(prev.weights)
         means, cov = prev.means, prev.covariances
         z_t = plots_t(z)
         maha, det = maha_det_t(*offsets_t(z_t, means), cov)
         glp = log_pdf_t(maha, det)
         free = self.n_components - prev.n_components
         if free > 0:
-            far = (_min(maha, axis=0) > CHI2_2_99).nonzero()[0]  # np.flatnonzero's indices
+            far = (min_(maha, axis=0) > CHI2_2_99).nonzero()[0]
             if len(far) >= max(self.min_points, 1.0):
                 novel = z.take(far, axis=0)
                 centres = kmeanspp_centres(novel, free, rng(), existing=means)
@@ -366,12 +366,6 @@ class MixtureClutter(ClutterEstimator):
                     glp = np.concatenate((glp, log_pdf_t(*maha_det_t(
                         *offsets_t(z_t, new.means), new.covariances))))
         return Mixture(w, means, cov, bg, box), glp
-
-
-# NumPy's reductions called directly (what ``.sum()``/``.min()``/``.max()``/``.all()``
-# call): the same results
-_sum, _min, _max = np.add.reduce, np.minimum.reduce, np.maximum.reduce
-_all = np.logical_and.reduce
 
 
 class _LazyRng:

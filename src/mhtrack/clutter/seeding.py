@@ -6,6 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from mhtrack.clutter.em import Mixture
+from mhtrack.kernels import cov_biased
 
 _EYE2 = np.eye(2)
 #: Scans whose generators :class:`ScanRngs` makes together. Setting one up is mostly
@@ -40,25 +41,22 @@ def kmeanspp_centres(
     (Arthur & Vassilvitskii 2007; the first one uniformly unless ``existing`` centres are
     given, to which distances are then measured). Stops early when every remaining plot
     sits on a centre (``D² = 0``), so identical plots give one centre."""
-    # NumPy's reductions called directly (the ones .sum/.min/cumsum call): same floats
-    add = np.add
     chosen: list[np.ndarray] = []
     if existing is not None and len(existing):
-        d2 = np.minimum.reduce(add.reduce((z[:, None, :] - existing[None, :, :]) ** 2,
-                                          axis=2), axis=1)
+        d2 = ((z[:, None, :] - existing[None, :, :]) ** 2).sum(axis=2).min(axis=1)
     else:
         first = z[int(rng.integers(len(z)))]
         chosen.append(first)
-        d2 = add.reduce((z - first) ** 2, axis=1)
+        d2 = ((z - first) ** 2).sum(axis=1)
     while len(chosen) < k:
-        total = add.reduce(d2)
+        total = d2.sum()
         if not total > 0:
             break
-        i = int(add.accumulate(d2).searchsorted(rng.random() * total, side="right"))
+        i = int(d2.cumsum().searchsorted(rng.random() * total, side="right"))
         c = z[min(i, len(z) - 1)]
         chosen.append(c)
         if len(chosen) < k:  # the last centre's distances would not be used
-            d2 = np.minimum(d2, add.reduce((z - c) ** 2, axis=1))
+            d2 = np.minimum(d2, ((z - c) ** 2).sum(axis=1))
     return np.array(chosen, float).reshape(-1, 2)
 
 
@@ -75,21 +73,21 @@ def mixture_from_centres(
     data's covariance divided by the number of centres (+ ``reg_covar``); a centre with no
     plot keeps its position with a tiny weight."""
     k = len(centres)
-    d2 = np.add.reduce((z[:, None, :] - centres[None, :, :]) ** 2, axis=2)  # .sum(axis=2)
+    d2 = ((z[:, None, :] - centres[None, :, :]) ** 2).sum(axis=2)
     lab = d2.argmin(axis=1)
     n_in = np.bincount(lab, minlength=k)
     sizes = n_in.tolist()
     counts = n_in.astype(float)
     reg = reg_covar * _EYE2
     # each centre's plots summed in plot order from 0.0: the additions of
-    # np.add.reduce(z[lab == j], axis=0), all centres in one pass; a mean is that sum / m
+    # z[lab == j].sum(axis=0), all centres in one pass; a mean is that sum / m
     sums = np.zeros((k, 2))
     np.add.at(sums, lab, z)
     means = centres.astype(float)  # a copy; a centre with no plot keeps its position
     np.divide(sums, counts[:, None], out=means, where=n_in[:, None] > 0)
     cov = np.empty((k, 2, 2))
     if min(sizes) < 3:  # some centre keeps the broad covariance
-        data_cov = _cov_biased(z) if len(z) > 1 else np.zeros((2, 2))
+        data_cov = cov_biased(z) if len(z) > 1 else np.zeros((2, 2))
         cov[:] = data_cov / k + reg
     if max(sizes) >= 3:
         grouped = z.take(lab.argsort(kind="stable"), axis=0)  # centre by centre, in plot order
@@ -100,16 +98,5 @@ def mixture_from_centres(
                 d = grouped[start:stop] - means[j]  # z[lab == j] − μ_j
                 cov[j] = d.T @ d / m + reg
     w = np.maximum(counts, 1e-3)
-    w = (1.0 - background_weight) * w / np.add.reduce(w)
+    w = (1.0 - background_weight) * w / w.sum()
     return Mixture(w, means, cov, float(background_weight), background_box)
-
-
-def _cov_biased(z: np.ndarray) -> np.ndarray:
-    """``np.cov(z.T, bias=True)`` of (n ≥ 2, 2) plots: NumPy's own steps for this case
-    (copy, subtract the row means, ``dot(X, Xᵀ)``, times ``1/n``), without its argument
-    handling — the same floats."""
-    x = np.array(z.T, ndmin=2, dtype=np.float64)
-    x -= (np.add.reduce(x, axis=1) / x.shape[1])[:, None]  # x.mean(axis=1): its sum and division
-    c = np.dot(x, x.T.conj())
-    c *= np.true_divide(1, x.shape[1])
-    return c

@@ -9,8 +9,8 @@ tree best leaf first and "none" last; the bound of a node is its running total p
 remaining tree's best score; a greedy incumbent first. It returns the *first* solution, in
 that depth-first order, whose running total beats every earlier one, so the choice among
 equal totals is fixed (ties: lower leaf index). :func:`search_two` is the same search
-unrolled for the commonest cluster, two trees, with the same sums and comparisons in the
-same order: the same choice, without the stack.
+unrolled for the commonest cluster, two trees (:func:`mhtrack.kernels.two_tree_search`),
+with the same sums and comparisons in the same order: the same choice, without the stack.
 
 :func:`solve_small` builds every clashing cluster's options from one sort and one set of
 plot keys.
@@ -22,7 +22,7 @@ import itertools
 
 import numpy as np
 
-from mhtrack.mht.tree import changes
+from mhtrack.kernels import changes, two_tree_search
 
 #: One tree's options, best first: ``(score, plot mask, leaf)``.
 Option = tuple[float, int, int]
@@ -118,33 +118,14 @@ def search(options: list[list[Option]], node_limit: int) -> list[int] | None:
 
 
 def search_two(options: list[list[Option]], node_limit: int) -> list[int] | None:
-    """:func:`search` on two trees, unrolled: the same nodes in the same order, the same
-    sums and comparisons, hence the same choice (and ``None`` exactly when the search
-    would pass ``node_limit``, which it then decides)."""
+    """:func:`search` on two trees: :func:`mhtrack.kernels.two_tree_search` (the same
+    search unrolled: the same nodes in the same order, the same sums and comparisons,
+    hence the same choice) when it cannot pass ``node_limit``; else :func:`search`,
+    which then decides (``None`` exactly when the search passes it)."""
     a_opts, b_opts = options
     if (-b_opts[0][0], b_opts[0][2]) < (-a_opts[0][0], a_opts[0][2]):
         a_opts, b_opts = b_opts, a_opts  # search's order: best tree first
     p, q = len(a_opts), len(b_opts)
     if 1 + (p + 1) * (q + 2) > node_limit:  # nodes: root, A's p + 1, each's q + 1
         return search(options, node_limit)
-    a1, m1, i1 = a_opts[0]
-    b1 = b_opts[0][0]
-    # greedy incumbent: A's best, then B's first leaf compatible with it
-    best_val, best_sel = a1, [i1]  # 0.0 + a1
-    for sc, m, i in b_opts:
-        if not m & m1:
-            best_val += sc
-            best_sel.append(i)
-            break
-    if b1 + a1 <= best_val:  # the root: 0.0 + bound[0], bound[0] = (0.0 + b1) + a1
-        return best_sel
-    for sa, ma, ia in a_opts:
-        if sa + b1 <= best_val:  # node (A takes ia): its total plus bound[1] = b1
-            continue
-        for sb, mb, ib in b_opts:  # B's compatible leaves in order, then "none"
-            if not mb & ma and sa + sb > best_val:
-                best_val, best_sel = sa + sb, [ia, ib]
-        if sa > best_val:
-            best_val, best_sel = sa, [ia]
-    # "leave A out" is pruned at its node: 0.0 + b1 <= a1 <= best_val
-    return best_sel
+    return two_tree_search(a_opts, b_opts)

@@ -55,7 +55,6 @@ import dataclasses
 import logging
 
 from mhtrack.mht.config import MHTConfig
-from mhtrack.mht.hypothesis import GlobalHypothesis
 
 #: The tracker's logger (the name users and the Monte-Carlo runner filter on).
 logger = logging.getLogger("mhtrack.mht.tracker")
@@ -110,14 +109,6 @@ def scan_config(cfg: MHTConfig, n_plots: int, n_tracks: int) -> MHTConfig:
     if all(lim[k] == getattr(cfg, k) for k in SCALED):
         return cfg
     return dataclasses.replace(cfg, **lim)
-
-
-def solver_caps(hyp: GlobalHypothesis, caps: dict[str, int]) -> None:
-    """Record the clusters solved greedily (too large) or stopped by the MILP node limit."""
-    if hyp.n_greedy:
-        caps["max_cluster_size"] = hyp.n_greedy
-    if hyp.n_node_limited:
-        caps["milp_node_limit"] = hyp.n_node_limited
 
 
 def describe(caps: dict[str, int], limits: dict[str, int] | None = None) -> str:

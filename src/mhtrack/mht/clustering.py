@@ -15,7 +15,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from mhtrack.mht.tree import NO_PLOT, changes
+from mhtrack.kernels import changes
+from mhtrack.mht.tree import NO_PLOT
 
 
 def plot_keys(window: np.ndarray, *, by_id: bool = False) -> tuple[np.ndarray, np.ndarray]:

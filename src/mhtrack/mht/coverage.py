@@ -23,6 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from mhtrack.kernels import mean
 from mhtrack.models.radars import SensorSet
 from mhtrack.records import Scan
 
@@ -192,10 +193,8 @@ class RadarCoverage(Coverage):
                 z = np.asarray(scan.z, float).reshape(-1, 2)
                 beam = np.radians(grid_bearing(z[:, 0] - site[0], z[:, 1] - site[1])
                                   + omega * (tf - t_plots))
-                # the circular mean; np.add.reduce(·)/n is ndarray.mean's own formula
-                n = beam.size
-                a_f = math.degrees(math.atan2(np.add.reduce(np.sin(beam)) / n,
-                                              np.add.reduce(np.cos(beam)) / n))
+                # the circular mean
+                a_f = math.degrees(math.atan2(mean(np.sin(beam)), mean(np.cos(beam))))
                 d0 = t0 - tf
                 q0 = grid_bearing(px + x[:, 1] * d0, py + x[:, 3] * d0)
                 phi_f = (a_f - grid_bearing(px, py)) % 360.0

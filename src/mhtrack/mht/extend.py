@@ -13,8 +13,9 @@ from typing import Any
 
 import numpy as np
 
+from mhtrack.mht.context import FrameContext
 from mhtrack.mht.gating import Gated
-from mhtrack.mht.tree import NO_PLOT, Leaves, filled
+from mhtrack.mht.tree import NO_PLOT, Leaves
 from mhtrack.models.motion import MotionModel, States, row_index
 
 #: Updated children per block of :func:`grow_children`.
@@ -53,8 +54,8 @@ def propose_children(
     value or one per leaf (its sensor coverage's ``P_D``)."""
     n = len(leaves)
     parent = np.concatenate((np.arange(n, dtype=np.int64), gated.track))
-    plot = np.concatenate((filled(n, NO_PLOT), gated.plot))
-    pair = np.concatenate((filled(n, -1), np.arange(len(gated), dtype=np.int64)))
+    plot = np.concatenate((np.full(n, NO_PLOT, np.int64), gated.plot))
+    pair = np.concatenate((np.full(n, -1, np.int64), np.arange(len(gated), dtype=np.int64)))
     score = np.concatenate((leaves.score + miss_dl, leaves.score[gated.track] + update_dl))
     # gated pairs are sorted by (leaf, plot); a stable sort on the parent puts the miss
     # first and keeps the plot order.
@@ -63,29 +64,22 @@ def propose_children(
     return Children(parent, plot, score, np.maximum(leaves.peak[parent], score), pair)
 
 
-def grow_children(
-    leaves: Leaves,
-    pred: States,
-    children: Children,
-    z: np.ndarray,
-    R: np.ndarray,
-    rows: np.ndarray,
-    motion: MotionModel,
-    time: float,
-    pair_pred: States | None = None,
-    plot_time: np.ndarray | None = None,
-    posterior: Any = None,
-) -> Leaves:
+def grow_children(frame: FrameContext, leaves: Leaves, pred: States, children: Children, *,
+                  motion: MotionModel, pair_pred: States | None = None,
+                  posterior: Any = None) -> Leaves:
     """Materialise ``children`` as leaves: misses keep the prediction ``pred`` (at the
-    frame's ``time``), updates get the motion model's update with their plot (``R``
-    shared (2, 2) or per plot (n, 2, 2); with an IMM, each model's update and ``x, P``
-    their mixture). With asynchronous plots the update starts from ``pair_pred``, the
-    parent predicted to its plot's own time (one row per gated pair), and the child's
-    time is the plot's, ``plot_time`` (n,). ``posterior``: per gated pair, what the
-    gate computed for the update (:attr:`~mhtrack.mht.gating.Gated.posterior`)."""
+    frame's time), updates get the motion model's update with their plot of the frame
+    (``frame.R`` shared (2, 2) or per plot (n, 2, 2); with an IMM, each model's update and
+    ``x, P`` their mixture). With asynchronous plots the update starts from
+    ``pair_pred``, the parent predicted to its plot's own time (one row per gated pair),
+    and the child's time is the plot's (``frame.t``, when the frame has plot times).
+    ``posterior``: per gated pair, what the gate computed for the update
+    (:attr:`~mhtrack.mht.gating.Gated.posterior`)."""
+    z, R, rows, time = frame.z, frame.R, frame.rows, frame.time
+    plot_time = frame.t
     par, plot = children.parent, children.plot
     st = pred.take(par)
-    child_time = filled(len(par), float(time), float)
+    child_time = np.full(len(par), float(time), float)
     is_upd = plot >= 0
     upd = is_upd.nonzero()[0]
     # the update block by block of rows: a block's copies stay in the CPU cache (the
@@ -102,7 +96,7 @@ def grow_children(
                else motion.update(start, zu, Ru, posterior=posterior[pairs]))
     if upd.size and plot_time is not None:
         child_time[upd] = plot_time[plot[upd]]
-    new_col = filled(len(par), NO_PLOT)
+    new_col = np.full(len(par), NO_PLOT, np.int64)
     new_col[upd] = rows.take(plot.take(upd))  # the plot's row id; a miss: NO_PLOT
     window = np.concatenate((leaves.window.take(par, axis=0)[:, 1:], new_col[:, None]),
                             axis=1)
@@ -120,7 +114,7 @@ def grow_children(
         mu=st.mu,
         xm=st.xm,
         Pm=st.Pm,
-        node=filled(len(par), -1),
+        node=np.full(len(par), -1, np.int64),
         parent=leaves.node[par],
         time=child_time,
     )

@@ -10,7 +10,7 @@ of true plots (:func:`gate_threshold`). The pairs are found by a sweep over plot
 (:func:`gate_sweep`) without forming the M × N matrix — or, when M × N is small
 (≤ :data:`DENSE_MAX_PAIRS`), on that whole matrix at once, which costs fewer NumPy calls
 and gives the same pairs and floats; :class:`Gate` is the tracker's
-stage: the work budget ``max_gated_pairs`` and the motion model's likelihood for the score.
+stage: the frame's work budget ``max_gated_pairs`` and the motion model's likelihood for the score.
 """
 
 from __future__ import annotations
@@ -21,6 +21,7 @@ from typing import Any
 
 import numpy as np
 
+from mhtrack.mht.context import FrameContext
 from mhtrack.mht.tree import Leaves
 from mhtrack.models.linalg2 import gaussian_loglik2, sym_mahalanobis2
 from mhtrack.models.motion import MotionModel, States
@@ -204,33 +205,35 @@ def _pairs_in_boxes(
 
 
 class Gate:
-    """The gating stage: every predicted leaf against every plot, with bounded work.
+    """The gating stage: every predicted leaf against every plot of a frame, with bounded
+    work.
 
-    When the leaves' gate boxes hold more than ``max_pairs`` candidate pairs (a clutter
-    burst), leaves of confirmed trees and then the best-scoring leaves are gated first
-    until the budget is spent; the others only get a miss child this scan (counted in
-    ``caps["max_gated_pairs"]``). The pairs' ``loglik`` is the motion model's
-    (:meth:`~mhtrack.models.motion.MotionModel.gating_scores`: the IMM's mixture; the
-    single Gaussian's of ``x, P`` is computed only for a model that reads it,
-    :attr:`~mhtrack.models.motion.MotionModel.reads_gate_loglik`).
+    When the leaves' gate boxes hold more than the frame's ``max_gated_pairs`` candidate
+    pairs (a clutter burst), leaves of confirmed trees and then the best-scoring leaves
+    are gated first until the budget is spent; the others only get a miss child this scan
+    (counted as ``max_gated_pairs`` in the frame's caps). The pairs' ``loglik`` is the
+    motion model's (:meth:`~mhtrack.models.motion.MotionModel.gating_scores`: the IMM's
+    mixture; the single Gaussian's of ``x, P`` is computed only for a model that reads
+    it, :attr:`~mhtrack.models.motion.MotionModel.reads_gate_loglik`).
     """
 
-    def __init__(self, probability: float, max_pairs: int) -> None:
+    def __init__(self, probability: float) -> None:
         self.gamma = gate_threshold(probability)
-        self.max_pairs = int(max_pairs)
 
-    def __call__(self, leaves: Leaves, pred: States, z: np.ndarray, R: np.ndarray,
-                 motion: MotionModel, caps: dict[str, int]) -> Gated:
-        g = self.pairs(leaves, pred.x, pred.P, z, R, caps, motion.reads_gate_loglik)
-        return Gated(g.track, g.plot, g.d2,
-                     *motion.gating_scores(pred, g.track, g.plot, z, R, g.loglik))
+    def __call__(self, frame: FrameContext, leaves: Leaves, pred: States,
+                 motion: MotionModel) -> Gated:
+        g = self.pairs(frame, leaves, pred.x, pred.P, loglik=motion.reads_gate_loglik)
+        return Gated(g.track, g.plot, g.d2, *motion.gating_scores(
+            pred, g.track, g.plot, frame.z, frame.R, g.loglik))
 
-    def pairs(self, leaves: Leaves, xp: np.ndarray, Pp: np.ndarray, z: np.ndarray,
-              R: np.ndarray, caps: dict[str, int], loglik: bool = True) -> Gated:
-        """The pairs of :func:`gate_sweep` of states ``xp``, ``Pp`` within the work budget
+    def pairs(self, frame: FrameContext, leaves: Leaves, xp: np.ndarray, Pp: np.ndarray, *,
+              R: np.ndarray | None = None, loglik: bool = True) -> Gated:
+        """The pairs of :func:`gate_sweep` of states ``xp``, ``Pp`` against the frame's
+        plots (with covariances ``R``; ``None``: the frame's) within the work budget
         (class docstring), with the Gaussian ``loglik`` of ``xp, Pp`` (``loglik=False``:
         ``None``)."""
-        budget = self.max_pairs
+        z, R = frame.z, frame.R if R is None else R
+        budget = frame.limits.max_gated_pairs
         if len(leaves) * len(z) <= budget or len(leaves) == 0 or len(z) == 0:
             return gate_sweep(xp, Pp, z, R, self.gamma, loglik)
         # the candidate boxes are found once: counted against the budget, then tested
@@ -242,7 +245,7 @@ class Gate:
             return _pairs_in_boxes(xp, Pp, z, R, shared, self.gamma, boxes, loglik)
         order = np.lexsort((-leaves.score, leaves.track < 0))
         sel = np.sort(order[np.cumsum(counts[order]) <= budget])
-        caps["max_gated_pairs"] = len(leaves) - sel.size
+        frame.cut("max_gated_pairs", len(leaves) - sel.size)
         new_index = np.full(len(leaves), -1, np.int64)
         new_index[sel] = np.arange(sel.size)
         q = new_index[tq] >= 0

@@ -27,7 +27,8 @@ from dataclasses import dataclass, fields
 
 import numpy as np
 
-from mhtrack.mht.tree import Leaves, changes
+from mhtrack.kernels import changes
+from mhtrack.mht.tree import Leaves
 from mhtrack.records import TrackTable
 
 

@@ -112,7 +112,7 @@ def best_hypothesis(
     Ties are broken deterministically (same input, same output).
     """
     score = np.asarray(score, float)
-    cand = (score > 0).nonzero()[0]  # the methods: no wrapper set-up (µs a call)
+    cand = (score > 0).nonzero()[0]
     if cand.size == 0:
         return _empty(score.size)
     s, w = score[cand], np.asarray(window).take(cand, axis=0)

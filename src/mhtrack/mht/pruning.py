@@ -12,8 +12,10 @@ from dataclasses import replace
 
 import numpy as np
 
+from mhtrack.kernels import changes, segment_sizes
 from mhtrack.mht.caps import CHILDREN_PER_PLOT, MISSES_PER_TREE
 from mhtrack.mht.config import MHTConfig
+from mhtrack.mht.context import FrameContext
 from mhtrack.mht.extend import Children
 from mhtrack.mht.hypothesis import GlobalHypothesis
 from mhtrack.mht.merging import merge_keep
@@ -21,9 +23,7 @@ from mhtrack.mht.sprt import SPRT
 from mhtrack.mht.tree import (
     NO_PLOT,
     Leaves,
-    changes,
     segment_ids,
-    segment_sizes,
     segment_starts,
     take_deferred,
 )
@@ -172,14 +172,15 @@ def _taken(up: np.ndarray, ut: np.ndarray, cols: np.ndarray, tree: np.ndarray) -
     return (up[j] == cols) & (cols != NO_PLOT) & (ut[j] != tree)
 
 
-def prune_children(leaves: Leaves, children: Children, n_births: int, sprt: SPRT,
-                   cfg: MHTConfig, caps: dict[str, int],
-                   scene_leaves: int | None = None) -> Children:
+def prune_children(frame: FrameContext, leaves: Leaves, children: Children, sprt: SPRT, *,
+                   n_births: int) -> Children:
     """Before the (costly) Kalman update: SPRT deletion, score-drop pruning within a
-    tree, the overload rule (``scene_leaves``: the leaves the scan supports,
+    tree, the overload rule (``frame.scene_leaves``: the leaves the scan supports,
     :func:`mhtrack.mht.caps.scene_leaves`; ``None``: off), then the caps on leaves per
-    tree and on all leaves (``n_births`` of ``max_leaves`` and of ``scene_leaves`` are
-    kept for this scan's new trees)."""
+    tree and on all leaves of the frame's limits (``n_births`` of ``max_leaves`` and of
+    ``scene_leaves`` are kept for this scan's new trees). What a cap cuts goes to the
+    frame's counters."""
+    cfg, scene_leaves = frame.limits, frame.scene_leaves
     rows = sprt.keep(children.score, children.peak,
                      leaves.track.take(children.parent) < 0).nonzero()[0]
     tree = leaves.tree.take(children.parent.take(rows))
@@ -195,17 +196,17 @@ def prune_children(leaves: Leaves, children: Children, n_births: int, sprt: SPRT
                                      among=leaves.track[children.parent] < 0)
             name = "max_tentative_per_plot"
         if cut:
-            caps[name] = cut
+            frame.cut(name, cut)
             children, tree = children.take(keep), tree[keep]
     keep, cut = cap_leaves_per_tree(tree, children.score, cfg.max_leaves_per_tree)
     if cut:
-        caps["max_leaves_per_tree"] = cut
+        frame.cut("max_leaves_per_tree", cut)
         children, tree = children.take(keep), tree[keep]
     budget = max(cfg.max_leaves - n_births, 0)
     confirmed = leaves.track.take(children.parent) >= 0
     keep, cut = cap_leaves(children.score, confirmed, budget)
     if cut:
-        caps["max_leaves"] = cut
+        frame.cut("max_leaves", cut)
         children = children.take(keep)
     return children
 
@@ -265,16 +266,16 @@ def removed_after_solve(leaves: Leaves, hyp: GlobalHypothesis,
     return remove & ~chosen
 
 
-def prune_after_solve(leaves: Leaves, chosen: np.ndarray, max_trees: int,
-                      caps: dict[str, int], *, by_id: bool = False,
-                      remove: np.ndarray | None = None,
+def prune_after_solve(frame: FrameContext, leaves: Leaves, chosen: np.ndarray, *,
+                      by_id: bool = False, remove: np.ndarray | None = None,
                       parts: tuple[Leaves, Leaves] | None = None) -> Leaves:
     """N-scan pruning around the best hypothesis (leaf indices ``chosen``), then the cap
-    on trees; marks the surviving chosen leaves. ``by_id``: trees step on their own looks
-    (:func:`n_scan_keep`'s ``window``). ``remove``: a mask of further leaves to drop
-    (:func:`removed_after_solve`). ``parts``: ``leaves`` is their
-    :func:`~mhtrack.mht.tree.deferred_concat`, whose states are copied once for the rows
-    kept (:func:`~mhtrack.mht.tree.take_deferred`)."""
+    on trees (the frame's ``max_trees``, counted in its caps); marks the surviving chosen
+    leaves. ``by_id``: trees step on their own looks (:func:`n_scan_keep`'s ``window``).
+    ``remove``: a mask of further leaves to drop (:func:`removed_after_solve`).
+    ``parts``: ``leaves`` is their :func:`~mhtrack.mht.tree.deferred_concat`, whose
+    states are copied once for the rows kept (:func:`~mhtrack.mht.tree.take_deferred`)."""
+    max_trees = frame.limits.max_trees
     n = len(leaves)
     is_chosen = np.zeros(n, bool)
     is_chosen[chosen] = True
@@ -290,7 +291,7 @@ def prune_after_solve(leaves: Leaves, chosen: np.ndarray, max_trees: int,
             protected = is_chosen | (leaves.track >= 0)
             keep_t, cut = cap_trees(tree, leaves.score.take(kept), protected.take(kept),
                                     max_trees)
-            caps["max_trees"] = cut
+            frame.cut("max_trees", cut)
             keep[kept[~keep_t]] = False
             n_kept = int(np.count_nonzero(keep))
     rows = None if n_kept == n else keep.nonzero()[0]  # None: nothing pruned

@@ -7,8 +7,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from mhtrack.mht.context import FrameContext
 from mhtrack.mht.hypothesis import GlobalHypothesis
-from mhtrack.mht.tree import Leaves, filled
+from mhtrack.mht.tree import Leaves
 from mhtrack.records import Scan, TrackTable
 
 
@@ -38,14 +39,15 @@ class StepStats:
     limits: dict[str, int] = field(default_factory=dict)
 
     @classmethod
-    def of(cls, scan: Scan, n_plots: int, leaves: Leaves, births: Leaves,
-           hyp: GlobalHypothesis, out: TrackTable, time_s: float,
-           caps: dict[str, int], limits: dict[str, int] | None = None) -> StepStats:
-        return cls(scan=int(scan.index), n_plots=n_plots, n_leaves=len(leaves),
+    def of(cls, frame: FrameContext, leaves: Leaves, *, births: Leaves,
+           hyp: GlobalHypothesis, out: TrackTable, time_s: float) -> StepStats:
+        """The statistics of a step: the frame's counters (its plots, the caps that acted
+        and its scaled limits), the leaves kept, the new trees, the solve and the
+        report."""
+        return cls(scan=frame.index, n_plots=frame.n_plots, n_leaves=len(leaves),
                    n_trees=leaves.n_trees, n_clusters=hyp.n_clusters,
                    largest_cluster=hyp.largest_cluster, n_confirmed=len(out), time_s=time_s,
-                   caps=caps, n_births=births.n_trees,
-                   limits={} if limits is None else limits)
+                   caps=frame.caps, n_births=births.n_trees, limits=frame.scaled_limits())
 
 
 def confirmed_windows(leaves: Leaves, rep: np.ndarray | None = None) -> np.ndarray:
@@ -69,7 +71,7 @@ def report(scan: Scan, leaves: Leaves, stepped: np.ndarray | None = None,
     n = sel.size
     # ``take``: a copy of the rows, without fancy indexing's set-up
     return TrackTable(
-        scan=filled(n, int(scan.index)),
+        scan=np.full(n, int(scan.index), np.int64),
         time=leaves.time.take(sel),
         track_id=leaves.track.take(sel),
         x=x[:, 0].copy(),

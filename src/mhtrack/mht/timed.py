@@ -24,9 +24,10 @@ from __future__ import annotations
 
 import numpy as np
 
+from mhtrack.mht.context import FrameContext
 from mhtrack.mht.coverage import Looks
 from mhtrack.mht.gating import Gate, Gated
-from mhtrack.mht.tree import FIELDS, Leaves, contains
+from mhtrack.mht.tree import Leaves, contains
 from mhtrack.models.linalg2 import gaussian_loglik2, sym_mahalanobis2
 from mhtrack.models.motion import MotionModel, States
 
@@ -49,44 +50,36 @@ def split_looked(leaves: Leaves, looks: Looks) -> tuple[Leaves, Looks, Leaves]:
             leaves.take(~mask))
 
 
-#: Stores of no leaves by (window width, IMM models): the idle part of a scan that
-#: stepped every tree (its arrays are never written).
-_EMPTY: dict[tuple[int, int], Leaves] = {}
-
-
 def _no_leaves(leaves: Leaves) -> Leaves:
-    """An empty store shaped as ``leaves`` (one per shape, reused)."""
-    key = (leaves.window.shape[1], leaves.mu.shape[1])
-    empty = _EMPTY.get(key)
-    if empty is None:
-        # copies: a view would keep the whole store it was sliced from alive
-        empty = _EMPTY[key] = Leaves(*[getattr(leaves, f)[:0].copy() for f in FIELDS])
-    return empty
+    """An empty store shaped as ``leaves``."""
+    return Leaves.empty(leaves.window.shape[1], leaves.n_models)
 
 
-def gate_looked(gate: Gate, leaves: Leaves, pred: States, pd: np.ndarray | None,
-                z: np.ndarray, R: np.ndarray, t: np.ndarray | None, time: float,
-                motion: MotionModel, caps: dict[str, int]) -> tuple[Gated, States | None]:
-    """Gated pairs of the leaves with ``pd > 0`` (indices into ``leaves``; ``pd`` ``None``:
-    every leaf) and, for timed plots (``t`` not all ``time``), each pair's state predicted
-    to its plot's time."""
+def gate_looked(frame: FrameContext, gate: Gate, leaves: Leaves, pred: States, *,
+                looks: Looks, motion: MotionModel) -> tuple[Gated, States | None]:
+    """Gated pairs of the leaves looked at (``looks.pd > 0``; indices into ``leaves``)
+    against the frame's plots and, for timed plots (``t`` not all the frame's time), each
+    pair's state predicted to its plot's time."""
+    pd = None if looks.uniform is not None else looks.pd
     sub = None if pd is None or (pd > 0).all() else np.flatnonzero(pd > 0)
     lv, pr = (leaves, pred) if sub is None else (leaves.take(sub), pred.take(sub))
-    if t is None or (t == time).all():
-        g, pair_pred = gate(lv, pr, z, R, motion, caps), None
+    t = frame.t
+    if t is None or (t == frame.time).all():
+        g, pair_pred = gate(frame, lv, pr, motion), None
     else:
-        g, pair_pred = gate_timed(gate, lv, pr, z, R, t, time, motion, caps)
+        g, pair_pred = gate_timed(frame, gate, lv, pr, motion=motion)
     if sub is not None:
         g = Gated(sub[g.track], g.plot, g.d2, g.loglik, g.posterior)
     return g, pair_pred
 
 
-def gate_timed(gate: Gate, leaves: Leaves, pred: States, z: np.ndarray, R: np.ndarray,
-               t: np.ndarray, time: float, motion: MotionModel,
-               caps: dict[str, int]) -> tuple[Gated, States]:
-    """Coarse gate at the frame's ``time``, then the exact gate of each candidate pair
-    at its plot's time (module docstring). Returns the pairs (ordered by leaf, then plot)
-    and their predicted states."""
+def gate_timed(frame: FrameContext, gate: Gate, leaves: Leaves, pred: States, *,
+               motion: MotionModel) -> tuple[Gated, States]:
+    """Coarse gate at the frame's time, then the exact gate of each candidate pair at its
+    plot's time (module docstring). Returns the pairs (ordered by leaf, then plot) and
+    their predicted states."""
+    z, R, t, time = frame.z, frame.R, frame.t, frame.time
+    assert t is not None
     gamma = gate.gamma
     span = max(time - float(t.min()), 0.0) if t.size else 0.0
     P = pred.P
@@ -96,7 +89,7 @@ def gate_timed(gate: Gate, leaves: Leaves, pred: States, z: np.ndarray, R: np.nd
     Pc = 2.0 * P
     Pc[:, 0, 0] += extra
     Pc[:, 2, 2] += extra
-    coarse = gate.pairs(leaves, pred.x, Pc, z, 2.0 * R, caps, loglik=False)
+    coarse = gate.pairs(frame, leaves, pred.x, Pc, R=2.0 * R, loglik=False)
     ti, pj = coarse.track, coarse.plot
     pp = motion.predict(leaves.states().take(ti), t[pj] - leaves.time[ti])
     Rp = R if R.ndim == 2 else R.take(pj, axis=0)

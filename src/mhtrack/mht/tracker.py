@@ -1,34 +1,34 @@
 """The track-oriented MHT (P1 §1.3, Fig. 1): one call of :meth:`MHTTracker.step` per scan.
 
-The tracking cycle, one stage per line of :meth:`MHTTracker.step`::
+The tracking cycle, one stage per line of :meth:`MHTTracker.step`, each given the frame's
+context (:class:`~mhtrack.mht.context.FrameContext`: validated plots, scaled limits, the
+tracks on air, the caps' counters) where it needs more than its own arrays::
 
-    validate         validate.validate_scan          the scan at the library boundary
-    coverage         coverage.Coverage               P_D of each leaf (0: sensor did not look)
-    looked-at trees  timed.split_looked              trees the frame steps; others carried
-    predict          predict.predict_leaves          all leaves to the scan time (motion model)
-    gate             timed.gate_looked               every leaf against every plot (each at
-                                                       its plot's own time), ln p(z|T)
-    clutter          intensity.clutter_intensity     κ̂(z) of the scan's plots (estimator)
-    score            scoring.update_increment        ΔL of every gated pair
-    extend trees     extend.propose_children         miss + one child per gated plot
-    propose births   births.Birth.propose            new trees' first leaves (birth process)
-    prune children   pruning.prune_children          SPRT deletion, score drop, caps — before
-                                                     the (costly) update
-    grow             extend.grow_children            the children's filter update
-    seed births      births.Birth.seed               the new trees, with tree ids
-    number nodes,    numbering.number_and_merge      leaf ids for the history links; the
-    merge                                              trees the frame did not step back
-    global hyp.      hypothesis.best_hypothesis      clusters → best compatible leaves
-    N-scan pruning   pruning.prune_after_solve       decide scan k − N; cap on trees
-    hand over        identity.hand_over              a track follows its plots
-    confirm          sprt.SPRT.confirms,             SPRT (or M-of-N) confirmation → new
-                     identity.confirm                  track ids
-    backfill         history.TentativeHistory        the tentative past of new tracks
-    forget           Birth.forget_used,              the confirmed tracks' plots leave the
-                     ClutterEstimator.forget           birth window and the estimator's
-    report           report.report, StepStats        confirmed tracks of the best hypothesis
-    caps             caps.scan_config, CapWarnings   limits scaled to the scan's plots and
-                                                     tracks; log the hard caps that acted
+    validate    validate.validate_scan,         the scan at the library boundary; limits
+                context.FrameContext.of           scaled to its plots and tracks (caps)
+    look        coverage.Coverage,              P_D of each leaf (0: sensor did not look);
+                timed.split_looked                trees the frame steps, others carried
+    predict     predict.predict_leaves          all leaves to the scan time (motion model)
+    gate        timed.gate_looked               every leaf against every plot (each at
+                                                  its plot's own time), ln p(z|T)
+    clutter     intensity.clutter_intensity     κ̂(z) of the scan's plots (estimator)
+    score       scoring.update_increment        ΔL of every gated pair
+    propose     extend.propose_children,        miss + one child per gated plot; new
+                births.Birth.propose              trees' first leaves (birth process)
+    prune       pruning.prune_children          SPRT deletion, score drop, caps — before
+                                                  the (costly) update
+    grow        extend.grow_children            the children's filter update
+    births      births.Birth.seed,              the new trees, with tree ids; leaf ids for
+                numbering.number_and_merge        the history links; idle trees merged back
+    hypothesis  hypothesis.best_hypothesis      clusters → best compatible leaves
+    prune       pruning.prune_after_solve       N-scan: decide scan k − N; cap on trees
+    confirm     identity.hand_over,             a track follows its plots; SPRT (or
+                sprt.SPRT.confirms,               M-of-N) confirmation → new track ids;
+                history.TentativeHistory          the tentative past of new tracks
+    report      report.report, StepStats,       the confirmed tracks' plots leave the
+                Birth.forget_used,                birth window and the estimator's; the
+                ClutterEstimator.forget,          confirmed tracks of the best hypothesis;
+                caps.CapWarnings                  log the hard caps that acted
 
 The motion model (:class:`~mhtrack.models.motion.MotionModel`: CV or IMM), the clutter
 estimator (:class:`~mhtrack.clutter.base.ClutterEstimator`), the birth process
@@ -51,13 +51,14 @@ import numpy as np
 from mhtrack.clutter.base import ClutterEstimator
 from mhtrack.clutter.known import KnownClutter
 from mhtrack.mht.births import Birth, make_birth
-from mhtrack.mht.caps import SCALED, CapWarnings, scan_config, scene_leaves, solver_caps
+from mhtrack.mht.caps import CapWarnings
 from mhtrack.mht.config import MHTConfig
+from mhtrack.mht.context import FrameContext
 from mhtrack.mht.coverage import Coverage, Everywhere, Looks
 from mhtrack.mht.extend import grow_children, propose_children
 from mhtrack.mht.gating import Gate, plots_in_confirmed_gates
 from mhtrack.mht.history import TentativeHistory
-from mhtrack.mht.hypothesis import best_hypothesis
+from mhtrack.mht.hypothesis import GlobalHypothesis, best_hypothesis
 from mhtrack.mht.identity import Reported, confirm, hand_over, newly_confirmed
 from mhtrack.mht.intensity import clutter_intensity
 from mhtrack.mht.numbering import Counter, number_and_merge
@@ -113,7 +114,7 @@ class MHTTracker:
         #: parts; ``None`` for a tracker assembled by hand.
         self.recipe: dict[str, Any] | None = None
         self.sprt = SPRT.from_config(cfg)
-        self.gate = Gate(cfg.gate_probability, cfg.max_gated_pairs)
+        self.gate = Gate(cfg.gate_probability)
         self._R = np.eye(2) * cfg.sigma_w**2
         self._miss_pg = cfg.gate_probability if cfg.miss_uses_gate_probability else None
         self._leaves = Leaves.empty(cfg.n_scan + 1, self.motion.n_models)
@@ -142,55 +143,45 @@ class MHTTracker:
         confirmed tracks of the best global hypothesis. Statistics go to :attr:`last_stats`,
         the earlier rows of tracks confirmed now to :attr:`last_backfill`."""
         t0 = time.perf_counter()
-        cfg, ftime = self.config, float(scan.time)
-        caps: dict[str, int] = {}
-        z, R, rows = validate_scan(scan, self._R, self._last_time, self._last_index)
-        on_air = self._leaves.reported()  # the tracks reported at the last scan
-        n_tracks = int(np.count_nonzero(on_air))
-        lim = scan_config(cfg, len(z), n_tracks)  # caps scaled to the scan
-        self.gate.max_pairs = lim.max_gated_pairs
-        self.birth.limit(lim.max_births_per_scan)
-        by_id = self.coverage.per_tree_looks
-        previous = Reported.of(self._leaves, by_id=by_id, reported=on_air)
+        f = self._frame(scan)
         leaves, looks, idle = self._look(scan)
-        pred = predict_leaves(self.motion, leaves, ftime)
-        gated, pair_pred = gate_looked(self.gate, leaves, pred,
-                                       None if looks.uniform is not None else looks.pd,
-                                       z, R, scan.t, ftime, self.motion, caps)
-        in_gates = plots_in_confirmed_gates(leaves, gated, len(z))
-        kappa = clutter_intensity(self.clutter, scan, z, in_gates, cfg.min_clutter_density)
+        pred = predict_leaves(self.motion, leaves, f.time)
+        gated, pair_pred = gate_looked(f, self.gate, leaves, pred, looks=looks,
+                                       motion=self.motion)
+        in_gates = plots_in_confirmed_gates(leaves, gated, f.n_plots)
+        kappa = clutter_intensity(self.clutter, f, in_gates, self.config.min_clutter_density)
         update_dl = update_increment(gated.loglik, kappa, self.coverage.plot_pd(scan),
-                                     cfg.new_target_density, gated.plot)
+                                     self.config.new_target_density, gated.plot)
         children = propose_children(leaves, gated, self._miss(looks), update_dl)
-        cand = self.birth.propose(scan, z, R, rows, kappa, in_gates, caps)
-        children = prune_children(leaves, children, len(cand) + len(idle), self.sprt, lim,
-                                  caps, scene_leaves(cfg, len(z), n_tracks))
-        grown = grow_children(leaves, pred, children, z, R, rows, self.motion, ftime,
-                              pair_pred, scan.t, gated.posterior)
-        births = self.birth.seed(scan, cand, grown.window, self.trees, caps)
-        first_node = self.nodes.next
-        parts = (grown, births) if len(idle) == 0 and len(births) else None
-        leaves = number_and_merge(grown, births, idle, self.nodes, parts is not None)
-        hyp = best_hypothesis(leaves.score, leaves.tree, leaves.window, cfg.max_cluster_size,
-                              cfg.milp_node_limit, by_id=by_id, n_best=cfg.n_best)
-        solver_caps(hyp, caps)
-        leaves = prune_after_solve(leaves, hyp.leaves, lim.max_trees, caps, by_id=by_id,
-                                   remove=removed_after_solve(leaves, hyp, cfg), parts=parts)
-        is_new = None if len(idle) == 0 else leaves.node >= first_node
-        first_new = self.tracks.next
-        leaves = hand_over(leaves, previous, by_id=by_id)
-        leaves = confirm(leaves, self.sprt.confirms(leaves), self.tracks)
-        self.last_backfill = self._history.backfill(leaves, newly_confirmed(leaves, first_new))
-        rep = leaves.reported()
-        self._history.record(int(scan.index), ftime, leaves, is_new, rep)
-        self._forget(leaves, rows, rep)
-        self._leaves, self._last_time, self._last_index = leaves, ftime, int(scan.index)
-        out = report(scan, leaves, is_new, rep)
-        limits = {k: getattr(lim, k) for k in SCALED}
-        self.last_stats = StepStats.of(scan, len(z), leaves, births, hyp, out,
-                                       time.perf_counter() - t0, caps, limits)
-        self._cap_warnings(int(scan.index), caps, len(z), limits)
+        cand = self.birth.propose(f, kappa, in_gates)
+        children = prune_children(f, leaves, children, self.sprt,
+                                  n_births=len(cand) + len(idle))
+        grown = grow_children(f, leaves, pred, children, motion=self.motion,
+                              pair_pred=pair_pred, posterior=gated.posterior)
+        births = self.birth.seed(f, cand, grown.window, self.trees)
+        leaves, parts, first_node = self._number(grown, births, idle)
+        hyp = self._hypothesis(f, leaves)
+        leaves = prune_after_solve(f, leaves, hyp.leaves, by_id=self.coverage.per_tree_looks,
+                                   remove=removed_after_solve(leaves, hyp, self.config),
+                                   parts=parts)
+        stepped = None if len(idle) == 0 else leaves.node >= first_node
+        leaves = self._confirm(f, leaves)
+        out = self._report(f, leaves, stepped)
+        self.last_stats = StepStats.of(f, leaves, births=births, hyp=hyp, out=out,
+                                       time_s=time.perf_counter() - t0)
+        self._cap_warnings(f.index, f.caps, f.n_plots, self.last_stats.limits)
         return out
+
+    # ------------------------------------------------------------------ stages
+    def _frame(self, scan: Scan) -> FrameContext:
+        """Validate: the frame's context (:class:`~mhtrack.mht.context.FrameContext`) — its
+        plots, the tracks reported at the last frame and the limits scaled to both; the
+        birth process is told its limit."""
+        plots = validate_scan(scan, self._R, self._last_time, self._last_index)
+        previous = Reported.of(self._leaves, by_id=self.coverage.per_tree_looks)
+        frame = FrameContext.of(scan, plots, config=self.config, previous=previous)
+        self.birth.limit(frame.limits.max_births_per_scan)
+        return frame
 
     def _look(self, scan: Scan) -> tuple[Leaves, Looks, Leaves]:
         """Coverage: each leaf's ``P_D`` in this frame; the leaves its sensor did not look
@@ -204,6 +195,51 @@ class MHTTracker:
         if looks.uniform is not None:
             return miss_increment(looks.uniform, self._miss_pg)
         return miss_increments(looks.miss_pd, self._miss_pg)
+
+    def _number(self, grown: Leaves, births: Leaves, idle: Leaves
+                ) -> tuple[Leaves, tuple[Leaves, Leaves] | None, int]:
+        """Node ids for the new leaves (the history's links) and the idle trees merged
+        back: ``(leaves, parts, first new node id)``; ``parts`` the two stores ``leaves``
+        defers the concatenation of (``None``: concatenated)."""
+        first_node = self.nodes.next
+        parts = (grown, births) if len(idle) == 0 and len(births) else None
+        leaves = number_and_merge(grown, births, idle, self.nodes, parts is not None)
+        return leaves, parts, first_node
+
+    def _hypothesis(self, frame: FrameContext, leaves: Leaves) -> GlobalHypothesis:
+        """The best global hypothesis; clusters solved greedily (over
+        ``max_cluster_size``) or stopped by ``milp_node_limit`` count as caps."""
+        cfg = self.config
+        hyp = best_hypothesis(leaves.score, leaves.tree, leaves.window, cfg.max_cluster_size,
+                              cfg.milp_node_limit, by_id=self.coverage.per_tree_looks,
+                              n_best=cfg.n_best)
+        if hyp.n_greedy:
+            frame.cut("max_cluster_size", hyp.n_greedy)
+        if hyp.n_node_limited:
+            frame.cut("milp_node_limit", hyp.n_node_limited)
+        return hyp
+
+    def _confirm(self, frame: FrameContext, leaves: Leaves) -> Leaves:
+        """Hand over track ids that follow their plots, confirm by the SPRT (new track ids),
+        and keep the tentative past of the tracks confirmed now (:attr:`last_backfill`)."""
+        assert frame.previous is not None
+        first_new = self.tracks.next
+        leaves = hand_over(leaves, frame.previous, by_id=self.coverage.per_tree_looks)
+        leaves = confirm(leaves, self.sprt.confirms(leaves), self.tracks)
+        self.last_backfill = self._history.backfill(leaves, newly_confirmed(leaves, first_new))
+        return leaves
+
+    def _report(self, frame: FrameContext, leaves: Leaves,
+                stepped: np.ndarray | None) -> TrackTable:
+        """Record the frame in the history, let the birth process and the clutter estimator
+        forget the confirmed tracks' plots, keep ``leaves`` for the next frame; the
+        confirmed tracks of the best hypothesis that the frame ``stepped`` (mask;
+        ``None``: all)."""
+        rep = leaves.reported()
+        self._history.record(frame.index, frame.time, leaves, stepped, rep)
+        self._forget(leaves, frame.rows, rep)
+        self._leaves, self._last_time, self._last_index = leaves, frame.time, frame.index
+        return report(frame.scan, leaves, stepped, rep)
 
     def _forget(self, leaves: Leaves, rows: np.ndarray, rep: np.ndarray) -> None:
         """The plots the confirmed tracks used (``rep``: the leaves that report them)

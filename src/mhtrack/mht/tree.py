@@ -16,6 +16,7 @@ from dataclasses import dataclass, fields, replace
 
 import numpy as np
 
+from mhtrack.kernels import changes
 from mhtrack.models.motion import States, row_index
 
 NO_PLOT = -1
@@ -191,38 +192,11 @@ def contains(values: np.ndarray, query: np.ndarray) -> np.ndarray:
     return v[j] == query
 
 
-def filled(n: int, value: float, dtype: type = np.int64) -> np.ndarray:
-    """``np.full(n, value, dtype)`` without its Python wrapper (about half its cost on
-    the few hundred rows of a scan)."""
-    out = np.empty(n, dtype)
-    out.fill(value)
-    return out
-
-
 def segment_starts(sorted_keys: np.ndarray) -> np.ndarray:
     """Start index of each run of equal values in ``sorted_keys`` (empty for no rows)."""
     if sorted_keys.size == 0:
         return np.zeros(0, np.int64)
     return changes(sorted_keys).nonzero()[0]
-
-
-def changes(sorted_keys: np.ndarray) -> np.ndarray:
-    """Mask over the rows of ``sorted_keys``: the row starts a run of equal values (the
-    first row always). ``np.r_[True, k[1:] != k[:-1]]`` without the index trick's
-    set-up (several µs a call)."""
-    flag = np.empty(sorted_keys.size, bool)
-    flag[:1] = True
-    np.not_equal(sorted_keys[1:], sorted_keys[:-1], out=flag[1:])
-    return flag
-
-
-def segment_sizes(starts: np.ndarray, n: int) -> np.ndarray:
-    """Rows of each segment from its ``starts`` over ``n`` rows: ``np.diff(np.r_[starts,
-    n])`` without the wrappers' set-up (several µs a call on a scan's few hundred rows)."""
-    sizes = np.empty(starts.size, np.int64)
-    np.subtract(starts[1:], starts[:-1], out=sizes[:-1])
-    sizes[-1:] = n - starts[-1:]
-    return sizes
 
 
 def segment_ids(sorted_keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -263,15 +237,15 @@ def new_trees(
         score=score,
         peak=peak,
         tree=tree,
-        track=filled(n, -1),
-        birth=filled(n, scan_index),
+        track=np.full(n, -1, np.int64),
+        birth=np.full(n, scan_index, np.int64),
         n_updates=n_updates,
         window=window,
         chosen=np.zeros(n, bool),
         mu=states.mu,
         xm=states.xm,
         Pm=states.Pm,
-        node=filled(n, -1),
-        parent=filled(n, -1),
+        node=np.full(n, -1, np.int64),
+        parent=np.full(n, -1, np.int64),
         time=np.asarray(time, float),
     )

@@ -1,7 +1,10 @@
 """The birth process of the MHT: which plots start new track trees, and how.
 
 A birth process is a part of the tracker, passed in like the motion model and the clutter
-estimator. Every scan the tracker calls
+estimator. Every scan the tracker calls, with the frame's context
+(:class:`~mhtrack.mht.context.FrameContext`: the validated plots ``z``, ``R``, ``rows``,
+the scan, the frame's limits, and :meth:`~mhtrack.mht.context.FrameContext.cut` to count
+what a cap removed),
 
 1. :meth:`Birth.propose` after the clutter intensity is known: the candidate new trees'
    first leaves (:class:`BirthCandidates`); their count is reserved in ``max_leaves``;
@@ -25,10 +28,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from mhtrack.mht.context import FrameContext
 from mhtrack.mht.numbering import Counter
-from mhtrack.mht.tree import Leaves, filled, new_trees
+from mhtrack.mht.tree import Leaves, new_trees
 from mhtrack.models.motion import MotionModel, row_index
-from mhtrack.records import Scan
 
 
 @dataclass(frozen=True, slots=True)
@@ -71,26 +74,27 @@ class Birth(ABC):
         self.motion = motion
 
     @abstractmethod
-    def propose(self, scan: Scan, z: np.ndarray, R: np.ndarray, rows: np.ndarray,
-                kappa: np.ndarray, in_gates: np.ndarray | None,
-                caps: dict[str, int]) -> BirthCandidates:
-        """Candidate new trees from the scan's plots ``z`` (n, 2), covariances ``R``
-        ((2, 2) or (n, 2, 2)), row ids ``rows``, clutter intensity ``kappa`` (n,) and the
-        plots in confirmed tracks' gates (``None``: no confirmed track). A cap that acts
-        adds its count to ``caps``."""
+    def propose(self, frame: FrameContext, kappa: np.ndarray,
+                in_gates: np.ndarray | None) -> BirthCandidates:
+        """Candidate new trees from the frame's plots ``frame.z`` (n, 2), covariances
+        ``frame.R`` ((2, 2) or (n, 2, 2)) and row ids ``frame.rows`` (``frame.scan``: the
+        scan as given), the clutter intensity ``kappa`` (n,) and the plots in confirmed
+        tracks' gates (``None``: no confirmed track). A cap that acts says what it cut
+        with ``frame.cut(name, count)``."""
 
-    def select(self, cand: BirthCandidates, leaf_window: np.ndarray,
-               caps: dict[str, int]) -> tuple[BirthCandidates, np.ndarray]:
+    def select(self, frame: FrameContext, cand: BirthCandidates,
+               leaf_window: np.ndarray) -> tuple[BirthCandidates, np.ndarray]:
         """Which candidates start trees, given the grown leaves' windows ``leaf_window``:
         ``(candidates, tree index 0…g−1 of each, ascending)``. Default: all, one tree each."""
         return cand, np.arange(len(cand), dtype=np.int64)
 
-    def seed(self, scan: Scan, cand: BirthCandidates, leaf_window: np.ndarray,
-             trees: Counter, caps: dict[str, int]) -> Leaves:
+    def seed(self, frame: FrameContext, cand: BirthCandidates, leaf_window: np.ndarray,
+             trees: Counter) -> Leaves:
         """The new trees' leaves: :meth:`select`, then consecutive tree ids from ``trees``."""
-        cand, group = self.select(cand, leaf_window, caps)
+        cand, group = self.select(frame, cand, leaf_window)
         first = trees.take(int(group.max()) + 1 if len(cand) else 0)
-        time = filled(len(cand), float(scan.time), float) if cand.time is None else cand.time
+        scan = frame.scan
+        time = np.full(len(cand), float(scan.time), float) if cand.time is None else cand.time
         return new_trees(self.motion.new_states(cand.x, cand.P), cand.score, cand.peak,
                          first + group, int(scan.index), cand.n_updates, cand.window, time)
 

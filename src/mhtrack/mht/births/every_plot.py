@@ -7,6 +7,7 @@ from collections.abc import Callable
 import numpy as np
 
 from mhtrack.mht.births.base import Birth, BirthCandidates
+from mhtrack.mht.context import FrameContext
 from mhtrack.mht.scoring import birth_score
 from mhtrack.mht.tree import NO_PLOT, one_point_state
 from mhtrack.models.motion import MotionModel
@@ -50,22 +51,21 @@ class EveryPlotBirth(Birth):
     def limit(self, max_per_scan: int) -> None:
         self.max_per_scan = int(max_per_scan)
 
-    def propose(self, scan: Scan, z: np.ndarray, R: np.ndarray, rows: np.ndarray,
-                kappa: np.ndarray, in_gates: np.ndarray | None,
-                caps: dict[str, int]) -> BirthCandidates:
+    def propose(self, frame: FrameContext, kappa: np.ndarray,
+                in_gates: np.ndarray | None) -> BirthCandidates:
+        scan, z, R, rows = frame.scan, frame.z, frame.R, frame.rows
         pd = self.p_detection if self.plot_pd is None else self.plot_pd(scan)
         score = birth_score(kappa, pd, self.new_target_density)
-        sel = (score > self.floor).nonzero()[0]  # np.flatnonzero without its wrapper
+        sel = (score > self.floor).nonzero()[0]
         if sel.size > self.max_per_scan:
             gated_first = np.zeros(len(z), bool) if in_gates is None else in_gates
             order = sel[np.lexsort((-score[sel], gated_first[sel]))]
-            caps["max_births_per_scan"] = sel.size - self.max_per_scan
+            frame.cut("max_births_per_scan", sel.size - self.max_per_scan)
             sel = np.sort(order[: self.max_per_scan])
         n = sel.size
         x, P = one_point_state(z.take(sel, axis=0), R if R.ndim == 2 else R.take(sel, axis=0),
                                self.v_max)
-        window = np.empty((n, self.width), np.int64)  # np.full without its wrapper
-        window.fill(NO_PLOT)
+        window = np.full((n, self.width), NO_PLOT, np.int64)
         window[:, -1] = rows.take(sel)
         start = np.asarray(score.take(sel), float)
         return BirthCandidates(x, P, start, start.copy(), window, np.ones(n, np.int64),

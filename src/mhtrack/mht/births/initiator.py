@@ -35,6 +35,7 @@ from mhtrack.initiation.factory import make_initiator
 from mhtrack.initiation.window import Window
 from mhtrack.mht.births.base import Birth, BirthCandidates
 from mhtrack.mht.births.sequence import score_upper_bound, sequence_score
+from mhtrack.mht.context import FrameContext
 from mhtrack.mht.pruning import cap_leaves_per_tree, score_drop_keep
 from mhtrack.models.motion import MotionModel
 from mhtrack.names import INITIATORS
@@ -168,22 +169,21 @@ class InitiatorBirth(Birth):
     def limit(self, max_per_scan: int) -> None:
         self.max_per_scan = int(max_per_scan)
 
-    def propose(self, scan: Scan, z: np.ndarray, R: np.ndarray, rows: np.ndarray,
-                kappa: np.ndarray, in_gates: np.ndarray | None,
-                caps: dict[str, int]) -> BirthCandidates:
+    def propose(self, frame: FrameContext, kappa: np.ndarray,
+                in_gates: np.ndarray | None) -> BirthCandidates:
         """The initiated tracks with a plot at this scan (:meth:`initiate`); over
         ``max_per_scan``, the highest birth scores (then initiator order)."""
-        cand = self.initiate(scan, z, R, rows, kappa)
+        cand = self.initiate(frame, kappa)
         cap = self.max_per_scan
         if len(cand) > cap:
-            caps["max_births_per_scan"] = len(cand) - cap
+            frame.cut("max_births_per_scan", len(cand) - cap)
             cand = cand.take(np.sort(np.argsort(-cand.score, kind="stable")[:cap]))
         return cand
 
-    def initiate(self, scan: Scan, z: np.ndarray, R: np.ndarray, rows: np.ndarray,
-                 kappa: np.ndarray) -> BirthCandidates:
-        """Add the scan to the window, run the initiator and return the initiated tracks
-        that have a plot at this scan, seeded and scored (module docstring)."""
+    def initiate(self, frame: FrameContext, kappa: np.ndarray) -> BirthCandidates:
+        """Add the frame's plots to the window, run the initiator and return the initiated
+        tracks that have a plot at this scan, seeded and scored (module docstring)."""
+        scan, z, R, rows = frame.scan, frame.z, frame.R, frame.rows
         self._push(int(scan.index), float(scan.time), z, R, rows, kappa)
         m = len(self.count)
         if m < self.min_plots or self.count[-1] == 0:
@@ -222,8 +222,8 @@ class InitiatorBirth(Birth):
         window[:, self.width - k:] = rows_seq[:, m - k:]
         return BirthCandidates(x, P, score, peak, window, has.sum(axis=1).astype(np.int64))
 
-    def select(self, cand: BirthCandidates, leaf_window: np.ndarray,
-               caps: dict[str, int]) -> tuple[BirthCandidates, np.ndarray]:
+    def select(self, frame: FrameContext, cand: BirthCandidates,
+               leaf_window: np.ndarray) -> tuple[BirthCandidates, np.ndarray]:
         """Drop candidates already followed by a leaf and repeats of one leaf window, group
         the rest by their plot at the current scan — one new tree per group (module
         docstring) — and prune each group as children are (score drop, leaves per tree):
@@ -233,7 +233,7 @@ class InitiatorBirth(Birth):
         cand, group = cand.take(keep), group[keep]
         keep, cut = cap_leaves_per_tree(group, cand.score, self.max_leaves_per_tree)
         if cut:
-            caps["max_leaves_per_tree"] = caps.get("max_leaves_per_tree", 0) + cut
+            frame.cut("max_leaves_per_tree", cut)
             cand, group = cand.take(keep), group[keep]
         return cand, group
 

@@ -31,7 +31,7 @@ from mhtrack.bounds import (
 from mhtrack.errors import InputError
 from mhtrack.io._arrow import from_numpy, is_null, to_numpy
 from mhtrack.io._source import PathArg, Source, file_format
-from mhtrack.io.atomic import atomic_path
+from mhtrack.io.atomic import OutputError, atomic_path
 
 #: Column kinds of a schema: integers, floats, and times (read as they are written —
 #: text in CSV, any type in Parquet — and converted by :mod:`mhtrack.io._times`).
@@ -352,8 +352,8 @@ def write_frame(path: PathArg, columns: Mapping[str, pa.Array]) -> None:
                 import pyarrow.parquet as pq
 
                 pq.write_table(table, str(tmp))
-    except OSError as e:
-        raise InputError(f"{path}: cannot write ({e.strerror or e})", file=str(path)) from None
+    except OutputError as e:  # names the file already (disk full, permission, …)
+        raise InputError(str(e), file=str(path)) from None
 
 
 def int_array(values: np.ndarray, missing: np.ndarray | None = None) -> pa.Array:

@@ -62,6 +62,21 @@ def _writable_folder(path: Path, what: str) -> None:
                          file=str(path))
 
 
+def _name_fits(path: Path, what: str) -> None:
+    """The last part of ``path`` fits the file system's name limit (``NAME_MAX``, 255 bytes
+    on most), so that nothing computed is lost to a name refused at the end. The atomic
+    writer's temporary names are at most 49 bytes (:mod:`mhtrack.io.atomic`): any name
+    that fits is written."""
+    try:
+        limit = os.pathconf(_nearest_existing(path.absolute().parent), "PC_NAME_MAX")
+    except (OSError, ValueError, AttributeError):
+        limit = 255
+    n = len(os.fsencode(path.name))
+    if n > limit:
+        raise InputError(f"{path}: cannot write the {what}: its name is {n} bytes long, the "
+                         f"file system allows {limit}", file=str(path))
+
+
 def _same_file(a: Path, b: Path) -> bool:
     try:
         return a.resolve() == b.resolve() or (a.exists() and b.exists() and a.samefile(b))
@@ -89,6 +104,7 @@ def check_output_file(path: Path, *, inputs: Iterable[Path | None] = (),
         raise InputError(f"{path}: cannot write the {what}: folder {parent} does not exist",
                          file=str(path))
     _writable_folder(parent, what)
+    _name_fits(path, what)
 
 
 def check_output_dir(path: Path, *, inputs: Iterable[Path | None] = (),
@@ -103,3 +119,4 @@ def check_output_dir(path: Path, *, inputs: Iterable[Path | None] = (),
             raise InputError(f"{path}: the {what} folder is the input {inp}; choose another "
                              f"{option}", file=str(path))
     _writable_folder(path, what)
+    _name_fits(path, what)

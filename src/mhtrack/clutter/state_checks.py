@@ -19,7 +19,7 @@ from typing import Any
 
 import numpy as np
 
-from mhtrack.bounds import MAX_DENSITY, MAX_INDEX, MAX_MAGNITUDE, MAX_TIME_S
+from mhtrack.bounds import MAX_DENSITY, MAX_INDEX, MAX_MAGNITUDE, MAX_TIME_S, clip, show
 from mhtrack.records import MAX_COORDINATE
 
 
@@ -35,7 +35,7 @@ def number(v: object, field: str, lo: float = -MAX_MAGNITUDE, hi: float = MAX_MA
         raise _fail(field, f"expected {'an integer' if integer else 'a number'}, got "
                     f"{type(v).__name__}")
     if not lo <= v <= hi:  # false for NaN
-        raise _fail(field, f"{v!r} is out of range [{lo:g}, {hi:g}]")
+        raise _fail(field, f"{clip(repr(v))} is out of range [{show(lo)}, {show(hi)}]")
     return v  # type: ignore[return-value]
 
 

@@ -90,6 +90,7 @@ def check_output_file(path: Path, *, inputs: Iterable[Path | None] = (),
     """``path`` may be written: its extension is one of ``suffixes``, it is none of the
     ``inputs``, and its folder exists and is writable."""
     path = Path(path)
+    _name_fits(path, what)
     if path.suffix.lower() not in suffixes:
         raise InputError(f"{path}: unknown extension {path.suffix or '(none)'!r} for the "
                          f"{what} (expected {', '.join(suffixes)})", file=str(path))
@@ -104,7 +105,6 @@ def check_output_file(path: Path, *, inputs: Iterable[Path | None] = (),
         raise InputError(f"{path}: cannot write the {what}: folder {parent} does not exist",
                          file=str(path))
     _writable_folder(parent, what)
-    _name_fits(path, what)
 
 
 def check_output_dir(path: Path, *, inputs: Iterable[Path | None] = (),
@@ -112,6 +112,7 @@ def check_output_dir(path: Path, *, inputs: Iterable[Path | None] = (),
     """``path`` may hold written files: it is not a file, holds none of the ``inputs``'
     names as the files it will write over, and is (or can be created) writable."""
     path = Path(path)
+    _name_fits(path, what)
     if path.exists() and not path.is_dir():
         raise InputError(f"{path}: is a file, not a folder for the {what}", file=str(path))
     for inp in inputs:
@@ -119,4 +120,3 @@ def check_output_dir(path: Path, *, inputs: Iterable[Path | None] = (),
             raise InputError(f"{path}: the {what} folder is the input {inp}; choose another "
                              f"{option}", file=str(path))
     _writable_folder(path, what)
-    _name_fits(path, what)

@@ -10,10 +10,12 @@ with a timeout — refusing is deterministic and never hangs).
 
 from __future__ import annotations
 
+import contextlib
 import os
 import stat
-from collections.abc import Iterable
+from collections.abc import Iterable, Iterator
 from pathlib import Path
+from typing import BinaryIO
 
 from mhtrack.errors import InputError
 
@@ -120,3 +122,18 @@ def check_output_dir(path: Path, *, inputs: Iterable[Path | None] = (),
             raise InputError(f"{path}: the {what} folder is the input {inp}; choose another "
                              f"{option}", file=str(path))
     _writable_folder(path, what)
+
+
+@contextlib.contextmanager
+def arrow_file(path: str | os.PathLike[str], mode: str = "rb") -> Iterator[str | BinaryIO]:
+    """``path`` for pyarrow: its text when it is UTF-8 (pyarrow's own reader), else an open
+    Python file (pyarrow refuses names that are not UTF-8, which Python keeps as surrogate
+    escapes; the OS takes the bytes as they are)."""
+    name = os.fspath(path)
+    try:
+        name.encode("utf-8")
+    except UnicodeEncodeError:
+        with open(name, mode) as fh:
+            yield fh
+        return
+    yield name

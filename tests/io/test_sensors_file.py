@@ -164,8 +164,9 @@ CASES = [
      "key 'sensors[0].lat': site (46.4253, 6.0989) is 20004 km from [origin] at "
      "(-46.4253, -173.901), farther than 3000 km: the local plane cannot hold it (wrong "
      "origin or a sign error in lat/lon?)"),
-    ("site 30 degrees of latitude from the origin (3327 km by GeographicLib)", {7: "lat = 16.8", 8: "lon = 8.2"},
-     7, "key 'sensors[0].lat': site (16.8, 8.2) is 3327 km from [origin] at (46.8, 8.2), "
+    ("site 30 degrees of latitude from the origin (3327 km by GeographicLib)",
+     {7: "lat = 16.8", 8: "lon = 8.2"}, 7,
+     "key 'sensors[0].lat': site (16.8, 8.2) is 3327 km from [origin] at (46.8, 8.2), "
      "farther than 3000 km: the local plane cannot hold it (wrong origin or a sign error "
      "in lat/lon?)"),
     ("position far from the origin", {7: None, 8: None, 9: "position = [3e6, 1e5]"}, 9,

@@ -13,7 +13,6 @@ from geographiclib.geodesic import Geodesic
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from mhtrack.models.linalg2 import det2
 from mhtrack.models.geodesy import (
     LocalFrame,
     direct,
@@ -21,6 +20,7 @@ from mhtrack.models.geodesy import (
     local_to_polar,
     polar_to_local,
 )
+from mhtrack.models.linalg2 import det2
 
 G = Geodesic.WGS84
 FULL = Geodesic.STANDARD | Geodesic.REDUCEDLENGTH

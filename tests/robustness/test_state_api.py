@@ -30,7 +30,7 @@ from mhtrack.records import Scan
 from mhtrack.scenario import preset, simulate
 
 sys.path.insert(0, str(Path(__file__).parents[1] / "mht"))
-from async_fixture import simulate_async  # noqa: E402
+from async_fixture import simulate_async
 
 FUZZ = settings(derandomize=True, deadline=None, max_examples=150, database=None,
                 suppress_health_check=[HealthCheck.function_scoped_fixture,

@@ -178,3 +178,41 @@ def test_readers_skip_temporaries(tmp_path: Path) -> None:
     assert not is_temporary(tmp_path / "result.json")
     src = Path(html_study.__file__).read_text()
     assert "is_temporary" in src
+
+
+_COMMAND = textwrap.dedent("""
+    import sys, time
+    sys.path.insert(0, {src!r})
+    import pyarrow.csv as pacsv
+    from mhtrack.io import atomic
+    real, k = pacsv.write_csv, int(sys.argv[1])
+    def slow(table, fh, *args, **kw):  # the command's own writer, slowed down at row k
+        real(table.slice(0, k), fh, *args, **kw)
+        fh.flush()
+        print(list(atomic._IN_FLIGHT)[0], flush=True)
+        while True:
+            time.sleep(0.01)
+    pacsv.write_csv = slow
+    from mhtrack.cli.main import cli
+    cli(sys.argv[2:], prog_name="mhtrack")
+""")
+
+
+@pytest.mark.parametrize("k", list(np.random.default_rng(7).integers(0, 200, 2)))
+def test_sigterm_during_a_command_keeps_the_old_output_and_no_temporary(
+        tmp_path: Path, k: int) -> None:
+    """``mhtrack simulate`` stopped by SIGTERM while it writes plots.csv (after ``k`` rows,
+    seeded): status 143, the previous plots.csv whole, no temporary left."""
+    out = tmp_path / "sim"
+    out.mkdir()
+    (out / "plots.csv").write_text("old\n")
+    script = tmp_path / "cmd.py"
+    script.write_text(_COMMAND.format(src=SRC))
+    p = subprocess.Popen([sys.executable, str(script), str(k), "simulate", "crossing",
+                          "--scans", "20", "--out", str(out)], stdout=subprocess.PIPE,
+                         text=True)
+    tmp = Path(p.stdout.readline().strip())  # type: ignore[union-attr]
+    assert tmp.exists() and is_temporary(tmp) and tmp.parent == out
+    p.terminate()
+    assert p.wait() == 143
+    assert (out / "plots.csv").read_text() == "old\n" and _temporaries(out) == []

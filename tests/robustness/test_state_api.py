@@ -114,6 +114,8 @@ CASES = [
     ("agmm", ("config", "sigma_w"), 1e308, "field 'config.sigma_w'"),  # OverflowError
     ("agmm", ("config", "imm_sigma_v"), 1e308, "field 'config.imm_sigma_v'"),  # at step
     ("agmm", ("config", "sigma_v"), None, "cannot be restored (MHTConfig.sigma_v"),
+    # a ValueError from MHTTracker.load: 'saved with 2 IMM models, the motion model ... 0'
+    ("agmm", ("config", "imm_sigma_v"), 0, "member 'leaves__mu': 2 IMM model probabilities"),
     ("agmm", ("recipe", "name"), None, "field 'recipe.name'"),  # ValueError 'recipe'
     ("agmm", ("recipe", "clutter_params"), "x", "field 'recipe.clutter_params'"),
     ("agmm", ("recipe", "clutter_density"), 10**30, "field 'recipe.clutter_density'"),

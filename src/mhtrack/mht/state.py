@@ -163,6 +163,14 @@ def load_state(path: str | PathLike[str], clutter: ClutterEstimator | None) -> S
     meta = _meta(path, arrays)
     config = saved_config(path, meta)
     check_arrays(path, arrays, meta, config.n_scan)
+    mu = arrays["leaves__mu"]
+    with located(path, "meta"):
+        n_models = config.motion.n_models
+    if meta.get("recipe") is not None and mu.shape[1] != n_models:
+        # the builder's trackers use the configuration's motion model
+        raise member_error(path, "leaves__mu", f"{mu.shape[1]} IMM model probabilities per "
+                           f"leaf, but the saved configuration's motion model has "
+                           f"{n_models} models")
     if clutter is None:
         if meta["clutter_name"] != KnownClutter.name:
             raise ValueError(

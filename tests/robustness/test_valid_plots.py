@@ -76,3 +76,29 @@ def test_track_command_takes_a_plot_at_range_zero(tmp_path: Path, near: list[flo
     assert res.exit_code == 0, res.output
     lines = (tmp_path / "tracks.csv").read_text().splitlines()
     assert lines[0].startswith("frame,time,track_id") and len(lines) > 1
+
+
+def test_scan_plots_at_range_zero_are_tracked_and_a_singular_one_is_named(
+        tmp_path: Path) -> None:
+    """A scan file with a (simulated-style) polar radar: range 0 converts to a positive
+    definite R (unbiased converted measurement, ``det = σr⁴(1 − λ'²)/4``) and is tracked;
+    errors so small that ``R`` is singular in float64 (σθ = 1e-300°) are refused where
+    the file is known — file, line and column — not by the tracker without a file."""
+    from mhtrack.clutter.known import KnownClutter
+    from mhtrack.errors import InputError
+    from mhtrack.mht import MHTConfig, MHTTracker
+    from mhtrack.models.sensors import PolarRadar
+
+    rows = ["scan,time,sensor,x,y,range,bearing"]
+    for k in range(6):
+        rows.append(f"{k},{float(k)},0,0,0,{2000.0 + 100 * k},45.0")
+        rows.append(f"{k},{float(k)},0,0,0,0.0,{30.0 * k}")
+    path = tmp_path / "plots.csv"
+    path.write_text("\n".join(rows) + "\n")
+    table = read_plots(path, {0: PolarRadar(0, sigma_range=20.0, sigma_bearing_deg=0.3)})
+    assert table.R is not None and (det2(table.R) > 0).all()
+    MHTTracker(MHTConfig(), KnownClutter(1e-9)).run(table)
+    with pytest.raises(InputError) as e:
+        read_plots(path, {0: PolarRadar(0, sigma_range=20.0, sigma_bearing_deg=1e-300)})
+    assert str(e.value).startswith(f"{path}, line 2, column 'range': range 2000")
+    assert "not positive definite" in str(e.value)

@@ -73,3 +73,36 @@ def test_state_and_sensors_files_with_odd_names(tmp_path: Path) -> None:
     s = SensorSet((46.8, 8.2), (RadarSensor(1, "cartesian", sigma=5.0, pd=0.9),))
     write_sensors(s, folder / os.fsdecode(b"r\xff.toml"))
     assert read_sensors(folder / os.fsdecode(b"r\xff.toml")) == s
+
+
+def test_run_report_montecarlo_and_study_page_in_odd_folders(tmp_path: Path) -> None:
+    """The report pages print the folder's name: before, atomic_write's UTF-8 encoding
+    failed on it ('surrogates not allowed') after all the work."""
+    run = tmp_path / ODD / "run"
+    code, text = _run(["run", "crossing", "--scans", "4", "--out", str(run), "--report"])
+    assert code == 0, text
+    page = (run / "report.html").read_bytes()
+    page.decode("utf-8")  # valid UTF-8, the odd bytes shown as \xff\xfe
+    study = tmp_path / ODD / os.fsdecode(b"mc\xff")
+    code, text = _run(["montecarlo", "crossing", "--runs", "2", "--scans", "4", "--out",
+                       str(study)])
+    assert code == 0, text
+    code, text = _run(["report", str(study)])
+    assert code == 0, text
+    (study / "report.html").read_bytes().decode("utf-8")
+
+
+def test_asterix_export_and_convert_with_odd_names(tmp_path: Path) -> None:
+    pytest.importorskip("asterix")
+    sim = tmp_path / ODD
+    code, text = _run(["simulate", "opensky-radars", "--out", str(sim)])
+    assert code == 0, text
+    rec = sim / os.fsdecode(b"rec\xff.pcap")
+    code, text = _run(["export", str(sim / "plots.csv"), "--sensors",
+                       str(sim / "sensors.toml"), "--out", str(rec)])
+    assert code == 0, text
+    conv = sim / os.fsdecode(b"conv\xfe.csv")
+    code, text = _run(["convert", str(rec), str(conv), "--sensors",
+                       str(sim / "sensors.toml")])
+    assert code == 0, text
+    assert conv.read_text().count("\n") > 1000

@@ -188,9 +188,14 @@ def _default_mode() -> int:
 
 def atomic_write(path: str | os.PathLike[str], data: bytes | str, *,
                  make_parent: bool = True) -> Path:
-    """Write ``data`` (text as UTF-8) to ``path`` atomically (see :func:`atomic_path`)."""
+    """Write ``data`` (text as UTF-8) to ``path`` atomically (see :func:`atomic_path`).
+    Text holding a file name that is not UTF-8 (surrogate escapes) gets its odd bytes
+    as ``\\xNN`` (:func:`~mhtrack.errors.printable`): the file stays valid UTF-8."""
     if isinstance(data, str):
-        data = data.encode("utf-8")
+        try:
+            data = data.encode("utf-8")
+        except UnicodeEncodeError:
+            data = printable(data).encode("utf-8")
     with atomic_path(path, make_parent=make_parent) as tmp, open(tmp, "wb") as fh:
         fh.write(data)
     return Path(path)

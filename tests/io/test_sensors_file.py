@@ -120,11 +120,11 @@ CASES = [
     ("origin longitude", {3: "lon = -180.5"}, 3,
      "key 'origin.lon': longitude must be within [-180, 180] degrees, got -180.5"),
     ("negative sigma_range", {10: "sigma_range = -80.0"}, 10,
-     "key 'sensors[0].sigma_range': must be in [0.001, 1e6] m, got -80"),
+     "key 'sensors[0].sigma_range': must be in [1e-09, 1e6] m, got -80"),
     ("negative sigma_bearing", {11: "sigma_bearing_deg = -0.1"}, 11,
-     "key 'sensors[0].sigma_bearing_deg': must be in [1e-06, 30] degrees, got -0.1"),
+     "key 'sensors[0].sigma_bearing_deg': must be in [1e-12, 30] degrees, got -0.1"),
     ("zero sigma", {19: "sigma = 0"}, 19,
-     "key 'sensors[1].sigma': must be in [0.001, 1e6] m, got 0"),
+     "key 'sensors[1].sigma': must be in [1e-09, 1e6] m, got 0"),
     ("pd zero", {12: "pd = 0.0"}, 12, "key 'sensors[0].pd': must be in (0, 1], got 0"),
     ("pd above one", {20: "pd = 1.5"}, 20, "key 'sensors[1].pd': must be in (0, 1], got 1.5"),
     ("pd nan", {12: "pd = nan"}, 12, "key 'sensors[0].pd': must be finite, got nan"),
@@ -175,7 +175,7 @@ CASES = [
     ("max_range beyond half the Earth", {14: "max_range = 3e7"}, 14,
      "key 'sensors[0].max_range': 3e+07 m is beyond 20000 km, half-way round the Earth"),
     ("bearing error that underflows", {11: "sigma_bearing_deg = 1e-300"}, 11,
-     "key 'sensors[0].sigma_bearing_deg': must be in [1e-06, 30] degrees, got 1e-300"),
+     "key 'sensors[0].sigma_bearing_deg': must be in [1e-12, 30] degrees, got 1e-300"),
 ]
 
 

@@ -289,8 +289,8 @@ def test_polar_covariance_beyond_sigma_range_is_unchanged():
 
 
 @settings(derandomize=True, deadline=None, max_examples=200, database=None)
-@given(r=st.floats(0.0, 2e7), b=st.floats(0.0, 360.0), sr=st.floats(1e-3, 1e6),
-       sb=st.floats(1e-6, 30.0))
+@given(r=st.floats(0.0, 2e7), b=st.floats(0.0, 360.0), sr=st.floats(1e-9, 1e6),
+       sb=st.floats(1e-12, 30.0))
 def test_every_valid_polar_plot_has_a_positive_definite_covariance(r, b, sr, sb):
     """Every range, bearing and σ a sensors file and a plots file may hold (their
     documented bounds) gives an R that the tracker's scan check accepts: symmetric,

@@ -186,18 +186,19 @@ def polar_to_local(
 
     **Near the site** the bearing term vanishes with ``r`` (``|∂(x, y)/∂θ| = r``), and at
     ``r = 0`` ``R`` would be singular. A plot cannot be placed nearer its site than its
-    range error, so the bearing column is taken at ``max(r, σr)``: within ``σr`` of the
-    site the cross-range error is ``σr σθ``, the bearing error at the minimum range
-    ``σr``. Beyond ``σr`` nothing changes. **Conditioning:** the cross-range variance
+    range error, so the bearing column is taken at the minimum range
+    ``r_min = max(σr, STEP_M)`` (``STEP_M`` = 10 m keeps the bearing difference's chord,
+    2 mm, far above the positions' rounding): within ``r_min`` of the site the
+    cross-range error is ``r_min σθ``. Beyond ``r_min`` nothing changes. **Conditioning:** the cross-range variance
     ``vθ = σθ² |∂(x, y)/∂θ|²`` and the range one ``vr = σr² |∂(x, y)/∂r|²`` are each kept
     at least :data:`MIN_VARIANCE_RATIO` of the other, so ``det R`` stays positive in
     float64 for every range and σ a sensors file may hold (this acts only when one
-    error is over 10⁶ times the other, e.g. ``σr`` = 1 mm at 1000 km).
+    error is over 10⁶ times the other, e.g. ``σr`` = 1 mm at 1000 km with σθ = 0.15°).
     """
     _, (r, b, sr, sb) = _flat(range_m, bearing_deg, sigma_range, sigma_bearing_deg)
     n = r.size
     db = np.degrees(STEP_RAD)
-    rb = np.maximum(r, sr)  # the bearing column at the minimum range σr
+    rb = np.maximum(r, np.maximum(sr, STEP_M))  # the bearing column at r_min at least
     rr = np.concatenate((r, r + STEP_M, r - STEP_M, rb, rb))
     bb = np.concatenate((b, b, b, b + db, b - db))
     la, lo = direct(site_lat, site_lon, bb, rr)

@@ -37,9 +37,10 @@ MAX_SITE_DISTANCE_M = 3e6
 #: Largest instrumented range (m): 20 000 km, about half a meridian (the plots reader's
 #: bound on a range).
 MAX_RANGE_M = 2e7
-#: Smallest errors a radar can have: ``σr`` ≥ 1 mm, ``σθ`` ≥ 10⁻⁶ degree (3.6 milli-
-#: arcseconds); below them ``σ²`` loses its precision (or underflows) in float64.
-MIN_SIGMA_M, MIN_SIGMA_BEARING_DEG = 1e-3, 1e-6
+#: Smallest errors accepted: ``σr``, ``σ`` ≥ 1 nm, ``σθ`` ≥ 10⁻¹² degree — far below any
+#: sensor (noise-free test geometries use them); smaller ones make ``σ²`` underflow
+#: towards 0 in float64 and the plots' covariances singular (1e-300 gave 0).
+MIN_SIGMA_M, MIN_SIGMA_BEARING_DEG = 1e-9, 1e-12
 
 
 class SensorFieldError(ValueError):

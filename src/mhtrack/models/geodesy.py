@@ -191,9 +191,10 @@ def polar_to_local(
     2 mm, far above the positions' rounding): within ``r_min`` of the site the
     cross-range error is ``r_min σθ``. Beyond ``r_min`` nothing changes.
     **Conditioning:** the cross-range variance ``vθ = σθ² |∂(x, y)/∂θ|²`` and the range
-    one ``vr = σr² |∂(x, y)/∂r|²`` are each kept at least :data:`MIN_VARIANCE_RATIO` of the other, so ``det R`` stays positive in
-    float64 for every range and σ a sensors file may hold (this acts only when one
-    error is over 10⁶ times the other, e.g. ``σr`` = 1 mm at 1000 km with σθ = 0.15°).
+    one ``vr = σr² |∂(x, y)/∂r|²`` are each kept at least :data:`MIN_VARIANCE_RATIO` of
+    the other, so ``det R`` stays positive in float64 for every range and σ a sensors
+    file may hold (this acts only when one error is over 10⁶ times the other, e.g.
+    ``σr`` = 1 mm at 1000 km with σθ = 0.15°).
     """
     _, (r, b, sr, sb) = _flat(range_m, bearing_deg, sigma_range, sigma_bearing_deg)
     n = r.size

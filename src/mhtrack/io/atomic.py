@@ -19,12 +19,14 @@ I/O error) is raised again as :class:`OutputError` — still an ``OSError`` with
 SIGTERM and SIGINT remove the temporaries of the writes in flight and the registered
 temporary folders (:func:`temporary_dir`) before the process ends.
 
-**SIGKILL** cannot be caught: its temporary stays. The writer holds an exclusive
-``flock`` on its temporary for as long as it writes; the kernel drops the lock when the
-process dies, however it dies. The first write of a process in a folder removes the
-temporaries there whose writer is provably gone: the pid in the name no longer runs, or
-it runs (a pid reused) but nobody holds the temporary's lock. A pid alone is not proof
-(pids are reused); the lock is. Temporaries of live writers are never touched.
+**SIGKILL** cannot be caught: its temporary stays, named with its writer's pid. The writer
+holds an exclusive ``flock`` on its temporary for as long as it writes; the kernel drops
+the lock when the process dies, however it dies. The first write of a process in a
+folder removes the temporaries there whose writer is provably gone: nobody holds the
+lock. We chose the lock over the pid (and its start time): a pid is reused, and a writer
+on another machine sharing the folder has its own pids; the lock covers both. Only on a
+file system without locks does the pid decide (gone when no process has it).
+Temporaries of live writers are never touched.
 """
 
 from __future__ import annotations
@@ -86,28 +88,36 @@ def _lock(fd: int) -> None:
         fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
 
 
+def _pid_alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except OSError:
+        return True  # another user's process
+    return True
+
+
 def _stale(path: Path, pid: int) -> bool:
-    """The writer of the temporary ``path`` is gone: its pid runs no process, or nobody
-    holds the temporary's lock (the pid was reused)."""
+    """The writer of the temporary ``path`` is gone: nobody holds the temporary's lock
+    (the kernel drops it with its process, however it ends; a pid alone proves nothing:
+    it is reused, and a writer on another machine sharing the folder has a pid of its
+    own). Where the file system has no locks, the pid decides: gone when no process has
+    it."""
     try:
         import fcntl
     except ImportError:
         return False
-    if pid != os.getpid():
-        try:
-            os.kill(pid, 0)
-        except ProcessLookupError:
-            return True
-        except OSError:
-            pass  # alive (another user's): the lock decides
     try:
         fd = os.open(path, os.O_RDONLY | getattr(os, "O_NOFOLLOW", 0))
     except OSError:
         return False
     try:
         fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-    except OSError:
+    except BlockingIOError:
         return False  # a live writer holds it
+    except OSError:
+        return pid != os.getpid() and not _pid_alive(pid)
     finally:
         os.close(fd)
     return True

@@ -216,3 +216,53 @@ def test_sigterm_during_a_command_keeps_the_old_output_and_no_temporary(
     p.terminate()
     assert p.wait() == 143
     assert (out / "plots.csv").read_text() == "old\n" and _temporaries(out) == []
+
+
+_TRACKING = textwrap.dedent("""
+    import sys, time
+    sys.path.insert(0, {src!r})
+    from mhtrack.mht import MHTTracker
+    real = MHTTracker.step
+    calls = [0]
+    def step(self, scan):  # tracking, with the decoded recording on disk
+        calls[0] += 1
+        if calls[0] == int(sys.argv[1]):
+            print("tracking", flush=True)
+            while True:
+                time.sleep(0.01)
+        return real(self, scan)
+    MHTTracker.step = step
+    from mhtrack.cli.main import cli
+    cli(sys.argv[2:], prog_name="mhtrack")
+""")
+
+
+def test_sigterm_while_tracking_a_recording_removes_the_decoded_copy(tmp_path: Path) -> None:
+    """``mhtrack track REC.pcap`` decodes the recording into a temporary folder; SIGTERM
+    while tracking (at a seeded frame) leaves no such folder and no output."""
+    pytest.importorskip("asterix")
+    from click.testing import CliRunner
+
+    from mhtrack.cli.main import cli
+
+    sim = tmp_path / "sim"
+    runner = CliRunner()
+    assert runner.invoke(cli, ["simulate", "opensky-radars", "--out", str(sim)]).exit_code == 0
+    rec = sim / "radar.pcap"
+    assert runner.invoke(cli, ["export", str(sim / "plots.csv"), "--sensors",
+                               str(sim / "sensors.toml"), "--out", str(rec)]).exit_code == 0
+    tmpdir = tmp_path / "tmp"
+    tmpdir.mkdir()
+    script = tmp_path / "cmd.py"
+    script.write_text(_TRACKING.format(src=SRC))
+    frame = int(np.random.default_rng(11).integers(1, 200))
+    p = subprocess.Popen([sys.executable, str(script), str(frame), "track", str(rec),
+                          "--sensors", str(sim / "sensors.toml"), "--out",
+                          str(tmp_path / "tracks.csv")], stdout=subprocess.PIPE, text=True,
+                         env={**os.environ, "TMPDIR": str(tmpdir)})
+    assert p.stdout.readline().strip() == "tracking"  # type: ignore[union-attr]
+    assert [d.name for d in tmpdir.iterdir() if d.name.startswith("mhtrack-asterix-")]
+    p.terminate()
+    assert p.wait() == 143
+    assert list(tmpdir.iterdir()) == [] and not (tmp_path / "tracks.csv").exists()
+    assert _temporaries(tmp_path) == []

@@ -170,14 +170,19 @@ def test_a_temporary_of_a_reused_pid_without_its_lock_is_stale(tmp_path: Path) -
 
 
 def test_readers_skip_temporaries(tmp_path: Path) -> None:
-    """The study page lists ``*.json`` results: a temporary ending in .json is not one."""
-    from mhtrack.reports import html_study
+    """The study page takes the first ``*.json`` with paired comparisons: a half-written
+    temporary sorted before the real file (``.`` sorts first) is not read."""
+    import json
 
-    (tmp_path / ".mhtrack-99999999-0123456789ab.tmp.json").write_text("{not json")
+    from mhtrack.reports.html_study import PAIRED_FIELDS, paired_from_json
+
+    row = dict.fromkeys(PAIRED_FIELDS, 1.0)
+    (tmp_path / ".mhtrack-99999999-0123456789ab.tmp.json").write_text(
+        json.dumps({"paired": [{**row, "note": "half"}]}))
+    (tmp_path / "results.json").write_text(json.dumps({"paired": [row]}))
     assert is_temporary(tmp_path / ".mhtrack-99999999-0123456789ab.tmp.json")
-    assert not is_temporary(tmp_path / "result.json")
-    src = Path(html_study.__file__).read_text()
-    assert "is_temporary" in src
+    assert not is_temporary(tmp_path / "results.json")
+    assert paired_from_json(tmp_path)[1] == "results.json"
 
 
 _COMMAND = textwrap.dedent("""

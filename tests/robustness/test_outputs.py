@@ -38,6 +38,26 @@ def test_any_name_the_file_system_accepts_is_written(tmp_path: Path, n: int) -> 
     assert path.read_text() == "x,y\n1,2\n" and _temporaries(tmp_path) == []
 
 
+def test_track_writes_an_output_name_of_255_bytes(tmp_path: Path) -> None:
+    """Through the command: ``mhtrack track --out`` with a 255-byte name (before: refused
+    after the tracking, the temporary's name being longer)."""
+    from click.testing import CliRunner
+
+    from mhtrack.cli.main import cli
+
+    runner = CliRunner()
+    sim = tmp_path / "s"
+    assert runner.invoke(cli, ["simulate", "crossing", "--scans", "4", "--out",
+                               str(sim)]).exit_code == 0
+    out = tmp_path / ("t" * 251 + ".csv")
+    res = runner.invoke(cli, ["track", str(sim / "plots.csv"), "--out", str(out)])
+    assert res.exit_code == 0, res.output
+    assert out.read_text().startswith("scan,") and _temporaries(tmp_path) == []
+    res = runner.invoke(cli, ["track", str(sim / "plots.csv"), "--out",
+                              str(tmp_path / ("t" * 252 + ".csv"))])
+    assert res.exit_code == 2 and "its name is 256 bytes long" in res.output, res.output
+
+
 def test_a_name_too_long_is_refused_before_the_work(tmp_path: Path) -> None:
     path = tmp_path / ("a" * 252 + ".csv")
     with pytest.raises(InputError, match=r"its name is 256 bytes long, the file system "

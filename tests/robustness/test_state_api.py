@@ -118,6 +118,7 @@ CASES = [
     ("agmm", ("config", "imm_sigma_v"), 0, "member 'leaves__mu': 2 IMM model probabilities"),
     ("agmm", ("recipe", "name"), None, "field 'recipe.name'"),  # ValueError 'recipe'
     ("agmm", ("recipe", "clutter_params"), "x", "field 'recipe.clutter_params'"),
+    ("agmm", ("recipe", "clutter_params"), {"bogus": 1}, "field 'recipe.clutter_params'"),
     ("agmm", ("recipe", "clutter_density"), 10**30, "field 'recipe.clutter_density'"),
     ("agmm", ("recipe", "sensors"), [], "field 'recipe.sensors'"),
     ("agmm", ("clutter_name",), "x", "field 'clutter_name'"),  # plain ValueError

@@ -170,6 +170,15 @@ def _recipe(path: PathArg, recipe: object) -> None:
         raise fail("clutter_params", "expected an object of names and plain values")
     if params:
         _config_numbers(path, {f"recipe.clutter_params.{k}": v for k, v in params.items()})
+        from mhtrack.clutter import AGMMClutter, GMMClutter
+
+        # the builder passes them to its mixture estimator (None: the default)
+        cls = {"mht-gmm": GMMClutter, "mht-agmm": AGMMClutter}.get(recipe["name"])
+        if cls is not None:
+            try:
+                cls(**{k: v for k, v in params.items() if v is not None})
+            except (TypeError, ValueError, OverflowError) as e:
+                raise fail("clutter_params", clip(str(e), 120)) from None
     sensors = recipe.get("sensors")
     if sensors is not None:
         from mhtrack.models.radars import RadarSensor, SensorSet

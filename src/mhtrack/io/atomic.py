@@ -148,7 +148,7 @@ def atomic_path(path: str | os.PathLike[str], *, make_parent: bool = True) -> It
     ``pq.write_table``, ``Figure.savefig``, …); on success it is flushed to disk (fsync) and
     replaces ``path``, on an exception it is removed and ``path`` is left as it was. The
     parent folder is created (``make_parent``; else a missing one raises
-    ``FileNotFoundError``). The temporary name keeps ``path``'s suffix (up to
+    :class:`OutputError` with ``errno.ENOENT``). The temporary name keeps ``path``'s suffix (up to
     :data:`MAX_SUFFIX` bytes), for writers that choose a format by it. The new file gets the
     permissions an ordinary ``open(path, "w")`` would give (``0o666`` less the umask).
     An ``OSError`` becomes :class:`OutputError` naming ``path``."""

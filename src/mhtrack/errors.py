@@ -31,6 +31,14 @@ def short_number(x: float) -> str:
     return f"{x:g}"
 
 
+def printable(text: object) -> str:
+    """``text`` (a message or a path) as text any stream can print: the bytes of a file
+    name that are not UTF-8 (which Python keeps as surrogate escapes, PEP 383) shown as
+    ``\\xNN``; everything else unchanged."""
+    s = text.decode("utf-8", "surrogateescape") if isinstance(text, bytes) else str(text)
+    return s.encode("utf-8", "surrogateescape").decode("utf-8", "backslashreplace")
+
+
 class InputError(ValueError):
     """A user-supplied file (or path) is missing, unreadable or malformed.
 
@@ -54,7 +62,7 @@ class InputError(ValueError):
         column: str | None = None,
         key: str | None = None,
     ) -> None:
-        super().__init__(message)
+        super().__init__(printable(message))
         self.file = file
         self.line = line
         self.row = row

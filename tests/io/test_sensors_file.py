@@ -120,11 +120,11 @@ CASES = [
     ("origin longitude", {3: "lon = -180.5"}, 3,
      "key 'origin.lon': longitude must be within [-180, 180] degrees, got -180.5"),
     ("negative sigma_range", {10: "sigma_range = -80.0"}, 10,
-     "key 'sensors[0].sigma_range': must be > 0 and <= 1e6 m, got -80"),
+     "key 'sensors[0].sigma_range': must be in [1e-09, 1e6] m, got -80"),
     ("negative sigma_bearing", {11: "sigma_bearing_deg = -0.1"}, 11,
-     "key 'sensors[0].sigma_bearing_deg': must be > 0 and <= 30 degrees, got -0.1"),
+     "key 'sensors[0].sigma_bearing_deg': must be in [1e-12, 30] degrees, got -0.1"),
     ("zero sigma", {19: "sigma = 0"}, 19,
-     "key 'sensors[1].sigma': must be > 0 and <= 1e6 m, got 0"),
+     "key 'sensors[1].sigma': must be in [1e-09, 1e6] m, got 0"),
     ("pd zero", {12: "pd = 0.0"}, 12, "key 'sensors[0].pd': must be in (0, 1], got 0"),
     ("pd above one", {20: "pd = 1.5"}, 20, "key 'sensors[1].pd': must be in (0, 1], got 1.5"),
     ("pd nan", {12: "pd = nan"}, 12, "key 'sensors[0].pd': must be finite, got nan"),
@@ -152,6 +152,30 @@ CASES = [
      "key 'sensors[0].position': expected [x, y], two numbers, got array [1.0, 'a']"),
     ("origin not a table", {1: "origin = 4", 2: None, 3: None}, 1,
      "key 'origin': expected a table, got integer 4"),
+    # physically impossible geometry (issue 33): refused at the key
+    ("altitude in km units", {9: "alt = 1.6e6"}, 9,
+     "key 'sensors[0].alt': altitude 1.6e+06 m is not physically possible for a site "
+     "(expected [-500, 100000] m; a unit error?)"),
+    ("altitude below the sea", {9: "alt = -11000"}, 9,
+     "key 'sensors[0].alt': altitude -11000 m is not physically possible for a site "
+     "(expected [-500, 100000] m; a unit error?)"),
+    # the antipode of (46.4253, 6.0989); 20 004 km by GeographicLib
+    ("origin at the antipode", {2: "lat = -46.4253", 3: "lon = -173.9011"}, 7,
+     "key 'sensors[0].lat': site (46.4253, 6.0989) is 20004 km from [origin] at "
+     "(-46.4253, -173.901), farther than 3000 km: the local plane cannot hold it (wrong "
+     "origin or a sign error in lat/lon?)"),
+    ("site 30 degrees of latitude from the origin (3327 km by GeographicLib)",
+     {7: "lat = 16.8", 8: "lon = 8.2"}, 7,
+     "key 'sensors[0].lat': site (16.8, 8.2) is 3327 km from [origin] at (46.8, 8.2), "
+     "farther than 3000 km: the local plane cannot hold it (wrong origin or a sign error "
+     "in lat/lon?)"),
+    ("position far from the origin", {7: None, 8: None, 9: "position = [3e6, 1e5]"}, 9,
+     "key 'sensors[0].position': site 3002 km from the frame's origin, farther than "
+     "3000 km (the local plane cannot hold it)"),
+    ("max_range beyond half the Earth", {14: "max_range = 3e7"}, 14,
+     "key 'sensors[0].max_range': 3e+07 m is beyond 20000 km, half-way round the Earth"),
+    ("bearing error that underflows", {11: "sigma_bearing_deg = 1e-300"}, 11,
+     "key 'sensors[0].sigma_bearing_deg': must be in [1e-12, 30] degrees, got 1e-300"),
 ]
 
 

@@ -10,6 +10,8 @@ import pickle
 import numpy as np
 import pytest
 from geographiclib.geodesic import Geodesic
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from mhtrack.models.geodesy import (
     LocalFrame,
@@ -18,6 +20,7 @@ from mhtrack.models.geodesy import (
     local_to_polar,
     polar_to_local,
 )
+from mhtrack.models.linalg2 import det2
 
 G = Geodesic.WGS84
 FULL = Geodesic.STANDARD | Geodesic.REDUCEDLENGTH
@@ -244,3 +247,58 @@ def test_frame_validates_and_pickles():
     g = pickle.loads(pickle.dumps(f))
     assert g == f
     assert g.to_local(47.0, 8.0) == f.to_local(47.0, 8.0)
+
+
+@pytest.mark.parametrize("r", [0.0, 1e-300, 1.0, 79.0])
+def test_polar_covariance_near_the_site_is_positive_definite(r):
+    """Issue 33: a plot at range 0 (or 1e-300) had a singular R (the bearing term is
+    ``r²σθ²``). Within ``σr`` of the site the bearing column is GeographicLib's at the
+    range ``σr`` (the docstring's rule); the range column is the plot's own."""
+    lat0, lon0, _, _ = CASES[0]
+    frame = LocalFrame(lat0, lon0)
+    slat, slon = site_of(*CASES[0])
+    for b in (0.0, 77.0, 300.0):
+        _, R = polar_to_local(frame, slat, slon, r, b, 80.0, 0.15)
+        jr = reference_polar_jacobian(lat0, lon0, slat, slon, r, b)[:, 0]
+        jt = reference_polar_jacobian(lat0, lon0, slat, slon, 80.0, b)[:, 1]
+        ref = 80.0**2 * np.outer(jr, jr) + math.radians(0.15) ** 2 * np.outer(jt, jt)
+        assert np.abs(R[0] - ref).max() < 1e-6 * np.abs(ref).max()
+        assert R[0, 0, 0] > 0 and np.linalg.det(R[0]) > 0
+        np.linalg.cholesky(R[0])
+
+
+def test_polar_covariance_beyond_sigma_range_is_unchanged():
+    """At and beyond ``σr`` the rule changes nothing: R is exactly the plain
+    ``vr jr jrᵀ + vθ jθ jθᵀ`` of the same central differences (the former code path)."""
+    lat0, lon0, _, _ = CASES[0]
+    frame = LocalFrame(lat0, lon0)
+    slat, slon = site_of(*CASES[0])
+    r = np.array([80.0, 81.0, 5e3, 250e3])
+    b = np.array([10.0, 100.0, 200.0, 350.0])
+    _, R = polar_to_local(frame, slat, slon, r, b, 80.0, 0.15)
+    db = math.degrees(1e-4)
+    la, lo = direct(slat, slon, np.concatenate((b, b, b + db, b - db)),
+                    np.concatenate((r + 10, r - 10, r, r)))
+    x, y = frame.to_local(la, lo)
+    p = np.stack((x, y), axis=-1).reshape(4, r.size, 2)
+    jr, jt = (p[0] - p[1]) / 20.0, (p[2] - p[3]) / 2e-4
+    vr, vt = 80.0**2, math.radians(0.15) ** 2
+    assert np.array_equal(R[:, 0, 0], vr * jr[:, 0] ** 2 + vt * jt[:, 0] ** 2)
+    assert np.array_equal(R[:, 1, 1], vr * jr[:, 1] ** 2 + vt * jt[:, 1] ** 2)
+    assert np.array_equal(R[:, 0, 1], vr * jr[:, 0] * jr[:, 1] + vt * jt[:, 0] * jt[:, 1])
+
+
+@settings(derandomize=True, deadline=None, max_examples=200, database=None)
+@given(r=st.floats(0.0, 2e7), b=st.floats(0.0, 360.0), sr=st.floats(1e-9, 1e6),
+       sb=st.floats(1e-12, 30.0))
+def test_every_valid_polar_plot_has_a_positive_definite_covariance(r, b, sr, sb):
+    """Every range, bearing and σ a sensors file and a plots file may hold (their
+    documented bounds) gives an R that the tracker's scan check accepts: symmetric,
+    finite, ``R[0, 0] > 0`` and ``det2(R) > 0``, Cholesky succeeding."""
+    lat0, lon0, _, _ = CASES[0]
+    frame = LocalFrame(lat0, lon0)
+    slat, slon = site_of(*CASES[0])
+    _, R = polar_to_local(frame, slat, slon, r, b, sr, sb)
+    assert np.isfinite(R).all() and R[0, 0, 1] == R[0, 1, 0]
+    assert R[0, 0, 0] > 0 and det2(R)[0] > 0, (R, det2(R))
+    np.linalg.cholesky(R[0])

@@ -76,7 +76,9 @@ def test_write_killed_midway_leaves_the_old_file_whole(tmp_path: Path) -> None:
     from mhtrack.cli.common import table_path
 
     leftovers = [p.name for p in tmp_path.iterdir() if p.name != "tracks.csv"]
-    assert all(name.startswith(".tracks.csv.") for name in leftovers), leftovers
+    from mhtrack.io.atomic import is_temporary
+
+    assert all(is_temporary(name) for name in leftovers), leftovers
     assert table_path(tmp_path, "tracks") == path
 
 

@@ -7,13 +7,17 @@ for the traceback).
 
 from __future__ import annotations
 
+import contextlib
+import io
 import logging
 import os
+import sys
 
 import click
 
 from mhtrack import __version__
 from mhtrack.cli.common import InputProblem, bound_number_options
+from mhtrack.errors import printable
 
 #: Errors that are the user's input, not a bug: reported as one line, no traceback.
 USER_ERRORS: tuple[type[BaseException], ...] = (ValueError, OSError, KeyError)
@@ -30,7 +34,7 @@ class Group(click.Group):
         except USER_ERRORS as exc:
             if os.environ.get("MHTRACK_DEBUG"):
                 raise
-            msg = str(exc) or type(exc).__name__
+            msg = printable(str(exc) or type(exc).__name__)
             if isinstance(exc, KeyError):
                 msg = f"missing key {msg}"
             raise InputProblem(msg) from None
@@ -42,8 +46,14 @@ class Group(click.Group):
 def cli(verbose: int) -> None:
     """Multiple-target tracking in unknown, varying clutter (MHT, MHT-GMM, MHT-AGMM) and
     multi-radar track initiation."""
+    from mhtrack.io.atomic import install_signal_cleanup
+
     level = logging.WARNING - 10 * min(verbose, 2)
     logging.basicConfig(level=level, format="mhtrack: %(levelname)s: %(message)s")
+    install_signal_cleanup()  # SIGTERM/SIGINT remove the temporaries of writes in flight
+    for stream in (sys.stdout, sys.stderr):  # file names that are not UTF-8 print as \xNN
+        with contextlib.suppress(AttributeError, ValueError, io.UnsupportedOperation):
+            stream.reconfigure(errors="backslashreplace")
 
 
 def _register() -> None:

@@ -36,4 +36,6 @@ class KnownClutter(ClutterEstimator):
         return {"kappa": self.kappa}
 
     def set_state(self, state: dict[str, Any]) -> None:
-        self.kappa = float(state["kappa"])
+        from mhtrack.clutter.state_checks import check_known
+
+        self.kappa = check_known(state)

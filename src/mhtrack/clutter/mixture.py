@@ -30,6 +30,7 @@ from mhtrack.clutter.base import ClutterEstimator
 from mhtrack.clutter.density import PDF_DIRECT, log_pdf_t, maha_det_t, offsets_t, plots_t
 from mhtrack.clutter.em import Mixture, PruneRule, fit_em
 from mhtrack.clutter.seeding import ScanRngs, kmeanspp_centres, mixture_from_centres
+from mhtrack.clutter.state_checks import check_mixture_estimator
 from mhtrack.kernels import all_, max_, min_, same_floats, sum_
 from mhtrack.models.clutter import Region
 from mhtrack.records import Scan
@@ -292,7 +293,9 @@ class MixtureClutter(ClutterEstimator):
         }
 
     def set_state(self, state: dict[str, Any]) -> None:
-        """Restore what :meth:`get_state` returned (parameters are the constructor's)."""
+        """Restore what :meth:`get_state` returned (parameters are the constructor's),
+        checked first (:mod:`mhtrack.clutter.state_checks`)."""
+        check_mixture_estimator(state)
         self._reset()
         for w in state["window"]:
             self._window.append(np.asarray(w, dtype=float).reshape(-1, 2))

@@ -26,6 +26,7 @@ from typing import Any
 
 import numpy as np
 
+from mhtrack.bounds import MAX_INDEX, MAX_TIME_S
 from mhtrack.clutter.base import ClutterEstimator
 from mhtrack.records import Scan
 
@@ -130,6 +131,21 @@ class PerSensorClutter(ClutterEstimator):
         }
 
     def set_state(self, state: dict[str, Any]) -> None:
+        from mhtrack.clutter.state_checks import check_scan, number
+
+        f = "clutter_state"
+        for i in [state["current"]] if state["current"] is not None else []:
+            number(i, f"{f}.current", 0, MAX_INDEX, integer=True)
+        for key in ("fed", "sensors"):
+            if not isinstance(state[key], list):
+                raise ValueError(f"field {f}.{key}: expected a list")
+            for i in state[key]:
+                number(i, f"{f}.{key}", 0, MAX_INDEX, integer=True)
+        for v in state["start"].values():
+            number(v, f"{f}.start", -MAX_TIME_S, MAX_TIME_S)
+        for i in state["sensors"]:
+            for j, s in enumerate(state["pending"][str(i)]):
+                check_scan(s, f"{f}.pending[{i}][{j}]")
         self._current = state["current"]
         self._fed = {int(i) for i in state["fed"]}
         self._start = {int(i): float(v) for i, v in state["start"].items()}

@@ -31,7 +31,8 @@ from mhtrack.bounds import (
 from mhtrack.errors import InputError
 from mhtrack.io._arrow import from_numpy, is_null, to_numpy
 from mhtrack.io._source import PathArg, Source, file_format
-from mhtrack.io.atomic import atomic_path
+from mhtrack.io.atomic import OutputError, atomic_path
+from mhtrack.io.paths import arrow_file
 
 #: Column kinds of a schema: integers, floats, and times (read as they are written —
 #: text in CSV, any type in Parquet — and converted by :mod:`mhtrack.io._times`).
@@ -109,7 +110,8 @@ class Frame:
             opts = pacsv.ConvertOptions(
                 include_columns=[name], column_types={name: pa.string()}, null_values=[]
             )
-            col = pacsv.read_csv(self.src.path, convert_options=opts).column(0)
+            with arrow_file(self.src.path) as fh:
+                col = pacsv.read_csv(fh, convert_options=opts).column(0)
             return str(col[row].as_py())
         return repr(self.table.column(name)[row].as_py())
 
@@ -200,7 +202,8 @@ def _column_names(src: Source) -> list[str]:
         import pyarrow.parquet as pq  # only for Parquet files (fast start)
 
         try:
-            names = pq.read_schema(src.path).names
+            with arrow_file(src.path) as fh:
+                names = pq.read_schema(fh).names
         except (pa.ArrowException, OSError) as e:
             raise src.error(f"not a readable Parquet file ({clip(str(e), 200)})") from None
     _check_width(src, names)
@@ -236,7 +239,8 @@ def read_frame(
         opts = pacsv.ConvertOptions(column_types=types, include_columns=present,
                                     null_values=[""], strings_can_be_null=True)
         try:
-            table = pacsv.read_csv(src.path, convert_options=opts)
+            with arrow_file(src.path) as fh:
+                table = pacsv.read_csv(fh, convert_options=opts)
         except pa.ArrowInvalid as e:
             raise _csv_error(src, names, str(e)) from None
         except (pa.ArrowException, OSError) as e:
@@ -245,7 +249,8 @@ def read_frame(
         import pyarrow.parquet as pq
 
         try:
-            table = pq.read_table(src.path, columns=present)
+            with arrow_file(src.path) as fh:
+                table = pq.read_table(fh, columns=present)
         except (pa.ArrowException, OSError) as e:
             raise src.error(f"not a readable Parquet file ({clip(str(e), 200)})") from None
     return Frame(src, table)
@@ -267,7 +272,8 @@ def _csv_error(src: Source, names: list[str], message: str) -> InputError:
         opts = pacsv.ConvertOptions(
             include_columns=[name], column_types={name: pa.string()}, null_values=[]
         )
-        col = pacsv.read_csv(src.path, convert_options=opts).column(0)
+        with arrow_file(src.path) as fh:
+            col = pacsv.read_csv(fh, convert_options=opts).column(0)
         row = pc.index(col, value).as_py()
         where = {"row": None if row < 0 else row, "column": name}
         if integer and re.fullmatch(r"\s*[+-]?\d+\s*", value):
@@ -351,9 +357,10 @@ def write_frame(path: PathArg, columns: Mapping[str, pa.Array]) -> None:
             else:
                 import pyarrow.parquet as pq
 
-                pq.write_table(table, str(tmp))
-    except OSError as e:
-        raise InputError(f"{path}: cannot write ({e.strerror or e})", file=str(path)) from None
+                with arrow_file(tmp, "wb") as fh:
+                    pq.write_table(table, fh)
+    except OutputError as e:  # names the file already (disk full, permission, …)
+        raise InputError(str(e), file=str(path)) from None
 
 
 def int_array(values: np.ndarray, missing: np.ndarray | None = None) -> pa.Array:

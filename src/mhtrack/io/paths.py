@@ -10,10 +10,12 @@ with a timeout — refusing is deterministic and never hangs).
 
 from __future__ import annotations
 
+import contextlib
 import os
 import stat
-from collections.abc import Iterable
+from collections.abc import Iterable, Iterator
 from pathlib import Path
+from typing import BinaryIO
 
 from mhtrack.errors import InputError
 
@@ -62,6 +64,21 @@ def _writable_folder(path: Path, what: str) -> None:
                          file=str(path))
 
 
+def _name_fits(path: Path, what: str) -> None:
+    """The last part of ``path`` fits the file system's name limit (``NAME_MAX``, 255 bytes
+    on most), so that nothing computed is lost to a name refused at the end. The atomic
+    writer's temporary names are at most 49 bytes (:mod:`mhtrack.io.atomic`): any name
+    that fits is written."""
+    try:
+        limit = os.pathconf(_nearest_existing(path.absolute().parent), "PC_NAME_MAX")
+    except (OSError, ValueError, AttributeError):
+        limit = 255
+    n = len(os.fsencode(path.name))
+    if n > limit:
+        raise InputError(f"{path}: cannot write the {what}: its name is {n} bytes long, the "
+                         f"file system allows {limit}", file=str(path))
+
+
 def _same_file(a: Path, b: Path) -> bool:
     try:
         return a.resolve() == b.resolve() or (a.exists() and b.exists() and a.samefile(b))
@@ -75,6 +92,7 @@ def check_output_file(path: Path, *, inputs: Iterable[Path | None] = (),
     """``path`` may be written: its extension is one of ``suffixes``, it is none of the
     ``inputs``, and its folder exists and is writable."""
     path = Path(path)
+    _name_fits(path, what)
     if path.suffix.lower() not in suffixes:
         raise InputError(f"{path}: unknown extension {path.suffix or '(none)'!r} for the "
                          f"{what} (expected {', '.join(suffixes)})", file=str(path))
@@ -96,6 +114,7 @@ def check_output_dir(path: Path, *, inputs: Iterable[Path | None] = (),
     """``path`` may hold written files: it is not a file, holds none of the ``inputs``'
     names as the files it will write over, and is (or can be created) writable."""
     path = Path(path)
+    _name_fits(path, what)
     if path.exists() and not path.is_dir():
         raise InputError(f"{path}: is a file, not a folder for the {what}", file=str(path))
     for inp in inputs:
@@ -103,3 +122,18 @@ def check_output_dir(path: Path, *, inputs: Iterable[Path | None] = (),
             raise InputError(f"{path}: the {what} folder is the input {inp}; choose another "
                              f"{option}", file=str(path))
     _writable_folder(path, what)
+
+
+@contextlib.contextmanager
+def arrow_file(path: str | os.PathLike[str], mode: str = "rb") -> Iterator[str | BinaryIO]:
+    """``path`` for pyarrow: its text when it is UTF-8 (pyarrow's own reader), else an open
+    Python file (pyarrow refuses names that are not UTF-8, which Python keeps as surrogate
+    escapes; the OS takes the bytes as they are)."""
+    name = os.fspath(path)
+    try:
+        name.encode("utf-8")
+    except UnicodeEncodeError:
+        with open(name, mode) as fh:
+            yield fh
+        return
+    yield name

@@ -25,6 +25,7 @@ from mhtrack.io._frame import (
 )
 from mhtrack.io._source import PathArg, Source
 from mhtrack.io.timed_plots import DEFAULT_REORDER_WINDOW_S, read_timed_plots
+from mhtrack.models.linalg2 import det2
 from mhtrack.models.radars import SensorSet
 from mhtrack.models.sensors import CartesianSensor, PolarRadar
 from mhtrack.records import MAX_COORDINATE, NO_PLOT, PlotTable
@@ -128,6 +129,14 @@ def read_plots(
             ~np.isfinite(R).all(axis=(1, 2)),
             "range",
             lambda r: f"range {num(rng[r])} is too large (its covariance overflows)",
+        )
+        # the tracker's own check (mhtrack.mht.validate), here where the file is known
+        f.check(
+            ~((R[:, 0, 0] > 0) & (det2(R) > 0)),
+            "range",
+            lambda r: f"range {num(rng[r])} and bearing {num(bearing[r])} give a covariance "
+            f"{R[r].tolist()} that is not positive definite (sensor {num(sensor[r])}'s "
+            "errors are too small for float64)",
         )
     return PlotTable(
         scan=scan, time=time, sensor=sensor, x=x, y=y,

@@ -23,6 +23,7 @@ from typing import Any
 
 import numpy as np
 
+from mhtrack.bounds import clip
 from mhtrack.clutter.base import ClutterEstimator
 from mhtrack.clutter.known import KnownClutter
 from mhtrack.errors import InputError
@@ -105,7 +106,8 @@ def located(path: str | PathLike[str], member: str) -> Iterator[None]:
         yield
     except InputError:
         raise
-    except (ValueError, TypeError, KeyError, IndexError, AttributeError) as e:
+    except (ValueError, TypeError, KeyError, IndexError, AttributeError,
+            OverflowError) as e:
         what = f"missing {e}" if isinstance(e, KeyError) else str(e)
         raise member_error(path, member, f"cannot be restored ({what})") from None
 
@@ -132,10 +134,19 @@ def _meta(path: str | PathLike[str], arrays: dict[str, np.ndarray]) -> dict[str,
     return meta
 
 
+def saved_config(path: str | PathLike[str], meta: dict[str, Any]) -> MHTConfig:
+    """The configuration of checked ``meta`` (its own checks as an :class:`InputError`)."""
+    with located(path, "meta"):
+        return MHTConfig.from_json(json.dumps(meta["config"]))
+
+
 def saved_meta(path: str | PathLike[str]) -> dict[str, Any]:
     """The checked JSON bookkeeping of a state file (configuration, estimator name, and
-    the builder's ``recipe`` when :func:`mhtrack.build.make_tracker` made the tracker)."""
-    return _meta(path, read_npz(path))
+    the builder's ``recipe`` when :func:`mhtrack.build.make_tracker` made the tracker),
+    the configuration and the recipe included (:mod:`mhtrack.mht.state_checks`)."""
+    meta = _meta(path, read_npz(path))
+    saved_config(path, meta)
+    return meta
 
 
 def load_state(path: str | PathLike[str], clutter: ClutterEstimator | None) -> SavedState:
@@ -150,9 +161,16 @@ def load_state(path: str | PathLike[str], clutter: ClutterEstimator | None) -> S
     """
     arrays = read_npz(path)
     meta = _meta(path, arrays)
-    with located(path, "meta"):
-        config = MHTConfig.from_json(json.dumps(meta["config"]))
+    config = saved_config(path, meta)
     check_arrays(path, arrays, meta, config.n_scan)
+    mu = arrays["leaves__mu"]
+    with located(path, "meta"):
+        n_models = config.motion.n_models
+    if meta.get("recipe") is not None and mu.shape[1] != n_models:
+        # the builder's trackers use the configuration's motion model
+        raise member_error(path, "leaves__mu", f"{mu.shape[1]} IMM model probabilities per "
+                           f"leaf, but the saved configuration's motion model has "
+                           f"{n_models} models")
     if clutter is None:
         if meta["clutter_name"] != KnownClutter.name:
             raise ValueError(
@@ -161,11 +179,10 @@ def load_state(path: str | PathLike[str], clutter: ClutterEstimator | None) -> S
                 "mhtrack.build.load_tracker (trackers made by make_tracker)"
             )
         clutter = KnownClutter()
-    elif clutter.name != meta["clutter_name"]:
-        raise ValueError(
-            f"{path}: saved with clutter estimator {meta['clutter_name']!r}, "
-            f"got {clutter.name!r}"
-        )
+    elif clutter.name != meta["clutter_name"]:  # an InputError is a ValueError too
+        raise member_error(path, "meta", f"field 'clutter_name': saved with clutter "
+                           f"estimator {clip(repr(meta['clutter_name']))}, got "
+                           f"{clutter.name!r}")
     with located(path, "meta"):
         state = decode(meta.get("clutter_state"), arrays)
     with located(path, "clutter_state"):

@@ -18,8 +18,16 @@ from typing import Any
 
 import numpy as np
 
-from mhtrack.bounds import MAX_INDEX, MAX_TIME_S
+from mhtrack.bounds import (
+    MAX_DENSITY,
+    MAX_INDEX,
+    MAX_TIME_S,
+    clip,
+    float_problem,
+    int_problem,
+)
 from mhtrack.io.npzfile import member_error
+from mhtrack.names import CLUTTER_FRAMES, TRACKERS
 
 PathArg = str | PathLike[str]
 
@@ -123,8 +131,75 @@ def _meta_number(path: PathArg, meta: Mapping[str, Any], key: str, *, integer: b
                            f"{hi:g}]{' or null' if nullable else ''}, got {v!r}")
 
 
+def _config_numbers(path: PathArg, config: Mapping[str, Any]) -> None:
+    """Every number of the saved configuration within :mod:`mhtrack.bounds` (``±1e15``,
+    integers ``±2^53``), so that no later square or exponential overflows; the
+    configuration's own checks (``MHTConfig``) follow."""
+    for key, v in config.items():
+        if isinstance(v, bool) or not isinstance(v, int | float):
+            continue
+        problem = (int_problem(v) if isinstance(v, int) else float_problem(v))
+        if problem is not None:
+            raise member_error(path, "meta", f"field 'config.{key}': {problem}")
+
+
+def _recipe(path: PathArg, recipe: object) -> None:
+    """The builder's recipe (:func:`mhtrack.build.make_tracker`): its names, numbers and
+    radars, so that rebuilding the tracker from it cannot fail."""
+    if recipe is None:
+        return
+
+    def fail(key: str, problem: str) -> Exception:
+        return member_error(path, "meta", f"field 'recipe.{key}': {problem}")
+
+    if not isinstance(recipe, dict):
+        raise member_error(path, "meta", f"field 'recipe': expected an object, got "
+                           f"{type(recipe).__name__}")
+    if recipe.get("name") not in TRACKERS:
+        raise fail("name", f"expected one of {', '.join(TRACKERS)}, got "
+                   f"{clip(repr(recipe.get('name')))}")
+    kappa = recipe.get("clutter_density")
+    if kappa is not None and (problem := float_problem(kappa, 0.0, MAX_DENSITY,
+                                                        lo_open=True)) is not None:
+        raise fail("clutter_density", problem)
+    if recipe.get("clutter_frame", "polar") not in CLUTTER_FRAMES:
+        raise fail("clutter_frame", f"expected one of {', '.join(CLUTTER_FRAMES)}")
+    params = recipe.get("clutter_params")
+    if params is not None and not (isinstance(params, dict) and all(
+            isinstance(v, bool | int | float | str) or v is None for v in params.values())):
+        raise fail("clutter_params", "expected an object of names and plain values")
+    if params:
+        _config_numbers(path, {f"recipe.clutter_params.{k}": v for k, v in params.items()})
+        from mhtrack.clutter import AGMMClutter, GMMClutter
+
+        # the builder passes them to its mixture estimator (None: the default)
+        cls = {"mht-gmm": GMMClutter, "mht-agmm": AGMMClutter}.get(recipe["name"])
+        if cls is not None:
+            try:
+                cls(**{k: v for k, v in params.items() if v is not None})
+            except (TypeError, ValueError, OverflowError) as e:
+                raise fail("clutter_params", clip(str(e), 120)) from None
+    sensors = recipe.get("sensors")
+    if sensors is not None:
+        from mhtrack.models.radars import RadarSensor, SensorSet
+
+        try:
+            origin = sensors["origin"]
+            SensorSet(None if origin is None else (float(origin[0]), float(origin[1])),
+                      tuple(RadarSensor(**{k: (tuple(v) if isinstance(v, list) else v)
+                                           for k, v in d.items()})
+                            for d in sensors["sensors"]))
+        except (ValueError, TypeError, KeyError, IndexError, AttributeError,
+                OverflowError) as e:
+            raise fail("sensors", f"not a set of radars ({clip(str(e), 120)})") from None
+
+
 def check_meta(path: PathArg, meta: Mapping[str, Any]) -> None:
-    """The bookkeeping numbers and names of ``meta``."""
+    """The bookkeeping numbers and names of ``meta`` (every key present)."""
+    for key in ("next_tree", "next_track", "next_node", "last_index", "last_time",
+                "clutter_name", "config"):
+        if key not in meta:
+            raise member_error(path, "meta", f"field {key!r}: missing")
     for key in ("next_tree", "next_track", "next_node"):
         _meta_number(path, meta, key, integer=True, lo=0, hi=MAX_INDEX)
     _meta_number(path, meta, "last_index", integer=True, lo=-MAX_INDEX, hi=MAX_INDEX,
@@ -137,6 +212,8 @@ def check_meta(path: PathArg, meta: Mapping[str, Any]) -> None:
                                f"{meta.get(key)!r}")
     if not isinstance(meta.get("config"), dict):
         raise member_error(path, "meta", "field 'config': expected an object")
+    _config_numbers(path, meta["config"])
+    _recipe(path, meta.get("recipe"))
 
 
 def check_arrays(path: PathArg, arrays: Mapping[str, np.ndarray], meta: Mapping[str, Any],
@@ -160,6 +237,12 @@ def check_arrays(path: PathArg, arrays: Mapping[str, np.ndarray], meta: Mapping[
         if v.size and (v.min() < lo or v.max() >= meta[counter]):
             raise c.fail(f"leaves__{name}", f"ids must be in [{lo}, {meta[counter]}) (the "
                          f"saved {counter}), got {v.min()} to {v.max()}")
+    t = leaves.get("time")
+    last = meta["last_time"]
+    if t is not None and t.size and (np.abs(t).max() > MAX_TIME_S or (
+            last is not None and t.max() > last)):
+        raise c.fail("leaves__time", f"leaf times must be within ±{MAX_TIME_S:g} s and not "
+                     f"after the last scan's time ({last} s)")
     for name in ("n_updates", "birth"):
         if leaves[name].size and leaves[name].min() < 0:
             raise c.fail(f"leaves__{name}", "must be >= 0")

@@ -55,6 +55,10 @@ WGS84 = pyproj.Geod(ellps="WGS84")
 STEP_M = 10.0
 #: Central-difference step in bearing (radians, 0.0057°).
 STEP_RAD = 1e-4
+#: Smallest ratio of a polar plot's cross-range and range variances (either way round):
+#: a condition number of at most 10¹², so that the 2×2 determinant, ``Rxx Ryy − Rxy²``
+#: computed with relative rounding 10⁻¹⁶, stays positive.
+MIN_VARIANCE_RATIO = 1e-12
 
 ArrayLike = Any  # float, sequence or np.ndarray
 
@@ -179,11 +183,24 @@ def polar_to_local(
     central differences (±:data:`STEP_M` in range, ±:data:`STEP_RAD` in bearing), so the
     turn of the geodesic and the meridian convergence are in ``R``. Sigmas are scalars or
     one per plot.
+
+    **Near the site** the bearing term vanishes with ``r`` (``|∂(x, y)/∂θ| = r``), and at
+    ``r = 0`` ``R`` would be singular. A plot cannot be placed nearer its site than its
+    range error, so the bearing column is taken at the minimum range
+    ``r_min = max(σr, STEP_M)`` (``STEP_M`` = 10 m keeps the bearing difference's chord,
+    2 mm, far above the positions' rounding): within ``r_min`` of the site the
+    cross-range error is ``r_min σθ``. Beyond ``r_min`` nothing changes.
+    **Conditioning:** the cross-range variance ``vθ = σθ² |∂(x, y)/∂θ|²`` and the range
+    one ``vr = σr² |∂(x, y)/∂r|²`` are each kept at least :data:`MIN_VARIANCE_RATIO` of
+    the other, so ``det R`` stays positive in float64 for every range and σ a sensors
+    file may hold (this acts only when one error is over 10⁶ times the other, e.g.
+    ``σr`` = 1 mm at 1000 km with σθ = 0.15°).
     """
     _, (r, b, sr, sb) = _flat(range_m, bearing_deg, sigma_range, sigma_bearing_deg)
     n = r.size
     db = np.degrees(STEP_RAD)
-    rr = np.concatenate((r, r + STEP_M, r - STEP_M, r, r))
+    rb = np.maximum(r, np.maximum(sr, STEP_M))  # the bearing column at r_min at least
+    rr = np.concatenate((r, r + STEP_M, r - STEP_M, rb, rb))
     bb = np.concatenate((b, b, b, b + db, b - db))
     la, lo = direct(site_lat, site_lon, bb, rr)
     x, y = frame.to_local(la, lo)
@@ -193,6 +210,11 @@ def polar_to_local(
     jt = (p[3] - p[4]) / (2 * STEP_RAD)  # ∂(x, y)/∂θ, θ in radians
     vr = sr**2
     vt = np.radians(sb) ** 2
+    lr = vr * (jr**2).sum(axis=1)  # the two principal variances (jr ⟂ jt)
+    lt = vt * (jt**2).sum(axis=1)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        vr = np.where(lr < MIN_VARIANCE_RATIO * lt, vr * (MIN_VARIANCE_RATIO * lt / lr), vr)
+        vt = np.where(lt < MIN_VARIANCE_RATIO * lr, vt * (MIN_VARIANCE_RATIO * lr / lt), vt)
     R = np.empty((n, 2, 2))
     R[:, 0, 0] = vr * jr[:, 0] ** 2 + vt * jt[:, 0] ** 2
     R[:, 1, 1] = vr * jr[:, 1] ** 2 + vt * jt[:, 1] ** 2

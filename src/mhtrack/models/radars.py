@@ -26,6 +26,21 @@ if TYPE_CHECKING:
 
 #: The kinds of real sensor a sensors file may declare.
 RADAR_KINDS = ("polar", "cartesian")
+#: Lowest and highest site altitude (m): no land lies below the Dead Sea shore (−430 m),
+#: and above 100 km (the Kármán line) a sensor is a satellite, not a site.
+MIN_ALT_M, MAX_ALT_M = -500.0, 100_000.0
+#: Farthest a site may lie from the local frame's origin (m). The azimuthal equidistant
+#: plane stretches lengths across the line to its origin by ``s/m12 ≈ 1 + s²/6R²``
+#: (docs/geodesy.md): 3.7 % at 3 000 km, ``π/2`` at a quarter meridian, and without
+#: bound towards the antipode, where plots would be silently misplaced.
+MAX_SITE_DISTANCE_M = 3e6
+#: Largest instrumented range (m): 20 000 km, about half a meridian (the plots reader's
+#: bound on a range).
+MAX_RANGE_M = 2e7
+#: Smallest errors accepted: ``σr``, ``σ`` ≥ 1 nm, ``σθ`` ≥ 10⁻¹² degree — far below any
+#: sensor (noise-free test geometries use them); smaller ones make ``σ²`` underflow
+#: towards 0 in float64 and the plots' covariances singular (1e-300 gave 0).
+MIN_SIGMA_M, MIN_SIGMA_BEARING_DEG = 1e-9, 1e-12
 
 
 class SensorFieldError(ValueError):
@@ -92,6 +107,10 @@ class RadarSensor:
                 object.__setattr__(self, key, float(v))
                 if not np.isfinite(float(v)):
                     raise SensorFieldError(w, key, f"must be finite, got {v}")
+        if self.alt is not None and not MIN_ALT_M <= self.alt <= MAX_ALT_M:
+            raise SensorFieldError(w, "alt", f"altitude {self.alt:g} m is not physically "
+                                   f"possible for a site (expected [{MIN_ALT_M:g}, "
+                                   f"{MAX_ALT_M:g}] m; a unit error?)")
         if (self.lat is None) != (self.lon is None):
             missing = "lon" if self.lon is None else "lat"
             raise SensorFieldError(w, missing, "missing: lat and lon give the site together")
@@ -105,6 +124,11 @@ class RadarSensor:
                                         for v in pos):
                 raise SensorFieldError(w, "position", "must be two finite coordinates within "
                                        f"±{short_number(MAX_COORDINATE)} m, got {self.position!r}")
+            if float(np.hypot(*pos)) > MAX_SITE_DISTANCE_M:
+                raise SensorFieldError(w, "position", f"site {np.hypot(*pos) / 1e3:.0f} km "
+                                       "from the frame's origin, farther than "
+                                       f"{MAX_SITE_DISTANCE_M / 1e3:.0f} km (the local "
+                                       "plane cannot hold it)")
             object.__setattr__(self, "position", pos)
         self._check_errors()
         if not 0.0 < self.pd <= 1.0:
@@ -113,31 +137,35 @@ class RadarSensor:
             v = getattr(self, key)
             if v is not None and v <= 0:
                 raise SensorFieldError(w, key, f"must be > 0, got {v:g}")
+        if self.max_range is not None and self.max_range > MAX_RANGE_M:
+            raise SensorFieldError(w, "max_range", f"{self.max_range:g} m is beyond "
+                                   f"{MAX_RANGE_M / 1e3:.0f} km, half-way round the Earth")
 
     def _check_errors(self) -> None:
         """The error keys of the sensor's kind are present and in range; the other kind's
         are absent."""
         w = f"sensor {self.id}"
         if self.kind == "polar":
-            limits = {"sigma_range": (MAX_SIGMA, "m"),
-                      "sigma_bearing_deg": (MAX_SIGMA_BEARING_DEG, "degrees")}
+            limits = {"sigma_range": (MIN_SIGMA_M, MAX_SIGMA, "m"),
+                      "sigma_bearing_deg": (MIN_SIGMA_BEARING_DEG, MAX_SIGMA_BEARING_DEG,
+                                            "degrees")}
             other = ("sigma",)
             if not self.has_site:
                 raise SensorFieldError(w, "lat", "a polar sensor needs its site: lat and lon, "
                                        "or position = [x, y]")
         else:
-            limits = {"sigma": (MAX_SIGMA, "m")}
+            limits = {"sigma": (MIN_SIGMA_M, MAX_SIGMA, "m")}
             other = ("sigma_range", "sigma_bearing_deg")
         for key in other:
             if getattr(self, key) is not None:
                 raise SensorFieldError(w, key, f"not used by a {self.kind} sensor")
-        for key, (hi, unit) in limits.items():
+        for key, (lo, hi, unit) in limits.items():
             v = getattr(self, key)
             if v is None:
                 raise SensorFieldError(w, key, f"missing: required for a {self.kind} sensor")
-            if not 0 < v <= hi:
-                raise SensorFieldError(w, key, f"must be > 0 and <= {short_number(hi)} {unit}, "
-                                       f"got {v:g}")
+            if not lo <= v <= hi:
+                raise SensorFieldError(w, key, f"must be in [{short_number(lo)}, "
+                                       f"{short_number(hi)}] {unit}, got {v:g}")
 
     @property
     def has_site(self) -> bool:
@@ -170,6 +198,7 @@ class SensorSet:
                 raise SensorFieldError(f"sensors[{i}]", "id", f"duplicate id {s.id} (also "
                                        f"sensors[{seen[s.id]}])", index=i)
             seen[s.id] = i
+        self._check_distances()
         if self.reference is None:
             for i, s in enumerate(self.sensors):
                 if s.kind == "polar":
@@ -177,6 +206,26 @@ class SensorSet:
                         f"sensors[{i}]", "position",
                         "a polar sensor placed by position needs [origin] (or a sensor with "
                         "lat/lon) to put its range and bearing on the ellipsoid", index=i)
+
+    def _check_distances(self) -> None:
+        """Every lat/lon site within :data:`MAX_SITE_DISTANCE_M` of the frame's origin
+        (geodesic distance on WGS-84); ``position`` sites are checked by the sensor."""
+        ref = self.reference
+        far = [(i, s) for i, s in enumerate(self.sensors) if s.lat is not None]
+        if ref is None or not far:
+            return
+        from mhtrack.models.geodesy import inverse  # pyproj only when sites are given
+
+        d, _ = inverse(ref[0], ref[1], [s.lat for _, s in far], [s.lon for _, s in far])
+        for (i, s), di in zip(far, np.atleast_1d(d).tolist(), strict=True):
+            if di > MAX_SITE_DISTANCE_M:
+                what = ("[origin]" if self.origin is not None
+                        else "the first site (the frame's origin)")
+                raise SensorFieldError(
+                    f"sensors[{i}]", "lat", f"site ({s.lat:g}, {s.lon:g}) is "
+                    f"{di / 1e3:.0f} km from {what} at ({ref[0]:g}, {ref[1]:g}), farther "
+                    f"than {MAX_SITE_DISTANCE_M / 1e3:.0f} km: the local plane cannot hold "
+                    "it (wrong origin or a sign error in lat/lon?)", index=i)
 
     @property
     def reference(self) -> tuple[float, float] | None:

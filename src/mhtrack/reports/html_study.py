@@ -18,6 +18,7 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from mhtrack.io.atomic import is_temporary
 from mhtrack.reports.html_metrics import METRIC_ROWS, fmt
 
 if TYPE_CHECKING:
@@ -69,7 +70,7 @@ def _valid(rows: Sequence[Any]) -> list[dict[str, Any]]:
 def paired_from_json(directory: Path) -> tuple[list[dict[str, Any]], str | None]:
     """The ``"paired"`` list of the first JSON file in ``directory`` (sorted by name) that
     has one, and that file's name; ``([], None)`` if none."""
-    for path in sorted(directory.glob("*.json")):
+    for path in sorted(p for p in directory.glob("*.json") if not is_temporary(p)):
         try:
             data = json.loads(path.read_text(encoding="utf-8"))
         except (OSError, ValueError):

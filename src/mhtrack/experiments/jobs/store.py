@@ -25,6 +25,7 @@ from typing import Any
 from mhtrack.errors import InputError
 from mhtrack.experiments.jobs.job import Job
 from mhtrack.io.atomic import atomic_path, atomic_write
+from mhtrack.io.paths import arrow_file
 
 #: Checks a done job's record (raises ``ValueError("<field>: <problem>")``).
 RecordCheck = Callable[[Job, Mapping[str, Any]], None]
@@ -118,15 +119,16 @@ class ParquetRecords(RecordFormat):
             arrays.append(pa.array([v], type=t))
         meta = {b"mhtrack.job_hash": job.hash.encode()}
         table = pa.Table.from_arrays(arrays, schema=pa.schema(fields, metadata=meta))
-        with atomic_path(path) as tmp:
-            pq.write_table(table, tmp)
+        with atomic_path(path) as tmp, arrow_file(tmp, "wb") as fh:
+            pq.write_table(table, fh)
 
     def read(self, path: Path) -> dict[str, Any]:
         import pyarrow as pa
         import pyarrow.parquet as pq
 
         try:
-            rows = pq.read_table(path).to_pylist()
+            with arrow_file(path) as fh:
+                rows = pq.read_table(fh).to_pylist()
         except (OSError, pa.ArrowException) as e:
             raise InputError(f"{path}: not a readable job record ({str(e)[:120]})",
                              file=str(path)) from None
@@ -141,7 +143,8 @@ class ParquetRecords(RecordFormat):
         import pyarrow.parquet as pq
 
         try:
-            meta = pq.read_schema(path).metadata or {}
+            with arrow_file(path) as fh:
+                meta = pq.read_schema(fh).metadata or {}
         except (OSError, pa.ArrowException):
             return None
         h = meta.get(b"mhtrack.job_hash")

@@ -1,0 +1,136 @@
+"""Checks of a clutter estimator's saved state before it is restored (``set_state``).
+
+A saved tracker (:mod:`mhtrack.mht.state`) carries its estimator's ``get_state()``; a
+damaged or hostile one must fail when it is loaded, with the field named, never at a
+later ``step`` (a broadcasting error from weights of the wrong length, an overflow from a
+huge counter). Each function raises ``ValueError("<field>: <problem>")``, which the
+state loader reports as one :class:`~mhtrack.errors.InputError` line naming the file and
+``clutter_state``. Checked: types; every float finite and within ``±MAX_MAGNITUDE``;
+counters integers in ``[0, 2^53]``; positions within ``±MAX_COORDINATE``; a mixture's
+``K`` the same in weights, means and covariances, weights in ``[0, 1]`` summing with the
+background's to 1 (1e-6), covariances symmetric positive definite, a background box with
+``x0 < x1``, ``y0 < y1``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Any
+
+import numpy as np
+
+from mhtrack.bounds import MAX_DENSITY, MAX_INDEX, MAX_MAGNITUDE, MAX_TIME_S, clip, show
+from mhtrack.records import MAX_COORDINATE
+
+
+def _fail(field: str, problem: str) -> ValueError:
+    return ValueError(f"field {field}: {problem}")
+
+
+def number(v: object, field: str, lo: float = -MAX_MAGNITUDE, hi: float = MAX_MAGNITUDE,
+           *, integer: bool = False) -> float:
+    """``v`` as a finite number (an integer when ``integer``) in ``[lo, hi]``."""
+    ok = isinstance(v, int) if integer else isinstance(v, int | float)
+    if isinstance(v, bool) or not ok:
+        raise _fail(field, f"expected {'an integer' if integer else 'a number'}, got "
+                    f"{type(v).__name__}")
+    if not lo <= v <= hi:  # false for NaN
+        raise _fail(field, f"{clip(repr(v))} is out of range [{show(lo)}, {show(hi)}]")
+    return v  # type: ignore[return-value]
+
+
+def array(v: object, field: str, shape: tuple[int, ...], *, kind: str = "f",
+          bound: float = MAX_MAGNITUDE) -> np.ndarray:
+    """``v`` as an array of ``shape`` (``-1``: any length) of numbers (``kind`` ``"f"``
+    finite floats, ``"i"`` integers), every value within ``±bound``."""
+    if isinstance(v, np.ndarray):
+        a = v
+    elif isinstance(v, list):
+        try:
+            a = np.asarray(v)
+        except (TypeError, ValueError, OverflowError):
+            raise _fail(field, "expected numbers") from None
+        if a.size == 0:
+            a = a.astype(np.int64 if kind == "i" else float)
+    else:
+        raise _fail(field, f"expected an array, got {type(v).__name__}")
+    if a.dtype.kind not in ("biu" if kind == "i" else "biuf") or a.dtype.kind == "b":
+        raise _fail(field, f"expected {'integers' if kind == 'i' else 'numbers'}, got {a.dtype}")
+    if a.ndim != len(shape) or any(s not in (-1, n) for s, n in zip(shape, a.shape, strict=True)):
+        raise _fail(field, f"has shape {a.shape}, expected {shape}")
+    if a.size and not (np.abs(a.astype(float)) <= bound).all():  # false for NaN
+        raise _fail(field, f"holds values that are not finite or beyond ±{bound:g}")
+    return a
+
+
+def check_known(state: Mapping[str, Any]) -> float:
+    """The known estimator's ``kappa`` (per m²), finite in ``(0, MAX_DENSITY]``."""
+    kappa = number(state["kappa"], "clutter_state.kappa", 0.0, MAX_DENSITY)
+    if kappa <= 0:
+        raise _fail("clutter_state.kappa", f"must be > 0, got {kappa!r}")
+    return float(kappa)
+
+
+def check_mixture(m: Mapping[str, Any], field: str = "clutter_state.mixture") -> None:
+    """A :class:`~mhtrack.clutter.density.Mixture` state (``to_state``)."""
+    w = array(m["weights"], f"{field}.weights", (-1,))
+    k = len(w)
+    means = array(m["means"], f"{field}.means", (k, 2), bound=MAX_COORDINATE)
+    cov = array(m["covariances"], f"{field}.covariances", (k, 2, 2))
+    del means
+    bg = number(m["background_weight"], f"{field}.background_weight", 0.0, 1.0)
+    if (w < 0).any() or (w > 1).any() or abs(float(w.sum()) + bg - 1.0) > 1e-6:
+        raise _fail(f"{field}.weights", "must be in [0, 1] and sum to 1 with the "
+                    "background's")
+    a, b, c, d = cov[:, 0, 0], cov[:, 0, 1], cov[:, 1, 0], cov[:, 1, 1]
+    bad = ~((b == c) & (a > 0) & (a * d - b * c > 0))
+    if bad.any():
+        raise _fail(f"{field}.covariances", f"matrix {int(np.argmax(bad))} is not symmetric "
+                    "positive definite")
+    box = m["background_box"]
+    if box is not None:
+        x0, x1, y0, y1 = array(box, f"{field}.background_box", (4,), bound=MAX_COORDINATE)
+        if not (x0 < x1 and y0 < y1):
+            raise _fail(f"{field}.background_box", "expected x0 < x1 and y0 < y1")
+    elif bg > 0:
+        raise _fail(f"{field}.background_weight", "is > 0 without a background box")
+
+
+def check_mixture_estimator(state: Mapping[str, Any]) -> None:
+    """A GMM/AGMM estimator's state (:meth:`MixtureClutter.get_state`)."""
+    f = "clutter_state"
+    if not isinstance(state["window"], list):
+        raise _fail(f"{f}.window", "expected a list of scans")
+    for i, w in enumerate(state["window"]):
+        z = array(w, f"{f}.window[{i}]", (-1,) * np.ndim(w), bound=MAX_COORDINATE)
+        if z.size % 2:
+            raise _fail(f"{f}.window[{i}]", "expected (n, 2) positions")
+    if "kept" in state:
+        array(state["kept"], f"{f}.kept", (-1,) * np.ndim(state["kept"]), kind="i",
+              bound=MAX_INDEX)
+    if state["mixture"] is not None:
+        if not isinstance(state["mixture"], dict):
+            raise _fail(f"{f}.mixture", "expected an object or null")
+        check_mixture(state["mixture"])
+    number(state["count"], f"{f}.count", 0.0)
+    for key in ("n_iter", "n_pruned", "n_updates", "n_subsampled"):
+        number(state[key], f"{f}.{key}", 0, MAX_INDEX, integer=True)
+    if not isinstance(state["converged"], bool):
+        raise _fail(f"{f}.converged", "expected true or false")
+    if state["log_likelihood"] is not None:
+        number(state["log_likelihood"], f"{f}.log_likelihood")
+
+
+def check_scan(d: Mapping[str, Any], field: str) -> None:
+    """A pending scan of the per-radar estimator."""
+    number(d["index"], f"{field}.index", -MAX_INDEX, MAX_INDEX, integer=True)
+    number(d["time"], f"{field}.time", -MAX_TIME_S, MAX_TIME_S)
+    z = array(d["z"], f"{field}.z", (-1,) * np.ndim(d["z"]), bound=MAX_COORDINATE)
+    n = z.size // 2
+    if z.size % 2:
+        raise _fail(f"{field}.z", "expected (n, 2) positions")
+    for key in ("sensor", "rows"):
+        array(d[key], f"{field}.{key}", (n,), kind="i", bound=MAX_INDEX)
+    t = array(d["t"], f"{field}.t", (n,), bound=MAX_TIME_S)
+    if n and (t > d["time"]).any():
+        raise _fail(f"{field}.t", "plot times after the scan's time")

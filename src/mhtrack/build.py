@@ -111,7 +111,7 @@ def make_tracker(
     birth: str | None = None,
     theta_deg: float | None = None,
     sensors: SensorSet | None = None,
-    clutter_frame: str = "polar",
+    clutter_frame: str = names.DEFAULT_CLUTTER_FRAME,
     clutter_params: dict[str, Any] | None = None,
 ) -> MHTTracker:
     """A fresh tracker by name (:data:`TRACKER_ESTIMATORS`).
@@ -204,7 +204,7 @@ def load_tracker(path: str | os.PathLike[str]) -> MHTTracker:
                    else sensors_from_recipe(recipe["sensors"]))
         fresh = make_tracker(recipe["name"], MHTConfig.from_json(json.dumps(meta["config"])),
                              clutter_density=recipe.get("clutter_density"), sensors=sensors,
-                             clutter_frame=recipe.get("clutter_frame", "polar"),
+                             clutter_frame=recipe.get("clutter_frame", names.DEFAULT_CLUTTER_FRAME),
                              clutter_params=recipe.get("clutter_params"))
     except (KeyError, TypeError, ValueError) as e:
         raise ValueError(f"{path}: member 'meta': field 'recipe' cannot be rebuilt "
@@ -352,6 +352,12 @@ TRACKER_FUSERS: dict[str, Callable[[], AdaptiveKMeansFusion] | None] = {
 #: of clusters.
 INITIATION_FUSER_CLASSES: dict[str, type[Any] | None] = {
     "adaptive-kmeans": AdaptiveKMeansFusion, "kmeans": KMeansFusion, "none": None}
+
+
+def birth_suffix(birth: str | None) -> str:
+    """``-BIRTH`` naming a birth process other than the default (every plot), else ``""``
+    (the names of run directories)."""
+    return "" if birth is None or birth == names.EVERY_PLOT else f"-{birth}"
 
 
 def default_fusion(n_sensors: int) -> str:

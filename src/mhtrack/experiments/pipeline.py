@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from mhtrack.build import make_tracker
+from mhtrack.build import TRACKER_FUSERS, make_tracker
 from mhtrack.mht import MHTConfig, MHTTracker, StepStats
 from mhtrack.models.radars import SensorSet
 from mhtrack.names import OUTPUTS
@@ -88,7 +88,7 @@ def track(
         raise ValueError(f"unknown output {output!r} (expected one of {', '.join(OUTPUTS)})")
     if isinstance(tracker, str):
         name, tracker = tracker, make_tracker(tracker, config, sensors=sensors)
-    if isinstance(scans, PlotTable) and scans.timed and fusion != "none":
+    if isinstance(scans, PlotTable) and scans.timed and TRACKER_FUSERS.get(fusion):
         raise ValueError("plots with their own times are tracked frame by frame, one "
                          f"sensor per frame: use fusion 'none', not {fusion!r}")
     total = None

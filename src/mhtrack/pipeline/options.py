@@ -10,6 +10,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 from mhtrack.build import (
+    TRACKER_FUSERS,
     DEFAULT_CLUTTER_DENSITY,
     P1_BIRTHS_PER_SCAN,
     PlotsArea,
@@ -123,7 +124,7 @@ def choose(source: Source, options: TrackOptions, survey: Survey | None,
         fusion = "none" if source.timed else default_fusion(_n_sensors(source, survey))
     if fusion not in TRACKER_FUSIONS:
         raise ValueError(f"unknown fusion {fusion!r} (expected {', '.join(TRACKER_FUSIONS)})")
-    if source.timed and fusion != "none":
+    if source.timed and TRACKER_FUSERS[fusion] is not None:
         raise ValueError("plots with their own times are tracked frame by frame, one "
                          f"sensor per frame: use fusion 'none', not {fusion!r}")
     tracker = make_tracker(options.tracker, config, clutter_density=options.clutter_density,

@@ -7,13 +7,13 @@ import pytest
 
 pytest.importorskip("asterix")
 
-from mhtrack.io import write_plots  # noqa: E402
-from mhtrack.io.asterix.cat062 import export_tracks  # noqa: E402
-from mhtrack.io.sensors import write_sensors  # noqa: E402
-from mhtrack.pipeline import Pipeline, TrackOptions  # noqa: E402
-from mhtrack.scenario import preset, simulate  # noqa: E402
-from mhtrack.scenario.overrides import apply_overrides  # noqa: E402
-from mhtrack.sinks import Cat062Sink, TracksFileSink  # noqa: E402
+from mhtrack.io import write_plots
+from mhtrack.io.asterix.cat062 import export_tracks
+from mhtrack.io.sensors import write_sensors
+from mhtrack.pipeline import Pipeline, TrackOptions
+from mhtrack.scenario import preset, simulate
+from mhtrack.scenario.overrides import apply_overrides
+from mhtrack.sinks import Cat062Sink, TracksFileSink
 
 
 def test_cat062_sink_equals_export_of_the_tracks_file(tmp_path):

@@ -10,9 +10,9 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 from mhtrack.build import (
-    TRACKER_FUSERS,
     DEFAULT_CLUTTER_DENSITY,
     P1_BIRTHS_PER_SCAN,
+    TRACKER_FUSERS,
     PlotsArea,
     capped_pd,
     config_with,

@@ -24,6 +24,7 @@ from mhtrack.pipeline import (
     TrackOptions,
     cap_scans,
     caps_acted,
+    feed,
     fuse_scan,
     fused,
     mean_step_time,
@@ -96,11 +97,8 @@ def track(
         total = scans.n_scans
         scans = MemorySource(scans)
     rows = TrackCollector(output)
-    stats = []
-    for out in step_frames(tracker, scans, fusion=fusion, name=name, progress=progress,
-                           total=total):
-        stats.append(out.stats)
-        rows.write(out)
+    stats, _ = feed(step_frames(tracker, scans, fusion=fusion, name=name, progress=progress,
+                                total=total), [rows])
     return TrackingRun(name, rows.tracks(), tuple(stats), output)
 
 

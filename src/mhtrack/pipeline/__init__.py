@@ -16,6 +16,7 @@ from mhtrack.pipeline.run import (
     RunResult,
     cap_scans,
     caps_acted,
+    feed,
     fuse_scan,
     fused,
     mean_step_time,
@@ -23,5 +24,5 @@ from mhtrack.pipeline.run import (
 )
 
 __all__ = ["Pipeline", "RunResult", "TrackOptions", "birth_density_note", "cap_scans",
-           "caps_acted", "fuse_scan", "fused", "mean_step_time", "open_input",
+           "caps_acted", "feed", "fuse_scan", "fused", "mean_step_time", "open_input",
            "step_frames"]

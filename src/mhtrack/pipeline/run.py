@@ -190,17 +190,27 @@ class Pipeline:
     def run(self, sinks: Sequence[Sink] = (), *, progress: bool = False) -> RunResult:
         """Step the tracker over every frame of the source into ``sinks`` (each
         started before the first frame and closed after the last)."""
+        stats, n_tracks = feed(self.outputs(progress=progress), sinks, self.source,
+                               backfill_ids=self.output == "history")
+        return RunResult(self.options.tracker, tuple(stats), n_tracks, self.source.timed)
+
+
+def feed(outputs: Iterable[FrameOutput], sinks: Sequence[Sink], source: Source | None = None,
+         *, backfill_ids: bool = True) -> tuple[list[StepStats], int]:
+    """Hand every frame's output to ``sinks`` (started with ``source`` first, closed
+    after the last frame); returns the steps' statistics and the number of distinct
+    track ids reported (with ``backfill_ids``, those of the backfill too)."""
+    for sink in sinks:
+        sink.start(source)
+    stats: list[StepStats] = []
+    ids: set[int] = set()
+    for out in outputs:
+        stats.append(out.stats)
+        ids.update(out.online.track_id.tolist())
+        if backfill_ids:
+            ids.update(out.backfill.track_id.tolist())
         for sink in sinks:
-            sink.start(self.source)
-        stats: list[StepStats] = []
-        ids: set[int] = set()
-        for out in self.outputs(progress=progress):
-            stats.append(out.stats)
-            ids.update(out.online.track_id.tolist())
-            if self.output == "history":
-                ids.update(out.backfill.track_id.tolist())
-            for sink in sinks:
-                sink.write(out)
-        for sink in sinks:
-            sink.close()
-        return RunResult(self.options.tracker, tuple(stats), len(ids), self.source.timed)
+            sink.write(out)
+    for sink in sinks:
+        sink.close()
+    return stats, len(ids)

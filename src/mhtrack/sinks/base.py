@@ -42,9 +42,10 @@ class Sink(ABC):
     """Receives every frame's output; :meth:`start` before the first, :meth:`close`
     after the last (a file sink writes there)."""
 
-    def start(self, source: Source) -> None:  # noqa: B027 - optional hook
+    def start(self, source: Source | None) -> None:  # noqa: B027 - optional hook
         """Called once before the first frame with the source (its ``file_rows``,
-        ``timed``)."""
+        ``timed``); ``None`` when the frames come from no source (rows kept as they
+        are, scans)."""
 
     @abstractmethod
     def write(self, out: FrameOutput) -> None:

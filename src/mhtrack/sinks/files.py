@@ -25,7 +25,7 @@ class _Rows(Sink):
         self.rows = TrackCollector(output)
         self.source: Source | None = None
 
-    def start(self, source: Source) -> None:
+    def start(self, source: Source | None) -> None:
         self.source = source
 
     def write(self, out: FrameOutput) -> None:

@@ -59,16 +59,16 @@ def convert(recording: Path, output: Path, sensors_file: Path | None) -> None:
               "tracks without lat/lon].")
 @click.option("--out", type=click.Path(dir_okay=False, path_type=Path), required=True,
               help="Recording to write: .pcap (UDP datagrams) or .ast (raw data blocks).")
-@click.option("--category", type=click.Choice(EXPORT_CATEGORIES), default=None,
-              help="[048] 048: PLOTS are timed plots, written as CAT048 target "
-              "reports with CAT034 sweeps; 062: PLOTS is a tracks file, written as CAT062 "
-              "system tracks.")
+@click.option("--category", type=click.Choice(EXPORT_CATEGORIES),
+              default=EXPORT_CATEGORIES[0], show_default=True, help="048: PLOTS are timed "
+              "plots, written as CAT048 target reports with CAT034 sweeps; 062: PLOTS is a "
+              "tracks file, written as CAT062 system tracks.")
 @click.option("--sac", type=click.IntRange(0, 255), default=None,
               help="CAT062: the tracker's system area code (I062/010) [0].")
 @click.option("--sic", type=click.IntRange(0, 255), default=None,
               help="CAT062: the tracker's system identification code (I062/010) [1].")
 @needs_libasterix
-def export(plots: Path, sensors_file: Path | None, out: Path, category: str | None,
+def export(plots: Path, sensors_file: Path | None, out: Path, category: str,
            sac: int | None, sic: int | None) -> None:
     """Encode timed PLOTS (time, sensor, range or slant_range, bearing) as ASTERIX
     CAT048 target reports with CAT034 north markers and sector crossings; or, with

@@ -153,7 +153,7 @@ class Pipeline:
         self.source = source
         self.options = TrackOptions() if options is None else options
         self.output = check_output(self.options.output)
-        survey = self.survey if source.scenario is None and config is None else None
+        survey = self.survey if source.scenario is None else None
         self.choices = choose(source, self.options, survey, config)
         self.config, self.tracker = self.choices.config, self.choices.tracker
         self.fusion, self.frame = self.choices.fusion, self.choices.frame

@@ -1,9 +1,7 @@
 """mhtrack — multiple-target tracking in unknown, varying clutter.
 
-Layers (data flows one way; no module imports a later layer):
-``records``/``errors``/``io`` → ``models`` → ``scenario``, ``clutter`` → ``mht``,
-``initiation`` → ``build`` (the tracker builder) → ``metrics`` → ``experiments`` →
-``plotting``, ``reports`` → ``cli``. ``names`` (every part's name list) imports nothing.
+The layers of the package (data flows one way) are in ``docs/architecture.md``,
+*Layers*, and checked by ``tests/test_layers.py``.
 
 The tables (``PlotTable``, ``Scan``, ``TrackTable``, ``TruthTable``) are imported from
 :mod:`mhtrack.records` on first use (PEP 562), so that ``import mhtrack`` — and

@@ -11,11 +11,15 @@ from __future__ import annotations
 #: Trackers of P1 §3: the plain MHT with a known clutter density, and the MHT whose
 #: clutter intensity is estimated online by a GMM or by the adaptive GMM.
 TRACKERS: tuple[str, ...] = ("mht", "mht-agmm", "mht-gmm")
+#: The tracker of a run when none is named: the MHT with P1's adaptive GMM.
+DEFAULT_TRACKER = "mht-agmm"
 #: Clutter-intensity estimators (``mhtrack.clutter``).
 CLUTTER_ESTIMATORS: tuple[str, ...] = ("known", "gmm", "agmm")
 #: Coordinates a radar's clutter is estimated in (asynchronous data): the local
 #: east-north plane, or the radar's own range and bearing.
 CLUTTER_FRAMES: tuple[str, ...] = ("plane", "polar")
+#: The clutter frame when none is chosen: each radar's own range and bearing.
+DEFAULT_CLUTTER_FRAME = "polar"
 #: P2's track initiators and their modified variants (``mhtrack.initiation``).
 INITIATORS: tuple[str, ...] = ("logic", "modified-logic", "hough", "modified-hough")
 #: The MHT's default birth process: every plot may start a tree (P1).
@@ -30,3 +34,7 @@ INITIATION_FUSIONS: tuple[str, ...] = ("adaptive-kmeans", "kmeans", "none")
 CLUSTER_METHODS: tuple[str, ...] = ("adaptive", "random")
 #: Tracker output modes: ``history`` adds each confirmed track's tentative past.
 OUTPUTS: tuple[str, ...] = ("history", "online")
+#: The output mode when none is chosen.
+DEFAULT_OUTPUT = OUTPUTS[0]
+#: What ``mhtrack export`` writes: ASTERIX CAT048 plots (the default) or CAT062 tracks.
+EXPORT_CATEGORIES: tuple[str, ...] = ("048", "062")

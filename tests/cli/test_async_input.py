@@ -12,10 +12,12 @@ import pytest
 from click.testing import CliRunner
 
 from mhtrack.cli.main import cli
-from mhtrack.experiments import pipeline
 from mhtrack.io import read_tracks
 from mhtrack.io.sensors import read_sensors
-from mhtrack.records import PlotTable, TrackTable
+from mhtrack.mht import StepStats
+from mhtrack.pipeline import run as pipeline_run
+from mhtrack.records import TrackTable
+from mhtrack.sinks import FrameOutput
 
 SENSORS = """\
 [origin]
@@ -147,15 +149,17 @@ def test_track_passes_the_sensor_set_and_writes_geodetic_tracks(tmp_path, monkey
     plots, sensors = files(tmp_path, GOOD)
     seen: dict = {}
 
-    def fake_track(tracker, table: PlotTable, **kw):
+    def fake_steps(tracker, frames, **kw):  # the pipeline's stepping, replaced
+        table = frames.table
         seen.update(kw, table=table, tracker=tracker)
         k = int(np.flatnonzero(table.time == table.time.max())[0])  # the last polar plot
         tr = TrackTable(np.array([table.scan[k]]), np.array([table.time[k]]), np.array([1]),
                         table.x[k:k + 1], table.y[k:k + 1], np.array([100.0]),
                         np.array([0.0]), np.array([k]))
-        return pipeline.TrackingRun("mht", tr, ())
+        scan = next(iter(table.scans()))
+        yield FrameOutput(scan, tr, TrackTable.empty(), StepStats(0, 0, 0, 0, 0, 0, 1, 0.0))
 
-    monkeypatch.setattr(pipeline, "track", fake_track)
+    monkeypatch.setattr(pipeline_run, "step_frames", fake_steps)
     code, stdout, stderr = invoke("track", str(plots), "--sensors", str(sensors),
                                   "--out", str(tmp_path / "t.csv"), "--no-progress")
     assert code == 0, stderr
@@ -173,7 +177,7 @@ def test_track_passes_the_sensor_set_and_writes_geodetic_tracks(tmp_path, monkey
     assert (out["lat"][0], out["lon"][0]) == (float(lat), float(lon))
     ve, vn = frame.velocity_to_geodetic(table.x[3], table.y[3], 100.0, 0.0)
     assert (out["vx"][0], out["vy"][0]) == (float(ve), float(vn))
-    assert out["vx_grid"] == [100.0] and stdout.startswith("mht-agmm: 0 frames, 1 tracks")
+    assert out["vx_grid"] == [100.0] and stdout.startswith("mht-agmm: 1 frames, 1 tracks")
     back = read_tracks(tmp_path / "t.csv")
     assert back.vx.tolist() == [100.0] and back.x[0] == table.x[3]
 

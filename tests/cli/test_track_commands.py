@@ -293,8 +293,12 @@ def test_track_warns_about_polar_plots_without_scenario(tmp_path, caplog):
 
 
 def test_track_area_ignores_and_reports_wild_plots(small_crossing, tmp_path, caplog):
-    from mhtrack.cli.track_commands import _plots_area
     from mhtrack.io import read_plots
+    from mhtrack.pipeline.options import survey_area
+    from mhtrack.sources.memory import MemorySource
+
+    def _plots_area(path, table):  # the area the pipeline takes from the plots' survey
+        return survey_area(str(path), MemorySource(table).survey())
 
     plots = small_crossing / "p" / "plots.csv"
     rows = iter(range(10**6))

@@ -9,8 +9,8 @@ from click.testing import CliRunner
 
 from mhtrack.cli.main import cli
 from mhtrack.errors import InputError
-from mhtrack.experiments import pipeline
 from mhtrack.io.paths import check_output_dir, check_output_file
+from mhtrack.pipeline import run as pipeline_run
 
 
 def test_check_output_file(tmp_path: Path) -> None:
@@ -47,7 +47,7 @@ def test_track_refuses_its_input_as_output_before_any_work(tmp_path, monkeypatch
     def never(*a, **k):  # the tracker must not run
         raise AssertionError("tracked although the output is the input")
 
-    monkeypatch.setattr(pipeline, "track", never)
+    monkeypatch.setattr(pipeline_run, "step_frames", never)
     res = runner.invoke(cli, ["track", str(plots), "--out", str(plots), "--no-progress"])
     assert res.exit_code != 0 and "is the input file" in res.output
     assert plots.read_bytes() == before

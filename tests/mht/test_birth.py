@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 from crossing_fixture import same_tracks
 
-from mhtrack.build import default_config, default_fusion, make_tracker
+from mhtrack.build import default_config, default_fusion, make_birth, make_tracker
 from mhtrack.clutter import KnownClutter
 from mhtrack.experiments.pipeline import fuse_scan, run_scenario
 from mhtrack.mht import MHTConfig, MHTTracker
@@ -117,7 +117,7 @@ def test_clean_target_is_initiated_within_four_scans_and_tracked(birth):
     scans = [Scan(t.index, t.time, np.concatenate((c.z, t.z)),
                   np.zeros(len(c) + 1, np.int64), np.append(c.rows, 1000 + t.index))
              for t, c in zip(target, clutter, strict=True)]
-    trk = MHTTracker(MHTConfig(birth=birth), KnownClutter(5 / 64e6))
+    trk = _by_hand(MHTConfig(birth=birth), KnownClutter(5 / 64e6))
     outs, born = [], []
     for s in scans:
         before = trk.leaves.tree.max(initial=-1)
@@ -168,12 +168,18 @@ def clutter_scans(n: int, rate: float, seed: int) -> list[Scan]:
     return out
 
 
+def _by_hand(cfg: MHTConfig, clutter: KnownClutter) -> MHTTracker:
+    """A tracker assembled by hand with the birth its configuration names (the builder's
+    :func:`make_birth`)."""
+    return MHTTracker(cfg, clutter, birth=make_birth(cfg, cfg.motion))
+
+
 def test_logic_birth_starts_far_fewer_trees_in_clutter():
     scans = clutter_scans(20, 20.0, seed=4)
     kappa = 20.0 / 64e6
     counts = {}
     for birth in ("every-plot", "logic", "modified-logic"):
-        trk = MHTTracker(MHTConfig(birth=birth), KnownClutter(kappa))
+        trk = _by_hand(MHTConfig(birth=birth), KnownClutter(kappa))
         n = []
         for s in scans:
             trk.step(s)
@@ -187,16 +193,18 @@ def test_logic_birth_starts_far_fewer_trees_in_clutter():
 def test_save_restore_with_modified_logic_is_bit_identical(crossing10, tmp_path):
     cfg = MHTConfig(birth="modified-logic")
     scans = crossing10.scans[:40]
-    full = MHTTracker(cfg, KnownClutter(crossing10.clutter_density)).run(scans)
-    trk = MHTTracker(cfg, KnownClutter(crossing10.clutter_density))
+    full = _by_hand(cfg, KnownClutter(crossing10.clutter_density)).run(scans)
+    trk = _by_hand(cfg, KnownClutter(crossing10.clutter_density))
     first = trk.run(scans[:17])
     trk.save(tmp_path / "s.npz")
     with np.load(tmp_path / "s.npz", allow_pickle=False) as data:
         assert "birth__rows" in data.files and "birth__kappa" in data.files
-    back = MHTTracker.load(tmp_path / "s.npz")
+    with pytest.raises(ValueError, match="make_birth"):  # the builder's part, not a default
+        MHTTracker.load(tmp_path / "s.npz")
+    back = MHTTracker.load(tmp_path / "s.npz", birth=make_birth(cfg, cfg.motion))
     assert back.config.birth == "modified-logic"
-    for k, v in trk.birth_process.arrays().items():
-        assert np.array_equal(v, back.birth_process.arrays()[k]), k
+    for k, v in trk.birth.arrays().items():
+        assert np.array_equal(v, back.birth.arrays()[k]), k
     rest = back.run(scans[17:])
     assert same_tracks(TrackTable.concat([first, rest]), full)
     assert len(np.unique(full.track_id)) >= 2

@@ -7,14 +7,20 @@ from crossing_fixture import same_tracks, simulate
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from mhtrack.build import make_birth
 from mhtrack.clutter import KnownClutter
 from mhtrack.mht import MHTConfig, MHTTracker
 from mhtrack.mht.history import TentativeHistory
 from mhtrack.records import Scan, TrackTable
 
 
+def _by_hand(cfg: MHTConfig, clutter: KnownClutter) -> MHTTracker:
+    """A tracker by hand with the birth its configuration names (the builder's)."""
+    return MHTTracker(cfg, clutter, birth=make_birth(cfg, cfg.motion))
+
+
 def _tracker(sim, **changes) -> MHTTracker:
-    return MHTTracker(MHTConfig(**changes), KnownClutter(sim.clutter_density))
+    return _by_hand(MHTConfig(**changes), KnownClutter(sim.clutter_density))
 
 
 def test_online_part_of_the_history_is_the_online_output(crossing10):
@@ -84,7 +90,7 @@ def test_backfilled_states_are_the_filtered_states_of_the_branch():
     textbook Kalman filter over the target's plots."""
     scans = _one_target(8)
     cfg = MHTConfig(imm_sigma_v=0.0, sigma_w=50.0, alpha=1e-6)  # confirms late
-    trk = MHTTracker(cfg, KnownClutter(1e-8))
+    trk = _by_hand(cfg, KnownClutter(1e-8))
     hist = trk.run(scans)
     assert set(hist.track_id.tolist()) == {0}
     confirmed_at = hist.scan[~hist.tentative].min()
@@ -101,7 +107,7 @@ def test_backfilled_states_are_the_filtered_states_of_the_branch():
 def test_history_depth_bounds_the_backfill():
     scans = _one_target(8)
     cfg = MHTConfig(imm_sigma_v=0.0, sigma_w=50.0, alpha=1e-6)
-    full = MHTTracker(cfg, KnownClutter(1e-8)).run(scans)
+    full = _by_hand(cfg, KnownClutter(1e-8)).run(scans)
     c = int(full.scan[~full.tentative].min())
     short = MHTTracker(MHTConfig(imm_sigma_v=0.0, sigma_w=50.0, alpha=1e-6, history_scans=1),
                        KnownClutter(1e-8)).run(scans)
@@ -170,8 +176,8 @@ def test_history_invariants(scene, depth):
     ``history_scans`` of them, and no (scan, track) appears twice."""
     scans, kappa = scene
     cfg = MHTConfig(history_scans=depth)
-    hist = MHTTracker(cfg, KnownClutter(kappa)).run(scans)
-    online = MHTTracker(cfg, KnownClutter(kappa)).run(scans, history=False)
+    hist = _by_hand(cfg, KnownClutter(kappa)).run(scans)
+    online = _by_hand(cfg, KnownClutter(kappa)).run(scans, history=False)
     assert same_tracks(hist.online(), online)
     key = hist.scan * 10**6 + hist.track_id
     assert np.all(np.diff(key) > 0)
@@ -196,11 +202,11 @@ def test_no_plot_is_given_to_two_tracks_at_a_scan(seed, clutter, birth):
     These two draws had such clashes before (plots 482, 511, 583 at scans 12–14; plot 1063
     at scan 86)."""
     sim = simulate(clutter_rate=clutter, seed=seed)
-    trk = MHTTracker(MHTConfig(birth=birth), KnownClutter(sim.clutter_density))
+    trk = _by_hand(MHTConfig(birth=birth), KnownClutter(sim.clutter_density))
     hist = trk.run(sim.scans)
     used = hist.plot >= 0
     pairs = np.column_stack((hist.scan[used], hist.plot[used]))
     assert len(np.unique(pairs, axis=0)) == len(pairs)
-    online = MHTTracker(MHTConfig(birth=birth), KnownClutter(sim.clutter_density)).run(
+    online = _by_hand(MHTConfig(birth=birth), KnownClutter(sim.clutter_density)).run(
         sim.scans, history=False)
     assert same_tracks(hist.online(), online)

@@ -126,7 +126,7 @@ def test_a_custom_birth_process_by_hand() -> None:
     trk.step(SCAN2)
     assert trk.leaves.n_trees == 1 and trk.last_stats.n_births == 0
     assert _branch_scores(trk) == pytest.approx([L_MISS, L_UPDATE], abs=1e-6)
-    assert trk.birth_process is birth
+    assert trk.birth is birth
 
 
 def test_the_motion_model_is_a_part() -> None:

@@ -21,7 +21,7 @@ from typing import Any
 import numpy as np
 from tqdm.auto import tqdm
 
-from mhtrack.build import make_initiator
+from mhtrack.build import INITIATION_FUSER_CLASSES, make_initiator
 from mhtrack.experiments.jobs import run_seeds
 from mhtrack.initiation.fused import FusedScan
 from mhtrack.initiation.fusion import AdaptiveKMeansFusion, KMeansFusion
@@ -64,7 +64,7 @@ def fused_scans(scans: Sequence[Scan], fusion: str, *, run_seed: int = 0,
     K-means of :func:`fuse` — or ``"none"``) and the seconds spent on each; ``params``
     are options of the fusion (e.g. P2's own steps only, ``reproduce p2
     --tracker-settings paper``)."""
-    if fusion == "none":
+    if fusion in INITIATION_FUSER_CLASSES and INITIATION_FUSER_CLASSES[fusion] is None:
         return list(scans), [0.0] * len(scans)
     methods = {"adaptive-kmeans": "adaptive", "kmeans": "random"}
     if fusion not in methods:

@@ -1,80 +1,44 @@
-"""One tracking run: feed a tracker scans, time it, score it (the tracker itself comes
-from the builder, :mod:`mhtrack.build`).
+"""One tracking run: feed a tracker scans, time it, score it — through the library's one
+pipeline (:mod:`mhtrack.pipeline`: source → frames → tracker → sinks), so that a tracker
+is run, timed and evaluated the same way by the CLI's ``track`` and ``run`` and by the
+Monte-Carlo runner.
 
-The CLI's ``track`` and ``run`` and the Monte-Carlo runner all go through here, so a
-tracker is run, timed and evaluated the same way everywhere.
-
-Birth process (``birth``, ``theta_deg``): which plots start new track trees
-(``MHTConfig.birth``, ``docs/mht.md``). Fusion (``fusion``): the MHT assumes at most one
-plot per target per scan, so with several sensors each scan is first fused by
-:class:`~mhtrack.initiation.AdaptiveKMeansFusion` (P2 §1.2) — the default when the scenario
-has more than one sensor (:func:`default_fusion`) — with a χ² consistency split and
-information weighting (:func:`tracker_fuser`). A fused plot's row id (the ``plot``
-column of the tracks) is the plot-table row of the first plot of its cluster (in scan
-order), so it stays a valid plot-table row.
+The fusion of several sensors' scans and the row ids of fused plots are
+:mod:`mhtrack.pipeline.run`'s (:func:`fuse_scan`, :func:`fused`, re-exported here).
 """
 
 from __future__ import annotations
 
-import dataclasses
 from collections.abc import Iterable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
-from tqdm.auto import tqdm
 
-from mhtrack.build import (
-    TRACKER_FUSERS,
-    default_config,
-    default_fusion,
-    make_tracker,
-    tracker_fuser,
-)
-from mhtrack.initiation.fusion import AdaptiveKMeansFusion
+from mhtrack.build import TRACKER_FUSERS, make_tracker
 from mhtrack.mht import MHTConfig, MHTTracker, StepStats
 from mhtrack.models.radars import SensorSet
-from mhtrack.names import OUTPUTS, TRACKER_FUSIONS
+from mhtrack.names import OUTPUTS
+from mhtrack.pipeline import (
+    Pipeline,
+    TrackOptions,
+    cap_scans,
+    caps_acted,
+    feed,
+    fuse_scan,
+    fused,
+    mean_step_time,
+    step_frames,
+)
 from mhtrack.records import PlotTable, Scan, TrackTable
+from mhtrack.sinks import TrackCollector
+from mhtrack.sources.memory import MemorySource
 
 if TYPE_CHECKING:  # loaded by run_scenario only (fast start of `mhtrack track`)
     from mhtrack.metrics import Evaluation
     from mhtrack.scenario import Scenario, Simulation
 
-
-def fuse_scan(scan: Scan, fuser: AdaptiveKMeansFusion | None = None) -> Scan:
-    """``scan`` fused by adaptive K-means (P2 §1.2): one plot per cluster, with its fused
-    ``R`` and, as row id, the row of the cluster's first plot (module docstring). Default
-    ``fuser``: :func:`tracker_fuser`."""
-    if len(scan) == 0:
-        return scan
-    f = (tracker_fuser() if fuser is None else fuser).fuse(scan)
-    k = len(f.scan)
-    first = np.full(k, -1, np.int64)
-    first[f.labels[::-1]] = np.arange(len(f.labels))[::-1]
-    return dataclasses.replace(f.scan, rows=np.asarray(scan.rows, np.int64)[first])
-
-
-def fused(scans: Iterable[Scan], fusion: str,
-          caps: dict[int, dict[str, int]] | None = None) -> Iterable[Scan]:
-    """``scans`` unchanged (``"none"``) or each fused (``"adaptive-kmeans"``). The caps
-    the fusion applied in a burst (``Fuser.caps_``, logged by ``Fuser.fuse``) go to
-    ``caps[scan index]``."""
-    if fusion not in TRACKER_FUSIONS:
-        raise ValueError(f"unknown fusion {fusion!r} (expected {', '.join(TRACKER_FUSIONS)})")
-    factory = TRACKER_FUSERS[fusion]
-    if factory is None:
-        return scans
-    fuser = factory()
-
-    def each(s: Scan) -> Scan:
-        out = fuse_scan(s, fuser)  # logs the caps that acted (Fuser.fuse)
-        acted = dict(getattr(fuser, "caps_", None) or {}) if len(s) else {}
-        if acted and caps is not None:
-            caps[int(s.index)] = acted
-        return out
-
-    return (each(s) for s in scans)
+__all__ = ["ScenarioRun", "TrackingRun", "fuse_scan", "fused", "run_scenario", "track"]
 
 
 @dataclass(frozen=True)
@@ -93,30 +57,19 @@ class TrackingRun:
     @property
     def t_avg(self) -> float:
         """Mean tracker time per scan (s) — P1 Table 3's ``Tavg``."""
-        t = self.seconds_per_scan
-        return float(t.mean()) if t.size else 0.0
+        return mean_step_time(self.stats)
 
     @property
     def caps(self) -> dict[str, int]:
         """Total of every hard cap that acted, over the run, and under ``"scans"`` the
         number of scans (frames) on which any acted; empty when none acted."""
-        total: dict[str, int] = {}
-        for s in self.stats:
-            for k, v in s.caps.items():
-                total[k] = total.get(k, 0) + v
-        if total:
-            total["scans"] = sum(1 for s in self.stats if s.caps)
-        return total
+        return caps_acted(self.stats)
 
     @property
     def cap_scans(self) -> dict[str, list[int]]:
         """The scans at which each hard cap acted (``StepStats.caps``; with the fusion's
         caps, ``fusion_*``, of each scan)."""
-        out: dict[str, list[int]] = {}
-        for s in self.stats:
-            for k in sorted(s.caps):
-                out.setdefault(k, []).append(s.scan)
-        return out
+        return cap_scans(self.stats)
 
 
 def track(
@@ -136,21 +89,17 @@ def track(
         raise ValueError(f"unknown output {output!r} (expected one of {', '.join(OUTPUTS)})")
     if isinstance(tracker, str):
         name, tracker = tracker, make_tracker(tracker, config, sensors=sensors)
-    if isinstance(scans, PlotTable) and scans.timed and fusion != "none":
+    if isinstance(scans, PlotTable) and scans.timed and TRACKER_FUSERS.get(fusion):
         raise ValueError("plots with their own times are tracked frame by frame, one "
                          f"sensor per frame: use fusion 'none', not {fusion!r}")
     total = None
     if isinstance(scans, PlotTable):
         total = scans.n_scans
-        scans = scans.scans()
-    stats: list[StepStats] = []
-    fusion_caps: dict[int, dict[str, int]] = {}
-    bar = tqdm(fused(scans, fusion, fusion_caps), total=total, desc=name, unit="scan",
-               disable=not progress, leave=False)
-    tracks = tracker.run(bar, stats, history=output == "history")
-    for st in stats:  # the fusion's caps join the scan's own
-        st.caps.update(fusion_caps.get(st.scan, {}))
-    return TrackingRun(name, tracks, tuple(stats), output)
+        scans = MemorySource(scans)
+    rows = TrackCollector(output)
+    stats, _ = feed(step_frames(tracker, scans, fusion=fusion, name=name, progress=progress,
+                                total=total), [rows])
+    return TrackingRun(name, rows.tracks(), tuple(stats), output)
 
 
 @dataclass(frozen=True)
@@ -160,6 +109,8 @@ class ScenarioRun:
     simulation: Simulation
     run: TrackingRun
     evaluation: Evaluation
+    #: The line naming the new-target density chosen (None when the user set it).
+    birth_note: str | None = None
 
     def summary(self) -> dict[str, Any]:
         """The ``evaluate`` JSON object plus ``t_avg`` (s/scan), ``tracker``, ``caps`` (the
@@ -176,6 +127,13 @@ class ScenarioRun:
         }
 
 
+def scenario_source(scenario: Scenario, plots: PlotTable) -> MemorySource:
+    """A simulation's plots as a source: with its scenario, and — plots with their own
+    times — its radars (coverage, per-radar clutter, the lat/lon of the outputs)."""
+    sensors = scenario.sensor_set() if plots.timed else None
+    return MemorySource(plots, name=scenario.name, sensors=sensors, scenario=scenario)
+
+
 def run_scenario(
     scenario: Scenario,
     seed: int,
@@ -183,36 +141,39 @@ def run_scenario(
     config: MHTConfig | None = None,
     *,
     clutter_density: float | None = None,
-    cutoff: float = 500.0,
-    order: float = 2.0,
+    cutoff: float | None = None,
+    order: float | None = None,
     progress: bool = False,
     birth: str | None = None,
     theta_deg: float | None = None,
     fusion: str | None = None,
     output: str = "history",
     clutter_params: dict[str, Any] | None = None,
+    options: TrackOptions | None = None,
 ) -> ScenarioRun:
-    """Simulate ``scenario`` with ``seed``, run tracker ``tracker`` on it and evaluate.
+    """Simulate ``scenario`` with ``seed``, run the tracker on it and evaluate.
 
-    ``birth`` / ``theta_deg``: see :func:`make_tracker`; ``fusion``: ``"none"`` or
-    ``"adaptive-kmeans"``, default :func:`default_fusion` of the scenario's sensors;
-    ``output``: see :func:`track`; ``clutter_params``: keywords of the clutter estimator
-    (:func:`make_tracker`). A scenario of rotating radars (plots with their own
-    times) is tracked as ``mhtrack track --sensors`` tracks it: frame by frame, unfused,
-    with the radars' coverage and per-radar clutter."""
+    The tracker is ``options`` (:class:`~mhtrack.pipeline.TrackOptions`) when given, else
+    the one the keywords name (``tracker``, ``clutter_density``, ``birth``,
+    ``theta_deg``, ``fusion``, ``output``, ``clutter_params``); ``config``: the base
+    configuration (default :func:`~mhtrack.build.default_config` of the scenario). The
+    run goes through :class:`~mhtrack.pipeline.Pipeline` as ``mhtrack track`` does: a
+    scenario of rotating radars (plots with their own times) is tracked frame by frame,
+    unfused, with the radars' coverage and per-radar clutter; scans of several sensors
+    are fused by default. ``cutoff``/``order``: OSPA/GOSPA's (default
+    :func:`~mhtrack.metrics.evaluate`'s)."""
     from mhtrack.metrics import evaluate
     from mhtrack.scenario import simulate
 
+    if options is None:
+        options = TrackOptions(tracker=tracker, clutter_density=clutter_density, birth=birth,
+                               birth_theta_deg=theta_deg, fusion=fusion, output=output,
+                               clutter_params=clutter_params)
     sim = simulate(scenario, seed=seed)
-    config = default_config(scenario) if config is None else config
-    timed = sim.plots.timed
-    trk = make_tracker(tracker, config, clutter_density=clutter_density, birth=birth,
-                       theta_deg=theta_deg, clutter_params=clutter_params,
-                       sensors=scenario.sensor_set() if timed else None)
-    if fusion is None:
-        fusion = "none" if timed else default_fusion(len(scenario.sensors))
-    run = track(trk, sim.plots, name=tracker, progress=progress, fusion=fusion, output=output)
-    ev = evaluate(run.tracks, sim.truth, plots=sim.plots, cutoff=cutoff, order=order)
-    return ScenarioRun(sim, run, ev)
-
-
+    pipe = Pipeline(scenario_source(scenario, sim.plots), options, config=config)
+    rows = TrackCollector(pipe.output)
+    result = pipe.run([rows], progress=progress)
+    run = TrackingRun(options.tracker, rows.tracks(), result.stats, pipe.output)
+    metric = {k: v for k, v in (("cutoff", cutoff), ("order", order)) if v is not None}
+    ev = evaluate(run.tracks, sim.truth, plots=sim.plots, **metric)
+    return ScenarioRun(sim, run, ev, pipe.birth_note)

@@ -6,7 +6,7 @@ one object, checked, with every problem one :class:`~mhtrack.errors.InputError` 
 from __future__ import annotations
 
 import json
-from collections.abc import Mapping, Sequence
+from collections.abc import Sequence
 from os import PathLike
 from typing import Any
 
@@ -17,10 +17,6 @@ from mhtrack.io.tomlfile import too_deep
 
 #: Largest JSON file read (bytes): job records and study specs are a few kB.
 MAX_JSON_BYTES = 64 << 20
-
-_KIND_NAMES = {dict: "an object", list: "an array", str: "a string", int: "an integer",
-               float: "a number", bool: "true or false"}
-
 
 def key_error(path: str | PathLike[str], key: str | None, problem: str) -> InputError:
     """``<file>, key '<key>': <problem>`` (``<file>: <problem>`` without a key)."""
@@ -68,19 +64,3 @@ def read_json_object(path: str | PathLike[str], what: str,
             raise key_error(path, key, f"missing (a JSON file of {what} has "
                             f"{', '.join(required)})")
     return data
-
-
-def check_fields(path: str | PathLike[str], obj: Mapping[str, Any],
-                 kinds: Mapping[str, type | tuple[type, ...]], prefix: str = "") -> None:
-    """Each key of ``kinds`` present in ``obj`` has a value of that Python type (bools are
-    not integers or numbers); a missing key is an error."""
-    for key, kind in kinds.items():
-        name = f"{prefix}{key}"
-        if key not in obj:
-            raise key_error(path, name, "missing")
-        v = obj[key]
-        types = kind if isinstance(kind, tuple) else (kind,)
-        if (isinstance(v, bool) and bool not in types) or not isinstance(v, types):
-            want = " or ".join(_KIND_NAMES.get(t, t.__name__) for t in types)
-            raise key_error(path, name, f"expected {want}, got {kind_of(v)} "
-                            f"{clip(json.dumps(v))}")

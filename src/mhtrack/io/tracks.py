@@ -7,6 +7,7 @@ east/north ``vx, vy`` (:mod:`mhtrack.io._geodetic`). See ``docs/file-formats.md`
 
 from __future__ import annotations
 
+from dataclasses import replace
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -138,7 +139,16 @@ def write_tracks(
     (:func:`~mhtrack.io.plots.plots_to_file_rows`). Tracks of timed plots are written
     with ``frame`` in place of ``scan``: their rows have their states' own times."""
     plot = table.plot if plots is None else plots_to_file_rows(table.plot, plots)
-    timed = plots is not None and plots.timed
+    write_track_rows(replace(table, plot=plot), path, frame,
+                     timed=plots is not None and plots.timed)
+
+
+def write_track_rows(table: TrackTable, path: PathArg, frame: LocalFrame | None = None, *,
+                     timed: bool = False) -> None:
+    """Write ``table`` whose ``plot`` already holds the input's own rows (a sink's
+    :meth:`~mhtrack.sources.base.Source.file_rows`), as :func:`write_tracks` does; ``timed``:
+    rows numbered by ``frame`` (tracks of timed plots), else by ``scan``."""
+    plot = table.plot
     cols = {
         "frame" if timed else "scan": int_array(table.scan),
         "time": float_array(table.time),

@@ -50,7 +50,7 @@ import numpy as np
 
 from mhtrack.clutter.base import ClutterEstimator
 from mhtrack.clutter.known import KnownClutter
-from mhtrack.mht.births import Birth, make_birth
+from mhtrack.mht.births import Birth, default_birth
 from mhtrack.mht.caps import CapWarnings
 from mhtrack.mht.config import MHTConfig
 from mhtrack.mht.context import FrameContext
@@ -85,8 +85,9 @@ class MHTTracker:
         ``κ = 1e−9`` per m² (P1's plain MHT).
     motion : the motion model; default :attr:`MHTConfig.motion` (the IMM, or a single
         constant-velocity model when ``imm_sigma_v = 0``).
-    birth : the birth process; default the one ``config.birth`` names
-        (:func:`~mhtrack.mht.births.make_birth`).
+    birth : the birth process (:func:`mhtrack.build.make_birth` builds the one
+        ``config.birth`` names); default P1's every-plot birth
+        (:func:`~mhtrack.mht.births.default_birth`).
     coverage : the sensors' coverage (:mod:`mhtrack.mht.coverage`); default
         :class:`~mhtrack.mht.coverage.Everywhere` with ``config.p_detection`` (every leaf
         looked at every scan: P1's scans).
@@ -107,7 +108,7 @@ class MHTTracker:
         self.clutter: ClutterEstimator = KnownClutter() if clutter is None else clutter
         self.motion: MotionModel = cfg.motion if motion is None else motion
         self.coverage: Coverage = Everywhere(cfg.p_detection) if coverage is None else coverage
-        self.birth: Birth = (make_birth(cfg, self.motion, self.coverage.plot_pd)
+        self.birth: Birth = (default_birth(cfg, self.motion, self.coverage.plot_pd)
                              if birth is None else birth)
         #: How :func:`mhtrack.build.make_tracker` made this tracker (JSON-able), saved
         #: with its state so that :func:`mhtrack.build.load_tracker` can rebuild its
@@ -132,11 +133,6 @@ class MHTTracker:
     def leaves(self) -> Leaves:
         """The current hypothesis store (read-only view for inspection and tests)."""
         return self._leaves
-
-    @property
-    def birth_process(self) -> Birth:
-        """The birth process (its window, for an initiator birth)."""
-        return self.birth
 
     def step(self, scan: Scan) -> TrackTable:
         """Process one scan (or frame) through the module docstring's cycle; return the
@@ -294,8 +290,6 @@ class MHTTracker:
         trk = cls(saved.config, saved.clutter, motion=motion, birth=birth, coverage=coverage)
         meta = saved.meta
         leaves = saved.part("leaves")
-        if "time" not in leaves:  # saved before leaves had their own times
-            leaves["time"] = np.full(len(leaves["score"]), meta["last_time"] or 0.0)
         trk._leaves = Leaves.from_arrays(leaves)
         if trk._leaves.n_models != trk.motion.n_models:
             raise ValueError(f"{path}: saved with {trk._leaves.n_models} IMM models, the "

@@ -10,7 +10,6 @@ density is renormalised by the mixture's mass inside the region.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Protocol
 
 import numpy as np
 
@@ -57,20 +56,6 @@ class Region:
 
     def as_tuple(self) -> tuple[float, float, float, float]:
         return (self.xmin, self.xmax, self.ymin, self.ymax)
-
-
-class ClutterModel(Protocol):
-    """What the simulator and the clutter-estimation metrics need of a clutter model."""
-
-    region: Region
-
-    def rate(self, scan: int) -> float: ...
-
-    def density(self, z: np.ndarray, scan: int) -> np.ndarray: ...
-
-    def intensity(self, z: np.ndarray, scan: int) -> np.ndarray: ...
-
-    def sample(self, rng: np.random.Generator, scan: int) -> np.ndarray: ...
 
 
 @dataclass(frozen=True)

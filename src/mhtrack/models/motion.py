@@ -150,10 +150,6 @@ class ConstantVelocity(MotionModel):
         q[:, 1, 1] = q[:, 3, 3] = d**2
         return q * self.sigma_v**2
 
-    def propagate(self, x: np.ndarray, dt: float) -> np.ndarray:
-        """Noise-free propagation of states ``x`` (…, 4) by ``dt``."""
-        return x @ self.F(dt).T
-
     # ------------------------------------------------------------------ MotionModel
     @property
     def n_models(self) -> int:

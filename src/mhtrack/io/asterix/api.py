@@ -20,6 +20,7 @@ from mhtrack.io.asterix.earth import ground_range, slant_range
 from mhtrack.io.asterix.encode import encode_blocks, plot_messages, sweep_messages
 from mhtrack.io.asterix.writer import write_blocks
 from mhtrack.models.radars import SensorSet
+from mhtrack.names import EXPORT_CATEGORIES
 
 #: Largest sensor id an ASTERIX data source holds (SAC·256 + SIC).
 MAX_SENSOR_ID = 0xFFFF
@@ -112,11 +113,25 @@ class Converted:
     n_plots: int
     recording: Recording
 
+    def describe(self) -> str:
+        """One line: container, plots, radars (SAC/SIC), CAT034 sweep marks and periods."""
+        rec = self.recording
+        radars = ", ".join(f"{s >> 8}/{s & 0xFF}"
+                           for s in sorted(set(rec.plots["sensor"].tolist())))
+        periods = ", ".join(f"{s}: {p:.3g} s" for s, p in sorted(rec.periods().items()))
+        return (f"{rec.container} recording: {self.n_plots} plots from radars (SAC/SIC) "
+                f"{radars}; {rec.sweeps['time'].size} CAT034 sweep marks"
+                + (f" (periods {periods})" if periods else ""))
+
 
 def convert(source: str | Path, out: str | Path, sensors: SensorSet | None = None, *,
             recording: Recording | None = None) -> Converted:
-    """Decode ``source`` and write its plots to ``out`` (CSV or Parquet)."""
-    rec = recording if recording is not None else read_recording(source)
+    """Decode ``source`` (warning one line per kind of part skipped) and write its plots
+    to ``out`` (CSV or Parquet); ``recording``: ``source`` already decoded."""
+    if recording is None:
+        recording = read_recording(source)
+        recording.problems.warn(str(source))
+    rec = recording
     if len(rec) == 0:
         raise InputError(f"{source}: no CAT048 plot with a measured position (I048/040) "
                          f"in this {rec.container} recording", file=str(source))
@@ -136,6 +151,41 @@ def sensors_with_periods(sensors: SensorSet, rec: Recording | dict[int, float]
 
 
 # --- export -----------------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class Exported:
+    """What :func:`export_file` wrote."""
+
+    n_rows: int
+    n_blocks: int
+    category: str
+
+    def describe(self) -> str:
+        """``N plots|track updates in B data blocks (CAT…)``."""
+        if self.category == "062":
+            return f"{self.n_rows} track updates in {self.n_blocks} data blocks (CAT062)"
+        return f"{self.n_rows} plots in {self.n_blocks} data blocks (CAT048, CAT034)"
+
+
+def export_file(path: str | Path, sensors: SensorSet | None, out: str | Path, *,
+                category: str | None = None, sac: int | None = None,
+                sic: int | None = None) -> Exported:
+    """``mhtrack export`` (:data:`~mhtrack.names.EXPORT_CATEGORIES`, the first the
+    default): timed plots as CAT048 target reports with CAT034 sweeps (:func:`export`;
+    needs ``sensors``), or with ``category "062"`` a tracks file as CAT062 system tracks
+    from data source ``sac``/``sic`` (:func:`~mhtrack.io.asterix.cat062.export_tracks`)."""
+    from mhtrack.io.asterix.cat062 import export_tracks
+
+    category = EXPORT_CATEGORIES[0] if category is None else category
+    if category not in EXPORT_CATEGORIES:
+        raise ValueError(f"unknown category {category!r} (expected "
+                         f"{', '.join(EXPORT_CATEGORIES)})")
+    if category == "062":
+        return Exported(*export_tracks(path, sensors, out, sac=sac, sic=sic), category)
+    if sensors is None:
+        raise ValueError("export of plots (CAT048) needs --sensors FILE")
+    return Exported(*export(path, sensors, out), category)
+
 
 _EXPORT = {"time": TIME, "sensor": INT, "range": FLOAT, "slant_range": FLOAT,
            "bearing": FLOAT, "flight_level": FLOAT, "typ": INT, "track_number": INT,

@@ -8,8 +8,9 @@ recordings").
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -24,6 +25,10 @@ from mhtrack.io.asterix.problems import Problems
 from mhtrack.io.asterix.timeaxis import DAY_S, unwrap_days
 from mhtrack.io.asterix.writer import write_blocks
 from mhtrack.models.radars import SensorSet
+from mhtrack.records import TrackTable
+
+if TYPE_CHECKING:
+    from mhtrack.models.geodesy import LocalFrame
 
 _TRACKS = {"time": TIME, "track_id": INT, "lat": FLOAT, "lon": FLOAT, "x": FLOAT,
            "y": FLOAT, "vx": FLOAT, "vy": FLOAT, "plot": INT, "tentative": INT}
@@ -49,21 +54,26 @@ def _status(tentative: int, coasting: int) -> tuple[Any, ...]:
             (0, 0, 0, 0, 0, None), (("CST", coasting), 0, 0, 0, 0, 0, 0, None))
 
 
+#: The data source (I062/010) of exported system tracks when none is given.
+DEFAULT_SAC = 0
+DEFAULT_SIC = 1
+
+#: ``check(bad rows, column, message of row r)``: raises on the first bad row.
+Check = Callable[[np.ndarray, str, Callable[[int], str]], None]
+
+
 def export_tracks(tracks: str | Path, sensors: SensorSet | None, out: str | Path, *,
-                  sac: int = 0, sic: int = 1) -> tuple[int, int]:
-    """Encode a tracks file as CAT062 system tracks from data source ``sac``/``sic``;
-    positions from ``lat, lon`` (else ``x, y`` through the sensors file's frame),
-    velocities east/north. Returns ``(track rows, data blocks)``."""
+                  sac: int | None = None, sic: int | None = None) -> tuple[int, int]:
+    """Encode a tracks file as CAT062 system tracks from data source ``sac``/``sic``
+    (default :data:`DEFAULT_SAC`/:data:`DEFAULT_SIC`); positions from ``lat, lon`` (else
+    ``x, y`` through the sensors file's frame), velocities east/north. Returns
+    ``(track rows, data blocks)``."""
     _lib.modules()
     f = read_frame(tracks, _TRACKS, ("time", "track_id"), "tracks")
     if f.n == 0:
         f.fail("no rows (nothing to export)")
     time = seconds(f)
-    f.check(time < 0, "time", lambda r: f"time {time[r]:g} s is negative (ASTERIX times "
-            "are times of day)")
     tn = f.ints("track_id")
-    f.check((tn < 0) | (tn > 0xFFFF), "track_id", lambda r: f"track_id {tn[r]} does not "
-            "fit I062/040 (0 to 65535)")
     if f.has("lat") and f.has("lon"):
         lat, lon = f.floats("lat"), f.floats("lon")
         ve = f.floats("vx") if f.has("vx") else np.zeros(f.n)
@@ -77,27 +87,68 @@ def export_tracks(tracks: str | Path, sensors: SensorSet | None, out: str | Path
         vx = f.floats("vx") if f.has("vx") else np.zeros(f.n)
         vy = f.floats("vy") if f.has("vy") else np.zeros(f.n)
         ve, vn = frame.velocity_to_geodetic(x, y, vx, vy)
-    L = lsb062()
-    raw = {k: np.round(v / L["mps"]).astype(np.int64) for k, v in (("vx", ve), ("vy", vn))}
-    for k, v in raw.items():
-        f.check(np.abs(v) > 0x7FFF, "vx" if k == "vx" else "vy", lambda r, k=k: (
-            f"velocity {k} beyond I062/185's ±8192 m/s"))
-    lat_raw = np.round(lat / L["deg"]).astype(np.int64)
-    lon_raw = np.round(((lon + 180.0) % 360.0 - 180.0) / L["deg"]).astype(np.int64)
     coasting = (f.ints("plot", nullable=True) < 0).astype(int) if f.has("plot") \
         else np.zeros(f.n, int)
     tentative = (f.ints("tentative", nullable=True, fill=0) != 0).astype(int) \
         if f.has("tentative") else np.zeros(f.n, int)
+    messages = track_messages(time, tn, lat, lon, ve, vn, coasting, tentative, f.check,
+                              sac=sac, sic=sic)
+    n = write_blocks(out, encode_blocks(messages))
+    return f.n, n
+
+
+def table_messages(tracks: TrackTable, frame: LocalFrame, name: str, *,
+                   sac: int | None = None, sic: int | None = None) -> list[Message]:
+    """The CAT062 messages of tracker output ``tracks`` (local ``x, y, vx, vy`` turned
+    into WGS-84 and east/north by ``frame``, as a tracks file's ``lat, lon, vx, vy``;
+    a miss is coasting, a ``tentative`` row tentative) — the same messages
+    :func:`export_tracks` makes of the tracks file written from ``tracks``. Problems
+    raise :class:`ValueError` naming ``name``, the track and its time."""
+    x, y = tracks.x, tracks.y
+    lat, lon = frame.to_geodetic(x, y)
+    ve, vn = frame.velocity_to_geodetic(x, y, tracks.vx, tracks.vy)
+    coasting = (tracks.plot < 0).astype(int)
+    tentative = (np.zeros(len(tracks), int) if tracks.tentative is None
+                 else tracks.tentative.astype(int))
+
+    def check(bad: np.ndarray, column: str, text: Callable[[int], str]) -> None:
+        if bad.any():
+            r = int(np.argmax(bad))
+            raise ValueError(f"{name}: track {int(tracks.track_id[r])} at time "
+                             f"{float(tracks.time[r]):g} s, {column}: {text(r)}")
+
+    return track_messages(np.asarray(tracks.time, float), tracks.track_id, lat, lon, ve, vn,
+                          coasting, tentative, check, sac=sac, sic=sic)
+
+
+def track_messages(time: np.ndarray, track_id: np.ndarray, lat: np.ndarray,
+                   lon: np.ndarray, ve: np.ndarray, vn: np.ndarray, coasting: np.ndarray,
+                   tentative: np.ndarray, check: Check, *, sac: int | None = None,
+                   sic: int | None = None) -> list[Message]:
+    """One CAT062 message per track row (I062/010, 070, 105, 185, 040, 080), values
+    rounded to the items' LSBs (:func:`lsb062`); ``check`` reports rows that do not fit."""
+    sac = DEFAULT_SAC if sac is None else sac
+    sic = DEFAULT_SIC if sic is None else sic
+    check(time < 0, "time", lambda r: f"time {time[r]:g} s is negative (ASTERIX times "
+          "are times of day)")
+    tn = np.asarray(track_id, np.int64)
+    check((tn < 0) | (tn > 0xFFFF), "track_id", lambda r: f"track_id {tn[r]} does not "
+          "fit I062/040 (0 to 65535)")
+    L = lsb062()
+    raw = {k: np.round(v / L["mps"]).astype(np.int64) for k, v in (("vx", ve), ("vy", vn))}
+    for k, v in raw.items():
+        check(np.abs(v) > 0x7FFF, "vx" if k == "vx" else "vy", lambda r, k=k: (
+            f"velocity {k} beyond I062/185's ±8192 m/s"))
+    lat_raw = np.round(lat / L["deg"]).astype(np.int64)
+    lon_raw = np.round(((lon + 180.0) % 360.0 - 180.0) / L["deg"]).astype(np.int64)
     tod = raw_tod(time)
     sid = (sac << 8) | sic
-    messages = [Message(float(time[i]), sid, 62, {
+    return [Message(float(time[i]), sid, 62, {
         "010": (("SAC", sac), ("SIC", sic)), "070": int(tod[i]),
         "105": (("LAT", int(lat_raw[i])), ("LON", int(lon_raw[i]))),
         "185": (("VX", int(raw["vx"][i])), ("VY", int(raw["vy"][i]))),
         "040": int(tn[i]), "080": _status(int(tentative[i]), int(coasting[i])),
-    }) for i in range(f.n)]
-    n = write_blocks(out, encode_blocks(messages))
-    return f.n, n
+    }) for i in range(len(time))]
 
 
 def read_system_tracks(path: str | Path) -> tuple[dict[str, np.ndarray], Problems]:

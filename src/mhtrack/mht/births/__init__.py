@@ -4,7 +4,8 @@
 * ``logic`` / ``modified-logic`` / ``hough`` / ``modified-hough``: a P2 initiator over the
   last scans (:mod:`.initiator`), scored by :mod:`.sequence`.
 
-:func:`make_birth` builds the one an :class:`~mhtrack.mht.config.MHTConfig` names.
+:func:`default_birth` is the tracker's when none is passed; :func:`mhtrack.build.make_birth`
+builds the one an :class:`~mhtrack.mht.config.MHTConfig` names.
 """
 
 from __future__ import annotations
@@ -15,32 +16,27 @@ from mhtrack.mht.births.base import Birth, BirthCandidates
 from mhtrack.mht.births.every_plot import EveryPlotBirth
 from mhtrack.mht.births.initiator import InitiatorBirth
 from mhtrack.mht.config import MHTConfig
-from mhtrack.mht.scoring import miss_increment
 from mhtrack.mht.sprt import sprt_thresholds
 from mhtrack.models.motion import MotionModel
 from mhtrack.names import EVERY_PLOT
 from mhtrack.records import Scan
 
 
-def make_birth(cfg: MHTConfig, motion: MotionModel,
-               plot_pd: Callable[[Scan], float] | None = None) -> Birth:
-    """The birth process ``cfg.birth`` with the configuration's parameters; new trees
-    start only above the SPRT deletion threshold ``ln(β/(1−α))``. ``plot_pd``: the
-    ``P_D`` of a scan's sensor for the every-plot birth score (``None``:
-    ``cfg.p_detection``)."""
-    floor = sprt_thresholds(cfg.alpha, cfg.beta)[1]
-    if cfg.birth == EVERY_PLOT:
-        return EveryPlotBirth(motion, p_detection=cfg.p_detection,
-                              new_target_density=cfg.new_target_density, floor=floor,
-                              v_max=cfg.v_max, width=cfg.n_scan + 1,
-                              max_per_scan=cfg.max_births_per_scan, plot_pd=plot_pd)
-    return InitiatorBirth(
-        cfg.birth, motion, theta_deg=cfg.birth_theta_deg, width=cfg.n_scan + 1,
-        p_detection=cfg.p_detection, new_target_density=cfg.new_target_density,
-        miss_dl=miss_increment(cfg.p_detection, cfg.gate_probability
-                               if cfg.miss_uses_gate_probability else None),
-        v_max=cfg.v_max, floor=floor, max_per_scan=cfg.max_births_per_scan,
-        prune_drop=cfg.prune_drop, max_leaves_per_tree=cfg.max_leaves_per_tree)
+def default_birth(cfg: MHTConfig, motion: MotionModel,
+                  plot_pd: Callable[[Scan], float] | None = None) -> EveryPlotBirth:
+    """P1's birth (every plot may start a tree, above the SPRT deletion threshold
+    ``ln(β/(1−α))``) with the configuration's parameters: the tracker's birth when none
+    is passed. A configuration naming another birth is built by
+    :func:`mhtrack.build.make_birth` (the builder holds every part's table)."""
+    if cfg.birth != EVERY_PLOT:
+        raise ValueError(f"MHTConfig.birth is {cfg.birth!r}: build the tracker with "
+                         "mhtrack.build.make_tracker, or pass "
+                         "birth=mhtrack.build.make_birth(config, motion)")
+    return EveryPlotBirth(motion, p_detection=cfg.p_detection,
+                          new_target_density=cfg.new_target_density,
+                          floor=sprt_thresholds(cfg.alpha, cfg.beta)[1], v_max=cfg.v_max,
+                          width=cfg.n_scan + 1, max_per_scan=cfg.max_births_per_scan,
+                          plot_pd=plot_pd)
 
 
-__all__ = ["Birth", "BirthCandidates", "EveryPlotBirth", "InitiatorBirth", "make_birth"]
+__all__ = ["Birth", "BirthCandidates", "EveryPlotBirth", "InitiatorBirth", "default_birth"]

@@ -1,60 +1,48 @@
-"""The tracker builder: every part by its name, and the MHT's defaults fitted to the data.
-
-The CLI, the experiments and users build trackers here. Each name a user chooses a part
-by is listed once in :mod:`mhtrack.names`; this module maps those names to the classes:
+"""Every part by its name: the one table per kind of part from the names of
+:mod:`mhtrack.names` to the classes or factories, and the functions that build them.
 
 * trackers (:data:`~mhtrack.names.TRACKERS`) → the clutter estimator each one runs
   (:data:`TRACKER_ESTIMATORS`), built by :func:`make_tracker`;
 * clutter estimators (:data:`~mhtrack.names.CLUTTER_ESTIMATORS`) →
   :data:`CLUTTER_ESTIMATOR_CLASSES`, built by :func:`make_clutter_estimator`;
-* initiators (:data:`~mhtrack.names.INITIATORS`) → :data:`INITIATOR_CLASSES`, built by
+* births (:data:`~mhtrack.names.BIRTHS`) → :data:`BIRTH_FACTORIES`, built by
+  :func:`make_birth`;
+* initiators (:data:`~mhtrack.names.INITIATORS`) →
+  :data:`~mhtrack.initiation.factory.INITIATOR_CLASSES` (kept beside the initiators,
+  layer 3, because the MHT's initiator birth builds one per window), built by
   :func:`make_initiator`;
 * plot fusions (:data:`~mhtrack.names.TRACKER_FUSIONS`,
   :data:`~mhtrack.names.INITIATION_FUSIONS`) → :data:`TRACKER_FUSERS`,
   :data:`INITIATION_FUSER_CLASSES`.
 
-Defaults (:func:`default_config`): P1 §3's parameters, with the new-target density scaled
-to the surveillance area (:func:`birth_density_for_area`, the area of a scenario's region
-or of a plots file's robust bounding box, :func:`plots_area`) and, with one sensor, that
-sensor's ``P_D`` (at most :data:`MAX_TRACKER_PD`) and Cartesian ``σ``.
-
-Layer: after ``mht`` and ``initiation``, before ``metrics`` and ``experiments``; it
-imports neither of those, nor plotting or the CLI.
+Nothing outside this module branches on a part's name.
 """
 
 from __future__ import annotations
 
-import dataclasses
 import json
 import os
 from collections.abc import Callable
-from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
-
-import numpy as np
-import numpy.typing as npt
+from typing import Any
 
 from mhtrack import names
+from mhtrack.build.defaults import DEFAULT_CLUTTER_DENSITY, config_with
+from mhtrack.build.recipe import sensors_from_recipe, sensors_recipe
 from mhtrack.clutter.agmm import AGMMClutter
 from mhtrack.clutter.base import ClutterEstimator
 from mhtrack.clutter.gmm import GMMClutter
 from mhtrack.clutter.known import KnownClutter
 from mhtrack.clutter.per_sensor import PerSensorClutter
 from mhtrack.clutter.polar import PolarClutter
-from mhtrack.initiation.factory import INITIATOR_CLASSES, make_initiator
 from mhtrack.initiation.fusion import AdaptiveKMeansFusion, KMeansFusion
 from mhtrack.mht import MHTConfig, MHTTracker
-from mhtrack.mht.coverage import RadarCoverage
-from mhtrack.models.radars import RadarSensor, SensorSet
-from mhtrack.models.sensors import CartesianSensor
-
-if TYPE_CHECKING:
-    from mhtrack.scenario import Scenario
-
-# ---------------------------------------------------------------- clutter estimators
-
-#: Default known clutter density of the plain MHT (P1 §3: 1e−9 per m²).
-DEFAULT_CLUTTER_DENSITY = 1e-9
+from mhtrack.mht.births import Birth, InitiatorBirth, default_birth
+from mhtrack.mht.coverage import Coverage, Everywhere, RadarCoverage
+from mhtrack.mht.scoring import miss_increment
+from mhtrack.mht.sprt import sprt_thresholds
+from mhtrack.models.motion import MotionModel
+from mhtrack.models.radars import SensorSet
+from mhtrack.records import Scan
 
 #: Plots a branch must hold before a tree of asynchronous plots is confirmed. A tree
 #: starts from one plot with velocity ``0 ± v_max/2``, so its second plot's
@@ -66,7 +54,6 @@ DEFAULT_CLUTTER_DENSITY = 1e-9
 #: *Asynchronous plots*): on seed 1 all 7 tracks confirmed on clutter and 2 of the 5
 #: short duplicates held exactly 2 plots. Synchronous scans keep P1's 2 (bit for bit).
 TIMED_CONFIRM_MIN_PLOTS = 3
-
 #: Clutter-estimator name (:data:`mhtrack.names.CLUTTER_ESTIMATORS`) → class.
 CLUTTER_ESTIMATOR_CLASSES: dict[str, type[Any]] = dict(
     zip(names.CLUTTER_ESTIMATORS, (KnownClutter, GMMClutter, AGMMClutter), strict=True))
@@ -111,7 +98,7 @@ def make_tracker(
     birth: str | None = None,
     theta_deg: float | None = None,
     sensors: SensorSet | None = None,
-    clutter_frame: str = "polar",
+    clutter_frame: str = names.DEFAULT_CLUTTER_FRAME,
     clutter_params: dict[str, Any] | None = None,
 ) -> MHTTracker:
     """A fresh tracker by name (:data:`TRACKER_ESTIMATORS`).
@@ -145,8 +132,8 @@ def make_tracker(
               "clutter_frame": clutter_frame, "clutter_params": params or None,
               "sensors": None if sensors is None else sensors_recipe(sensors)}
     if sensors is None:
-        return _with_recipe(MHTTracker(
-            config, make_clutter_estimator(estimator, kappa=kappa, **params)), recipe)
+        return _assemble(config, make_clutter_estimator(estimator, kappa=kappa, **params),
+                         Everywhere(config.p_detection), recipe)
     config = config_with(config, confirm_min_plots=max(config.confirm_min_plots,
                                                        TIMED_CONFIRM_MIN_PLOTS))
     if clutter_frame not in names.CLUTTER_FRAMES:
@@ -161,27 +148,53 @@ def make_tracker(
         lambda: make_clutter_estimator(estimator, kappa=kappa, **params),
         {s.id: s.period for s in sensors.sensors},
         initial=DEFAULT_CLUTTER_DENSITY if kappa is None else kappa, wrap=wrap)
-    return _with_recipe(MHTTracker(config, clutter, coverage=RadarCoverage(sensors)), recipe)
+    return _assemble(config, clutter, RadarCoverage(sensors), recipe)
 
 
-def _with_recipe(trk: MHTTracker, recipe: dict[str, Any]) -> MHTTracker:
+def _assemble(config: MHTConfig, clutter: ClutterEstimator, coverage: Coverage,
+              recipe: dict[str, Any]) -> MHTTracker:
+    """The tracker of ``config`` with its parts: the configuration's motion model, the
+    birth ``config.birth`` names (:func:`make_birth`, scored with the coverage's
+    ``P_D``), and the builder's ``recipe``."""
+    motion = config.motion
+    trk = MHTTracker(config, clutter, motion=motion, coverage=coverage,
+                     birth=make_birth(config, motion, coverage.plot_pd))
     trk.recipe = recipe
     return trk
 
 
-def sensors_recipe(sensors: SensorSet) -> dict[str, Any]:
-    """``sensors`` as JSON-able values (:func:`sensors_from_recipe` reverses it)."""
-    return {"origin": None if sensors.origin is None else list(sensors.origin),
-            "sensors": [{k: (list(v) if isinstance(v, tuple) else v)
-                         for k, v in dataclasses.asdict(s).items()}
-                        for s in sensors.sensors]}
+# ------------------------------------------------------------------------ births
+
+def _initiator_birth(method: str) -> Callable[..., Birth]:
+    """The birth of P2's initiator ``method`` over the last scans (:class:`InitiatorBirth`)."""
+    def make(cfg: MHTConfig, motion: MotionModel,
+             plot_pd: Callable[[Scan], float] | None) -> Birth:
+        return InitiatorBirth(
+            method, motion, theta_deg=cfg.birth_theta_deg, width=cfg.n_scan + 1,
+            p_detection=cfg.p_detection, new_target_density=cfg.new_target_density,
+            miss_dl=miss_increment(cfg.p_detection, cfg.gate_probability
+                                   if cfg.miss_uses_gate_probability else None),
+            v_max=cfg.v_max, floor=sprt_thresholds(cfg.alpha, cfg.beta)[1],
+            max_per_scan=cfg.max_births_per_scan, prune_drop=cfg.prune_drop,
+            max_leaves_per_tree=cfg.max_leaves_per_tree)
+    return make
 
 
-def sensors_from_recipe(d: dict[str, Any]) -> SensorSet:
-    """The :class:`SensorSet` of :func:`sensors_recipe`."""
-    return SensorSet(None if d["origin"] is None else tuple(d["origin"]), tuple(
-        RadarSensor(**{k: (tuple(v) if isinstance(v, list) else v) for k, v in s.items()})
-        for s in d["sensors"]))
+#: Birth name (:data:`mhtrack.names.BIRTHS`) → factory ``(config, motion, plot_pd) → Birth``.
+BIRTH_FACTORIES: dict[str, Callable[..., Birth]] = {
+    names.EVERY_PLOT: default_birth, **{m: _initiator_birth(m) for m in names.INITIATORS}}
+
+
+def make_birth(cfg: MHTConfig, motion: MotionModel,
+               plot_pd: Callable[[Scan], float] | None = None) -> Birth:
+    """The birth process ``cfg.birth`` (:data:`BIRTH_FACTORIES`) with the configuration's
+    parameters; new trees start only above the SPRT deletion threshold ``ln(β/(1−α))``.
+    ``plot_pd``: the ``P_D`` of a scan's sensor for the every-plot birth score (``None``:
+    ``cfg.p_detection``)."""
+    if cfg.birth not in BIRTH_FACTORIES:
+        raise ValueError(f"unknown birth {cfg.birth!r} "
+                         f"(expected one of {', '.join(BIRTH_FACTORIES)})")
+    return BIRTH_FACTORIES[cfg.birth](cfg, motion, plot_pd)
 
 
 def load_tracker(path: str | os.PathLike[str]) -> MHTTracker:
@@ -204,7 +217,7 @@ def load_tracker(path: str | os.PathLike[str]) -> MHTTracker:
                    else sensors_from_recipe(recipe["sensors"]))
         fresh = make_tracker(recipe["name"], MHTConfig.from_json(json.dumps(meta["config"])),
                              clutter_density=recipe.get("clutter_density"), sensors=sensors,
-                             clutter_frame=recipe.get("clutter_frame", "polar"),
+                             clutter_frame=recipe.get("clutter_frame", names.DEFAULT_CLUTTER_FRAME),
                              clutter_params=recipe.get("clutter_params"))
     except (KeyError, TypeError, ValueError) as e:
         raise ValueError(f"{path}: member 'meta': field 'recipe' cannot be rebuilt "
@@ -213,113 +226,6 @@ def load_tracker(path: str | os.PathLike[str]) -> MHTTracker:
                           coverage=fresh.coverage)
     trk.recipe = recipe
     return trk
-
-
-# ---------------------------------------------------------------------- defaults
-
-#: New targets per scan that P1's λv = 1e−7 per m² means over P1's 8 km × 8 km region
-#: (P1 §3): 6.4. :func:`default_config` keeps this rate and scales the density to the
-#: surveillance area at hand, so that P1's value is used on P1's region and a 500 km
-#: air-surveillance picture does not expect 29 000 new targets per scan.
-P1_BIRTHS_PER_SCAN = 1e-7 * 8000.0**2
-
-#: Largest ``P_D`` the tracker takes from a scenario: a sensor with ``P_D = 1`` would make
-#: one missed plot (gating, a plot lost in fusion) cost ``ln 0``; at 0.999 a miss costs
-#: ``ln 0.001 ≈ −6.9``, two delete the track (``β = 1e−4``).
-MAX_TRACKER_PD = 0.999
-
-
-def capped_pd(pd: float) -> float:
-    """``min(P_D, MAX_TRACKER_PD)``: the detection probability the tracker assumes for
-    sensors detecting with ``pd``."""
-    return min(pd, MAX_TRACKER_PD)
-
-
-def birth_density_for_area(area: float) -> float:
-    """``λv = 6.4 / A`` per m² per scan: P1's new-target rate over an area of ``A`` m²."""
-    if not (np.isfinite(area) and area > 0):
-        raise ValueError(f"surveillance area must be finite and > 0, got {area}")
-    return P1_BIRTHS_PER_SCAN / area
-
-
-def default_config(scenario: Scenario | None = None, *, area: float | None = None) -> MHTConfig:
-    """The tracker defaults (:class:`MHTConfig`, P1 §3) fitted to what is known of the data.
-
-    * The new-target density is scaled to the surveillance area — the scenario's region,
-      or ``area`` (e.g. :func:`plots_area` of a plots file) — by
-      :func:`birth_density_for_area`; P1's crossing region gives P1's 1e−7.
-    * With a scenario of **one** sensor, the tracker's ``P_D`` is that sensor's
-      (:func:`capped_pd`), and with a Cartesian sensor ``σw`` is its ``sigma`` (its plots
-      carry no covariance of their own; polar plots do). With several sensors the scans
-      are fused first and a fused plot's detection probability is not one sensor's, so
-      ``P_D`` stays P1's 0.9. On P1's crossing (``P_D`` 0.9, σ 100 m) nothing changes.
-    """
-    if scenario is None:
-        return MHTConfig() if area is None else MHTConfig(
-            new_target_density=birth_density_for_area(area))
-    changes: dict[str, Any] = {"new_target_density": birth_density_for_area(
-        scenario.region.area)}
-    if len(scenario.sensors) == 1:
-        changes["p_detection"] = capped_pd(float(scenario.pd[0]))
-        sensor = scenario.sensors[0]
-        if isinstance(sensor, CartesianSensor):
-            changes["sigma_w"] = float(sensor.sigma)
-    return MHTConfig(**changes)
-
-
-def config_with(config: MHTConfig | None = None, **changes: Any) -> MHTConfig:
-    """``config`` (default :class:`MHTConfig`) with the non-``None`` ``changes`` applied."""
-    config = MHTConfig() if config is None else config
-    return dataclasses.replace(config, **{k: v for k, v in changes.items() if v is not None})
-
-
-#: The surveillance area of plots without a scenario is the box between these quantiles
-#: of their x and y (so a few wild plots do not inflate it).
-AREA_QUANTILES = (0.005, 0.995)
-
-
-@dataclass(frozen=True)
-class PlotsArea:
-    """The robust bounding box of a set of plots (see :func:`plots_area`)."""
-
-    x0: float
-    x1: float
-    y0: float
-    y1: float
-    #: Box sides (m), each at least 1 m.
-    width: float
-    height: float
-    #: Plots farther outside the box than its own width (east-west) or height.
-    n_far: int
-
-    @property
-    def area(self) -> float:
-        """``width × height`` (m²)."""
-        return self.width * self.height
-
-
-def plots_area(x: npt.ArrayLike, y: npt.ArrayLike) -> PlotsArea:
-    """The box between the :data:`AREA_QUANTILES` (0.5 % and 99.5 %) of the plots' ``x``
-    and ``y`` (each side at least 1 m), and how many plots lie farther outside it than
-    its width or height — a surveillance area for :func:`default_config` when no scenario
-    gives the region."""
-    x, y = np.asarray(x), np.asarray(y)
-    (x0, x1), (y0, y1) = (np.quantile(v, AREA_QUANTILES) for v in (x, y))
-    wx, wy = max(float(x1 - x0), 1.0), max(float(y1 - y0), 1.0)
-    with np.errstate(over="ignore", invalid="ignore"):
-        far = (x < x0 - wx) | (x > x1 + wx) | (y < y0 - wy) | (y > y1 + wy)
-    return PlotsArea(x0, x1, y0, y1, wx, wy, int(np.count_nonzero(far)))
-
-
-def known_kappa_mismatch(scenario: Scenario,
-                         kappa: float = DEFAULT_CLUTTER_DENSITY) -> float | None:
-    """The scenario's mean clutter density ``S λ̄ / A`` when it is over 10× ``kappa`` or
-    (being > 0) under a tenth of it — a tracker assuming ``kappa`` then scores its plots
-    mostly as targets, or its targets as clutter; ``None`` when they are close."""
-    mean = scenario.mean_clutter_density()
-    if mean > 10 * kappa or 0 < mean < 0.1 * kappa:
-        return mean
-    return None
 
 
 # ---------------------------------------------------------------------- fusion
@@ -354,35 +260,9 @@ INITIATION_FUSER_CLASSES: dict[str, type[Any] | None] = {
     "adaptive-kmeans": AdaptiveKMeansFusion, "kmeans": KMeansFusion, "none": None}
 
 
-def default_fusion(n_sensors: int) -> str:
-    """The tracker's fusion: ``"adaptive-kmeans"`` with more than one sensor (the MHT
-    assumes at most one plot per target per scan), else ``"none"``."""
-    return "adaptive-kmeans" if n_sensors > 1 else "none"
+def birth_suffix(birth: str | None) -> str:
+    """``-BIRTH`` naming a birth process other than the default (every plot), else ``""``
+    (the names of run directories)."""
+    return "" if birth is None or birth == names.EVERY_PLOT else f"-{birth}"
 
 
-__all__ = [
-    "AREA_QUANTILES",
-    "CLUTTER_ESTIMATOR_CLASSES",
-    "DEFAULT_CLUTTER_DENSITY",
-    "INITIATION_FUSER_CLASSES",
-    "INITIATOR_CLASSES",
-    "MAX_TRACKER_PD",
-    "P1_BIRTHS_PER_SCAN",
-    "TRACKER_ESTIMATORS",
-    "TRACKER_FUSERS",
-    "TRACKER_FUSION_CONSISTENCY",
-    "TRACKER_FUSION_WEIGHTING",
-    "PlotsArea",
-    "birth_density_for_area",
-    "capped_pd",
-    "config_with",
-    "default_config",
-    "default_fusion",
-    "known_kappa_mismatch",
-    "make_clutter_estimator",
-    "make_initiator",
-    "make_tracker",
-    "plots_area",
-    "takes_clutter_density",
-    "tracker_fuser",
-]

@@ -1,0 +1,216 @@
+"""The tracker stepped frame by frame from a source into sinks (:class:`Pipeline`).
+
+Fusion (``fusion``): the MHT assumes at most one plot per target per scan, so with
+several sensors each scan is first fused by
+:class:`~mhtrack.initiation.AdaptiveKMeansFusion` (P2 §1.2) with a χ² consistency split
+and information weighting (:func:`~mhtrack.build.tracker_fuser`). A fused plot's row id
+(the ``plot`` column of the tracks) is the row of the first plot of its cluster (in scan
+order), so it stays a row of the source.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Iterable, Iterator, Sequence
+from dataclasses import dataclass
+from functools import cached_property
+from typing import TYPE_CHECKING
+
+import numpy as np
+from tqdm.auto import tqdm
+
+from mhtrack.build import TRACKER_FUSERS, tracker_fuser
+from mhtrack.names import TRACKER_FUSIONS
+from mhtrack.pipeline.options import TrackOptions, birth_density_note, choose
+from mhtrack.records import Scan
+from mhtrack.sinks.base import FrameOutput, Sink, check_output
+
+if TYPE_CHECKING:
+    from mhtrack.initiation.fusion import AdaptiveKMeansFusion
+    from mhtrack.mht import MHTConfig, MHTTracker, StepStats
+    from mhtrack.sources.base import Source, Survey
+
+
+def fuse_scan(scan: Scan, fuser: AdaptiveKMeansFusion | None = None) -> Scan:
+    """``scan`` fused by adaptive K-means (P2 §1.2): one plot per cluster, with its fused
+    ``R`` and, as row id, the row of the cluster's first plot (module docstring). Default
+    ``fuser``: :func:`~mhtrack.build.tracker_fuser`."""
+    if len(scan) == 0:
+        return scan
+    f = (tracker_fuser() if fuser is None else fuser).fuse(scan)
+    k = len(f.scan)
+    first = np.full(k, -1, np.int64)
+    first[f.labels[::-1]] = np.arange(len(f.labels))[::-1]
+    return dataclasses.replace(f.scan, rows=np.asarray(scan.rows, np.int64)[first])
+
+
+def fused(scans: Iterable[Scan], fusion: str,
+          caps: dict[int, dict[str, int]] | None = None) -> Iterable[Scan]:
+    """``scans`` unchanged (``"none"``) or each fused (``"adaptive-kmeans"``). The caps
+    the fusion applied in a burst (``Fuser.caps_``, logged by ``Fuser.fuse``) go to
+    ``caps[scan index]``."""
+    if fusion not in TRACKER_FUSIONS:
+        raise ValueError(f"unknown fusion {fusion!r} (expected {', '.join(TRACKER_FUSIONS)})")
+    factory = TRACKER_FUSERS[fusion]
+    if factory is None:
+        return scans
+    fuser = factory()
+
+    def each(s: Scan) -> Scan:
+        out = fuse_scan(s, fuser)  # logs the caps that acted (Fuser.fuse)
+        acted = dict(getattr(fuser, "caps_", None) or {}) if len(s) else {}
+        if acted and caps is not None:
+            caps[int(s.index)] = acted
+        return out
+
+    return (each(s) for s in scans)
+
+
+def step_frames(tracker: MHTTracker, frames: Iterable[Scan], *, fusion: str = "none",
+                name: str = "mht", progress: bool = False,
+                total: int | None = None) -> Iterator[FrameOutput]:
+    """Each frame fused (``fusion``), stepped through ``tracker``, and its output — the
+    online rows, the backfill and the step's statistics with the fusion's caps merged
+    in. ``progress``: a tqdm bar of ``total`` frames."""
+    fusion_caps: dict[int, dict[str, int]] = {}
+    bar = tqdm(fused(frames, fusion, fusion_caps), total=total, desc=name, unit="scan",
+               disable=not progress, leave=False)
+    for scan in bar:
+        online = tracker.step(scan)
+        stats = tracker.last_stats
+        assert stats is not None  # set by every step
+        stats.caps.update(fusion_caps.pop(stats.scan, {}))
+        yield FrameOutput(scan, online, tracker.last_backfill, stats)
+
+
+def mean_step_time(stats: Sequence[StepStats]) -> float:
+    """Mean tracker time per scan (s) — P1 Table 3's ``Tavg``."""
+    t = np.array([s.time_s for s in stats])
+    return float(t.mean()) if t.size else 0.0
+
+
+def caps_acted(stats: Sequence[StepStats]) -> dict[str, int]:
+    """Total of every hard cap that acted over ``stats``, and under ``"scans"`` the number
+    of scans (frames) on which any acted; empty when none acted."""
+    total: dict[str, int] = {}
+    for s in stats:
+        for k, v in s.caps.items():
+            total[k] = total.get(k, 0) + v
+    if total:
+        total["scans"] = sum(1 for s in stats if s.caps)
+    return total
+
+
+def cap_scans(stats: Sequence[StepStats]) -> dict[str, list[int]]:
+    """The scans at which each hard cap acted (``StepStats.caps``; with the fusion's
+    caps, ``fusion_*``, of each scan)."""
+    out: dict[str, list[int]] = {}
+    for s in stats:
+        for k in sorted(s.caps):
+            out.setdefault(k, []).append(s.scan)
+    return out
+
+
+@dataclass(frozen=True)
+class RunResult:
+    """What a pipeline run did (the tracks went to the sinks)."""
+
+    tracker: str
+    stats: tuple[StepStats, ...]
+    #: Distinct track ids reported.
+    n_tracks: int
+    #: Frames of timed plots (True) or synchronous scans.
+    timed: bool = False
+
+    @property
+    def t_avg(self) -> float:
+        """Mean tracker time per scan (s)."""
+        return mean_step_time(self.stats)
+
+    @property
+    def caps(self) -> dict[str, int]:
+        """:func:`caps_acted` of the run."""
+        return caps_acted(self.stats)
+
+    def describe(self) -> str:
+        """``TRACKER: N scans|frames, M tracks, T ms/scan[, caps acted: …]``."""
+        caps = f", caps acted: {self.caps}" if self.caps else ""
+        steps = "frames" if self.timed else "scans"
+        return (f"{self.tracker}: {len(self.stats)} {steps}, {self.n_tracks} tracks, "
+                f"{1e3 * self.t_avg:.2f} ms/scan{caps}")
+
+
+class Pipeline:
+    """A source, the tracker built for it, and the run into sinks.
+
+    Every default is chosen once, here (:func:`~mhtrack.pipeline.options.choose`):
+    configuration (``config`` if given, else from the source's scenario or plots),
+    fusion, the tracker with the source's sensors, the output frame. ``options``: what
+    the user set (:class:`TrackOptions`)."""
+
+    def __init__(self, source: Source, options: TrackOptions | None = None, *,
+                 config: MHTConfig | None = None) -> None:
+        self.source = source
+        self.options = TrackOptions() if options is None else options
+        self.output = check_output(self.options.output)
+        survey = self.survey if source.scenario is None else None
+        self.choices = choose(source, self.options, survey, config)
+        self.config, self.tracker = self.choices.config, self.choices.tracker
+        self.fusion, self.frame = self.choices.fusion, self.choices.frame
+
+    @classmethod
+    def open(cls, path: str, options: TrackOptions | None = None, *,
+             scenario_file: str | None = None, sensors_file: str | None = None,
+             reorder_window_s: float | None = None) -> Pipeline:
+        """A pipeline on a plots file or a recording (:func:`~mhtrack.pipeline.open_input`)."""
+        from mhtrack.pipeline.inputs import open_input
+
+        return cls(open_input(path, scenario_file=scenario_file, sensors_file=sensors_file,
+                              reorder_window_s=reorder_window_s), options)
+
+    @cached_property
+    def survey(self) -> Survey | None:
+        """The source's survey, read once."""
+        return self.source.survey()
+
+    @property
+    def birth_note(self) -> str | None:
+        """The line naming the new-target density chosen (None when the user set it)."""
+        if self.options.new_target_density is not None:
+            return None
+        return birth_density_note(self.config.new_target_density, self.choices.area_text)
+
+    def outputs(self, *, progress: bool = False) -> Iterator[FrameOutput]:
+        """The tracker's output frame by frame (the iterator form of a sink)."""
+        survey = self.survey if progress else None
+        yield from step_frames(self.tracker, self.source, fusion=self.fusion,
+                               name=self.options.tracker, progress=progress,
+                               total=None if survey is None else survey.n_frames)
+
+    def run(self, sinks: Sequence[Sink] = (), *, progress: bool = False) -> RunResult:
+        """Step the tracker over every frame of the source into ``sinks`` (each
+        started before the first frame and closed after the last)."""
+        stats, n_tracks = feed(self.outputs(progress=progress), sinks, self.source,
+                               backfill_ids=self.output == "history")
+        return RunResult(self.options.tracker, tuple(stats), n_tracks, self.source.timed)
+
+
+def feed(outputs: Iterable[FrameOutput], sinks: Sequence[Sink], source: Source | None = None,
+         *, backfill_ids: bool = True) -> tuple[list[StepStats], int]:
+    """Hand every frame's output to ``sinks`` (started with ``source`` first, closed
+    after the last frame); returns the steps' statistics and the number of distinct
+    track ids reported (with ``backfill_ids``, those of the backfill too)."""
+    for sink in sinks:
+        sink.start(source)
+    stats: list[StepStats] = []
+    ids: set[int] = set()
+    for out in outputs:
+        stats.append(out.stats)
+        ids.update(out.online.track_id.tolist())
+        if backfill_ids:
+            ids.update(out.backfill.track_id.tolist())
+        for sink in sinks:
+            sink.write(out)
+    for sink in sinks:
+        sink.close()
+    return stats, len(ids)

@@ -1,0 +1,108 @@
+"""File sinks: a tracks table (CSV or Parquet) and a CAT062 recording, each written
+atomically (:mod:`mhtrack.io.atomic`) — at the end, or for a table in rolling parts."""
+
+from __future__ import annotations
+
+import dataclasses
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from mhtrack.io.tracks import write_track_rows
+from mhtrack.sinks.base import FrameOutput, Sink, TrackCollector
+
+if TYPE_CHECKING:
+    from mhtrack.models.geodesy import LocalFrame
+    from mhtrack.records import TrackTable
+    from mhtrack.sources.base import Source
+
+
+class _Rows(Sink):
+    """Collects the rows an output mode keeps and the source's row mapping."""
+
+    def __init__(self, output: str | None) -> None:
+        self.rows = TrackCollector(output)
+        self.source: Source | None = None
+
+    def start(self, source: Source | None) -> None:
+        self.source = source
+
+    def write(self, out: FrameOutput) -> None:
+        self.rows.write(out)
+
+    def _file_rows(self, tracks: TrackTable) -> TrackTable:
+        """``tracks`` with ``plot`` as the input's own rows (:meth:`Source.file_rows`)."""
+        if self.source is None:
+            return tracks
+        return dataclasses.replace(tracks, plot=np.asarray(self.source.file_rows(tracks.plot),
+                                                           np.int64))
+
+
+class TracksFileSink(_Rows):
+    """The tracks file (``docs/file-formats.md``): the rows of ``output`` (history or
+    online), ``plot`` naming the input's rows, ``lat, lon`` and east/north velocities with
+    ``frame``; ``frame`` in place of ``scan`` for timed input.
+
+    Without ``part_frames`` the file is written once, atomically, at the end — the
+    bytes :func:`~mhtrack.io.write_tracks` writes of the whole run. With ``part_frames =
+    n``, every ``n`` frames the rows produced in them (online rows, and with ``history``
+    the backfill of the tracks confirmed in them, which may lie in earlier parts' frames)
+    go to ``STEM.part0000.SUFFIX``, ``STEM.part0001.SUFFIX``, …, each written atomically
+    and each sorted as a whole run's rows are; :attr:`paths` lists the files written."""
+
+    def __init__(self, path: str | Path, *, frame: LocalFrame | None = None,
+                 output: str | None = None, part_frames: int | None = None) -> None:
+        super().__init__(output)
+        if part_frames is not None and part_frames < 1:
+            raise ValueError(f"part_frames must be at least 1, got {part_frames}")
+        self.path, self.frame, self.part_frames = Path(path), frame, part_frames
+        self.paths: list[Path] = []
+        self._frames = 0
+
+    def write(self, out: FrameOutput) -> None:
+        super().write(out)
+        self._frames += 1
+        if self.part_frames is not None and self._frames % self.part_frames == 0:
+            self._flush()
+
+    def close(self) -> None:
+        if self.part_frames is None:
+            self._write(self.path)
+        elif self._frames % self.part_frames or not self.paths:
+            self._flush()
+
+    def _flush(self) -> None:
+        p = self.path
+        self._write(p.with_name(f"{p.stem}.part{len(self.paths):04d}{p.suffix}"))
+        self.rows.clear()
+
+    def _write(self, path: Path) -> None:
+        timed = self.source is not None and self.source.timed
+        write_track_rows(self._file_rows(self.rows.tracks()), path, self.frame, timed=timed)
+        self.paths.append(path)
+
+
+class Cat062Sink(_Rows):
+    """The tracks as ASTERIX CAT062 system tracks from data source ``sac``/``sic``
+    (:func:`~mhtrack.io.asterix.cat062.table_messages`; positions through ``frame``),
+    written atomically at the end to a ``.pcap`` or raw ``.ast`` file: the bytes
+    ``mhtrack export TRACKS --category 062`` writes of the tracks file of the same rows."""
+
+    def __init__(self, path: str | Path, frame: LocalFrame, *, output: str | None = None,
+                 sac: int | None = None, sic: int | None = None) -> None:
+        super().__init__(output)
+        self.path, self.frame, self.sac, self.sic = Path(path), frame, sac, sic
+        self.n_blocks = 0
+
+    def close(self) -> None:
+        from mhtrack.io.asterix.cat062 import table_messages
+        from mhtrack.io.asterix.encode import encode_blocks
+        from mhtrack.io.asterix.writer import write_blocks
+
+        tracks = self.rows.tracks()
+        if len(tracks) == 0:
+            raise ValueError(f"{self.path}: no track rows (nothing to export)")
+        messages = table_messages(tracks, self.frame, str(self.path), sac=self.sac,
+                                  sic=self.sic)
+        self.n_blocks = write_blocks(self.path, encode_blocks(messages))

@@ -89,7 +89,8 @@ def test_track_recording_unknown_radar(sim: Path, tmp_path: Path) -> None:
     (tmp_path / "s.toml").write_text(text)
     r = _run("track", rec, "--sensors", tmp_path / "s.toml", "--out", tmp_path / "t.csv")
     assert r.exit_code == 2
-    assert "radar(s) 3 (SAC 0, SIC 3) are not in" in r.output  # type: ignore[attr-defined]
+    assert "rec.ast, byte " in r.output  # type: ignore[attr-defined]
+    assert "radar 3 (SAC 0, SIC 3) is not in the sensors file" in r.output  # type: ignore[attr-defined]
     assert "Traceback" not in r.output  # type: ignore[attr-defined]
 
 

@@ -16,7 +16,7 @@ from mhtrack.io import read_tracks
 from mhtrack.io.sensors import read_sensors
 from mhtrack.mht import StepStats
 from mhtrack.pipeline import run as pipeline_run
-from mhtrack.records import TrackTable
+from mhtrack.records import PlotTable, TrackTable
 from mhtrack.sinks import FrameOutput
 
 SENSORS = """\
@@ -73,10 +73,6 @@ BAD = [
      "line 3, column 'range': sensor 2 is a cartesian sensor without a site: a "
      "range/bearing plot needs a polar sensor with its site (lat/lon or position) in the "
      "sensors file"),
-    ("beyond-reorder-window", edit(3, "time", "2024-05-01T12:00:01.000Z"),
-     "line 5, column 'time': time 2024-05-01T12:00:01.000Z is 3 s before time "
-     "2024-05-01T12:00:04.000Z on line 4, beyond the reorder window of 2 s; sort the rows "
-     "by time (or widen reorder_window_s)"),
     ("missing-time", edit(1, "time", ""), "line 3, column 'time': value is missing"),
     ("unparseable-time", edit(0, "time", "noon"),
      "line 2, column 'time': value 'noon' is neither a number of seconds nor an ISO-8601 "
@@ -118,6 +114,30 @@ def test_bad_timed_plots_give_one_located_line(tmp_path, rows, message):
     assert not (tmp_path / "t.csv").exists()
 
 
+def test_a_plot_beyond_the_reorder_window_is_dropped_with_one_line(tmp_path, caplog):
+    """Line 6 (12:00:03) comes after line 5 (12:00:15.25) has released the plots up to
+    12:00:04 to the tracker (window 2 s): it cannot be put in order, so the file is
+    tracked without it and one warning line names the file, the lateness and the line."""
+    late = "2024-05-01T12:00:03.000Z,2,,,1500,2500,,"
+    plots, sensors = files(tmp_path, [*GOOD, late])
+    with caplog.at_level("WARNING", logger="mhtrack"):
+        code, _, stderr = invoke("track", str(plots), "--sensors", str(sensors),
+                                 "--out", str(tmp_path / "t.csv"), "--no-progress")
+    assert code == 0, stderr
+    lines = [r.getMessage() for r in caplog.records if "dropped" in r.getMessage()]
+    assert len(lines) == 1
+    assert lines[0].startswith(f"{plots}: 1 plot dropped, late by 12.2 s"), lines[0]
+    assert "line 6" in lines[0]
+    # a row 3 s out of order that nothing released yet is re-ordered, not dropped
+    caplog.clear()
+    plots, sensors = files(tmp_path, edit(3, "time", "2024-05-01T12:00:01.000Z"))
+    with caplog.at_level("WARNING", logger="mhtrack"):
+        code, _, stderr = invoke("track", str(plots), "--sensors", str(sensors),
+                                 "--out", str(tmp_path / "t.csv"), "--no-progress")
+    assert code == 0, stderr
+    assert not [r for r in caplog.records if "dropped" in r.getMessage()]
+
+
 def test_range_without_bearing_column(tmp_path):
     plots, sensors = files(tmp_path, ["0.5,1,1000"], header="time,sensor,range\n")
     code, _, stderr = invoke("track", str(plots), "--sensors", str(sensors),
@@ -150,14 +170,14 @@ def test_track_passes_the_sensor_set_and_writes_geodetic_tracks(tmp_path, monkey
     seen: dict = {}
 
     def fake_steps(tracker, frames, **kw):  # the pipeline's stepping, replaced
-        table = frames.table
-        seen.update(kw, table=table, tracker=tracker)
+        scans = list(frames)  # every frame read (the source maps rows after it is read)
+        table = PlotTable.from_scans(scans)
+        seen.update(kw, table=table, tracker=tracker, file_rows=frames.file_rows)
         k = int(np.flatnonzero(table.time == table.time.max())[0])  # the last polar plot
         tr = TrackTable(np.array([table.scan[k]]), np.array([table.time[k]]), np.array([1]),
                         table.x[k:k + 1], table.y[k:k + 1], np.array([100.0]),
                         np.array([0.0]), np.array([k]))
-        scan = next(iter(table.scans()))
-        yield FrameOutput(scan, tr, TrackTable.empty(), StepStats(0, 0, 0, 0, 0, 0, 1, 0.0))
+        yield FrameOutput(scans[0], tr, TrackTable.empty(), StepStats(0, 0, 0, 0, 0, 0, 1, 0.0))
 
     monkeypatch.setattr(pipeline_run, "step_frames", fake_steps)
     code, stdout, stderr = invoke("track", str(plots), "--sensors", str(sensors),
@@ -169,7 +189,7 @@ def test_track_passes_the_sensor_set_and_writes_geodetic_tracks(tmp_path, monkey
     assert isinstance(coverage, RadarCoverage) and coverage.sensors == read_sensors(sensors)
     assert seen["fusion"] == "none"
     table = seen["table"]
-    assert table.timed and table.file_row.tolist() == [1, 0, 2, 3]
+    assert seen["file_rows"](np.arange(len(table))).tolist() == [1, 0, 2, 3]
     out = pacsv.read_csv(tmp_path / "t.csv").to_pydict()
     assert out["plot"] == [3]  # GOOD[3] is line 5 of the file: data row 3
     frame = read_sensors(sensors).frame()

@@ -262,7 +262,7 @@ def test_track_rejects_plots_outside_or_off_the_scenario_scans(small_crossing, t
     code, _, stderr = invoke("track", str(extra), "--scenario", scenario,
                              "--out", str(tmp_path / "t.csv"), "--no-progress")
     assert code != 0 and "Traceback" not in stderr
-    assert "column 'scan': scan 11 is not a scan of scenario" in stderr
+    assert "column 'scan': scan 11 is not a scan of the scenario" in stderr
     assert "(scans 1 to 10); 1 row(s) are outside it" in stderr
 
     def slow(f):
@@ -272,7 +272,7 @@ def test_track_rejects_plots_outside_or_off_the_scenario_scans(small_crossing, t
     code, _, stderr = invoke("track", str(off), "--scenario", scenario,
                              "--out", str(tmp_path / "t.csv"), "--no-progress")
     assert code != 0 and "Traceback" not in stderr
-    assert f"{off}, line 2, column 'time': scan 1 has time 1.5 s, but scenario" in stderr
+    assert f"{off}, line 2, column 'time': scan 1 has time 1.5 s, but the scenario" in stderr
     assert "gives 1.0 s" in stderr
     code, _, stderr = invoke("track", str(plots), "--scenario", scenario,
                              "--out", str(tmp_path / "t.csv"), "--no-progress")

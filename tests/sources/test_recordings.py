@@ -1,5 +1,5 @@
-"""ASTERIX recordings as sources: the frames of today's path (``recording_hook``: decode,
-temporary Parquet + sensors file, ``read_plots``) bit for bit; a packet arriving 40 s late
+"""ASTERIX recordings as sources: the frames of the former path (decode, temporary Parquet,
+``read_plots``: ``tests/reference/recording_table.py``) bit for bit; a packet arriving 40 s late
 dropped with one warning; midnight and a 13-hour gap on a monotonic axis; errors naming
 the user's file; any iterable of datagrams."""
 
@@ -7,20 +7,22 @@ from __future__ import annotations
 
 import logging
 import struct
+import tempfile
 from dataclasses import replace
 from pathlib import Path
 
-import click
 import numpy as np
+import pyarrow.csv as pacsv
 import pytest
 
 pytest.importorskip("asterix.generated", reason="libasterix not installed")
+
+from recording_table import recording_table
 
 from mhtrack.errors import InputError
 from mhtrack.io.asterix import export
 from mhtrack.io.asterix.container import datagrams
 from mhtrack.io.asterix.problems import Problems
-from mhtrack.io.plots import read_plots
 from mhtrack.io.sensors import read_sensors, write_sensors
 from mhtrack.records import Scan
 from mhtrack.sources import open_source
@@ -35,13 +37,10 @@ UDP_DATA = 16 + 14 + 20 + 8
 
 
 def _today(rec: Path, sensors: Path) -> tuple[list[Scan], np.ndarray]:
-    """Frames and file rows by today's path: ``track``'s recording hook, then
-    ``read_plots`` of the temporary files."""
-    from mhtrack.cli.asterix_commands import recording_hook
-
-    with click.Context(click.Command("track")):
-        plots, sens = recording_hook(rec, sensors)
-        table = read_plots(plots, sensors=read_sensors(sens))
+    """Frames and file rows by the former path (``tests/reference/recording_table.py``:
+    decode, temporary Parquet, ``read_plots``)."""
+    with tempfile.TemporaryDirectory() as tmp:
+        table = recording_table(rec, read_sensors(sensors), Path(tmp))
         return list(table.scans()), table.file_row
 
 
@@ -133,9 +132,33 @@ def test_packet_40_s_late(recs: dict[str, Path], opensky2: Path, tmp_path: Path,
     assert len(lines) == 1 and lines[0].startswith(head), lines
     offset = PCAP_HEAD + sum(len(r) for r in late[:to - 1]) + UDP_DATA
     assert f"first at byte {offset} (plot " in lines[0] and "mhtrack-asterix" not in lines[0]
-    # today's path refuses it, naming a file the user never made
-    with pytest.raises(InputError, match=r"mhtrack-asterix-.*plots\.parquet"):
+    # the former path refused it, naming a file the user never made
+    with pytest.raises(InputError, match=r"plots\.parquet, row"):
         _today(tmp_path / "late.pcap", opensky2 / "sensors.toml")
+    # `mhtrack track` tracks it: one warning line, tracks equal to those without the packet
+    from click.testing import CliRunner
+
+    from mhtrack.cli.main import cli
+
+    outs = []
+    for name in ("late.pcap", "without.pcap"):
+        out = tmp_path / f"{name}.csv"
+        r = CliRunner().invoke(cli, ["track", str(tmp_path / name), "--sensors",
+                                      str(opensky2 / "sensors.toml"), "--out", str(out)])
+        assert r.exit_code == 0, r.output
+        assert "tmp" not in r.output.replace(str(tmp_path), "")  # no temporary file named
+        outs.append(pacsv.read_csv(out).to_pydict())
+    # the same tracks; the `plot` column names each plot in its own file, where the late
+    # packet's plots come before the later ones
+    late_plot, without_plot = outs[0].pop("plot"), outs[1].pop("plot")
+    assert outs[0] == outs[1]
+    first = _decoded_before(late, to - 1)  # plots decoded before the moved packet
+    assert late_plot == [p if p is None or p < first else p + n for p in without_plot]
+
+
+def _decoded_before(packets: list[bytes], k: int) -> int:
+    """Plots in the CAT048 packets before packet ``k``."""
+    return sum(_plots_in_block(r[UDP_DATA:]) for r in packets[:k] if r[UDP_DATA] == 48)
 
 
 def _plots_in_block(block: bytes) -> int:

@@ -220,7 +220,7 @@ def check_arrays(path: PathArg, arrays: Mapping[str, np.ndarray], meta: Mapping[
                  n_scan: int) -> None:
     """The leaf and history arrays (module docstring)."""
     c = _Checker(path, arrays)
-    leaves = c.part("leaves__", LEAF_COLUMNS, {"w": n_scan + 1}, optional=("time",))
+    leaves = c.part("leaves__", LEAF_COLUMNS, {"w": n_scan + 1})
     c.covariances("leaves__P", leaves["P"])
     if leaves["Pm"].size:
         c.covariances("leaves__Pm", leaves["Pm"])
@@ -237,9 +237,9 @@ def check_arrays(path: PathArg, arrays: Mapping[str, np.ndarray], meta: Mapping[
         if v.size and (v.min() < lo or v.max() >= meta[counter]):
             raise c.fail(f"leaves__{name}", f"ids must be in [{lo}, {meta[counter]}) (the "
                          f"saved {counter}), got {v.min()} to {v.max()}")
-    t = leaves.get("time")
+    t = leaves["time"]
     last = meta["last_time"]
-    if t is not None and t.size and (np.abs(t).max() > MAX_TIME_S or (
+    if t.size and (np.abs(t).max() > MAX_TIME_S or (
             last is not None and t.max() > last)):
         raise c.fail("leaves__time", f"leaf times must be within ±{MAX_TIME_S:g} s and not "
                      f"after the last scan's time ({last} s)")

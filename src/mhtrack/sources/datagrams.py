@@ -33,6 +33,7 @@ from mhtrack.io.timed_plots import DEFAULT_REORDER_WINDOW_S, polar_plots
 from mhtrack.models.radars import SensorSet
 from mhtrack.records import Scan
 from mhtrack.sources.base import Source, SourceStats, Survey
+from mhtrack.sources.reorder import kept
 from mhtrack.sources.timed import TimedStream
 
 #: Plots decoded before they are converted and pushed on (memory: a few hundred kB).
@@ -158,10 +159,11 @@ class DatagramSource(Source):
         (:func:`~mhtrack.io.asterix.decode.sweep_periods`) and the :class:`Survey`
         (every plot's ``x, y``). Reads the datagrams: only for a replayable input."""
         sweeps: list[tuple[Any, ...]] = []
-        xs, ys, sensors = [], [], set()
+        xs, ys, ts, sensors = [], [], [], set()
         for cols in self._decoded(Problems(), sweeps):
             xs.append(cols["x"])
             ys.append(cols["y"])
+            ts.append(cols["time"])
             sensors.update(np.unique(cols["sensor"]).tolist())
         cols = list(zip(*sweeps, strict=True)) if sweeps else [()] * 5
         marks = {k: np.array(c, dtype=d) for k, c, d in zip(
@@ -169,4 +171,6 @@ class DatagramSource(Source):
             (float, np.int64, np.int64, float, float), strict=True)}
         x = np.concatenate(xs) if xs else np.zeros(0)
         y = np.concatenate(ys) if ys else np.zeros(0)
-        return sweep_periods(marks), Survey(int(x.size), tuple(sorted(sensors)), x, y)
+        on_time = kept(np.concatenate(ts) if ts else np.zeros(0), self.window_s)
+        return sweep_periods(marks), Survey(int(x.size), tuple(sorted(sensors)),
+                                            x[on_time], y[on_time])

@@ -133,3 +133,16 @@ class ReorderBuffer:
         self._held = {k: v[kpos] for k, v in self._held.items()}
         self._held_seq = keep
         return result
+
+
+def kept(time: np.ndarray, window_s: float = DEFAULT_REORDER_WINDOW_S) -> np.ndarray:
+    """Which plots (times in arrival order) :class:`ReorderBuffer` lets through: the
+    buffer's own rule replayed on the times alone, so that what is surveyed before
+    tracking (the plots' area) is what the tracker will get."""
+    buf = ReorderBuffer(window_s)
+    seq = [buf.push({"time": np.asarray(time, float)}).get("seq"), buf.flush().get("seq")]
+    out = np.zeros(np.size(time), bool)
+    for s in seq:
+        if s is not None:
+            out[s] = True
+    return out

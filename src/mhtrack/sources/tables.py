@@ -16,6 +16,7 @@ as they are yielded.
 from __future__ import annotations
 
 import dataclasses
+import logging
 from collections.abc import Iterator
 from typing import TYPE_CHECKING
 
@@ -27,6 +28,7 @@ from mhtrack.io.plots import check_scan_times, is_timed, read_plots
 from mhtrack.io.timed_plots import DEFAULT_REORDER_WINDOW_S, read_timed_columns
 from mhtrack.records import PlotTable, Scan
 from mhtrack.sources.base import Source, SourceStats, Survey
+from mhtrack.sources.reorder import kept
 from mhtrack.sources.timed import TimedStream
 
 if TYPE_CHECKING:
@@ -57,6 +59,8 @@ class TableSource(Source):
                                  "sensors come from a sensors file, not a scenario")
             self.sensors = sensors
             self._frame, self._cols = read_timed_columns(path, sensors)
+            if sensors is None and self._frame.has("range"):
+                _warn_polar(path, timed=True)
             self._table: PlotTable | None = None
         else:
             if sensors is not None:
@@ -112,7 +116,9 @@ class TableSource(Source):
             t = self._table
             return Survey(len(t), tuple(np.unique(t.sensor).tolist()), t.x, t.y, t.n_scans)
         c = self._cols
-        return Survey(int(c.time.size), tuple(np.unique(c.sensor).tolist()), c.x, c.y)
+        on_time = kept(c.time, self.window_s)  # the plots the re-order buffer lets through
+        return Survey(int(c.time.size), tuple(np.unique(c.sensor).tolist()), c.x[on_time],
+                      c.y[on_time])
 
 
 #: Rows pushed through the re-order buffer at a time.
@@ -120,10 +126,23 @@ CHUNK = 4096
 
 
 def _read_scans(path: PathArg, scenario: Scenario | None) -> PlotTable:
-    """A scan table, with the scenario's sensors and every scan time when given."""
+    """A scan table, with the scenario's sensors and every scan time when given; without
+    a scenario, range/bearing columns are only carried along (:func:`_warn_polar`)."""
     if scenario is None:
-        return read_plots(path)
+        table = read_plots(path)
+        if table.range is not None:
+            _warn_polar(path, timed=False)
+        return table
     table = read_plots(path, sensors={s.id: s for s in scenario.sensors})
     idx, times = scenario.scan_indices(), scenario.scan_times()
     check_scan_times(path, table, idx, times, "the scenario")
     return dataclasses.replace(table, scan_times=(idx, times))
+
+
+def _warn_polar(path: PathArg, *, timed: bool) -> None:
+    """Range/bearing columns without the sensors that place them: x, y are tracked."""
+    option = "--sensors with the radars" if timed else "--scenario with the radar(s)"
+    logging.getLogger("mhtrack").warning(
+        "%s has range/bearing columns (polar plots), but no %s gives its sensors: they are "
+        "ignored and x, y tracked as Cartesian plots with the tracker's σw; pass %s to use "
+        "the polar measurement model", path, "sensors file" if timed else "scenario", option)

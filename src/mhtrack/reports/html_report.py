@@ -22,6 +22,8 @@ import json
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from mhtrack.io.atomic import atomic_write
 from mhtrack.reports.html_metrics import curves_figure, fmt, metric_rows
 from mhtrack.reports.html_page import Page, require_plotly
@@ -77,7 +79,9 @@ def _evaluation(directory: Path, plots: Any, truth: Any, tracks: Any
             raise ValueError(f"{path}: expected one JSON object (evaluate --json)")
         return data, f"Metrics read from {path.name}."
     if truth is None or tracks is None:
-        return None, "No metrics: the directory has no metrics.json, truth or tracks file."
+        return None, ("No metrics: the directory has no metrics.json, and no truth file to "
+                      "evaluate the tracks against." if truth is None else
+                      "No metrics: the directory has no metrics.json and no tracks file.")
     from mhtrack.io.tracks import has_frames
     from mhtrack.metrics import evaluate
 
@@ -130,10 +134,47 @@ def _caps_text(caps: Any) -> list[tuple[str, str]]:
     return [(f"cap {k}", f"acted in {fmt(v)} scans") for k, v in dict(caps).items()]
 
 
+def _title(directory: Path, scenario: Any, tracker: Any, seed: Any, plots: Any,
+           tracks: Any, truth: Any) -> str:
+    """The page's title: scenario (or folder) name, tracker, seed; for a recording without
+    truth also its tracks, plots and radars."""
+    name = scenario.name if scenario is not None else (directory.resolve().name or "run")
+    parts = [name, tracker, None if seed is None else f"seed {seed}"]
+    if truth is None:
+        parts.append(None if tracks is None
+                     else f"{len(np.unique(tracks.online().track_id))} tracks")
+        if plots is not None:
+            n_radars = len(np.unique(plots.sensor))
+            parts.append(f"{len(plots)} plots from {n_radars} "
+                         f"radar{'s' if n_radars != 1 else ''}")
+    return ", ".join(str(v) for v in parts if v is not None)
+
+
+def _recording_sections(page: Page, plots: Any, tracks: Any, details: dict[str, Any],
+                        sensor_set: Any) -> None:
+    """Radars, tracks and the histogram of track lengths (:mod:`html_recording`)."""
+    from mhtrack.reports import html_recording as rec
+
+    if plots is not None and len(plots):
+        page.section("Radars")
+        page.note("Per sensor: its plots, how many the tracks used, and the median time "
+                  "between consecutive plots of one track from that sensor (its update "
+                  "interval as the tracks saw it), beside the sensors file's period.")
+        page.table(rec.RADAR_HEADER, rec.radar_rows(plots, tracks, rec.periods_of(sensor_set)))
+    if tracks is not None:
+        page.section("Tracks")
+        page.note("Durations from the first to the last row of each track reported at its "
+                  "own scan (rows written after confirmation not counted).")
+        page.table(["", "value"], rec.track_rows(tracks, details))
+        if len(tracks):
+            page.figure(rec.lengths_figure(tracks), "lengths")
+
+
 def run_page(directory: Path) -> Page:
     """The page of a run directory (module docstring)."""
     from mhtrack.io import read_plots, read_toml, read_tracks, read_truth
-    from mhtrack.reports.html_scene import scene_figure
+    from mhtrack.reports.html_recording import sensor_rows, track_details
+    from mhtrack.reports.html_scene import MAX_PLOTS, MAX_TRACK_POINTS, scene_figure
 
     paths = {s: _table(directory, s) for s in ("plots", "truth", "tracks")}
     if not any(paths.values()):
@@ -146,38 +187,53 @@ def run_page(directory: Path) -> Page:
     tracks = (read_tracks(paths["tracks"], frame=lframe,
                           plots=plots if plots is not None and plots.timed else None)
               if paths["tracks"] else None)
+    details = ({} if tracks is None else
+               track_details(tracks, paths["tracks"], plots, paths["plots"]))
     summary, source = _evaluation(directory, plots, truth, tracks)
     seed = (read_toml(directory / "scenario.toml").get("seed")
             if (directory / "scenario.toml").is_file() else None)
-    name = scenario.name if scenario is not None else directory.name
     tracker = (summary or {}).get("tracker")
-    title = ", ".join(str(v) for v in (name, tracker, None if seed is None else f"seed {seed}")
-                      if v is not None)
+    title = _title(directory, scenario, tracker, seed, plots, tracks, truth)
     page = Page(f"mhtrack report: {title}", str(directory))
     page.section("Scene")
-    page.note("Truth (black, o at birth, x at death), plots (clutter grey), tracks (one "
-              "colour per id, dotted before confirmation)" + (", radar sites (red)" if sites
-                                                              else "")
-              + ". Drag to pan, wheel or box to zoom, double-click to reset, click a legend "
-              "entry to hide it."
+    page.note(("Truth (black, o at birth, x at death), plots" if truth is not None
+               else "Plots") + " (clutter grey), tracks (one colour per id, dotted before "
+              "confirmation)" + (", radar sites (red)" if sites else "")
+              + ". Hover a track for its speed, heading and what the files give (flight "
+              "level, code, score, sensors). Drag to pan, wheel or box to zoom, "
+              "double-click to reset, click a legend entry to hide it."
               + (" Dashed lines: latitude and longitude (WGS-84), no map." if frame else ""))
-    page.figure(scene_figure(plots, truth, tracks, sites=sites, frame=frame, title=title),
-                "scene")
-    page.section("Metrics over time")
-    page.note(source)
-    if summary is not None and summary.get("scans"):
-        at_truth = summary.get("at") == "truth-times"
-        page.figure(curves_figure({str(tracker or "tracks"): summary},
-                                  cutoff=summary.get("cutoff"),
-                                  ospa2_window=summary.get("ospa2_window"),
-                                  x_title="truth time index" if at_truth else "scan"),
-                    "curves")
-    page.section("Metrics")
-    if summary is not None:
-        page.table(["metric", "value"], metric_rows(summary))
+    n_track_rows = 0 if tracks is None else len(tracks)
+    if (plots is not None and len(plots) > MAX_PLOTS) or n_track_rows > MAX_TRACK_POINTS:
+        page.note(f"Thinned for drawing: at most {MAX_PLOTS} plots of each kind and about "
+                  f"{MAX_TRACK_POINTS} track rows are drawn (every k-th, evenly spread; the "
+                  "legend says how many); the tables count every row.")
+    page.figure(scene_figure(plots, truth, tracks, sites=sites, frame=frame, title=title,
+                             details=details), "scene")
+    if truth is not None or summary is not None:
+        page.section("Metrics over time")
+        page.note(source)
+        if summary is not None and summary.get("scans"):
+            at_truth = summary.get("at") == "truth-times"
+            page.figure(curves_figure({str(tracker or "tracks"): summary},
+                                      cutoff=summary.get("cutoff"),
+                                      ospa2_window=summary.get("ospa2_window"),
+                                      x_title="truth time index" if at_truth else "scan"),
+                        "curves")
+        page.section("Metrics")
+        if summary is not None:
+            page.table(["metric", "value"], metric_rows(summary))
+    _recording_sections(page, plots, tracks, details, sensor_set)
     page.section("Parameters and caps")
     page.table(None, _run_parameters(scenario, summary, seed)
+               + ([] if scenario is not None else sensor_rows(sensor_set))
+               + [(f"{k} file", p.name) for k, p in paths.items() if p is not None]
                + _caps_text((summary or {}).get("caps")), numbers=False)
+    if truth is None and summary is None:
+        page.note("No truth file: the page shows what the recording and its tracks say; "
+                  "with truth (or metrics.json) it also shows the metrics. The tracker's "
+                  "own parameters are those `mhtrack track` printed; tracks.csv does not "
+                  "store them.")
     return page
 
 
@@ -235,9 +291,19 @@ def report_page(directory: str | Path) -> Page:
     return study_page(directory) if (directory / STUDY_FILE).is_file() else run_page(directory)
 
 
-def write_html_report(directory: str | Path, out: str | Path | None = None) -> Path:
+def write_html_report(directory: str | Path, out: str | Path | None = None, *,
+                      plotlyjs: str = "inline") -> Path:
     """Write the report of ``directory`` to ``out`` (default ``DIR/report.html``),
-    atomically; returns its path."""
+    atomically; returns its path. ``plotlyjs="file"`` writes Plotly's JavaScript once
+    beside the page (:func:`~mhtrack.reports.html_page.plotlyjs_name`, kept when already
+    there) instead of inlining it."""
+    from plotly.offline import get_plotlyjs
+
+    from mhtrack.reports.html_page import plotlyjs_name
+
     directory = Path(directory)
     path = Path(out) if out is not None else directory / REPORT_FILE
-    return atomic_write(path, report_page(directory).render())
+    text = report_page(directory).render(plotlyjs)
+    if plotlyjs == "file" and not (js := path.parent / plotlyjs_name()).is_file():
+        atomic_write(js, get_plotlyjs())
+    return atomic_write(path, text)

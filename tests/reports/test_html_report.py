@@ -16,7 +16,7 @@ import pytest
 
 pytest.importorskip("plotly", reason="the HTML report needs the optional extra [report]")
 
-from geographiclib.geodesic import Geodesic
+from geodesic_reference import WGS84
 
 from mhtrack.models.geodesy import LocalFrame
 from mhtrack.reports import montecarlo
@@ -111,7 +111,7 @@ def test_grid_lines_are_parallels_and_meridians():
     for s, e in zip(starts, cuts, strict=True):
         lat, lon = [], []
         for xi, yi in zip(x[s:e], y[s:e], strict=True):
-            g = Geodesic.WGS84.Direct(52.067, -1.454, math.degrees(math.atan2(xi, yi)),
+            g = WGS84.Direct(52.067, -1.454, math.degrees(math.atan2(xi, yi)),
                                       math.hypot(xi, yi))
             lat.append(g["lat2"])
             lon.append(g["lon2"])
@@ -177,15 +177,15 @@ def test_paired_figure_intervals():
 
 
 def test_study_without_paired_shows_the_tracker_table(study_dir, tmp_path, monkeypatch):
-    import pandas as pd
+    import pyarrow.parquet as pq  # a runtime dependency (pandas is not: the tour has none)
 
     monkeypatch.delattr(montecarlo, "paired_comparisons", raising=False)
     page = report_page(study_dir).render()
     assert "Paired comparisons</h2>" not in page
     assert "No paired comparisons in this directory." in page
     for t in ("mht-gmm", "mht-agmm"):
-        runs = [pd.read_parquet(study_dir / "runs" / t / f"run-{i}.parquet") for i in range(3)]
-        v = np.array([float(r["ospa_mean"].iloc[0]) for r in runs])
+        runs = [pq.read_table(study_dir / "runs" / t / f"run-{i}.parquet") for i in range(3)]
+        v = np.array([float(r.column("ospa_mean")[0].as_py()) for r in runs])
         assert f"{v.mean():.4g} ± {v.std():.4g} m" in page
 
 

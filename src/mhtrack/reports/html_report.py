@@ -19,15 +19,18 @@ extra ``mhtrack[report]``).
 from __future__ import annotations
 
 import json
+import logging
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from mhtrack.io.atomic import atomic_write
+from mhtrack.progress import Stages, silent
 from mhtrack.reports.html_metrics import curves_figure, fmt, metric_rows
 from mhtrack.reports.html_page import Page, require_plotly
 
+log = logging.getLogger("mhtrack.reports")
 REPORT_FILE = "report.html"
 #: ``montecarlo``'s spec file: its presence makes a directory a study.
 STUDY_FILE = "montecarlo.json"
@@ -65,7 +68,7 @@ def _geometry(directory: Path) -> tuple[Any, Any, list[Any], Any]:
     return scenario, None, sites, None
 
 
-def _evaluation(directory: Path, plots: Any, truth: Any, tracks: Any
+def _evaluation(directory: Path, plots: Any, truth: Any, tracks: Any, run: Stages
                 ) -> tuple[dict[str, Any] | None, str]:
     """``metrics.json`` if present, else an evaluation with ``evaluate``'s defaults when
     truth and tracks are there; and a note saying which."""
@@ -87,7 +90,7 @@ def _evaluation(directory: Path, plots: Any, truth: Any, tracks: Any
 
     tracks_path = _table(directory, "tracks")
     at = None if tracks_path is not None and has_frames(tracks_path) else "scans"
-    ev = evaluate(tracks, truth, plots=plots, at=at)
+    ev = run("evaluate", evaluate, tracks, truth, plots=plots, at=at)
     return ev.to_dict(), ("No metrics.json: metrics computed for this page with evaluate's "
                           "defaults (c = 500 m, p = 2).")
 
@@ -170,8 +173,12 @@ def _recording_sections(page: Page, plots: Any, tracks: Any, details: dict[str, 
             page.figure(rec.lengths_figure(tracks), "lengths")
 
 
-def run_page(directory: Path) -> Page:
-    """The page of a run directory (module docstring)."""
+#: Stages of a run's page (the progress bar's length).
+RUN_STAGES = 7
+
+
+def run_page(directory: Path, stages: Stages | None = None) -> Page:
+    """The page of a run directory (module docstring); ``stages`` shows its progress."""
     from mhtrack.io import read_plots, read_toml, read_tracks, read_truth
     from mhtrack.reports.html_recording import sensor_rows, track_details
     from mhtrack.reports.html_scene import MAX_PLOTS, MAX_TRACK_POINTS, scene_figure
@@ -180,16 +187,19 @@ def run_page(directory: Path) -> Page:
     if not any(paths.values()):
         raise ValueError(f"{directory} holds no plots, truth or tracks file (nor "
                          f"{STUDY_FILE}): nothing to report")
+    run = stages or silent()
     scenario, sensor_set, sites, frame = _geometry(directory)
-    plots = read_plots(paths["plots"], sensors=sensor_set) if paths["plots"] else None
+    plots = (run("read plots", read_plots, paths["plots"], sensors=sensor_set)
+             if paths["plots"] else None)
     lframe = sensor_set.frame() if sensor_set is not None and frame is not None else None
-    truth = read_truth(paths["truth"], frame=lframe) if paths["truth"] else None
-    tracks = (read_tracks(paths["tracks"], frame=lframe,
-                          plots=plots if plots is not None and plots.timed else None)
+    truth = run("read truth", read_truth, paths["truth"], frame=lframe) if paths["truth"] \
+        else None
+    tracks = (run("read tracks", read_tracks, paths["tracks"], frame=lframe,
+                  plots=plots if plots is not None and plots.timed else None)
               if paths["tracks"] else None)
-    details = ({} if tracks is None else
-               track_details(tracks, paths["tracks"], plots, paths["plots"]))
-    summary, source = _evaluation(directory, plots, truth, tracks)
+    details = ({} if tracks is None else run("track details", track_details, tracks,
+                                              paths["tracks"], plots, paths["plots"]))
+    summary, source = _evaluation(directory, plots, truth, tracks, run)
     seed = (read_toml(directory / "scenario.toml").get("seed")
             if (directory / "scenario.toml").is_file() else None)
     tracker = (summary or {}).get("tracker")
@@ -208,8 +218,8 @@ def run_page(directory: Path) -> Page:
         page.note(f"Thinned for drawing: at most {MAX_PLOTS} plots of each kind and about "
                   f"{MAX_TRACK_POINTS} track rows are drawn (every k-th, evenly spread; the "
                   "legend says how many); the tables count every row.")
-    page.figure(scene_figure(plots, truth, tracks, sites=sites, frame=frame, title=title,
-                             details=details), "scene")
+    page.figure(run("scene", scene_figure, plots, truth, tracks, sites=sites, frame=frame,
+                    title=title, details=details), "scene")
     if truth is not None or summary is not None:
         page.section("Metrics over time")
         page.note(source)
@@ -282,28 +292,36 @@ def study_page(directory: Path) -> Page:
     return page
 
 
-def report_page(directory: str | Path) -> Page:
+def report_page(directory: str | Path, stages: Stages | None = None) -> Page:
     """The page of ``directory``: a study when it holds ``montecarlo.json``, else a run."""
     directory = Path(directory)
     require_plotly()
     if not directory.is_dir():
         raise FileNotFoundError(f"{directory}: no such directory")
-    return study_page(directory) if (directory / STUDY_FILE).is_file() else run_page(directory)
+    if (directory / STUDY_FILE).is_file():
+        return study_page(directory)
+    return run_page(directory, stages)
 
 
 def write_html_report(directory: str | Path, out: str | Path | None = None, *,
-                      plotlyjs: str = "inline") -> Path:
+                      plotlyjs: str = "inline", progress: bool = False) -> Path:
     """Write the report of ``directory`` to ``out`` (default ``DIR/report.html``),
     atomically; returns its path. ``plotlyjs="file"`` writes Plotly's JavaScript once
     beside the page (:func:`~mhtrack.reports.html_page.plotlyjs_name`, kept when already
-    there) instead of inlining it."""
+    there) instead of inlining it. ``progress``: a bar over the stages on stderr."""
     from plotly.offline import get_plotlyjs
 
     from mhtrack.reports.html_page import plotlyjs_name
 
     directory = Path(directory)
     path = Path(out) if out is not None else directory / REPORT_FILE
-    text = report_page(directory).render(plotlyjs)
-    if plotlyjs == "file" and not (js := path.parent / plotlyjs_name()).is_file():
-        atomic_write(js, get_plotlyjs())
-    return atomic_write(path, text)
+    run = Stages(RUN_STAGES + 1, "report", progress)
+    try:
+        text = run("render", report_page(directory, run).render, plotlyjs)
+        if plotlyjs == "file" and not (js := path.parent / plotlyjs_name()).is_file():
+            atomic_write(js, get_plotlyjs())
+        written = atomic_write(path, text)
+    finally:
+        run.close()
+    log.info("report of %s: %s (%.1f MB)", directory, written, len(text) / 1e6)
+    return written

@@ -212,6 +212,13 @@ def executor_kwargs(workers: int | None, dask_scheduler: str | None,
     experiment runners, from :func:`executor_options`' values."""
     if workers is not None and dask_scheduler is not None:
         raise click.UsageError("give --workers or --dask-scheduler, not both")
+    if dask_scheduler is not None:
+        from mhtrack.experiments.jobs.executor import require_dask
+
+        try:
+            require_dask()
+        except ImportError as e:
+            raise click.ClickException(str(e)) from None
     return {
         "executor": "dask" if dask_scheduler else "local",
         "workers": workers,

@@ -18,7 +18,7 @@ from mhtrack.frames import frame_lengths, make_frames
 from mhtrack.io._checks import num
 from mhtrack.io._frame import FLOAT, INT, TIME, Frame, read_frame
 from mhtrack.io._source import PathArg
-from mhtrack.io._times import seconds
+from mhtrack.io._times import is_iso, seconds
 from mhtrack.models.radars import SensorSet
 from mhtrack.records import MAX_COORDINATE, PlotTable
 
@@ -86,7 +86,7 @@ def read_timed_plots(
     return PlotTable(
         scan=frame[order], time=time[order], sensor=sensor[order], x=take(x), y=take(y),
         range=take(rng), bearing=take(bearing), origin=take(origin), R=take(R),
-        timed=True, file_row=order.astype(np.int64),
+        timed=True, file_row=order.astype(np.int64), iso_times=is_iso(f),
     )  # type: ignore[arg-type]
 
 

@@ -103,3 +103,16 @@ def test_dask_scheduler_without_dask_is_one_line(tmp_path, monkeypatch):
     assert r.stderr.strip().splitlines() == [
         "Error: --dask-scheduler needs Dask's distributed scheduler: "
         "pip install 'mhtrack[dask]'"]
+
+
+def test_simulate_logs_per_scan_at_debug_and_a_summary_at_info(tmp_path):
+    r = CliRunner().invoke(cli, ["simulate", "crossing", "--scans", "3", "-vv", "-o",
+                                 str(tmp_path / "s")])
+    assert r.exit_code == 0, r.output
+    lines = r.stderr.splitlines()
+    per_scan = [ln for ln in lines if ln.startswith("mhtrack: DEBUG: simulate: scan ")]
+    assert len(per_scan) == 3  # one scan, one sensor each
+    assert [ln for ln in lines if ln.startswith("mhtrack: INFO: simulate crossing")]
+    r = CliRunner().invoke(cli, ["simulate", "crossing", "--scans", "3", "-v", "-o",
+                                 str(tmp_path / "t")])
+    assert "DEBUG" not in r.stderr and "INFO: simulate crossing" in r.stderr

@@ -70,7 +70,7 @@ def track_details(tracks: TrackTable, tracks_path: Path | None, plots: PlotTable
         out["score"] = np.asarray(tracks.score, float)
     own = file_details(tracks_path)
     hit = tracks.plot != NO_PLOT
-    if plots is not None and len(plots):
+    if refers_to(tracks, plots):
         rows = np.where(hit, tracks.plot, 0)
         out["sensor"] = np.where(hit, plots.sensor[rows], -1)
         from_plots = file_details(plots_path)
@@ -83,6 +83,12 @@ def track_details(tracks: TrackTable, tracks_path: Path | None, plots: PlotTable
     if own and all(len(v) == len(tracks) for v in own.values()):
         out.update(own)
     return out
+
+
+def refers_to(tracks: TrackTable, plots: PlotTable | None) -> bool:
+    """Whether every ``plot`` of ``tracks`` is a row of ``plots`` (files of one run)."""
+    return (plots is not None and len(plots) > 0
+            and int(tracks.plot.max(initial=NO_PLOT)) < len(plots))
 
 
 def _median_interval(times: np.ndarray, keys: np.ndarray) -> float:
@@ -104,7 +110,7 @@ def radar_rows(plots: PlotTable, tracks: TrackTable | None, periods: dict[int, f
     sensor_of = np.full(0, -1)
     t_used = np.zeros(0)
     id_used = np.zeros(0, np.int64)
-    if tracks is not None and len(tracks):
+    if tracks is not None and len(tracks) and refers_to(tracks, plots):
         online = tracks.online()
         hit = online.plot != NO_PLOT
         used[online.plot[hit]] = True

@@ -347,5 +347,5 @@ def _pandas(what: str) -> Any:
         import pandas
     except ImportError as e:
         raise ImportError(f"{what} needs pandas (not installed with mhtrack): "
-                          "pip install pandas") from e
+                          "pip install 'mhtrack[pandas]' (or pip install pandas)") from e
     return pandas

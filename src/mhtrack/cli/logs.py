@@ -42,10 +42,6 @@ class _Stderr(logging.StreamHandler):  # type: ignore[type-arg]
 
 #: The handlers this module installed on the root logger (replaced on each configure).
 _installed: list[logging.Handler] = []
-#: The current verbosity and log file, so that a command's own ``-v`` adds to the group's.
-_state: dict[str, Any] = {"verbose": 0, "log_file": None}
-
-
 def level_of(verbose: int) -> int:
     """WARNING, INFO (``-v``), DEBUG (``-vv`` or more)."""
     return logging.WARNING - 10 * min(max(verbose, 0), 2)
@@ -77,19 +73,27 @@ def configure(verbose: int = 0, log_file: str | Path | None = None) -> None:
     for h in _installed:
         root.addHandler(h)
     logging.getLogger("mhtrack").setLevel(own)
-    _state.update(verbose=verbose, log_file=log_file)
+
+
+def _apply(ctx: click.Context, key: str, value: Any) -> None:
+    """Configure from this invocation alone: the group's ``-v``/``--log-file`` (when the
+    command runs under the ``mhtrack`` group) plus the command's own."""
+    ctx.meta[key] = value
+    root = ctx.find_root()
+    group = root.params if root is not ctx else {}
+    verbose = int(group.get("verbose") or 0) + int(ctx.meta.get("mhtrack.verbose") or 0)
+    log_file = ctx.meta.get("mhtrack.log_file") or group.get("log_file")
+    configure(verbose, log_file)
 
 
 def _verbose_callback(ctx: click.Context, param: click.Parameter, value: int) -> int:
-    if value:
-        configure(_state["verbose"] + value, _state["log_file"])
+    _apply(ctx, "mhtrack.verbose", value)
     return value
 
 
 def _log_file_callback(ctx: click.Context, param: click.Parameter, value: Path | None
                        ) -> Path | None:
-    if value is not None:
-        configure(_state["verbose"], value)
+    _apply(ctx, "mhtrack.log_file", value)
     return value
 
 

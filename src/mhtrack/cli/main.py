@@ -91,9 +91,9 @@ def _register() -> None:
     for module in modules:
         for command in module.COMMANDS:
             cli.add_command(command)
-    bound_number_options(cli)
     for command in cli.commands.values():
         _every_command(command)
+    bound_number_options(cli)
 
 
 _register()

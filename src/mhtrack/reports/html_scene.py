@@ -195,7 +195,7 @@ def track_traces(tracks: TrackTable, scale: float, details: dict[str, np.ndarray
     solid = [r for r in solid if len(r)]
     whole = solid
     solid, thinned = _thin_rows(solid, MAX_TRACK_POINTS)
-    note = f", every {math.ceil(sum(map(len, whole)) / MAX_TRACK_POINTS)}th row drawn" \
+    note = f", every {math.ceil(sum(map(len, whole)) / MAX_TRACK_POINTS)}-th row drawn" \
         if thinned else ""
     if len(solid) > MAX_TRACK_TRACES:
         out.append(trace(solid, name=f"tracks ({len(solid)}{note})",

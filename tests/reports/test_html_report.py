@@ -57,7 +57,7 @@ def test_run_report_is_self_contained(run_dir):
     assert not [t for t in tags if t.startswith(("<link", "<iframe", "<img"))]
     scripts = re.findall(r"<script([^>]*)>", page)
     assert scripts and not [s for s in scripts if "src" in s]
-    assert page.count("Plotly.newPlot(") == 2  # the scene and the curves
+    assert page.count("Plotly.newPlot(") == 3  # the scene, the curves, the track lengths
     assert "plotly.js v" in page[:5_000_000]  # the library itself, inlined
     for heading in ("Scene", "Metrics over time", "Metrics", "Parameters and caps"):
         assert f"<h2>{heading}</h2>" in page
@@ -73,7 +73,7 @@ def test_metrics_table_shows_metrics_json(run_dir):
     page = (run_dir / REPORT_FILE).read_text(encoding="utf-8")
     m = json.loads((run_dir / "metrics.json").read_text())
     for key, unit in (("ospa_mean", " m"), ("gospa_mean", " m"), ("mota", ""),
-                      ("rcc", ""), ("l_avg", "")):
+                      ("rcc", ""), ("l_avg", " s")):  # track life in s, as evaluate
         assert f'<td class="num">{m[key]:.4g}{unit}</td>' in page, key
     assert f"<td>{m['n_false']}</td>" in page or f'<td class="num">{m["n_false"]}</td>' in page
     assert "<td>tracker</td><td>mht-agmm</td>" in page

@@ -116,3 +116,16 @@ def test_simulate_logs_per_scan_at_debug_and_a_summary_at_info(tmp_path):
     r = CliRunner().invoke(cli, ["simulate", "crossing", "--scans", "3", "-v", "-o",
                                  str(tmp_path / "t")])
     assert "DEBUG" not in r.stderr and "INFO: simulate crossing" in r.stderr
+
+
+def test_evaluate_and_report_progress_bar_only_when_asked_or_on_a_terminal(crossing):
+    pytest.importorskip("plotly", reason="report needs the extra [report]")
+    ev = ["evaluate", str(crossing / "tracks.csv"), str(crossing / "truth.csv")]
+    rep = ["report", str(crossing), "-o", str(crossing / "r.html")]
+    for args, last in ((ev, "HOTA"), (rep, "render")):
+        shown = CliRunner().invoke(cli, [*args, "--progress"])
+        assert shown.exit_code == 0, shown.output
+        assert f"{args[0]}:" in shown.stderr and last in shown.stderr  # the bar, its stages
+        for quiet in ([], ["--quiet"]):  # CliRunner's stderr is no terminal: no bar
+            r = CliRunner().invoke(cli, [*args, *quiet])
+            assert r.exit_code == 0 and r.stderr == "", r.stderr

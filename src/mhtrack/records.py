@@ -22,6 +22,7 @@ from __future__ import annotations
 
 from collections.abc import Iterator
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -117,6 +118,7 @@ class PlotTable:
     ``file_row`` optionally maps each row to its 0-based row in the file it was read from
     (a timed file is re-sorted on reading); ``None`` when the rows are in file order.
     Tracks refer to the table's rows (``Scan.rows``); writers translate them to file rows.
+    ``iso_times``: the file's times were ISO-8601 text or timestamps (kept as POSIX seconds).
     """
 
     scan: np.ndarray
@@ -131,6 +133,9 @@ class PlotTable:
     scan_times: tuple[np.ndarray, np.ndarray] | None = field(default=None, repr=False)
     timed: bool = False
     file_row: np.ndarray | None = field(default=None, repr=False)
+    #: The file gave ISO-8601 (or timestamp) times, read as POSIX seconds: outputs made
+    #: from these plots write their times as ISO-8601 too (docs/file-formats.md).
+    iso_times: bool = field(default=False, repr=False)
 
     def __post_init__(self) -> None:
         n = len(self.scan)
@@ -280,6 +285,44 @@ class TrackTable:
         i = np.zeros(0, np.int64)
         return cls(i, e, i, e, e, e, e, i)
 
+    def to_pandas(self) -> Any:
+        """A :class:`pandas.DataFrame`, one row per track row: the columns ``scan, time,
+        track_id, x, y, vx, vy, plot`` and, when present, ``score``, ``tentative`` (bool)
+        and ``P00 … P33`` (the covariance, row-major). Needs pandas (not a dependency of
+        mhtrack): :class:`ImportError` naming it otherwise."""
+        pd = _pandas("TrackTable.to_pandas")
+        cols: dict[str, np.ndarray] = {f: getattr(self, f) for f in _TRACK_COLUMNS}
+        for f in ("score", "tentative"):
+            if (v := getattr(self, f)) is not None:
+                cols[f] = v.astype(bool) if f == "tentative" else v
+        if self.P is not None:
+            for i, j in np.ndindex(4, 4):
+                cols[f"P{i}{j}"] = self.P[:, i, j]
+        return pd.DataFrame(cols)
+
+    @classmethod
+    def from_pandas(cls, df: Any) -> TrackTable:
+        """The table of a DataFrame as :meth:`to_pandas` makes it (``score``,
+        ``tentative`` and ``P00 … P33`` optional; a missing required column is a
+        :class:`ValueError` naming it)."""
+        _pandas("TrackTable.from_pandas")
+        missing = [c for c in _TRACK_COLUMNS if c not in df.columns]
+        if missing:
+            raise ValueError(f"DataFrame lacks column(s) {', '.join(missing)} (a tracks "
+                             f"table needs {', '.join(_TRACK_COLUMNS)})")
+        ints = ("scan", "track_id", "plot")
+        kw: dict[str, Any] = {c: df[c].to_numpy(np.int64 if c in ints else np.float64)
+                              for c in _TRACK_COLUMNS}
+        if "score" in df.columns:
+            kw["score"] = df["score"].to_numpy(np.float64)
+        if "tentative" in df.columns:
+            kw["tentative"] = df["tentative"].to_numpy(bool)
+        names = [f"P{i}{j}" for i, j in np.ndindex(4, 4)]
+        if all(n in df.columns for n in names):
+            kw["P"] = np.stack([df[n].to_numpy(np.float64) for n in names],
+                               axis=1).reshape(-1, 4, 4)
+        return cls(**kw)
+
     @classmethod
     def concat(cls, parts: list[TrackTable]) -> TrackTable:
         """Concatenate per-scan outputs, in order."""
@@ -292,3 +335,17 @@ class TrackTable:
             return None if any(v is None for v in vals) else np.concatenate(vals)
 
         return cls(**{f: cat(f) for f in cls.__dataclass_fields__})  # type: ignore[arg-type]
+
+
+#: The required columns of a tracks table, in order.
+_TRACK_COLUMNS = ("scan", "time", "track_id", "x", "y", "vx", "vy", "plot")
+
+
+def _pandas(what: str) -> Any:
+    """pandas, or :class:`ImportError` saying ``what`` needs it."""
+    try:
+        import pandas
+    except ImportError as e:
+        raise ImportError(f"{what} needs pandas (not installed with mhtrack): "
+                          "pip install 'mhtrack[pandas]' (or pip install pandas)") from e
+    return pandas

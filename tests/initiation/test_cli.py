@@ -55,6 +55,10 @@ def test_initiate_same_seed_same_output_and_text(tmp_path):
     assert a == b
     text = run(initiate, *args[:-1], "--fusion", "none", "--figure", str(tmp_path / "f.png"))
     assert "p_true" in text and (tmp_path / "f.png").stat().st_size > 0
+    # --out (-o) is the name now; --figure, the former one, is a hidden alias
+    run(initiate, *args[:-1], "--fusion", "none", "-o", str(tmp_path / "g.png"))
+    assert (tmp_path / "g.png").stat().st_size > 0
+    assert "--figure" not in CliRunner().invoke(initiate, ["--help"]).output
 
 
 def test_initiate_needs_a_four_scan_window():

@@ -3,7 +3,6 @@ compatible clusters (the estimators and fused plots: ``test_fusion.py``)."""
 
 import numpy as np
 import pytest
-from sklearn.cluster import KMeans
 
 from mhtrack.initiation import dissimilarity_threshold, kmeans_lloyd, merge_compatible_clusters
 
@@ -21,6 +20,8 @@ def test_threshold_indexing_is_one_based_and_clipped():
 
 @pytest.mark.parametrize("seed", [0, 1])
 def test_lloyd_refinement_equals_sklearn(seed):
+    KMeans = pytest.importorskip(  # the reference (dev extra), not a dependency
+        "sklearn.cluster", reason="scikit-learn (dev extra) not installed").KMeans
     rng = np.random.default_rng(seed)
     means = rng.uniform(0, 1000, size=(6, 2))
     z = np.concatenate([m + rng.normal(scale=120.0, size=(15, 2)) for m in means])

@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pyarrow.csv as pacsv
 import pytest
-from geographiclib.geodesic import Geodesic
+from geodesic_reference import WGS84
 
 from mhtrack.errors import InputError
 from mhtrack.io import read_tracks, read_truth, write_tracks, write_truth
@@ -39,7 +39,7 @@ def enu_by_geographiclib(lat: float, lon: float, x: float, y: float, vx: float, 
     """East/north velocity at a point whose grid velocity is (vx, vy): move 1 s along the
     grid, find the geodesic from the point to where that lands (GeographicLib inverse)."""
     lat2, lon2 = FRAME.to_geodetic(x + vx * 1e-3, y + vy * 1e-3)
-    g = Geodesic.WGS84.Inverse(lat, lon, float(lat2), float(lon2))
+    g = WGS84.Inverse(lat, lon, float(lat2), float(lon2))
     a = np.radians(g["azi1"])
     return g["s12"] * np.sin(a) * 1e3, g["s12"] * np.cos(a) * 1e3
 
@@ -65,7 +65,7 @@ def test_lat_lon_and_east_north_match_geographiclib(tmp_path):
     assert list(f) == ["scan", "time", "target_id", "x", "y", "lat", "lon", "vx", "vy",
                        "vx_grid", "vy_grid"]
     for i in range(len(truth)):
-        g = Geodesic.WGS84.Direct(46.8, 8.2, np.degrees(np.arctan2(truth.x[i], truth.y[i])),
+        g = WGS84.Direct(46.8, 8.2, np.degrees(np.arctan2(truth.x[i], truth.y[i])),
                                   np.hypot(truth.x[i], truth.y[i]))
         assert f["lat"][i] == pytest.approx(g["lat2"], abs=1e-9)
         assert f["lon"][i] == pytest.approx(g["lon2"], abs=1e-9)

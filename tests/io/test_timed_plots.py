@@ -10,7 +10,7 @@ import numpy as np
 import pyarrow as pa
 import pyarrow.parquet as pq
 import pytest
-from geographiclib.geodesic import Geodesic
+from geodesic_reference import WGS84
 
 from mhtrack.frames import frame_lengths, make_frames
 from mhtrack.io import read_plots, write_plots
@@ -57,7 +57,7 @@ def write(tmp_path, text: str, name: str = "plots.csv"):
 def local_by_geographiclib(lat: float, lon: float) -> tuple[float, float]:
     """The azimuthal equidistant plane from first principles: distance and azimuth from the
     origin by GeographicLib's inverse problem, ``x = s sin α1``, ``y = s cos α1``."""
-    g = Geodesic.WGS84.Inverse(*ORIGIN, lat, lon)
+    g = WGS84.Inverse(*ORIGIN, lat, lon)
     a = np.radians(g["azi1"])
     return g["s12"] * np.sin(a), g["s12"] * np.cos(a)
 
@@ -70,7 +70,7 @@ def test_polar_and_geodetic_plots_match_geographiclib(tmp_path, sensors):
                          + "\n".join(rows) + "\n"), sensors=sensors)
     assert t.timed and t.file_row.tolist() == list(range(6))
     for i, (r, b) in enumerate(plots):
-        d = Geodesic.WGS84.Direct(*SITE, b, r)
+        d = WGS84.Direct(*SITE, b, r)
         assert np.hypot(t.x[i] - local_by_geographiclib(d["lat2"], d["lon2"])[0],
                         t.y[i] - local_by_geographiclib(d["lat2"], d["lon2"])[1]) < 1e-3
     for i, (lat, lon) in zip((4, 5), ((47.9, 9.95), (45.1, 5.4)), strict=True):
@@ -79,7 +79,7 @@ def test_polar_and_geodetic_plots_match_geographiclib(tmp_path, sensors):
     # Polar R = J diag(σr², σθ²) Jᵀ, J = ∂(x, y)/∂(r, θ) of GeographicLib's chain (direct
     # problem from the site, then the plane above) by central differences.
     def plot_xy(r: float, b: float) -> np.ndarray:
-        d = Geodesic.WGS84.Direct(*SITE, b, r)
+        d = WGS84.Direct(*SITE, b, r)
         return np.array(local_by_geographiclib(d["lat2"], d["lon2"]))
 
     r0, b0 = plots[0]

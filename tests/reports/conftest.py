@@ -32,25 +32,30 @@ FLAGS = ("--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-
          "--disable-background-networking", "--disable-component-update", "--disable-sync",
          "--disable-default-apps", "--disable-extensions", "--mute-audio",
          "--remote-debugging-pipe")
-#: Per figure: its div id, traces given to Plotly, scatter traces drawn in SVG, SVGs.
+#: The SVG groups of drawn traces: scatter (lines, markers) and bar (histograms).
+TRACES = "'g.scatterlayer g.trace, g.barlayer g.trace'"
+#: Per figure: its div id, traces given to Plotly, traces drawn in SVG, SVGs.
 FIGURES_JS = """JSON.stringify(Array.from(document.querySelectorAll('div.plotly-graph-div'))
   .map(d => ({id: d.id, given: (d.data || []).length,
-              drawn: d.querySelectorAll('g.scatterlayer g.trace').length,
+              drawn: d.querySelectorAll(TRACES_).length,
               svg: d.querySelectorAll('svg.main-svg').length,
               points: d.querySelectorAll('g.scatterlayer path.point').length})))"""
+FIGURES_JS = FIGURES_JS.replace("TRACES_", TRACES)
 #: A promise that resolves once every Plotly figure has drawn all its traces, then two
 #: more animation frames (so the screenshot shows the finished page): the wait is for the
-#: page's own event, not for a time.
+#: page's own event, not for a time. Its value: milliseconds since the navigation began
+#: (the page's load time as the browser measured it, logged by the tests, never asserted).
 DRAWN_JS = """new Promise(done => {
   const ready = () => Array.from(document.querySelectorAll('div.plotly-graph-div'))
     .filter(d => d.data !== undefined)  // Plotly.newPlot sets data during the page's load
     .every(d => d.querySelectorAll('svg.main-svg').length
-                && d.querySelectorAll('g.scatterlayer g.trace').length >= (d.data || []).length);
+                && d.querySelectorAll(TRACES_).length >= (d.data || []).length);
   const tick = () => ready()
-    ? requestAnimationFrame(() => requestAnimationFrame(() => done(true)))
+    ? requestAnimationFrame(() => requestAnimationFrame(() => done(performance.now())))
     : requestAnimationFrame(tick);
   tick();
 })"""
+DRAWN_JS = DRAWN_JS.replace("TRACES_", TRACES)
 #: Local schemes: anything else requested by the page went to the network.
 LOCAL = ("file:", "data:", "about:", "blob:", "chrome:", "devtools:")
 
@@ -73,6 +78,7 @@ class PageCheck:
     errors: list[str] = field(default_factory=list)
     requests: list[str] = field(default_factory=list)
     screenshot: Path | None = None
+    load_ms: float = float("nan")
 
 
 class Chromium:
@@ -203,11 +209,11 @@ def check_page(exe: str, page: Path, work: Path, *, width: int = 1400) -> PageCh
     b = Chromium(exe, work / "profile")
     try:
         b.open(page.resolve().as_uri(), width)
-        b.evaluate(DRAWN_JS, await_promise=True)
+        load_ms = float(b.evaluate(DRAWN_JS, await_promise=True))
         figures = json.loads(b.evaluate(FIGURES_JS))
         shot = b.screenshot(work / f"{page.stem}.png", width)
         errors, requests = b.problems()
-        return PageCheck(figures, errors, requests, shot)
+        return PageCheck(figures, errors, requests, shot, load_ms)
     finally:
         b.close()
 
@@ -279,6 +285,16 @@ def geo_dir(tmp_path_factory) -> Path:
 
 
 @pytest.fixture(scope="session")
+def recording_dir(geo_dir, tmp_path_factory) -> Path:
+    """A recording as a user has it: plots, sensors and tracks, no truth, no scenario."""
+    out = tmp_path_factory.mktemp("html-recording") / "recording"
+    out.mkdir()
+    for name in ("plots.csv", "sensors.toml", "tracks.csv"):
+        shutil.copy(geo_dir / name, out / name)
+    return out
+
+
+@pytest.fixture(scope="session")
 def study_dir(tmp_path_factory) -> Path:
     """``montecarlo crossing``: two trackers, 3 runs of 20 scans, in this process."""
     out = tmp_path_factory.mktemp("html-study") / "mc"
@@ -297,3 +313,4 @@ def open_in_browser(chromium, tmp_path):
         return check_page(chromium, page, tmp_path / "browser", **kw)
 
     return run
+

@@ -45,7 +45,7 @@ def test_run_report_renders(run_dir, open_in_browser, track_ids):
     scene = 2 + 3 + len(confirmed) + tentative
     m = json.loads((run_dir / "metrics.json").read_text())
     curves = 3 + bool([v for v in m.get("ospa2") or [] if v is not None])
-    assert got == {"fig-scene": scene, "fig-curves": curves}
+    assert got == {"fig-scene": scene, "fig-curves": curves, "fig-lengths": 1}
     points = {f["id"]: f["points"] for f in check.figures}
     with open(run_dir / "plots.csv", newline="") as fh:
         n_plots = sum(1 for _ in csv.DictReader(fh))
@@ -91,3 +91,61 @@ def test_the_check_sees_errors_and_network(open_in_browser, tmp_path):
     assert any("broken" in e for e in check.errors), check.errors
     assert check.requests == ["http://127.0.0.1:9/x.png"]
     assert check.figures == [{"id": "", "given": 0, "drawn": 0, "svg": 0, "points": 0}]
+
+
+def test_recording_report_renders(recording_dir, open_in_browser, tmp_path, track_ids):
+    """Plots, sensors and tracks, no truth: the scene and the histogram of track lengths
+    draw; the page has the radars' and the tracks' tables."""
+    page = write_html_report(recording_dir, tmp_path / "recording.html")
+    check = open_in_browser(page)
+    _clean(check)
+    confirmed, tentative = track_ids(recording_dir / "tracks.csv")
+    # scene: lat/lon grid and its labels, plots (no origin column kept? it is: clutter and
+    # target plots), tracks, sites; lengths: one bar trace
+    with open(recording_dir / "plots.csv", newline="") as fh:
+        kinds = 2 if "origin" in next(csv.reader(fh)) else 1
+    scene = 2 + kinds + len(confirmed) + tentative + 1
+    assert {f["id"]: f["drawn"] for f in check.figures} == {"fig-scene": scene,
+                                                            "fig-lengths": 1}
+    text = page.read_text()
+    for heading in ("Scene", "Radars", "Tracks", "Parameters and caps"):
+        assert f"<h2>{heading}</h2>" in text
+
+
+@pytest.fixture(scope="module")
+def twenty_minutes(tmp_path_factory):
+    """``simulate opensky-radars`` for 20 minutes (120 scans of 10 s), ``track``, and the
+    truth removed: a recording of three radars."""
+    from click.testing import CliRunner
+
+    from mhtrack.cli.main import cli
+
+    d = tmp_path_factory.mktemp("rec20")
+    for args in (["simulate", "opensky-radars", "--seed", "1", "--scans", "120", "--out",
+                  str(d)],
+                 ["track", str(d / "plots.csv"), "--out", str(d / "tracks.csv"), "--quiet"]):
+        r = CliRunner().invoke(cli, args)
+        assert r.exit_code == 0, r.output
+    for name in ("truth.csv", "scenario.toml"):
+        (d / name).unlink()
+    return d
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("plotlyjs", ["inline", "file"])
+def test_twenty_minute_report_size_and_load_time(plotlyjs, twenty_minutes, open_in_browser,
+                                                 tmp_path, record_property):
+    """A 20-minute three-radar recording's report renders cleanly; its size and the time
+    until every figure is drawn (the browser's own clock) are logged, not asserted."""
+    d = tmp_path / "rec"
+    shutil.copytree(twenty_minutes, d)
+    page = write_html_report(d, d / f"report-{plotlyjs}.html", plotlyjs=plotlyjs)
+    check = open_in_browser(page)
+    _clean(check)
+    js = sum(p.stat().st_size for p in d.glob("plotly-*.min.js"))
+    assert (js > 0) == (plotlyjs == "file")
+    record_property("measured", (
+        f"20-minute 3-radar report (plotly.js {plotlyjs}): page "
+        f"{page.stat().st_size / 1e6:.2f} MB" + (f" + plotly.js {js / 1e6:.2f} MB" if js
+                                                  else "")
+        + f", drawn {check.load_ms / 1000:.2f} s after navigation (headless Chromium)"))

@@ -16,7 +16,7 @@ import pytest
 
 pytest.importorskip("plotly", reason="the HTML report needs the optional extra [report]")
 
-from geographiclib.geodesic import Geodesic
+from geodesic_reference import WGS84
 
 from mhtrack.models.geodesy import LocalFrame
 from mhtrack.reports import montecarlo
@@ -57,7 +57,7 @@ def test_run_report_is_self_contained(run_dir):
     assert not [t for t in tags if t.startswith(("<link", "<iframe", "<img"))]
     scripts = re.findall(r"<script([^>]*)>", page)
     assert scripts and not [s for s in scripts if "src" in s]
-    assert page.count("Plotly.newPlot(") == 2  # the scene and the curves
+    assert page.count("Plotly.newPlot(") == 3  # the scene, the curves, the track lengths
     assert "plotly.js v" in page[:5_000_000]  # the library itself, inlined
     for heading in ("Scene", "Metrics over time", "Metrics", "Parameters and caps"):
         assert f"<h2>{heading}</h2>" in page
@@ -73,7 +73,7 @@ def test_metrics_table_shows_metrics_json(run_dir):
     page = (run_dir / REPORT_FILE).read_text(encoding="utf-8")
     m = json.loads((run_dir / "metrics.json").read_text())
     for key, unit in (("ospa_mean", " m"), ("gospa_mean", " m"), ("mota", ""),
-                      ("rcc", ""), ("l_avg", "")):
+                      ("rcc", ""), ("l_avg", " s")):  # track life in s, as evaluate
         assert f'<td class="num">{m[key]:.4g}{unit}</td>' in page, key
     assert f"<td>{m['n_false']}</td>" in page or f'<td class="num">{m["n_false"]}</td>' in page
     assert "<td>tracker</td><td>mht-agmm</td>" in page
@@ -111,7 +111,7 @@ def test_grid_lines_are_parallels_and_meridians():
     for s, e in zip(starts, cuts, strict=True):
         lat, lon = [], []
         for xi, yi in zip(x[s:e], y[s:e], strict=True):
-            g = Geodesic.WGS84.Direct(52.067, -1.454, math.degrees(math.atan2(xi, yi)),
+            g = WGS84.Direct(52.067, -1.454, math.degrees(math.atan2(xi, yi)),
                                       math.hypot(xi, yi))
             lat.append(g["lat2"])
             lon.append(g["lon2"])
@@ -177,15 +177,15 @@ def test_paired_figure_intervals():
 
 
 def test_study_without_paired_shows_the_tracker_table(study_dir, tmp_path, monkeypatch):
-    import pandas as pd
+    import pyarrow.parquet as pq  # a runtime dependency (pandas is not: the tour has none)
 
     monkeypatch.delattr(montecarlo, "paired_comparisons", raising=False)
     page = report_page(study_dir).render()
     assert "Paired comparisons</h2>" not in page
     assert "No paired comparisons in this directory." in page
     for t in ("mht-gmm", "mht-agmm"):
-        runs = [pd.read_parquet(study_dir / "runs" / t / f"run-{i}.parquet") for i in range(3)]
-        v = np.array([float(r["ospa_mean"].iloc[0]) for r in runs])
+        runs = [pq.read_table(study_dir / "runs" / t / f"run-{i}.parquet") for i in range(3)]
+        v = np.array([float(r.column("ospa_mean")[0].as_py()) for r in runs])
         assert f"{v.mean():.4g} ± {v.std():.4g} m" in page
 
 

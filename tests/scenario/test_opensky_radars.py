@@ -7,7 +7,7 @@ import itertools
 
 import numpy as np
 import pytest
-from geographiclib.geodesic import Geodesic
+from geodesic_reference import WGS84
 
 from mhtrack.models.sensors import RotatingRadar
 from mhtrack.scenario import preset, simulate
@@ -19,7 +19,7 @@ def sim():
 
 
 def _dist(lat1, lon1, lat2, lon2):
-    return Geodesic.WGS84.Inverse(lat1, lon1, lat2, lon2)["s12"]
+    return WGS84.Inverse(lat1, lon1, lat2, lon2)["s12"]
 
 
 def test_three_rotating_radars_with_different_parameters():

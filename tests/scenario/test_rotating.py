@@ -1,12 +1,12 @@
 """Rotating radars: beam-crossing times, geodesic range/bearing, noise, P_D, clutter.
 
-Independent facts: GeographicLib's ``Geodesic.WGS84.Inverse`` for the true range and
+Independent facts: GeographicLib's ``WGS84.Inverse`` for the true range and
 azimuth; the closed-form crossing times of a stationary target; the beam's bearing at a
 plot's time; binomial and Poisson statistics."""
 
 import numpy as np
 import pytest
-from geographiclib.geodesic import Geodesic
+from geodesic_reference import WGS84
 
 from mhtrack.frames import frame_lengths
 from mhtrack.models.geodesy import LocalFrame, polar_to_local
@@ -35,7 +35,7 @@ def scenario(targets, *, period=2.0, phase=30.0, pd=1.0, sr=TINY_R, sb=TINY_B,
 
 def geodesic(lat, lon):
     """(range m, azimuth deg in [0, 360)) from SITE by GeographicLib."""
-    out = [Geodesic.WGS84.Inverse(SITE[0], SITE[1], a, b) for a, b in zip(lat, lon, strict=True)]
+    out = [WGS84.Inverse(SITE[0], SITE[1], a, b) for a, b in zip(lat, lon, strict=True)]
     return (np.array([g["s12"] for g in out]), np.array([g["azi1"] for g in out]) % 360.0)
 
 

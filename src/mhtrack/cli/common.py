@@ -126,6 +126,25 @@ def bound_number_options(command: click.Command) -> None:
         bound_number_options(sub)
 
 
+def out_option(dest: str, former: str, **kw: Any) -> Callable[..., Any]:
+    """``--out/-o`` (value in the parameter ``dest``) and the command's former spelling
+    ``former`` (e.g. ``--figure``), hidden and kept for a release; ``kw`` as for
+    :func:`click.option` (type, help)."""
+    def keep(ctx: click.Context, param: click.Parameter, value: Any) -> Any:
+        return value if value is not None else ctx.params.get(dest)
+
+    def old(ctx: click.Context, param: click.Parameter, value: Any) -> None:
+        if value is not None:
+            ctx.params[dest] = value
+
+    def decorate(f: Callable[..., Any]) -> Callable[..., Any]:
+        f = click.option(former, f"{dest}_former", hidden=True, expose_value=False,
+                         callback=old, type=kw.get("type"))(f)
+        return click.option("--out", "-o", dest, callback=keep, default=None, **kw)(f)
+
+    return decorate
+
+
 def scenario_options(f: Callable[..., Any]) -> Callable[..., Any]:
     """``SCENARIO`` (preset name or TOML file) and the common overrides."""
     for opt in reversed(
@@ -212,6 +231,13 @@ def executor_kwargs(workers: int | None, dask_scheduler: str | None,
     experiment runners, from :func:`executor_options`' values."""
     if workers is not None and dask_scheduler is not None:
         raise click.UsageError("give --workers or --dask-scheduler, not both")
+    if dask_scheduler is not None:
+        from mhtrack.experiments.jobs.executor import require_dask
+
+        try:
+            require_dask()
+        except ImportError as e:
+            raise click.ClickException(str(e)) from None
     return {
         "executor": "dask" if dask_scheduler else "local",
         "workers": workers,

@@ -14,6 +14,7 @@ from mhtrack.cli.common import (
     scenario_options,
     table_path,
 )
+from mhtrack.cli.terminal import progress_enabled, progress_option
 
 
 @click.command()
@@ -96,33 +97,58 @@ def _write_rotating(sim: Any, out: Path, fmt: str) -> None:
 @click.option("--max-age", "max_age_s", type=click.FloatRange(min=0), default=None,
               help="At truth times: the oldest track state (s) still predicted [15].")
 @click.option("--json", "as_json", is_flag=True, help="Print one JSON object.")
+@click.option("--out", "-o", "out", type=click.Path(dir_okay=False, path_type=Path),
+              default=None, help="Write the table (.txt) or the JSON (.json) to FILE "
+              "instead of stdout.")
+@progress_option
 def evaluate(tracks: Path, truth: Path, plots: Path | None, cutoff: float, order: float,
              match_distance: float | None, sensors_file: Path | None, at: str | None,
-             max_age_s: float | None, as_json: bool) -> None:
+             max_age_s: float | None, as_json: bool, out: Path | None,
+             progress: bool | None) -> None:
     """Score TRACKS against TRUTH: OSPA, GOSPA, cardinality, CLEAR-MOT, coverage."""
+    import logging
+
     from mhtrack.io import read_plots, read_tracks, read_truth
+    from mhtrack.io.atomic import atomic_write
+    from mhtrack.io.jsonsafe import dumps
+    from mhtrack.io.paths import check_output_file
     from mhtrack.io.sensors import read_sensors
     from mhtrack.io.tracks import has_frames
     from mhtrack.metrics import evaluate as run_evaluation
     from mhtrack.metrics.resample import DEFAULT_MAX_AGE_S, alignment
+    from mhtrack.progress import Stages
+
+    if out is not None:
+        check_output_file(out, inputs=(tracks, truth, plots), suffixes=(".json", ".txt"),
+                          what="metrics", option="--out")
 
     if sensors_file is None and (truth.parent / "sensors.toml").is_file():
         sensors_file = truth.parent / "sensors.toml"
     sensor_set = read_sensors(sensors_file) if sensors_file is not None else None
     frame = sensor_set.frame() if sensor_set is not None else None
-    pl = read_plots(plots, sensors=sensor_set) if plots is not None else None
-    tr = read_tracks(tracks, frame=frame, plots=pl)
-    gt = read_truth(truth, frame=frame)
-    if at is None and not has_frames(tracks):
-        at = "scans"  # tracks numbered by scan are scored at their scans, times checked
-    if alignment(tr, gt, pl, at) == "scans":
-        _check_same_times(tracks, tr, truth, gt)
-        if pl is not None and plots is not None:
-            _check_same_times(plots, pl, truth, gt)
-    ev = run_evaluation(tr, gt, plots=pl, cutoff=cutoff, order=order,
-                        match_distance=match_distance, at=at,
-                        max_age_s=DEFAULT_MAX_AGE_S if max_age_s is None else max_age_s)
-    if as_json:
+    run = Stages(3 + 8, "evaluate", progress_enabled(progress))  # 3 files, 8 metrics
+    try:
+        pl = run("read plots", read_plots, plots, sensors=sensor_set) if plots else None
+        tr = run("read tracks", read_tracks, tracks, frame=frame, plots=pl)
+        gt = run("read truth", read_truth, truth, frame=frame)
+        if at is None and not has_frames(tracks):
+            at = "scans"  # tracks numbered by scan are scored at their scans, times checked
+        if alignment(tr, gt, pl, at) == "scans":
+            _check_same_times(tracks, tr, truth, gt)
+            if pl is not None and plots is not None:
+                _check_same_times(plots, pl, truth, gt)
+        ev = run_evaluation(tr, gt, plots=pl, cutoff=cutoff, order=order,
+                            match_distance=match_distance, at=at, stages=run,
+                            max_age_s=DEFAULT_MAX_AGE_S if max_age_s is None else max_age_s)
+    finally:
+        run.close()
+    logging.getLogger("mhtrack.metrics").info(
+        "evaluated %s against %s: %d scans, %d tracks, %d targets", tracks, truth,
+        len(ev.scans), ev.n_tracks, ev.n_targets)
+    if out is not None:
+        text = (dumps(ev.to_dict()) if as_json else ev.to_table()) + "\n"
+        click.echo(f"wrote {atomic_write(out, text)}")
+    elif as_json:
         echo_json(ev.to_dict())
     else:
         click.echo(ev.to_table())
@@ -146,10 +172,13 @@ def _check_same_times(path_a: Path, a: Any, path_b: Path, b: Any) -> None:
 
 @click.command()
 @click.argument("directory", type=click.Path(exists=True, file_okay=False, path_type=Path))
-@click.option("-o", "--output", type=click.Path(dir_okay=False, path_type=Path), default=None,
-              help="Image file [default: DIR/scene.png].")
+@click.option("--out", "-o", "output", type=click.Path(dir_okay=False, path_type=Path),
+              default=None, help="Image file [default: DIR/scene.png].")
+@click.option("--output", "output_alias", type=click.Path(dir_okay=False, path_type=Path),
+              default=None, hidden=True)  # the former spelling, kept for a release
 @click.option("--title", default=None, help="Figure title [default: the directory name].")
-def plot(directory: Path, output: Path | None, title: str | None) -> None:
+def plot(directory: Path, output: Path | None, output_alias: Path | None,
+         title: str | None) -> None:
     """Draw DIR's truth, plots (clutter grey) and tracks, whichever are present."""
     from mhtrack.io import read_plots, read_toml, read_tracks, read_truth
     from mhtrack.io.paths import check_output_file
@@ -157,9 +186,10 @@ def plot(directory: Path, output: Path | None, title: str | None) -> None:
     from mhtrack.plotting.scene import plot_scene, save_figure, sensor_sites
 
     paths = {s: table_path(directory, s) for s in ("plots", "truth", "tracks")}
+    output = output if output is not None else output_alias
     if output is not None:
         check_output_file(output, inputs=paths.values(), suffixes=(".png",), what="figure",
-                          option="-o")
+                          option="--out")
     if not any(paths.values()):
         raise InputProblem(f"{directory} holds no plots, truth or tracks file")
     if title is None:

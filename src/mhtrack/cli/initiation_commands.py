@@ -2,7 +2,7 @@
 
 Both simulate ``--runs`` independent runs (seeds derived from ``--seed``), call
 :mod:`mhtrack.experiments.initiation_runs`, score with :mod:`mhtrack.metrics.initiation`
-and print; ``--figure`` is drawn by :mod:`mhtrack.reports.initiation`.
+and print; ``--out`` (formerly ``--figure``) is drawn by :mod:`mhtrack.reports.initiation`.
 """
 
 from __future__ import annotations
@@ -12,7 +12,7 @@ from typing import Any
 
 import click
 
-from mhtrack.cli.common import echo_json, load_scenario_arg, scenario_options
+from mhtrack.cli.common import echo_json, load_scenario_arg, out_option, scenario_options
 from mhtrack.cli.terminal import progress_enabled, progress_option
 from mhtrack.names import CLUSTER_METHODS, INITIATION_FUSIONS, INITIATORS
 
@@ -26,8 +26,8 @@ def _common(f: Any) -> Any:
                      help="Fused plot: cluster mean (P2) or information-weighted."),
         click.option("--json", "as_json", is_flag=True, help="Print one JSON object."),
         progress_option,
-        click.option("--figure", type=click.Path(dir_okay=False, path_type=Path),
-                     default=None, help="Also draw the first run (PNG/PDF/SVG)."),
+        out_option("figure", "--figure", type=click.Path(dir_okay=False, path_type=Path),
+                   help="Also draw the first run to FILE (PNG/PDF/SVG)."),
     ]
     for opt in reversed(opts):
         f = opt(f)

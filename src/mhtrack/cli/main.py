@@ -9,13 +9,14 @@ from __future__ import annotations
 
 import contextlib
 import io
-import logging
 import os
 import sys
+from pathlib import Path
 
 import click
 
 from mhtrack import __version__
+from mhtrack.cli import logs
 from mhtrack.cli.common import InputProblem, bound_number_options
 from mhtrack.errors import printable
 
@@ -42,18 +43,44 @@ class Group(click.Group):
 
 @click.group(cls=Group, context_settings={"help_option_names": ["-h", "--help"]})
 @click.version_option(__version__, prog_name="mhtrack")
-@click.option("-v", "--verbose", count=True, help="More log output (-vv for debug).")
-def cli(verbose: int) -> None:
+@click.option("-v", "--verbose", count=True,
+              help="More log output: -v mhtrack's summaries, -vv its per-frame progress "
+              "(other libraries stay at warnings). Also accepted after the command.")
+@click.option("--log-file", type=click.Path(dir_okay=False, path_type=Path), default=None,
+              help="Append mhtrack's log (INFO at least, time-stamped) to FILE. Also "
+              "accepted after the command.")
+def cli(verbose: int, log_file: Path | None) -> None:
     """Multiple-target tracking in unknown, varying clutter (MHT, MHT-GMM, MHT-AGMM) and
     multi-radar track initiation."""
     from mhtrack.io.atomic import install_signal_cleanup
 
-    level = logging.WARNING - 10 * min(verbose, 2)
-    logging.basicConfig(level=level, format="mhtrack: %(levelname)s: %(message)s")
+    logs.configure(verbose, log_file)
     install_signal_cleanup()  # SIGTERM/SIGINT remove the temporaries of writes in flight
     for stream in (sys.stdout, sys.stderr):  # file names that are not UTF-8 print as \xNN
         with contextlib.suppress(AttributeError, ValueError, io.UnsupportedOperation):
             stream.reconfigure(errors="backslashreplace")
+
+
+def _short_out(command: click.Command) -> None:
+    """``-o`` as the short form of ``--out`` (when the command has ``--out`` and no
+    ``-o`` of its own)."""
+    taken = {o for p in command.params for o in (*p.opts, *p.secondary_opts)}
+    for p in command.params:
+        if isinstance(p, click.Option) and "--out" in p.opts and "-o" not in taken:
+            p.opts.append("-o")
+
+
+def _every_command(command: click.Command) -> None:
+    """The options every command has: ``-v``, ``--log-file`` (:mod:`mhtrack.cli.logs`)
+    and ``-o`` for ``--out``; for a group's subcommands too."""
+    subs = getattr(command, "commands", None)
+    if subs is not None:
+        for sub in subs.values():
+            _every_command(sub)
+        return
+    names = {o for p in command.params for o in (*p.opts, *p.secondary_opts)}
+    command.params += [p for p in logs.logging_params() if not names & set(p.opts)]
+    _short_out(command)
 
 
 def _register() -> None:
@@ -74,6 +101,8 @@ def _register() -> None:
     for module in modules:
         for command in module.COMMANDS:
             cli.add_command(command)
+    for command in cli.commands.values():
+        _every_command(command)
     bound_number_options(cli)
 
 

@@ -1,4 +1,4 @@
-"""``report``: one self-contained HTML page of a run or a study directory."""
+"""``report``: one HTML page of a run, a recording or a study directory."""
 
 from __future__ import annotations
 
@@ -6,36 +6,52 @@ from pathlib import Path
 
 import click
 
+from mhtrack.cli.terminal import progress_enabled, progress_option
 
-def write_report_or_fail(directory: Path, output: Path | None = None) -> Path:
+
+def write_report_or_fail(directory: Path, output: Path | None = None, *,
+                         plotlyjs: str = "inline", progress: bool = False) -> Path:
     """:func:`~mhtrack.reports.html_report.write_html_report`, the missing optional extra
     turned into one line (exit 1)."""
     try:
         from mhtrack.reports.html_report import write_html_report
 
-        return write_html_report(directory, output)
+        return write_html_report(directory, output, plotlyjs=plotlyjs, progress=progress)
     except ImportError as e:
         raise click.ClickException(str(e)) from None
 
 
 @click.command()
 @click.argument("directory", type=click.Path(exists=True, file_okay=False, path_type=Path))
-@click.option("-o", "--output", type=click.Path(dir_okay=False, path_type=Path), default=None,
-              help="HTML file to write [default: DIR/report.html].")
-def report(directory: Path, output: Path | None) -> None:
-    """Write one self-contained HTML page of DIR (opens from disk, no network).
+@click.option("--out", "-o", "out", type=click.Path(dir_okay=False, path_type=Path),
+              default=None, help="HTML file to write [default: DIR/report.html].")
+@click.option("--output", "output_alias", type=click.Path(dir_okay=False, path_type=Path),
+              default=None, hidden=True)  # the former spelling, kept for a release
+@click.option("--plotlyjs", type=click.Choice(["inline", "file"]), default="inline",
+              show_default=True,
+              help="Plotly's JavaScript (4.8 MB) inlined in the page (one self-contained "
+              "file), or written once beside it as plotly-VERSION.min.js and shared by "
+              "every report in that folder.")
+@progress_option
+def report(directory: Path, out: Path | None, output_alias: Path | None, plotlyjs: str,
+           progress: bool | None) -> None:
+    """Write one HTML page of DIR (opens from disk, no network).
 
     DIR is a run (``run``'s output, or plots, truth, tracks and sensors files, with
-    metrics.json from ``evaluate --json`` if you have it) or a ``montecarlo`` study. The
-    page holds the scene (zoom, pan), OSPA, OSPA(2) when evaluated, and cardinality per
-    scan, the metrics, the parameters and caps, and for studies the paired comparisons.
+    metrics.json from ``evaluate --json`` if you have it), a recording (plots, sensors and
+    tracks, no truth) or a ``montecarlo`` study. The page holds the scene (zoom, pan,
+    hover a track for its details), per-radar plot counts and update intervals, track
+    durations; with truth, OSPA, OSPA(2) when evaluated, cardinality per scan and the
+    metrics; the parameters and caps; for studies the paired comparisons.
     Needs the optional extra: pip install "mhtrack[report]".
     """
     from mhtrack.io.paths import check_output_file
 
-    if output is not None:
-        check_output_file(output, inputs=(), suffixes=(".html",), what="report", option="-o")
-    path = write_report_or_fail(directory, output)
+    out = out if out is not None else output_alias
+    if out is not None:
+        check_output_file(out, inputs=(), suffixes=(".html",), what="report", option="--out")
+    path = write_report_or_fail(directory, out, plotlyjs=plotlyjs,
+                                progress=progress_enabled(progress))
     click.echo(f"wrote {path}")
 
 

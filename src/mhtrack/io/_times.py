@@ -10,6 +10,12 @@ converted to float seconds.
   ``Z`` or ``±hh:mm`` — so that no local time is guessed; a timestamp column without a
   time zone is taken as UTC (Arrow's convention for naive timestamps).
 
+**Written back** (:func:`time_column`): tracks made from plots with ISO-8601 or timestamp
+times keep them — ISO-8601 UTC text with nanoseconds in CSV
+(``2024-05-01T12:00:03.250000000Z``), a ``timestamp[ns, UTC]`` column in Parquet —
+and numeric times stay numbers, written as before. The nanoseconds are
+``round(frac · 10⁹)`` of the seconds' fraction, so a float read back is the same float.
+
 A float64 near 1.7·10⁹ s resolves 2.4·10⁻⁷ s, far below any radar's timing. The text is
 parsed by Arrow's ISO-8601 parser (``pyarrow.compute.cast`` to ``timestamp[ns, UTC]``);
 whole seconds and the nanoseconds are combined as ``s + ns / 10⁹`` (one rounding).
@@ -77,6 +83,30 @@ def seconds(f: Frame, name: str = "time") -> np.ndarray:
         r = _first_failure(text, lambda a: pc.cast(a, _NS))
         f.fail(_bad_iso(text[r].as_py()), row=r, column=name)
     return posix_seconds(ns.view(pa.int64()).to_numpy(zero_copy_only=False))
+
+
+def is_iso(f: Frame, name: str = "time") -> bool:
+    """Whether column ``name`` of ``f`` holds times as ISO-8601 text or timestamps (not
+    numbers of seconds)."""
+    col = f.table.column(name)
+    if pa.types.is_timestamp(col.type):
+        return True
+    if not (pa.types.is_string(col.type) or pa.types.is_large_string(col.type)):
+        return False
+    first = next((v for v in col.to_pylist()[:1] if v is not None), None)
+    return first is not None and not _is_number(first)
+
+
+def time_column(seconds_: np.ndarray, iso: bool, fmt: str) -> pa.Array:
+    """Times to write: float seconds, or (``iso``) POSIX seconds as ISO-8601 UTC text
+    (``fmt`` ``"csv"``) or a ``timestamp[ns, UTC]`` column (Parquet)."""
+    v = np.asarray(seconds_, np.float64)
+    if not iso:
+        return pa.array(v, pa.float64())
+    whole = np.floor(v)
+    ns = whole.astype(np.int64) * 10**9 + np.rint((v - whole) * 1e9).astype(np.int64)
+    stamps = pa.array(ns, pa.int64()).cast(_NS)
+    return pc.strftime(stamps, format="%Y-%m-%dT%H:%M:%SZ") if fmt == "csv" else stamps
 
 
 def _is_number(value: str) -> bool:

@@ -21,7 +21,7 @@ from mhtrack.frames import frame_lengths, make_frames
 from mhtrack.io._checks import num
 from mhtrack.io._frame import FLOAT, INT, TIME, Frame, read_frame
 from mhtrack.io._source import PathArg
-from mhtrack.io._times import seconds
+from mhtrack.io._times import is_iso, seconds
 from mhtrack.models.radars import SensorSet
 from mhtrack.records import MAX_COORDINATE, PlotTable
 
@@ -59,7 +59,7 @@ def read_timed_plots(
     """
     if not reorder_window_s >= 0:
         raise ValueError(f"reorder_window_s must be >= 0, got {reorder_window_s!r}")
-    _f, c = read_timed_columns(path, sensors, order=lambda f, time: _check_order(
+    f, c = read_timed_columns(path, sensors, order=lambda f, time: _check_order(
         f, time, reorder_window_s))
     periods = {s: sensors.sensor(s).period if sensors is not None else None
                for s in np.unique(c.sensor).tolist()}
@@ -71,7 +71,7 @@ def read_timed_plots(
     return PlotTable(
         scan=frame[order], time=c.time[order], sensor=c.sensor[order], x=take(c.x),
         y=take(c.y), range=take(c.range), bearing=take(c.bearing), origin=take(c.origin),
-        R=take(c.R), timed=True, file_row=order.astype(np.int64),
+        R=take(c.R), timed=True, file_row=order.astype(np.int64), iso_times=is_iso(f),
     )  # type: ignore[arg-type]
 
 

@@ -1,9 +1,11 @@
 """TOML files: the one reader (scenarios, configurations) and the scenario writer.
 
 Read with :mod:`tomllib` (UTF-8, with or without a byte-order mark); written with
-``tomli-w``, atomically. Floats are written in shortest round-trip form, so a written scenario reads
-back exactly. Every reading problem is an :class:`~mhtrack.errors.InputError` in the one
-message style of :mod:`mhtrack.errors`, ``<file>[, line L[, column C]]: <problem>``, e.g.
+``tomli-w``, atomically, each array of plain values on one line (``[1.0, 2.5, 3.0]``; an
+array of such arrays one row per line — :func:`compact_arrays`). Floats are written in
+shortest round-trip form, so a written scenario reads back exactly. Every reading
+problem is an :class:`~mhtrack.errors.InputError` in the one message style of
+:mod:`mhtrack.errors`, ``<file>[, line L[, column C]]: <problem>``, e.g.
 ``s.toml, line 4, column 6: Expected '=' after a key in a key/value pair`` or
 ``s.toml, line 6: not valid UTF-8 text (byte 0xe9)``; a reader of the parsed dict reports
 a bad value as ``<file>: <key path>: <problem>`` (:func:`key_error`).
@@ -26,6 +28,11 @@ from mhtrack.io.atomic import atomic_write
 from mhtrack.io.paths import check_input_file
 
 _AT = re.compile(r"\s*\(at line (\d+), column (\d+)\)\s*$")
+#: One value tomli-w writes on its own line inside an array: a basic string (escaped, on
+#: one line), a number, a boolean or a date — no array or inline table.
+_SCALAR = r'(?:"(?:[^"\\\n]|\\.)*"|[^\s\[\]{},"\'#]+)'
+#: A multi-line array of such values, as tomli-w writes it (items indented, one a line).
+_ARRAY = re.compile(r"\[\n((?:[ ]+" + _SCALAR + r",\n)+)[ ]*\]")
 #: A message that starts with a key path: ``T: …``, ``targets[2].birth: …``.
 _KEY = re.compile(r"^[A-Za-z_][\w-]*(\[\d+\])*(\.[\w-]+(\[\d+\])*)*: ")
 
@@ -120,6 +127,19 @@ def _plain(value: Any, key: str) -> Any:
     return value
 
 
+def compact_arrays(text: str) -> str:
+    """``text`` (TOML as tomli-w writes it) with every array of plain values on one line,
+    so an array of arrays has one row per line. The result parses to the same data as
+    ``text`` (checked; ``text`` is returned unchanged otherwise, e.g. with a NaN, which
+    equals nothing)."""
+    def one_line(m: re.Match[str]) -> str:
+        items = [ln.strip().removesuffix(",") for ln in m[1].splitlines()]
+        return "[" + ", ".join(items) + "]"
+
+    out = _ARRAY.sub(one_line, text)
+    return out if tomllib.loads(out) == tomllib.loads(text) else text
+
+
 def write_scenario_toml(data: Mapping[str, Any], path: PathArg) -> None:
     """Write ``data`` (nested dicts, lists, numbers, strings, booleans; NumPy values are
     converted) to the TOML file ``path``.
@@ -130,7 +150,8 @@ def write_scenario_toml(data: Mapping[str, Any], path: PathArg) -> None:
     TypeError : a value has a type TOML cannot hold.
     InputError : the file cannot be written.
     """
-    text = tomli_w.dumps(_plain(data, ""))
+    plain = _plain(data, "")
+    text = compact_arrays(tomli_w.dumps(plain))
     try:
         atomic_write(path, text, make_parent=False)
     except OSError as e:

@@ -18,13 +18,15 @@ from mhtrack.io._checks import check_scan_order, check_unique, num
 from mhtrack.io._frame import (
     FLOAT,
     INT,
+    TIME,
     column_names,
     float_array,
     int_array,
     read_frame,
     write_frame,
 )
-from mhtrack.io._source import PathArg
+from mhtrack.io._source import PathArg, file_format
+from mhtrack.io._times import seconds, time_column
 from mhtrack.io.plots import plots_to_file_rows, plots_to_table_rows
 from mhtrack.io.truth import read_truth
 from mhtrack.records import NO_PLOT, PlotTable, TrackTable, TruthTable
@@ -37,7 +39,7 @@ REQUIRED = ("scan", "time", "track_id", "x", "y", "vx", "vy", "plot")
 #: (:mod:`mhtrack.frames`) instead of ``scan``, and each row has its state's own time.
 TIMED_REQUIRED = ("frame", *REQUIRED[1:])
 COLUMNS = dict.fromkeys((*REQUIRED, "score"), FLOAT) | {
-    "scan": INT, "frame": INT, "track_id": INT, "plot": INT, "tentative": INT
+    "scan": INT, "frame": INT, "track_id": INT, "plot": INT, "tentative": INT, "time": TIME
 } | _geodetic.COLUMNS
 
 
@@ -95,7 +97,7 @@ def read_tracks(
             raise tracks_error from None
         return tracks_from_truth(truth)
     scan = f.ints("frame" if timed else "scan")
-    time = f.floats("time")
+    time = seconds(f)  # seconds, or ISO-8601 times as POSIX seconds
     tid = f.ints("track_id")
     cols = _geodetic.read_state(f, frame)
     plot = f.ints("plot", nullable=True, fill=NO_PLOT)
@@ -137,21 +139,26 @@ def write_tracks(
     ``lat, lon`` and east/north ``vx, vy`` (:func:`mhtrack.io._geodetic.state_columns`);
     with ``plots`` (the table the tracker ran on), ``plot`` names the row of its file
     (:func:`~mhtrack.io.plots.plots_to_file_rows`). Tracks of timed plots are written
-    with ``frame`` in place of ``scan``: their rows have their states' own times."""
+    with ``frame`` in place of ``scan``: their rows have their states' own times. Plots
+    read with ISO-8601 times (``plots.iso_times``) give ISO-8601 times here too
+    (:func:`~mhtrack.io._times.time_column`)."""
     plot = table.plot if plots is None else plots_to_file_rows(table.plot, plots)
     write_track_rows(replace(table, plot=plot), path, frame,
-                     timed=plots is not None and plots.timed)
+                     timed=plots is not None and plots.timed,
+                     iso=plots is not None and plots.iso_times)
 
 
 def write_track_rows(table: TrackTable, path: PathArg, frame: LocalFrame | None = None, *,
-                     timed: bool = False) -> None:
+                     timed: bool = False, iso: bool = False) -> None:
     """Write ``table`` whose ``plot`` already holds the input's own rows (a sink's
     :meth:`~mhtrack.sources.base.Source.file_rows`), as :func:`write_tracks` does; ``timed``:
-    rows numbered by ``frame`` (tracks of timed plots), else by ``scan``."""
+    rows numbered by ``frame`` (tracks of timed plots), else by ``scan``; ``iso``: times
+    as ISO-8601 (the plots' times were; :func:`~mhtrack.io._times.time_column`)."""
     plot = table.plot
     cols = {
         "frame" if timed else "scan": int_array(table.scan),
-        "time": float_array(table.time),
+        "time": time_column(table.time, iso, file_format(path)) if iso
+        else float_array(table.time),
         "track_id": int_array(table.track_id),
         **_geodetic.state_columns(table.x, table.y, table.vx, table.vy, frame),
         "plot": int_array(plot, missing=plot == NO_PLOT),

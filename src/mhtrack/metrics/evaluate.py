@@ -43,6 +43,7 @@ from mhtrack.metrics.resample import (
     tracks_at_times,
     truth_times,
 )
+from mhtrack.progress import Stages, silent
 from mhtrack.records import PlotTable, TrackTable, TruthTable
 
 
@@ -273,6 +274,7 @@ def evaluate(
     max_age_s: float = DEFAULT_MAX_AGE_S,
     ospa2_window: int = DEFAULT_OSPA2_WINDOW,
     hota_distance: float | None = None,
+    stages: Stages | None = None,
 ) -> Evaluation:
     """Score ``tracks`` against ``truth``: OSPA, GOSPA (α = 2), cardinality, CLEAR-MOT and
     P1 Table 3's Rcc, Rmc, Rfg, Lmin/Lavg/Lmax (:func:`association_metrics`), OSPA(2)
@@ -319,6 +321,8 @@ def evaluate(
     hota_distance : float, optional
         HOTA's ``d_max`` (m): the similarity ``max(0, 1 − d/d_max)`` of a truth–track
         pair falls to 0 at this distance; defaults to ``cutoff``.
+    stages : mhtrack.progress.Stages, optional
+        Runs each metric as a stage of a progress bar (``evaluate``'s, ``report``'s).
 
     Returns
     -------
@@ -347,24 +351,23 @@ def evaluate(
         tracks = tracks_at_times(tracks, t_idx, idx, age)
         if plots is not None and not is_synchronous(tracks, truth, plots):
             plots = None  # frames of timed plots are not the truth's scans: no Rcc/Rmc
-    data = ScanIndexed.build(tracks, truth, idx)  # checked and indexed once, for every metric
-    mot = clear_mot_indexed(data, d_match)
+    run = stages or silent()
+    data = run("index", ScanIndexed.build, tracks, truth, idx)  # checked once, for all
+    mot = run("CLEAR-MOT", clear_mot_indexed, data, d_match)
     return Evaluation(
-        cutoff=c,
-        order=p,
-        match_distance=d_match,
-        scans=idx,
-        ospa=ospa_indexed(data, c, p),
-        gospa=gospa_indexed(data, c, p),
-        cardinality=cardinality_indexed(data),
+        cutoff=c, order=p, match_distance=d_match, scans=idx,
+        ospa=run("OSPA", ospa_indexed, data, c, p),
+        gospa=run("GOSPA", gospa_indexed, data, c, p),
+        cardinality=run("cardinality", cardinality_indexed, data),
         clear_mot=mot,
         n_tracks=n_tracks,
         n_targets=len(np.unique(truth.target_id)),
-        association=association_indexed(data, plots, mot.matching, d_match),
+        association=run("association", association_indexed, data, plots, mot.matching,
+                        d_match),
         at=how,
         max_age_s=None if how == "scans" else age,
-        ospa2=ospa2_indexed(data, c, p, window),
-        hota=hota_indexed(data, d_max),
+        ospa2=run("OSPA(2)", ospa2_indexed, data, c, p, window),
+        hota=run("HOTA", hota_indexed, data, d_max),
     )
 
 
@@ -386,7 +389,6 @@ def _fmt(v: float, unit: str = "") -> str:
 
 def _render(header: tuple[str, ...], rows: list[tuple[str, ...]]) -> str:
     widths = [max(len(r[i]) for r in [header, *rows]) for i in range(len(header))]
-
     # first column left-aligned (labels), the others right-aligned (numbers)
     def line(r: tuple[str, ...]) -> str:
         cells = [r[0].ljust(widths[0])] + [

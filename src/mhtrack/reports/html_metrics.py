@@ -63,7 +63,8 @@ def curves_figure(curves: Mapping[str, Curves], *, cutoff: float | None = None,
                   x_title: str = "scan") -> go.Figure:
     """OSPA, OSPA(2) (when present) and cardinality per scan, one panel each, x shared;
     one colour per entry of ``curves`` (a label → per-scan lists), mean ± std bands where
-    the ``*_std`` lists are given, the true number of targets dashed black (last)."""
+    the ``*_std`` lists are given, the true number of targets dashed black (last). The
+    x axis and the hover both name the x values ``x_title``."""
     from plotly.subplots import make_subplots
 
     panels = panels_of(curves)
@@ -92,7 +93,7 @@ def curves_figure(curves: Mapping[str, Curves], *, cutoff: float | None = None,
             fig.add_trace({"type": "scatter", "x": x, "y": y, "mode": "lines",
                            "name": label, "legendgroup": label, "showlegend": row == 1,
                            "line": {"color": color, "width": 1.8},
-                           "hovertemplate": f"{label}: %{{y:.4g}} at scan %{{x}}"
+                           "hovertemplate": f"{label}: %{{y:.4g}} at {x_title} %{{x}}"
                                             "<extra></extra>"}, row=row, col=1)
             true = _values(c, "cardinality_true") if key == "cardinality" else None
             if true is not None and true_curve is None:
@@ -139,9 +140,9 @@ METRIC_ROWS: Sequence[tuple[str, str, str]] = (
     ("rcc", "Rcc (P1 Table 3)", ""),
     ("rmc", "Rmc", ""),
     ("rfg", "Rfg", ""),
-    ("l_min", "Lmin (scans)", ""),
-    ("l_avg", "Lavg (scans)", ""),
-    ("l_max", "Lmax (scans)", ""),
+    ("l_min", "Lmin (track life)", "s"),
+    ("l_avg", "Lavg", "s"),
+    ("l_max", "Lmax", "s"),
     ("delay_mean", "confirmation delay mean (scans)", ""),
     ("delay_max", "confirmation delay max (scans)", ""),
     ("t_avg", "tracker time per scan", "s"),

@@ -19,13 +19,18 @@ extra ``mhtrack[report]``).
 from __future__ import annotations
 
 import json
+import logging
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from mhtrack.io.atomic import atomic_write
+from mhtrack.progress import Stages, silent
 from mhtrack.reports.html_metrics import curves_figure, fmt, metric_rows
 from mhtrack.reports.html_page import Page, require_plotly
 
+log = logging.getLogger("mhtrack.reports")
 REPORT_FILE = "report.html"
 #: ``montecarlo``'s spec file: its presence makes a directory a study.
 STUDY_FILE = "montecarlo.json"
@@ -63,7 +68,7 @@ def _geometry(directory: Path) -> tuple[Any, Any, list[Any], Any]:
     return scenario, None, sites, None
 
 
-def _evaluation(directory: Path, plots: Any, truth: Any, tracks: Any
+def _evaluation(directory: Path, plots: Any, truth: Any, tracks: Any, run: Stages
                 ) -> tuple[dict[str, Any] | None, str]:
     """``metrics.json`` if present, else an evaluation with ``evaluate``'s defaults when
     truth and tracks are there; and a note saying which."""
@@ -77,13 +82,15 @@ def _evaluation(directory: Path, plots: Any, truth: Any, tracks: Any
             raise ValueError(f"{path}: expected one JSON object (evaluate --json)")
         return data, f"Metrics read from {path.name}."
     if truth is None or tracks is None:
-        return None, "No metrics: the directory has no metrics.json, truth or tracks file."
+        return None, ("No metrics: the directory has no metrics.json, and no truth file to "
+                      "evaluate the tracks against." if truth is None else
+                      "No metrics: the directory has no metrics.json and no tracks file.")
     from mhtrack.io.tracks import has_frames
     from mhtrack.metrics import evaluate
 
     tracks_path = _table(directory, "tracks")
     at = None if tracks_path is not None and has_frames(tracks_path) else "scans"
-    ev = evaluate(tracks, truth, plots=plots, at=at)
+    ev = run("evaluate", evaluate, tracks, truth, plots=plots, at=at)
     return ev.to_dict(), ("No metrics.json: metrics computed for this page with evaluate's "
                           "defaults (c = 500 m, p = 2).")
 
@@ -130,54 +137,113 @@ def _caps_text(caps: Any) -> list[tuple[str, str]]:
     return [(f"cap {k}", f"acted in {fmt(v)} scans") for k, v in dict(caps).items()]
 
 
-def run_page(directory: Path) -> Page:
-    """The page of a run directory (module docstring)."""
+def _title(directory: Path, scenario: Any, tracker: Any, seed: Any, plots: Any,
+           tracks: Any, truth: Any) -> str:
+    """The page's title: scenario (or folder) name, tracker, seed; for a recording without
+    truth also its tracks, plots and radars."""
+    name = scenario.name if scenario is not None else (directory.resolve().name or "run")
+    parts = [name, tracker, None if seed is None else f"seed {seed}"]
+    if truth is None:
+        parts.append(None if tracks is None
+                     else f"{len(np.unique(tracks.online().track_id))} tracks")
+        if plots is not None:
+            n_radars = len(np.unique(plots.sensor))
+            parts.append(f"{len(plots)} plots from {n_radars} "
+                         f"radar{'s' if n_radars != 1 else ''}")
+    return ", ".join(str(v) for v in parts if v is not None)
+
+
+def _recording_sections(page: Page, plots: Any, tracks: Any, details: dict[str, Any],
+                        sensor_set: Any) -> None:
+    """Radars, tracks and the histogram of track lengths (:mod:`html_recording`)."""
+    from mhtrack.reports import html_recording as rec
+
+    if plots is not None and len(plots):
+        page.section("Radars")
+        page.note("Per sensor: its plots, how many the tracks used, and the median time "
+                  "between consecutive plots of one track from that sensor (its update "
+                  "interval as the tracks saw it), beside the sensors file's period.")
+        page.table(rec.RADAR_HEADER, rec.radar_rows(plots, tracks, rec.periods_of(sensor_set)))
+    if tracks is not None:
+        page.section("Tracks")
+        page.note("Durations from the first to the last row of each track reported at its "
+                  "own scan (rows written after confirmation not counted).")
+        page.table(["", "value"], rec.track_rows(tracks, details))
+        if len(tracks):
+            page.figure(rec.lengths_figure(tracks), "lengths")
+
+
+#: Stages of a run's page (the progress bar's length).
+RUN_STAGES = 7
+
+
+def run_page(directory: Path, stages: Stages | None = None) -> Page:
+    """The page of a run directory (module docstring); ``stages`` shows its progress."""
     from mhtrack.io import read_plots, read_toml, read_tracks, read_truth
-    from mhtrack.reports.html_scene import scene_figure
+    from mhtrack.reports.html_recording import sensor_rows, track_details
+    from mhtrack.reports.html_scene import MAX_PLOTS, MAX_TRACK_POINTS, scene_figure
 
     paths = {s: _table(directory, s) for s in ("plots", "truth", "tracks")}
     if not any(paths.values()):
         raise ValueError(f"{directory} holds no plots, truth or tracks file (nor "
                          f"{STUDY_FILE}): nothing to report")
+    run = stages or silent()
     scenario, sensor_set, sites, frame = _geometry(directory)
-    plots = read_plots(paths["plots"], sensors=sensor_set) if paths["plots"] else None
+    plots = (run("read plots", read_plots, paths["plots"], sensors=sensor_set)
+             if paths["plots"] else None)
     lframe = sensor_set.frame() if sensor_set is not None and frame is not None else None
-    truth = read_truth(paths["truth"], frame=lframe) if paths["truth"] else None
-    tracks = (read_tracks(paths["tracks"], frame=lframe,
-                          plots=plots if plots is not None and plots.timed else None)
+    truth = run("read truth", read_truth, paths["truth"], frame=lframe) if paths["truth"] \
+        else None
+    tracks = (run("read tracks", read_tracks, paths["tracks"], frame=lframe,
+                  plots=plots if plots is not None and plots.timed else None)
               if paths["tracks"] else None)
-    summary, source = _evaluation(directory, plots, truth, tracks)
+    details = ({} if tracks is None else run("track details", track_details, tracks,
+                                              paths["tracks"], plots, paths["plots"]))
+    summary, source = _evaluation(directory, plots, truth, tracks, run)
     seed = (read_toml(directory / "scenario.toml").get("seed")
             if (directory / "scenario.toml").is_file() else None)
-    name = scenario.name if scenario is not None else directory.name
     tracker = (summary or {}).get("tracker")
-    title = ", ".join(str(v) for v in (name, tracker, None if seed is None else f"seed {seed}")
-                      if v is not None)
+    title = _title(directory, scenario, tracker, seed, plots, tracks, truth)
     page = Page(f"mhtrack report: {title}", str(directory))
     page.section("Scene")
-    page.note("Truth (black, o at birth, x at death), plots (clutter grey), tracks (one "
-              "colour per id, dotted before confirmation)" + (", radar sites (red)" if sites
-                                                              else "")
-              + ". Drag to pan, wheel or box to zoom, double-click to reset, click a legend "
-              "entry to hide it."
+    page.note(("Truth (black, o at birth, x at death), plots" if truth is not None
+               else "Plots") + " (clutter grey), tracks (one colour per id, dotted before "
+              "confirmation)" + (", radar sites (red)" if sites else "")
+              + ". Hover a track for its speed, heading and what the files give (flight "
+              "level, code, score, sensors). Drag to pan, wheel or box to zoom, "
+              "double-click to reset, click a legend entry to hide it."
               + (" Dashed lines: latitude and longitude (WGS-84), no map." if frame else ""))
-    page.figure(scene_figure(plots, truth, tracks, sites=sites, frame=frame, title=title),
-                "scene")
-    page.section("Metrics over time")
-    page.note(source)
-    if summary is not None and summary.get("scans"):
-        at_truth = summary.get("at") == "truth-times"
-        page.figure(curves_figure({str(tracker or "tracks"): summary},
-                                  cutoff=summary.get("cutoff"),
-                                  ospa2_window=summary.get("ospa2_window"),
-                                  x_title="truth time index" if at_truth else "scan"),
-                    "curves")
-    page.section("Metrics")
-    if summary is not None:
-        page.table(["metric", "value"], metric_rows(summary))
+    n_track_rows = 0 if tracks is None else len(tracks)
+    if (plots is not None and len(plots) > MAX_PLOTS) or n_track_rows > MAX_TRACK_POINTS:
+        page.note(f"Thinned for drawing: at most {MAX_PLOTS} plots of each kind and about "
+                  f"{MAX_TRACK_POINTS} track rows are drawn (every k-th, evenly spread; the "
+                  "legend says how many); the tables count every row.")
+    page.figure(run("scene", scene_figure, plots, truth, tracks, sites=sites, frame=frame,
+                    title=title, details=details), "scene")
+    if truth is not None or summary is not None:
+        page.section("Metrics over time")
+        page.note(source)
+        if summary is not None and summary.get("scans"):
+            at_truth = summary.get("at") == "truth-times"
+            page.figure(curves_figure({str(tracker or "tracks"): summary},
+                                      cutoff=summary.get("cutoff"),
+                                      ospa2_window=summary.get("ospa2_window"),
+                                      x_title="truth time index" if at_truth else "scan"),
+                        "curves")
+        page.section("Metrics")
+        if summary is not None:
+            page.table(["metric", "value"], metric_rows(summary))
+    _recording_sections(page, plots, tracks, details, sensor_set)
     page.section("Parameters and caps")
     page.table(None, _run_parameters(scenario, summary, seed)
+               + ([] if scenario is not None else sensor_rows(sensor_set))
+               + [(f"{k} file", p.name) for k, p in paths.items() if p is not None]
                + _caps_text((summary or {}).get("caps")), numbers=False)
+    if truth is None and summary is None:
+        page.note("No truth file: the page shows what the recording and its tracks say; "
+                  "with truth (or metrics.json) it also shows the metrics. The tracker's "
+                  "own parameters are those `mhtrack track` printed; tracks.csv does not "
+                  "store them.")
     return page
 
 
@@ -226,18 +292,36 @@ def study_page(directory: Path) -> Page:
     return page
 
 
-def report_page(directory: str | Path) -> Page:
+def report_page(directory: str | Path, stages: Stages | None = None) -> Page:
     """The page of ``directory``: a study when it holds ``montecarlo.json``, else a run."""
     directory = Path(directory)
     require_plotly()
     if not directory.is_dir():
         raise FileNotFoundError(f"{directory}: no such directory")
-    return study_page(directory) if (directory / STUDY_FILE).is_file() else run_page(directory)
+    if (directory / STUDY_FILE).is_file():
+        return study_page(directory)
+    return run_page(directory, stages)
 
 
-def write_html_report(directory: str | Path, out: str | Path | None = None) -> Path:
+def write_html_report(directory: str | Path, out: str | Path | None = None, *,
+                      plotlyjs: str = "inline", progress: bool = False) -> Path:
     """Write the report of ``directory`` to ``out`` (default ``DIR/report.html``),
-    atomically; returns its path."""
+    atomically; returns its path. ``plotlyjs="file"`` writes Plotly's JavaScript once
+    beside the page (:func:`~mhtrack.reports.html_page.plotlyjs_name`, kept when already
+    there) instead of inlining it. ``progress``: a bar over the stages on stderr."""
+    from plotly.offline import get_plotlyjs
+
+    from mhtrack.reports.html_page import plotlyjs_name
+
     directory = Path(directory)
     path = Path(out) if out is not None else directory / REPORT_FILE
-    return atomic_write(path, report_page(directory).render())
+    run = Stages(RUN_STAGES + 1, "report", progress)
+    try:
+        text = run("render", report_page(directory, run).render, plotlyjs)
+        if plotlyjs == "file" and not (js := path.parent / plotlyjs_name()).is_file():
+            atomic_write(js, get_plotlyjs())
+        written = atomic_write(path, text)
+    finally:
+        run.close()
+    log.info("report of %s: %s (%.1f MB)", directory, written, len(text) / 1e6)
+    return written

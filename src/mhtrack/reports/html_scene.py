@@ -28,9 +28,11 @@ if TYPE_CHECKING:
     from mhtrack.models.geodesy import LocalFrame
 
 #: Most plots drawn (SVG markers); more are thinned to every k-th plot.
-MAX_PLOTS = 30_000
+MAX_PLOTS = 10_000
 #: Most tracks drawn as one trace each (hover, own colour); more share one trace.
 MAX_TRACK_TRACES = 250
+#: Most track rows drawn; more are thinned to every k-th row of each track.
+MAX_TRACK_POINTS = 40_000
 #: Plotly's default qualitative colours (the ``D3`` palette, as matplotlib's ``tab10``).
 PALETTE = ("#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2",
            "#7f7f7f", "#bcbd22", "#17becf")
@@ -39,12 +41,17 @@ GRID_STEPS = (0.01, 0.02, 0.05, 0.1, 0.2, 0.25, 0.5, 1.0, 2.0, 5.0, 10.0, 15.0, 
 GRID_LINES = 8
 
 
+#: The type of drawn coordinates: float32 (7 digits: 0.1 m at 1000 km) halves their
+#: share of the page against float64. Hover data (times: POSIX seconds) stays float64.
+DRAWN = np.float32
+
+
 def _gapped(xs: Sequence[np.ndarray]) -> np.ndarray:
     """Concatenate polylines with a NaN between them (Plotly breaks a line at a gap)."""
     parts: list[np.ndarray] = []
     for x in xs:
-        parts += [np.asarray(x, float), np.array([np.nan])]
-    return np.concatenate(parts) if parts else np.empty(0)
+        parts += [np.asarray(x, DRAWN), np.array([np.nan], DRAWN)]
+    return np.concatenate(parts) if parts else np.empty(0, DRAWN)
 
 
 def _segments(ids: np.ndarray, order_key: np.ndarray) -> list[np.ndarray]:
@@ -61,11 +68,13 @@ def _thin(n: int, most: int) -> np.ndarray:
     return np.unique(np.linspace(0, n - 1, most).astype(np.int64))
 
 
-def plot_traces(plots: PlotTable, scale: float) -> list[dict[str, Any]]:
+def plot_traces(plots: PlotTable, scale: float, *, word: str = "scan"
+                ) -> list[dict[str, Any]]:
     """Plots as markers: clutter grey and target plots blue when ``origin`` is known;
-    each kind thinned to at most :data:`MAX_PLOTS` (its legend entry then says so)."""
-    hover = ("scan %{customdata[0]}, t = %{customdata[1]:.1f} s, sensor %{customdata[2]}"
-             "<extra></extra>")
+    each kind thinned to at most :data:`MAX_PLOTS` (its legend entry then says so).
+    Hover: ``word`` (scan, or frame for timed plots), time and sensor."""
+    hover = (f"{word} %{{customdata[0]}}, t = %{{customdata[1]:.1f}} s, sensor "
+             "%{customdata[2]}<extra></extra>")
     kinds = ([("plots", np.arange(len(plots)), {"size": 3, "color": "#8c8c8c"})]
              if plots.origin is None else
              [("clutter", np.flatnonzero(plots.origin < 0), {"size": 3, "color": "#b3b3b3"}),
@@ -76,7 +85,8 @@ def plot_traces(plots: PlotTable, scale: float) -> list[dict[str, Any]]:
         keep = rows[_thin(len(rows), MAX_PLOTS)]
         note = "" if len(keep) == len(rows) else f" ({len(keep)} of {len(rows)} drawn)"
         out.append({"type": "scatter", "mode": "markers", "name": name + note,
-                    "x": plots.x[keep] / scale, "y": plots.y[keep] / scale,
+                    "x": (plots.x[keep] / scale).astype(DRAWN),
+                    "y": (plots.y[keep] / scale).astype(DRAWN),
                     "customdata": np.column_stack([plots.scan[keep], plots.time[keep],
                                                    plots.sensor[keep]]),
                     "hovertemplate": hover, "marker": marker})
@@ -105,41 +115,97 @@ def truth_traces(truth: TruthTable, scale: float) -> list[dict[str, Any]]:
     return [line, *ends]
 
 
-def track_traces(tracks: TrackTable, scale: float) -> list[dict[str, Any]]:
+def _thin_rows(segs: list[np.ndarray], most: int) -> tuple[list[np.ndarray], bool]:
+    """Every k-th row of each polyline (its last kept) so that at most about ``most``
+    rows remain in all; whether anything was dropped."""
+    total = sum(len(r) for r in segs)
+    if total <= most:
+        return segs, False
+    k = math.ceil(total / most)
+    return [np.unique(np.append(r[::k], r[-1])) if len(r) else r for r in segs], True
+
+
+def _hover(details: dict[str, np.ndarray], word: str) -> tuple[list[str], str]:
+    """The per-row hover columns (besides id, scan and time) and their template."""
+    names, parts = [], []
+    j = 3
+    for name, fmt_ in (("speed", "speed %{customdata[J]:.0f} m/s"),
+                       ("heading", "heading %{customdata[J]:.0f}°"),
+                       ("flight_level", "FL %{customdata[J]:.0f}"),
+                       ("score", "score %{customdata[J]:.1f}"),
+                       ("sensor", "plot of sensor %{customdata[J]}")):
+        v = details.get(name)
+        if v is None or (v.dtype.kind == "f" and not np.isfinite(v).any()):
+            continue
+        names.append(name)
+        parts.append(fmt_.replace("J", str(j)))
+        j += 1
+    head = f"track %{{customdata[0]}}, {word} %{{customdata[1]}}, t = %{{customdata[2]:.1f}} s"
+    return names, head + ("<br>" + ", ".join(parts) if parts else "")
+
+
+def _track_labels(rows: np.ndarray, details: dict[str, np.ndarray]) -> str:
+    """What is constant along a track: its Mode 3/A codes, callsigns and sensors."""
+    out = []
+    for name, label in (("mode_3a", "code"), ("callsign", "callsign"), ("sensor", "sensors")):
+        v = details.get(name)
+        if v is None:
+            continue
+        vals = [x for x in v[rows].tolist() if x not in ("", -1)]
+        if vals:
+            out.append(f"{label} " + ", ".join(str(x) for x in sorted(set(vals))))
+    return "<br>" + ", ".join(out) if out else ""
+
+
+def track_traces(tracks: TrackTable, scale: float, details: dict[str, np.ndarray] | None
+                 = None, *, word: str = "scan") -> list[dict[str, Any]]:
     """Tracks: one trace per id (its own colour, labelled at its end) up to
     :data:`MAX_TRACK_TRACES` ids, else one trace for all; rows reported before the track
-    was confirmed (``tentative``, the history output) in one dotted trace."""
+    was confirmed (``tentative``, the history output) in one dotted trace. Hover: id,
+    ``word`` (scan or frame), time and the ``details`` given per row (speed, heading,
+    flight level, score, sensor; code, callsign and sensors per track —
+    :func:`mhtrack.reports.html_recording.track_details`). More than
+    :data:`MAX_TRACK_POINTS` rows are thinned to every k-th row of each track (the legend
+    says so)."""
+    details = details or {}
     tent = (np.zeros(len(tracks), bool) if tracks.tentative is None
             else np.asarray(tracks.tentative, bool))
     segs = _segments(tracks.track_id, tracks.time)
-    hover = ("track %{customdata[0]}, scan %{customdata[1]}, t = %{customdata[2]:.1f} s"
-             "<extra></extra>")
+    names, hover = _hover(details, word)
+    columns = [tracks.track_id, tracks.scan, tracks.time, *(details[n] for n in names)]
 
-    def trace(rows_list: list[np.ndarray], **kw: Any) -> dict[str, Any]:
-        data = [np.column_stack([tracks.track_id[r], tracks.scan[r], tracks.time[r]])
-                for r in rows_list]
-        gaps = np.full((1, 3), np.nan)
+    def trace(rows_list: list[np.ndarray], extra: str = "", **kw: Any) -> dict[str, Any]:
+        data = [np.column_stack([c[r] for c in columns]) for r in rows_list]
+        gaps = np.full((1, len(columns)), np.nan)
         custom = np.concatenate([p for d in data for p in (d, gaps)]) if data else gaps
         return {"type": "scatter", "mode": "lines", "legendgroup": "tracks",
                 "x": _gapped([tracks.x[r] / scale for r in rows_list]),
                 "y": _gapped([tracks.y[r] / scale for r in rows_list]),
-                "customdata": custom, "hovertemplate": hover, **kw}
+                "customdata": custom, "hovertemplate": hover + extra + "<extra></extra>",
+                **kw}
 
     out: list[dict[str, Any]] = []
     if tent.any():  # dotted up to the first confirmed row after the tentative ones
         dotted = [r[: np.flatnonzero(tent[r])[-1] + 2] for r in segs if tent[r].any()]
-        out.append(trace(dotted, name="tracks before confirmation", legendgroup="tentative",
+        dotted, thinned = _thin_rows(dotted, MAX_TRACK_POINTS // 4)
+        out.append(trace(dotted, name="tracks before confirmation"
+                         + (" (thinned)" if thinned else ""), legendgroup="tentative",
                          line={"color": "#7f7f7f", "width": 1.2, "dash": "dot"}))
     solid = [r[~tent[r]] for r in segs]
     solid = [r for r in solid if len(r)]
+    whole = solid
+    solid, thinned = _thin_rows(solid, MAX_TRACK_POINTS)
+    note = f", every {math.ceil(sum(map(len, whole)) / MAX_TRACK_POINTS)}-th row drawn" \
+        if thinned else ""
     if len(solid) > MAX_TRACK_TRACES:
-        out.append(trace(solid, name=f"tracks ({len(solid)})",
+        out.append(trace(solid, name=f"tracks ({len(solid)}{note})",
                          line={"color": "#1f77b4", "width": 1.4}))
         return out
-    for j, r in enumerate(solid):
+    for j, (r, full) in enumerate(zip(solid, whole, strict=True)):
         tid = int(tracks.track_id[r[0]])
-        t = trace([r], name="tracks", showlegend=j == 0, mode="lines+text",
-                  line={"color": PALETTE[tid % len(PALETTE)], "width": 1.8})
+        t = trace([r], _track_labels(full, details),
+                  name="tracks" + (f" ({note[2:]})" if note else ""), showlegend=j == 0,
+                  mode="lines+text", line={"color": PALETTE[tid % len(PALETTE)], "width": 1.8})
         t["text"] = [""] * (len(r) - 1) + [str(tid), ""]
         t["textposition"] = "top right"
         t["textfont"] = {"color": PALETTE[tid % len(PALETTE)], "size": 10}
@@ -230,10 +296,12 @@ def _box(tables: Sequence[Any], sites: Sequence[Site]) -> tuple[float, float, fl
 
 def scene_figure(plots: PlotTable | None = None, truth: TruthTable | None = None,
                  tracks: TrackTable | None = None, *, sites: Sequence[Site] = (),
-                 frame: LocalFrame | None = None, title: str = "") -> go.Figure:
+                 frame: LocalFrame | None = None, title: str = "",
+                 details: dict[str, np.ndarray] | None = None) -> go.Figure:
     """The scene as a :class:`plotly.graph_objects.Figure`: plots, truth, tracks, radar
     ``sites`` and, when ``frame`` is given (a geographic scene), the lat/lon grid.
-    Equal axes, kilometres when the scene spans more than 10 km."""
+    Equal axes, kilometres when the scene spans more than 10 km. ``details``: per track
+    row, what the hover shows besides id, scan and time (:func:`track_traces`)."""
     import plotly.graph_objects as go
 
     box = _box((plots, truth, tracks), sites)
@@ -244,11 +312,12 @@ def scene_figure(plots: PlotTable | None = None, truth: TruthTable | None = None
     if frame is not None:
         traces += latlon_grid(frame, box, scale)
     if plots is not None and len(plots):
-        traces += plot_traces(plots, scale)
+        traces += plot_traces(plots, scale, word="frame" if plots.timed else "scan")
     if truth is not None and len(truth):
         traces += truth_traces(truth, scale)
     if tracks is not None and len(tracks):
-        traces += track_traces(tracks, scale)
+        traces += track_traces(tracks, scale, details,
+                               word="frame" if plots is not None and plots.timed else "scan")
     traces += site_traces(sites, scale)
     fig = go.Figure(data=traces)
     fig.update_layout(

@@ -26,6 +26,7 @@ the beam, on the WGS-84 ellipsoid, the truth sampled every ``truth_dt`` seconds 
 
 from __future__ import annotations
 
+import logging
 from dataclasses import dataclass
 
 import numpy as np
@@ -36,6 +37,8 @@ from mhtrack.records import CLUTTER, PlotTable, TruthTable
 from mhtrack.scenario.spec import Scenario
 from mhtrack.scenario.targets import Target
 from mhtrack.scenario.trajectory import sample_truth, segments
+
+log = logging.getLogger("mhtrack.scenario")
 
 _TRUTH_STREAM = 0
 _PLOT_STREAM = 1
@@ -119,6 +122,7 @@ def simulate(scenario: Scenario, seed: int = 0) -> Simulation:
     parts: dict[str, list[np.ndarray]] = {
         k: [] for k in ("scan", "sensor", "z", "R", "rb", "origin")
     }
+    debug = log.isEnabledFor(logging.DEBUG)  # checked once: the per-scan line costs nothing
     for k, a, b in zip(
         scenario.scan_indices().tolist(), bounds.tolist(), ends.tolist(), strict=True
     ):
@@ -144,6 +148,9 @@ def simulate(scenario: Scenario, seed: int = 0) -> Simulation:
                 parts["rb"].append(np.full((n, 2), np.nan))
             parts["scan"].append(np.full(n, k, np.int64))
             parts["sensor"].append(np.full(n, sensor.id, np.int64))
+            if debug:
+                log.debug("simulate: scan %d, sensor %d: %d targets, %d detected, %d clutter",
+                          k, sensor.id, len(live_ids), len(det.z), len(clut.z))
 
     scan = np.concatenate(parts["scan"])
     z = np.concatenate(parts["z"]).reshape(-1, 2)
@@ -160,6 +167,8 @@ def simulate(scenario: Scenario, seed: int = 0) -> Simulation:
         R=np.concatenate(parts["R"]).reshape(-1, 2, 2) if keep_R else None,
         scan_times=(scenario.scan_indices(), scenario.scan_times()),
     )
+    log.info("simulate %s (seed %d): %d scans, %d plots, %d targets", scenario.name, seed,
+             len(scenario.scan_indices()), len(plots), len(np.unique(truth.target_id)))
     return Simulation(scenario=scenario, seed=seed, plots=plots, truth=truth)
 
 

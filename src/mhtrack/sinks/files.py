@@ -79,7 +79,9 @@ class TracksFileSink(_Rows):
 
     def _write(self, path: Path) -> None:
         timed = self.source is not None and self.source.timed
-        write_track_rows(self._file_rows(self.rows.tracks()), path, self.frame, timed=timed)
+        iso = self.source is not None and self.source.iso_times
+        write_track_rows(self._file_rows(self.rows.tracks()), path, self.frame, timed=timed,
+                         iso=iso)
         self.paths.append(path)
 
 

@@ -78,6 +78,7 @@ class Source(ABC):
     name : the input as the user named it (a path, ``"udp://…"``); errors name it.
     timed : whether the plots carry their own times (frames of one sensor each) rather
         than synchronous scans.
+    iso_times : whether the input wrote its times as ISO-8601 (the tracks then are too).
     sensors : the sensors' sites, errors and periods (timed plots, recordings), or
         ``None``.
     scenario : the scenario giving the sensors and every scan time (synchronous tables
@@ -87,6 +88,8 @@ class Source(ABC):
 
     name: str
     timed: bool
+    #: The input's times were ISO-8601 text or timestamps (tracks are written so too).
+    iso_times: bool = False
     sensors: SensorSet | None = None
     scenario: Scenario | None = None
 

@@ -30,6 +30,7 @@ class MemorySource(Source):
         self.table = table
         self.name = name
         self.timed = bool(table.timed)
+        self.iso_times = bool(table.iso_times)
         self.sensors = sensors
         self.scenario = scenario
 

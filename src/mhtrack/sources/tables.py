@@ -24,6 +24,7 @@ import numpy as np
 
 from mhtrack.frames import DEFAULT_FRAME_S, frame_lengths
 from mhtrack.io._source import PathArg
+from mhtrack.io._times import is_iso
 from mhtrack.io.plots import check_scan_times, is_timed, read_plots
 from mhtrack.io.timed_plots import DEFAULT_REORDER_WINDOW_S, read_timed_columns
 from mhtrack.records import PlotTable, Scan
@@ -59,6 +60,7 @@ class TableSource(Source):
                                  "sensors come from a sensors file, not a scenario")
             self.sensors = sensors
             self._frame, self._cols = read_timed_columns(path, sensors)
+            self.iso_times = is_iso(self._frame)
             if sensors is None and self._frame.has("range"):
                 _warn_polar(path, timed=True)
             self._table: PlotTable | None = None
@@ -68,6 +70,7 @@ class TableSource(Source):
                                  "from a scenario, not a sensors file")
             self.scenario = scenario
             self._table = _read_scans(path, scenario)
+            self.iso_times = self._table.iso_times
 
     def __iter__(self) -> Iterator[Scan]:
         self.stats = SourceStats()

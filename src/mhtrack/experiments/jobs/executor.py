@@ -113,6 +113,20 @@ def _run_pool(jobs: Iterator[Job], fn: JobFunction, workers: int, finish: Finish
     pool.shutdown(wait=True)
 
 
+#: The one line when Dask is missing (it is the optional extra ``dask``).
+MISSING_DASK = ("--dask-scheduler needs Dask's distributed scheduler: "
+                "pip install 'mhtrack[dask]'")
+
+
+def require_dask() -> None:
+    """Raise :class:`ImportError` with :data:`MISSING_DASK` when ``distributed`` is not
+    installed."""
+    try:
+        import distributed  # noqa: F401
+    except ImportError as e:
+        raise ImportError(MISSING_DASK) from e
+
+
 def dask_key(job: Job) -> str:
     """The Dask task key of ``job``: ``mhtrack-<key with / as ->-<hash[:12]>``."""
     return f"mhtrack-{job.key.replace('/', '-')}-{job.hash[:12]}"
@@ -120,6 +134,7 @@ def dask_key(job: Job) -> str:
 
 def _run_dask(jobs: Iterator[Job], fn: JobFunction, scheduler: Any, finish: Finish,
               window: int) -> None:
+    require_dask()
     from distributed import Client, as_completed
 
     own = not isinstance(scheduler, Client)

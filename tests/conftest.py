@@ -1,0 +1,14 @@
+"""Hooks for the whole suite (loaded by pytest-xdist's controller too)."""
+
+from __future__ import annotations
+
+
+def pytest_terminal_summary(terminalreporter) -> None:
+    """The measurements the browser tests record (``record_property("measured", …)``),
+    one line each at the end of the run (also from pytest-xdist's workers)."""
+    lines = [v for r in terminalreporter.stats.get("passed", [])
+             for k, v in getattr(r, "user_properties", []) if k == "measured"]
+    if lines:
+        terminalreporter.write_sep("-", "measured in the browser")
+        for line in lines:
+            terminalreporter.write_line(line)

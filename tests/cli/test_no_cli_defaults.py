@@ -80,6 +80,11 @@ def _options(tree: ast.AST) -> list[tuple[str, ast.Call]]:
                      and isinstance(a.value, str)]
             plain = [d for d in decls if d.isidentifier()]
             flags = [d.split("/")[0].strip() for d in decls if d.startswith("-")]
+            if not plain and not flags:  # names built at run time (a hidden alias)
+                has_default = any(k.arg == "default" for k in node.keywords)
+                assert not has_default, f"an option with computed names has a default: " \
+                    f"{ast.unparse(node)}"
+                continue
             name = plain[0] if plain else max(flags, key=len).lstrip("-").replace("-", "_")
             out.append((name, node))
     return out

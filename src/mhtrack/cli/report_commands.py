@@ -10,13 +10,14 @@ from mhtrack.cli.terminal import progress_enabled, progress_option
 
 
 def write_report_or_fail(directory: Path, output: Path | None = None, *,
-                         plotlyjs: str = "inline", progress: bool = False) -> Path:
-    """:func:`~mhtrack.reports.html_report.write_html_report`, the missing optional extra
-    turned into one line (exit 1)."""
+                         plotlyjs: str | None = None, progress: bool = False) -> Path:
+    """:func:`~mhtrack.reports.html_report.write_html_report` (``plotlyjs`` ``None``: its
+    default), the missing optional extra turned into one line (exit 1)."""
     try:
         from mhtrack.reports.html_report import write_html_report
 
-        return write_html_report(directory, output, plotlyjs=plotlyjs, progress=progress)
+        js = {} if plotlyjs is None else {"plotlyjs": plotlyjs}
+        return write_html_report(directory, output, progress=progress, **js)
     except ImportError as e:
         raise click.ClickException(str(e)) from None
 
@@ -27,13 +28,12 @@ def write_report_or_fail(directory: Path, output: Path | None = None, *,
               default=None, help="HTML file to write [default: DIR/report.html].")
 @click.option("--output", "output_alias", type=click.Path(dir_okay=False, path_type=Path),
               default=None, hidden=True)  # the former spelling, kept for a release
-@click.option("--plotlyjs", type=click.Choice(["inline", "file"]), default="inline",
-              show_default=True,
+@click.option("--plotlyjs", type=click.Choice(["inline", "file"]), default=None,
               help="Plotly's JavaScript (4.8 MB) inlined in the page (one self-contained "
               "file), or written once beside it as plotly-VERSION.min.js and shared by "
-              "every report in that folder.")
+              "every report in that folder [inline].")
 @progress_option
-def report(directory: Path, out: Path | None, output_alias: Path | None, plotlyjs: str,
+def report(directory: Path, out: Path | None, output_alias: Path | None, plotlyjs: str | None,
            progress: bool | None) -> None:
     """Write one HTML page of DIR (opens from disk, no network).
 

@@ -131,3 +131,56 @@ def test_envelope_is_the_rank_th_largest_rotation_maximum(
         maxima += [0.0] * max(0, rank - len(maxima))
         want.append(sorted(maxima)[-min(rank, len(set(k[live])))])
     assert np.array_equal(est.envelope(1), np.array(want))
+
+
+def _coverage_frames(max_range: float | None):  # type: ignore[no-untyped-def]
+    """A radar without a period (it looks everywhere each frame) whose plots reach 50 km
+    in every direction, three frames 10 s apart, then leaves at 30 km and 80 km."""
+    import dataclasses
+
+    from async_fixture import ORIGIN, Radar
+
+    from mhtrack.mht.coverage import RadarCoverage
+    from mhtrack.models.radars import SensorSet
+    from mhtrack.records import Scan
+
+    radar = Radar(1, 0.0, 0.0, period=8.0, phase_deg=0.0)
+    sensor = dataclasses.replace(radar.sensor(), period=None, max_range=max_range)
+    cov = RadarCoverage(SensorSet(ORIGIN, (sensor,)))
+    b = np.radians(np.arange(0.0, 360.0, 5.0))
+    z = np.column_stack((50e3 * np.sin(b), 50e3 * np.cos(b)))
+    leaves = np.array([[0.0, 0.0, 30e3, 0.0], [0.0, 0.0, 80e3, 0.0]])
+    P = np.tile(np.diag([100.0, 1.0, 100.0, 1.0]), (2, 1, 1))
+    looks = []
+    for k in range(3):
+        t = 10.0 * k
+        scan = Scan(k, t, z, np.ones(len(z), np.int64), np.arange(len(z)),
+                    t=np.full(len(z), t))
+        looks.append(cov.detection(scan, leaves, P, np.full(2, t)))
+    return cov, looks
+
+
+def test_radar_coverage_charges_no_miss_beyond_the_learned_reach() -> None:
+    """Without ``max_range``: a leaf beyond the farthest plots (80 km against 50 km) is
+    looked at (a plot may update it) but not certainly (no miss charged); one within them
+    is certain. With ``max_range`` in the file, the file's rule decides."""
+    cov, looks = _coverage_frames(None)
+    for lk in looks:
+        np.testing.assert_array_equal(lk.certain, [True, False])
+        assert (lk.pd > 0).all()
+    np.testing.assert_allclose(cov.reach.summary()[1], (50e3, 50e3, 50e3), rtol=1e-12)
+    _, looks = _coverage_frames(100e3)
+    for lk in looks:
+        np.testing.assert_array_equal(lk.certain, [True, True])
+
+
+def test_radar_coverage_state_keeps_the_learned_reach() -> None:
+    """``arrays``/``set_arrays`` carry the learned reach (a restored tracker continues)."""
+    from mhtrack.mht.coverage import RadarCoverage
+
+    cov, _ = _coverage_frames(None)
+    fresh = RadarCoverage(cov.sensors)
+    fresh.set_arrays(cov.arrays())
+    assert fresh.reach.summary() == cov.reach.summary()
+    np.testing.assert_array_equal(fresh.reach.within(1, np.array([30e3, 80e3]),
+                                                     np.array([0.0, 0.0])), [True, False])

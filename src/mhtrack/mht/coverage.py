@@ -24,6 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from mhtrack.kernels import mean
+from mhtrack.mht.reach import ReachEstimator
 from mhtrack.models.radars import SensorSet
 from mhtrack.records import Scan
 
@@ -130,6 +131,10 @@ class RadarCoverage(Coverage):
     cancels between the two). A sensor without a period (or without a site) looks at
     everything within range every frame.
 
+    *Reach.* A radar without ``max_range`` (real sensors files rarely give one) has its
+    reach learned from its own plots (:mod:`mhtrack.mht.reach`): a leaf beyond it is looked
+    at but not certainly — a plot may update it, no miss is charged.
+
     *Sector edges.* A leaf whose bearing is within ``band`` of either edge of the swept
     sector — ``3σ`` of its own bearing (``√max(Pxx, Pyy)/r``) plus ``3σθ`` of the radar,
     at most :data:`MAX_EDGE_DEG` — may be seen by this frame or by the sensor's next one:
@@ -141,11 +146,19 @@ class RadarCoverage(Coverage):
 
     per_tree_looks = True
 
-    def __init__(self, sensors: SensorSet, *, max_pd: float = MAX_COVERAGE_PD) -> None:
+    def __init__(self, sensors: SensorSet, *, max_pd: float = MAX_COVERAGE_PD,
+                 learn_reach: bool = True) -> None:
         self.sensors = sensors
         self.max_pd = float(max_pd)
+        #: Whether a radar without ``max_range`` has its reach learned (else it sees to
+        #: infinity, the former rule; kept for comparisons).
+        self.learn_reach = bool(learn_reach)
         self._last_end: dict[int, float] = {}
         self._site: dict[int, tuple[float, float] | None] = {}
+        #: The reach of each radar without ``max_range``, learned from its own plots
+        #: (:mod:`mhtrack.mht.reach`).
+        self.reach = ReachEstimator({s.id: s.period for s in sensors.sensors
+                                     if s.period is not None and s.max_range is None})
 
     def _sensor_id(self, scan: Scan) -> int:
         sensor = np.asarray(scan.sensor, np.int64)
@@ -186,6 +199,11 @@ class RadarCoverage(Coverage):
         dist = np.hypot(px, py)
         if sensor.max_range is not None:
             looked &= dist <= sensor.max_range
+            inside = looked
+        elif self.learn_reach:  # no miss charged beyond the reach learned from its plots
+            inside = self._learned_reach(sid, scan, site, px, py, dist)
+        else:
+            inside = looked
         if sensor.period is not None and len(scan):
             omega = 360.0 / sensor.period
             span = tf - t0
@@ -205,14 +223,28 @@ class RadarCoverage(Coverage):
                 crossed = phi_f < phi_0
                 certain = crossed & (phi_f >= band) & (phi_0 <= 360.0 - band)
                 possible = crossed | (phi_f > 360.0 - band) | (phi_0 < band)
-                return Looks(np.where(looked & possible, pd, 0.0), looked & certain)
-        return Looks(np.where(looked, pd, 0.0), looked)
+                return Looks(np.where(looked & possible, pd, 0.0), looked & certain & inside)
+        return Looks(np.where(looked, pd, 0.0), looked & inside)
+
+    def _learned_reach(self, sid: int, scan: Scan, site: tuple[float, float],
+                       px: np.ndarray, py: np.ndarray, dist: np.ndarray) -> np.ndarray:
+        """Feed the frame's plots to the radar's reach (ground range and grid bearing from
+        its site), then which leaves (at ``px, py`` from the site) lie within it: beyond
+        it a leaf may still be updated by a plot, but a miss is not certain."""
+        if len(scan):
+            z = np.asarray(scan.z, float).reshape(-1, 2)
+            dx, dy = z[:, 0] - site[0], z[:, 1] - site[1]
+            self.reach.update(sid, scan.plot_times(), np.hypot(dx, dy), grid_bearing(dx, dy))
+        return self.reach.within(sid, dist, grid_bearing(px, py))
 
     def arrays(self) -> dict[str, np.ndarray]:
         ids = sorted(self._last_end)
         return {"sensor": np.array(ids, np.int64),
-                "end": np.array([self._last_end[i] for i in ids], float)}
+                "end": np.array([self._last_end[i] for i in ids], float),
+                **self.reach.arrays()}
 
     def set_arrays(self, arrays: dict[str, np.ndarray]) -> None:
         self._last_end = {int(s): float(e) for s, e in
                           zip(arrays.get("sensor", []), arrays.get("end", []), strict=True)}
+        if "reach_sensor" in arrays:  # a state saved before the learned reach has none
+            self.reach.set_arrays(arrays)

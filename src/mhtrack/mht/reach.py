@@ -150,9 +150,29 @@ class ReachEstimator:
                                else np.zeros(0, np.int64))}
 
     def set_arrays(self, arrays: dict[str, np.ndarray]) -> None:
-        """Restore :meth:`arrays`."""
-        ids = [int(i) for i in arrays["reach_sensor"]]
-        cut = np.cumsum(arrays["reach_rotations"])[:-1]
+        """Restore :meth:`arrays` (checked: a damaged state raises ``ValueError``)."""
+        sensor = np.asarray(arrays["reach_sensor"])
+        start = np.asarray(arrays["reach_start"], float)
+        rotations = np.asarray(arrays["reach_rotations"])
+        maxima = np.asarray(arrays["reach_maxima"])
+        held = np.asarray(arrays["reach_held"])
+        n = sensor.size
+        if not (sensor.ndim == rotations.ndim == start.ndim == held.ndim == 1
+                and sensor.dtype.kind in "iu" and rotations.dtype.kind in "iu"
+                and held.dtype.kind in "iu" and start.size == rotations.size == n
+                and np.unique(sensor).size == n and (rotations >= 1).all()
+                and maxima.ndim == 2 and maxima.shape[1] == self.sectors
+                and maxima.shape[0] == held.size == int(rotations.sum())
+                and np.isfinite(start).all() and np.isfinite(maxima).all()
+                and (maxima >= 0).all() and (held >= -1).all()):
+            raise ValueError("the learned reach's arrays are inconsistent (sensors, starts, "
+                             f"rotations, a (rotations, {self.sectors}) array of ranges ≥ 0 "
+                             "and the rotation each row holds)")
+        ids = [int(i) for i in sensor]
+        if not ids:
+            self.start, self.maxima, self.held = {}, {}, {}
+            return
+        cut = np.cumsum(rotations)[:-1]
         self.start = {i: float(t) for i, t in zip(ids, arrays["reach_start"], strict=True)}
         self.maxima = {i: np.array(m, float) for i, m in zip(
             ids, np.split(np.asarray(arrays["reach_maxima"]), cut), strict=True)}

@@ -2,22 +2,29 @@
 file's packets) decoded in memory, chunk by chunk, into frames (``docs/sources.md``).
 
 Each datagram's data blocks are decoded by :class:`~mhtrack.io.asterix.decode.Decoder`
-(CAT048 plots, CAT034 sweep marks; other parts counted and skipped, one warning line per
-kind at the end); times of day go on one monotonic axis
-(:class:`~mhtrack.io.asterix.timeaxis.TimeAxis`, with the datagrams' capture times where
-given); every :data:`CHUNK` plots are converted to the local frame — ground range
-(:func:`~mhtrack.io.asterix.api.ground_ranges`) then
+(a block received twice within the duplicate window is dropped — redundant LANs —;
+CAT048 and CAT001 plots, reports that are no plots left out; CAT034/CAT002 sweep marks
+and sites; other parts counted and skipped, one warning line per kind at the end); times
+of day go on one monotonic axis (:class:`~mhtrack.io.asterix.timeaxis.TimeAxis`, with the
+datagrams' capture times where given); every :data:`CHUNK` plots are converted to the
+local frame — ground range (:func:`~mhtrack.io.asterix.api.ground_ranges`) then
 :func:`~mhtrack.io.timed_plots.polar_plots`, the conversion of ``mhtrack convert`` +
 ``read_timed_plots`` — and pushed through the re-order buffer and the framer
 (:class:`~mhtrack.sources.timed.TimedStream`).
 
+Radars: the sensors file's, else those whose site came in I034/120
+(:func:`~mhtrack.io.asterix.sites.sensors_with_sites`); the plots of a radar with no
+known site are skipped, and one warning line at the end lists those radars.
+
 A plot's file row is its 0-based number in decoding order (the row ``mhtrack convert``
-gives it). Frame lengths come from the sensors' periods (``SensorSet``); a radar without
-one gets frames of :data:`~mhtrack.frames.DEFAULT_FRAME_S`.
+gives it, skipped radars included). Frame lengths come from the sensors' periods
+(``SensorSet``); a radar without one gets frames of
+:data:`~mhtrack.frames.DEFAULT_FRAME_S`.
 """
 
 from __future__ import annotations
 
+import logging
 from collections.abc import Iterable, Iterator
 from typing import Any
 
@@ -26,8 +33,9 @@ import numpy as np
 from mhtrack.errors import InputError
 from mhtrack.frames import frame_lengths
 from mhtrack.io.asterix.api import ground_ranges
-from mhtrack.io.asterix.decode import Decoder, plot_columns, sweep_periods
+from mhtrack.io.asterix.decode import MARKS, PLOTS, Decoder, plot_columns, sweep_periods
 from mhtrack.io.asterix.problems import Problems
+from mhtrack.io.asterix.sites import sensors_with_sites, skipped_line
 from mhtrack.io.asterix.timeaxis import TimeAxis
 from mhtrack.io.timed_plots import DEFAULT_REORDER_WINDOW_S, polar_plots
 from mhtrack.models.radars import SensorSet
@@ -43,17 +51,19 @@ Datagram = bytes | tuple[bytes, float | None]
 class DatagramSource(Source):
     """Frames from datagrams of ASTERIX data blocks: each ``bytes``, or ``(bytes,
     capture time)`` with the capture time in POSIX seconds (or ``None``). ``sensors``
-    gives every radar's site, errors and (optionally) period; a radar missing from it is
-    an error. Errors and warnings name ``name`` and the byte offset in the stream of
-    datagrams (their payloads back to back)."""
+    gives radars' sites, errors and (optionally) periods; a radar it lacks is taken from
+    its CAT034 site (I034/120) or skipped (module docstring). Errors and warnings name
+    ``name`` and the byte offset in the stream of datagrams (their payloads back to
+    back)."""
 
     timed = True
 
-    def __init__(self, datagrams: Iterable[Datagram], *, sensors: SensorSet,
+    def __init__(self, datagrams: Iterable[Datagram], *, sensors: SensorSet | None = None,
                  name: str = "datagrams", reorder_window_s: float | None = None,
                  fast: bool = True) -> None:
         super().__init__()
         self.name = name
+        self.given = sensors
         self.sensors = sensors
         self.window_s = (DEFAULT_REORDER_WINDOW_S if reorder_window_s is None
                          else float(reorder_window_s))
@@ -63,6 +73,9 @@ class DatagramSource(Source):
         self.problems = Problems()
         self._input = datagrams
         self._stream: TimedStream | None = None
+        self._decoder: Decoder | None = None
+        self._seen: set[int] = set()  # radars whose site was settled (kept or skipped)
+        self._skipped: dict[int, list[int]] = {}  # radar -> [plots, first byte]
 
     def _datagrams(self, problems: Problems) -> Iterator[tuple[int, Any, float | None]]:
         """``(byte offset, payload, capture time)`` of each datagram."""
@@ -72,37 +85,63 @@ class DatagramSource(Source):
             yield offset, payload, when
             offset += len(payload)
 
-    def _decoded(self, problems: Problems, sweeps: list[tuple[Any, ...]] | None = None
-                 ) -> Iterator[dict[str, np.ndarray]]:
-        """Chunks of decoded, converted plots (columns ``time, sensor, x, y, R, file_row,
-        offset``), in decoding order; sweep marks (time on the axis) go to ``sweeps``."""
-        decoder, axis = Decoder(fast=self.fast), TimeAxis()
+    def _decoded(self, problems: Problems, sweeps: list[tuple[Any, ...]] | None = None,
+                 convert: bool = True) -> Iterator[dict[str, np.ndarray]]:
+        """Chunks of decoded plots in decoding order: converted (columns ``time, sensor,
+        x, y, R, file_row, offset``; radars without a site left out) or, with ``convert``
+        false, as decoded (:data:`~mhtrack.io.asterix.decode.PLOT_COLUMNS` with the time
+        on the axis, ``offset``); sweep marks (time on the axis) go to ``sweeps``."""
+        self._decoder = decoder = Decoder(fast=self.fast)
+        axis = TimeAxis()
         rows: list[tuple[Any, ...]] = []
         times: list[float] = []
         at_rows: list[int] = []
         n = 0
         for offset, payload, when in self._datagrams(problems):
-            for at, cat, found in decoder.blocks(payload, offset, problems):
+            for at, what, found in decoder.blocks(payload, offset, problems, when):
                 t = axis.times_list([r[0] for r in found], when)
-                if cat == 34:
+                if what == MARKS:
                     if sweeps is not None:
                         sweeps.extend((ti, *r[1:]) for ti, r in zip(t, found, strict=True))
+                    continue
+                if what != PLOTS:
+                    problems.add("adsb", at, len(found))
                     continue
                 rows.extend(found)
                 times.extend(t)
                 at_rows.extend([at] * len(found))
                 if len(rows) >= CHUNK:
-                    yield self._convert(rows, times, at_rows, n)
+                    yield self._chunk(rows, times, at_rows, n, convert)
                     n += len(rows)
                     rows, times, at_rows = [], [], []
         if rows:
-            yield self._convert(rows, times, at_rows, n)
+            yield self._chunk(rows, times, at_rows, n, convert)
 
-    def _convert(self, rows: list[tuple[Any, ...]], times: list[float],
-                 at: list[int], n0: int) -> dict[str, np.ndarray]:
+    def _chunk(self, rows: list[tuple[Any, ...]], times: list[float], at: list[int],
+               n0: int, convert: bool) -> dict[str, np.ndarray]:
         p = plot_columns(rows)
-        sensor, offset = p["sensor"], np.asarray(at, np.int64)
-        self._check_radars(sensor, offset)
+        p["time"] = np.array(times, float)
+        p["offset"] = np.asarray(at, np.int64)
+        p["file_row"] = np.arange(n0, n0 + len(rows), dtype=np.int64)
+        return self._convert(p) if convert else p
+
+    def _convert(self, p: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+        """Plots of radars with a known site in the local frame; the others counted."""
+        self._adopt(np.unique(p["sensor"]).tolist())
+        sensor, offset = p["sensor"], p["offset"]
+        ids = self.sensors.ids if self.sensors is not None else ()
+        ok = np.isin(sensor, np.asarray(ids, np.int64))
+        for sid in np.unique(sensor[~ok]).tolist():
+            mine = sensor == sid
+            got = self._skipped.setdefault(sid, [0, int(offset[mine][0])])
+            got[0] += int(mine.sum())
+        p = {k: v[ok] for k, v in p.items()}
+        sensor = p["sensor"]
+        out = {k: p[k] for k in ("time", "sensor", "file_row", "offset") if k in p}
+        if not sensor.size:
+            return {**out, "x": np.zeros(0), "y": np.zeros(0), "R": np.zeros((0, 2, 2))}
+        assert self.sensors is not None
+        self._check_radars(sensor, p["offset"])
         rng = ground_ranges(self.sensors, sensor, p["slant_range"], p["bearing"],
                             p["flight_level"])
         x, y, R = np.empty(sensor.size), np.empty(sensor.size), np.empty((sensor.size, 2, 2))
@@ -110,20 +149,21 @@ class DatagramSource(Source):
             mine = sensor == sid
             x[mine], y[mine], R[mine] = polar_plots(self.sensors, sid, rng[mine],
                                                     p["bearing"][mine])
-        return {"time": np.array(times, float), "sensor": sensor, "x": x, "y": y, "R": R,
-                "file_row": np.arange(n0, n0 + sensor.size, dtype=np.int64),
-                "offset": offset}
+        return {**out, "x": x, "y": y, "R": R}
+
+    def _adopt(self, radars: list[int]) -> None:
+        """Settle the radars not seen before: the sensors file's, else their CAT034 site
+        received so far, else skipped (until a site comes)."""
+        new = [r for r in radars if r not in self._seen]
+        if not new:
+            return
+        sites = self._decoder.sites if self._decoder is not None else {}
+        self.sensors, skipped = sensors_with_sites(self.sensors, sites, new, self.name)
+        self._seen.update(r for r in new if r not in skipped)
 
     def _check_radars(self, sensor: np.ndarray, offset: np.ndarray) -> None:
-        """Every radar is a polar sensor of the sensors file with a lat/lon site."""
-        ids = self.sensors.ids
-        missing = ~np.isin(sensor, np.asarray(ids, np.int64))
-        if missing.any():
-            s = int(sensor[missing][0])
-            raise InputError(
-                f"{self.name}, byte {int(offset[missing][0])}: radar {s} (SAC {s >> 8}, "
-                f"SIC {s & 0xFF}) is not in the sensors file (it lists "
-                f"{', '.join(map(str, ids))}); add it, id = SAC·256 + SIC", file=self.name)
+        """Every radar kept is a polar sensor of the sensors file with a lat/lon site."""
+        assert self.sensors is not None
         for sid in np.unique(sensor).tolist():
             s = self.sensors.sensor(sid)
             if s.kind != "polar" or s.lat is None:
@@ -133,11 +173,13 @@ class DatagramSource(Source):
                                  "plots are range and bearing)", file=self.name)
 
     def _frame_lengths(self) -> dict[int, float]:
-        return frame_lengths({s.id: s.period for s in self.sensors.sensors})
+        sensors = self.sensors.sensors if self.sensors is not None else ()
+        return frame_lengths({s.id: s.period for s in sensors})
 
     def __iter__(self) -> Iterator[Scan]:
         self.stats = SourceStats()
         self.problems = problems = Problems()
+        self._skipped = {}
         self._stream = stream = TimedStream(
             self.name, self.stats, self._frame_lengths(), self.window_s,
             lambda first: f"byte {first['offset']} (plot {first['file_row']})")
@@ -146,6 +188,17 @@ class DatagramSource(Source):
         yield from stream.finish()
         self.stats.skipped = dict(problems.counts)
         problems.warn(self.name)
+        self._warn_skipped()
+
+    def _warn_skipped(self) -> None:
+        """One warning line listing the radars skipped for want of a site."""
+        if not self._skipped:
+            return
+        n = sum(c for c, _ in self._skipped.values())
+        first = min(at for _, at in self._skipped.values())
+        self.stats.skipped["no_site"] = n
+        logging.getLogger("mhtrack").warning(
+            "%s", skipped_line(self.name, sorted(self._skipped), n, first))
 
     def file_rows(self, rows: np.ndarray) -> np.ndarray:
         """Each plot's 0-based number in decoding order."""
@@ -154,19 +207,28 @@ class DatagramSource(Source):
         return self._stream.file_rows(rows)
 
     def periods_and_survey(self) -> tuple[dict[int, float], Survey]:
-        """One pass over the input: the radars' periods from their CAT034 marks
+        """One pass over the input: the radars (:meth:`_adopt`: the sensors file's, else
+        their CAT034 sites), their periods from their CAT034 marks
         (:func:`~mhtrack.io.asterix.decode.sweep_periods`) and the :class:`Survey`
-        (every plot's ``x, y``). Reads the datagrams: only for a replayable input."""
+        (every kept plot's ``x, y``). Reads the datagrams: only for a replayable input."""
         sweeps: list[tuple[Any, ...]] = []
-        xs, ys, sensors = [], [], set()
-        for cols in self._decoded(Problems(), sweeps):
-            xs.append(cols["x"])
-            ys.append(cols["y"])
-            sensors.update(np.unique(cols["sensor"]).tolist())
+        chunks = [{k: c[k] for k in ("sensor", "slant_range", "bearing", "flight_level",
+                                     "offset")}
+                  for c in self._decoded(Problems(), sweeps, convert=False)]
         cols = list(zip(*sweeps, strict=True)) if sweeps else [()] * 5
         marks = {k: np.array(c, dtype=d) for k, c, d in zip(
             ("time", "sensor", "kind", "azimuth", "period"), cols,
             (float, np.int64, np.int64, float, float), strict=True)}
+        self._seen, self.sensors = set(), self.given
+        radars = sorted({int(s) for c in chunks for s in np.unique(c["sensor"]).tolist()})
+        self._adopt(radars)  # every site of the file is known now
+        self._seen.update(radars)  # the radars left out stay out (one warning, later)
+        xs, ys, kept = [], [], set()
+        for c in chunks:
+            done = self._convert(c)
+            xs.append(done["x"])
+            ys.append(done["y"])
+            kept.update(np.unique(done["sensor"]).tolist())
         x = np.concatenate(xs) if xs else np.zeros(0)
         y = np.concatenate(ys) if ys else np.zeros(0)
-        return sweep_periods(marks), Survey(int(x.size), tuple(sorted(sensors)), x, y)
+        return sweep_periods(marks), Survey(int(x.size), tuple(sorted(kept)), x, y)

@@ -54,8 +54,11 @@ def flags048(rec: Any) -> tuple[int, int, int, int]:
     """``(typ, sim, rab, tst)`` of a libasterix CAT048 record's I048/020 (``-1`` each
     without the item; TST 0 when the first extension is not sent)."""
     i020 = rec.get_item("020")
-    if i020 is None:
-        return -1, -1, -1, -1
+    return (-1, -1, -1, -1) if i020 is None else flags048_item(i020)
+
+
+def flags048_item(i020: Any) -> tuple[int, int, int, int]:
+    """``(typ, sim, rab, tst)`` of a libasterix I048/020 item."""
     v = i020.variation
     return _sub(v, "TYP"), _sub(v, "SIM"), _sub(v, "RAB"), _sub(v, "TST")
 

@@ -7,6 +7,7 @@ its site in CAT034."""
 from __future__ import annotations
 
 import logging
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -14,6 +15,8 @@ import pytest
 
 from mhtrack.io.asterix import read_recording
 from mhtrack.io.asterix.encode import lsb
+from mhtrack.io.sensors import read_sensors, write_sensors
+from mhtrack.models.radars import RadarSensor, SensorSet
 
 SICS = {11, 12, 13, 14, 201, 204, 205}
 
@@ -111,3 +114,48 @@ def test_tracked_without_a_sensors_file(conformance_pcap: Path,
                                           np.full(z.shape[0], radar.lat), lon, lat)
     assert np.abs((az - rec.plots["bearing"][rows] + 180) % 360 - 180).max() < 1e-6
     assert np.all(dist <= rec.plots["slant_range"][rows])
+
+
+def _frames(path: Path, sensors: SensorSet):  # type: ignore[no-untyped-def]
+    from mhtrack.sources import open_source
+
+    src = open_source(path, sensors=sensors)
+    return list(src), src
+
+
+SIC12 = 25 * 256 + 12
+SITE12 = (43.57102632522583, 16.4060640335083)
+
+
+def test_sensors_file_wins_and_warns_where_the_site_disagrees(
+        conformance_pcap: Path, tmp_path: Path, caplog: pytest.LogCaptureFixture) -> None:
+    radar = RadarSensor(SIC12, "polar", pd=0.9, lat=SITE12[0] + 0.002, lon=SITE12[1],
+                        sigma_range=40.0, sigma_bearing_deg=0.05)  # 222 m north
+    far = SensorSet(None, (radar,))
+    near = SensorSet(None, (replace(radar, lat=SITE12[0] + 0.0005),))  # 56 m north
+    for sensors, warned in ((far, True), (near, False)):
+        caplog.clear()
+        with caplog.at_level(logging.WARNING, logger="mhtrack"):
+            frames, src = _frames(conformance_pcap, sensors)
+        assert src.sensors.sensor(SIC12).lat == sensors.sensor(SIC12).lat  # the file wins
+        assert src.sensors.sensor(SIC12).sigma_range == 40.0 and len(frames) > 0
+        lines = [r.getMessage() for r in caplog.records if "I034/120" in r.getMessage()
+                 and "sends its site" in r.getMessage()]
+        assert len(lines) == int(warned)
+        if warned:
+            assert lines[0].startswith(f"{conformance_pcap}, byte 2926: radar {SIC12} "
+                                       "(SAC 25, SIC 12) sends its site")
+            assert " 222 m from the sensors file" in lines[0]
+
+
+def test_sensors_file_lacking_the_radar_is_filled_from_cat034(
+        conformance_pcap: Path, tmp_path: Path) -> None:
+    other = RadarSensor(25 * 256 + 11, "polar", pd=0.9, lat=45.0, lon=15.0,
+                        sigma_range=40.0, sigma_bearing_deg=0.05)
+    write_sensors(SensorSet((44.0, 16.0), (other,)), tmp_path / "one.toml")
+    got, src = _frames(conformance_pcap, read_sensors(tmp_path / "one.toml"))
+    assert src.sensors.ids == (25 * 256 + 11, SIC12)
+    assert src.sensors.origin == (44.0, 16.0)  # the file's frame is kept
+    assert (src.sensors.sensor(SIC12).lat, src.sensors.sensor(SIC12).lon) == SITE12
+    assert {int(s) for f in got for s in f.sensor} == {25 * 256 + 11, SIC12}
+    assert src.stats.skipped["no_site"] == 63 - 19 - 4  # SIC 11 has 4 plots, SIC 12 19

@@ -1,0 +1,118 @@
+"""Real feeds through the recording source: every datagram received twice (redundant LANs)
+gives the frames of the single copy; every framing gives the frames of the plain pcap;
+reports that are no plots are left out and counted (issue 28)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+pytest.importorskip("asterix.generated", reason="libasterix not installed")
+
+from mhtrack.io.asterix import export, wrap
+from mhtrack.io.asterix.container import blocks as split_blocks
+from mhtrack.io.asterix.framings import units
+from mhtrack.io.asterix.problems import Problems
+from mhtrack.io.sensors import read_sensors
+from mhtrack.models.radars import SensorSet
+from mhtrack.sources import open_source
+
+from .conftest import differences
+
+
+@pytest.fixture(scope="module")
+def rec(opensky2: Path, tmp_path_factory: pytest.TempPathFactory) -> Path:
+    path = tmp_path_factory.mktemp("feeds") / "rec.pcap"
+    export(opensky2 / "plots.csv", read_sensors(opensky2 / "sensors.toml"), path)
+    return path
+
+
+def _blocks_and_times(path: Path) -> tuple[list[bytes], list[float]]:
+    """Every data block of a pcap and its packet's capture time."""
+    out, times = [], []
+    for offset, when, payload in units(path.read_bytes(), "pcap", "x", {34, 48},
+                                       Problems()):
+        for at, _, raw in split_blocks(payload, offset, Problems()):
+            start = at - offset
+            out.append(bytes(payload[start:start + 3 + len(raw)]))
+            times.append(float(when))  # type: ignore[arg-type]
+    return out, times
+
+
+def _frames(path: Path, sensors: Path | SensorSet | None):  # type: ignore[no-untyped-def]
+    s = read_sensors(sensors) if isinstance(sensors, Path) else sensors
+    src = open_source(path, sensors=s)
+    return list(src), src
+
+
+def test_every_datagram_doubled_gives_the_single_copy(rec: Path, opensky2: Path,
+                                                      tmp_path: Path) -> None:
+    blocks, times = _blocks_and_times(rec)
+    eth = wrap.udp_frames(blocks, 513)
+    frames, ftimes = [], []
+    for f, t in zip(eth, times, strict=True):  # LAN B: another source MAC, 0.7 ms later
+        frames += [f, f[:6] + bytes([2, 0, 0, 0, 0, 9]) + f[12:]]
+        ftimes += [t, t + 0.0007]
+    (tmp_path / "two_lans.pcap").write_bytes(wrap.pcap(frames, ftimes))
+    (tmp_path / "twice.ast").write_bytes(b"".join(b + b for b in blocks))  # no times
+    ref, src0 = _frames(rec, opensky2 / "sensors.toml")
+    assert not src0.stats.skipped and len(ref) > 300
+    for name in ("two_lans.pcap", "twice.ast"):
+        got, src = _frames(tmp_path / name, opensky2 / "sensors.toml")
+        assert differences(ref, got) == [], name
+        assert src.stats.skipped == {"duplicate": len(blocks)}, name
+        rows = np.concatenate([f.rows for f in got])
+        assert np.array_equal(src.file_rows(rows), src0.file_rows(rows)), name
+
+
+def test_every_framing_gives_the_frames_of_the_plain_pcap(rec: Path, opensky2: Path,
+                                                          tmp_path: Path) -> None:
+    blocks, times = _blocks_and_times(rec)
+    eth = wrap.udp_frames(blocks, 513)
+    files = {
+        "a.pcapng": wrap.pcapng(eth, times, tsresol=9),
+        "be.pcap": wrap.pcap(eth, times, order=">", nano=True),
+        "vlan.pcap": wrap.pcap([wrap.vlan(f, [(0x88A8, 3), (0x8100, 5)]) for f in eth],
+                               times),
+        "sll.pcap": wrap.pcap([wrap.sll(f) for f in eth], times, link=113),
+        "sll2.pcapng": wrap.pcapng([wrap.sll2(f) for f in eth], times, link=276),
+        "llc.pcap": wrap.pcap([wrap.llc_frame(b, 513) for b in blocks], times),
+        "oradis_udp.pcap": wrap.pcap(wrap.udp_frames(
+            [wrap.oradis([b], [t]) for b, t in zip(blocks, times, strict=True)], 513), times),
+        "rec.gps": wrap.gps(blocks, times, b"GPS recorder"),
+        "rec.ff": wrap.final(blocks, times),
+        "rec.oradis": wrap.oradis(blocks, times),
+        "rec.ast": b"".join(blocks),
+    }
+    ref, _ = _frames(rec, opensky2 / "sensors.toml")
+    kinds = {}
+    for name, data in files.items():
+        (tmp_path / name).write_bytes(data)
+        got, src = _frames(tmp_path / name, opensky2 / "sensors.toml")
+        kinds[name] = src.container
+        assert differences(ref, got) == [], name
+        assert not src.stats.skipped, (name, src.stats.skipped)
+    assert set(kinds.values()) == {"pcap", "pcapng", "gps", "final", "oradis", "raw"}
+
+
+def test_reports_that_are_no_plots_are_left_out(opensky2: Path, tmp_path: Path) -> None:
+    """Radar-extrapolated reports (I048/020 TYP 0, no detection) among the plots: the
+    frames are those of the recording without them; the count is kept."""
+    import pyarrow.csv as pacsv
+
+    sensors = read_sensors(opensky2 / "sensors.toml")
+    t = pacsv.read_csv(opensky2 / "plots.csv")
+    n = t.num_rows
+    typ = np.where(np.arange(n) % 7 == 3, 0, 2)  # every 7th report: no detection
+    pacsv.write_csv(t.append_column("typ", [typ]), tmp_path / "mixed.csv")
+    pacsv.write_csv(t.filter(typ != 0).append_column("typ", [typ[typ != 0]]),
+                    tmp_path / "plots.csv")
+    for name in ("mixed", "plots"):
+        export(tmp_path / f"{name}.csv", sensors, tmp_path / f"{name}.pcap")
+    ref, _ = _frames(tmp_path / "plots.pcap", sensors)
+    got, src = _frames(tmp_path / "mixed.pcap", sensors)
+    assert src.stats.skipped == {"not_plot": int((typ == 0).sum())}
+    assert [f.z.tolist() for f in got] == [f.z.tolist() for f in ref]
+    assert [f.t.tolist() for f in got] == [f.t.tolist() for f in ref]

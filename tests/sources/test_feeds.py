@@ -116,3 +116,33 @@ def test_reports_that_are_no_plots_are_left_out(opensky2: Path, tmp_path: Path) 
     assert src.stats.skipped == {"not_plot": int((typ == 0).sum())}
     assert [f.z.tolist() for f in got] == [f.z.tolist() for f in ref]
     assert [f.t.tolist() for f in got] == [f.t.tolist() for f in ref]
+
+
+def test_cat001_plots_give_the_frames_of_their_cat048_twins(rec: Path, opensky2: Path,
+                                                           tmp_path: Path) -> None:
+    """The recording's plots re-encoded as CAT001 (time truncated to 512 s, restored from
+    the CAT002 north markers) with CAT002 marks: the same frames and times (both 1/128 s),
+    positions within one CAT001 range LSB (1/128 NM; bearings share their LSB)."""
+    from mhtrack.io.asterix import encode_other, read_recording
+
+    r = read_recording(rec)
+    p, w = r.plots, r.sweeps
+    msgs = [(t, s, 1, encode_other.plot001(t, s, rho, th, typ=2))
+            for t, s, rho, th in zip(p["time"].tolist(), p["sensor"].tolist(),
+                                     p["slant_range"].tolist(), p["bearing"].tolist(),
+                                     strict=True)]
+    msgs += [(t, s, 2, encode_other.mark002(t, s, k, 0.0 if np.isnan(a) else a))
+             for t, s, k, a in zip(w["time"].tolist(), w["sensor"].tolist(),
+                                   w["kind"].tolist(), w["azimuth"].tolist(), strict=True)]
+    got_blocks = encode_other.blocks(msgs)
+    data = wrap.pcap(wrap.udp_frames([b for _, _, b in got_blocks], 513),
+                     [t for t, _, _ in got_blocks])
+    (tmp_path / "cat001.pcap").write_bytes(data)
+    sensors = read_sensors(opensky2 / "sensors.toml")
+    ref, _ = _frames(rec, sensors)
+    got, src = _frames(tmp_path / "cat001.pcap", sensors)
+    assert not src.stats.skipped
+    assert len(got) == len(ref) > 300
+    for a, b in zip(ref, got, strict=True):
+        assert np.array_equal(a.t, b.t) and np.array_equal(a.sensor, b.sensor)
+        assert np.abs(a.z - b.z).max() <= 1852.0 / 128

@@ -141,7 +141,7 @@ CASES = [
     ("sigma on polar", {9: "sigma = 5.0"}, 9,
      "key 'sensors[0].sigma': not used by a polar sensor"),
     ("kind", {18: 'kind = "optical"'}, 18,
-     "key 'sensors[1].kind': must be 'polar' or 'cartesian', got 'optical'"),
+     "key 'sensors[1].kind': must be 'polar', 'cartesian' or 'adsb', got 'optical'"),
     ("pd string", {12: 'pd = "0.9"'}, 12,
      "key 'sensors[0].pd': expected a number, got string '0.9'"),
     ("id float", {17: "id = 2.0"}, 17, "key 'sensors[1].id': expected an integer, got float 2.0"),

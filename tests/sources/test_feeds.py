@@ -146,3 +146,46 @@ def test_cat001_plots_give_the_frames_of_their_cat048_twins(rec: Path, opensky2:
     for a, b in zip(ref, got, strict=True):
         assert np.array_equal(a.t, b.t) and np.array_equal(a.sensor, b.sensor)
         assert np.abs(a.z - b.z).max() <= 1852.0 / 128
+
+
+def test_adsb_reports_are_a_sensor_of_their_own(rec: Path, opensky2: Path,
+                                                tmp_path: Path) -> None:
+    """CAT021 reports beside the radars' CAT048: a station the sensors file does not list
+    becomes a sensor of kind ``adsb``; each report at its WGS-84 position in the local
+    frame, σ from its NACp (DO-260B EPU as a 95 % radius); NACp 0 counted and left out."""
+    from mhtrack.io.asterix import encode_other
+    from mhtrack.io.asterix.cat021 import NACP_EPU_M, R95_TO_SIGMA
+
+    sensors = read_sensors(opensky2 / "sensors.toml")
+    blocks, times = _blocks_and_times(rec)
+    rng = np.random.default_rng(3)
+    n, station = 30, 7 * 256 + 9
+    t = np.sort(rng.uniform(times[0], times[-1], n)) % 86400.0
+    lat, lon = rng.uniform(50, 52, n), rng.uniform(3, 6, n)
+    nacp = np.where(np.arange(n) % 10 == 4, 0, rng.integers(7, 12, n))
+    msgs = [(ti, station, 21, encode_other.report021(ti, station, la, lo, nacp=int(k)))
+            for ti, la, lo, k in zip(t.tolist(), lat.tolist(), lon.tolist(), nacp.tolist(),
+                                     strict=True)]
+    adsb = [b for m in msgs for b in encode_other.blocks([m])]  # a block per report
+    pairs = sorted([(tb, b) for tb, b in zip(times, blocks, strict=True)]
+                   + [(tb + times[0] - times[0] % 86400.0, b) for tb, _, b in adsb],
+                   key=lambda x: x[0])
+    data = wrap.pcap(wrap.udp_frames([b for _, b in pairs], 513), [x for x, _ in pairs])
+    (tmp_path / "mixed.pcap").write_bytes(data)
+    ref, _ = _frames(rec, sensors)
+    got, src = _frames(tmp_path / "mixed.pcap", sensors)
+    assert src.sensors.sensor(station).kind == "adsb"
+    assert src.stats.skipped == {"no_accuracy": int((nacp == 0).sum())}
+    radar = [f for f in got if f.sensor[0] != station]  # the radars' frames unchanged
+    assert len(radar) == len(ref) and all(
+        np.array_equal(a.z, b.z) and np.array_equal(a.t, b.t) and np.array_equal(a.R, b.R)
+        for a, b in zip(ref, radar, strict=True))
+    mine = [f for f in got if f.sensor[0] == station]
+    z = np.concatenate([f.z for f in mine])
+    R = np.concatenate([f.R for f in mine])
+    keep = nacp > 0
+    x, y = sensors.frame().to_local(lat[keep], lon[keep])
+    order = np.argsort(np.concatenate([f.t for f in mine]), kind="stable")
+    assert np.abs(z[order] - np.column_stack((x, y))).max() < 0.1  # 180/2^30 deg LSB
+    sigma = np.array([NACP_EPU_M[int(k)] for k in nacp[keep]]) * R95_TO_SIGMA
+    assert np.allclose(R[order][:, 0, 0], sigma**2) and np.all(R[:, 0, 1] == 0)

@@ -33,7 +33,7 @@ import numpy as np
 from mhtrack.errors import InputError
 from mhtrack.frames import frame_lengths
 from mhtrack.io.asterix.api import ground_ranges
-from mhtrack.io.asterix.decode import MARKS, PLOTS, Decoder, plot_columns, sweep_periods
+from mhtrack.io.asterix.decode import MARKS, PLOT_COLUMNS, Decoder, plot_columns, sweep_periods
 from mhtrack.io.asterix.problems import Problems
 from mhtrack.io.asterix.sites import sensors_with_sites, skipped_line
 from mhtrack.io.asterix.timeaxis import TimeAxis
@@ -104,9 +104,6 @@ class DatagramSource(Source):
                     if sweeps is not None:
                         sweeps.extend((ti, *r[1:]) for ti, r in zip(t, found, strict=True))
                     continue
-                if what != PLOTS:
-                    problems.add("adsb", at, len(found))
-                    continue
                 rows.extend(found)
                 times.extend(t)
                 at_rows.extend([at] * len(found))
@@ -119,55 +116,91 @@ class DatagramSource(Source):
 
     def _chunk(self, rows: list[tuple[Any, ...]], times: list[float], at: list[int],
                n0: int, convert: bool) -> dict[str, np.ndarray]:
-        p = plot_columns(rows)
+        k = len(PLOT_COLUMNS)
+        p = plot_columns([r[:k] for r in rows])
         p["time"] = np.array(times, float)
         p["offset"] = np.asarray(at, np.int64)
         p["file_row"] = np.arange(n0, n0 + len(rows), dtype=np.int64)
+        if any(len(r) > k for r in rows):  # ADS-B reports: lat, lon, sigma
+            extra = np.array([r[k:k + 3] if len(r) > k else (np.nan,) * 3 for r in rows],
+                             float)
+            p["lat"], p["lon"], p["sigma"] = extra.T
         return self._convert(p) if convert else p
 
     def _convert(self, p: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
-        """Plots of radars with a known site in the local frame; the others counted."""
-        self._adopt(np.unique(p["sensor"]).tolist())
+        """Plots of radars with a known site and ADS-B reports with an accuracy, in the
+        local frame; the others counted."""
         sensor, offset = p["sensor"], p["offset"]
+        adsb = np.isfinite(p["lat"]) if "lat" in p else np.zeros(sensor.size, bool)
+        first = (float(p["lat"][adsb][0]), float(p["lon"][adsb][0])) if adsb.any() else None
+        self._adopt(np.unique(sensor[~adsb]).tolist(), np.unique(sensor[adsb]).tolist(),
+                    first)
         ids = self.sensors.ids if self.sensors is not None else ()
         ok = np.isin(sensor, np.asarray(ids, np.int64))
         for sid in np.unique(sensor[~ok]).tolist():
             mine = sensor == sid
             got = self._skipped.setdefault(sid, [0, int(offset[mine][0])])
             got[0] += int(mine.sum())
+        if adsb.any():
+            assert self.sensors is not None
+            fallback = {s.id: np.nan if s.sigma is None else s.sigma
+                        for s in self.sensors.sensors}
+            sigma = np.where(np.isfinite(p["sigma"]), p["sigma"], np.array(
+                [fallback.get(int(s), np.nan) for s in sensor]))
+            blind = adsb & ok & ~np.isfinite(sigma)
+            if blind.any():
+                self.problems.add("no_accuracy", int(offset[blind][0]), int(blind.sum()))
+            ok &= ~blind
+            p["sigma"] = sigma
         p = {k: v[ok] for k, v in p.items()}
-        sensor = p["sensor"]
+        adsb, sensor = adsb[ok], p["sensor"]
         out = {k: p[k] for k in ("time", "sensor", "file_row", "offset") if k in p}
         if not sensor.size:
             return {**out, "x": np.zeros(0), "y": np.zeros(0), "R": np.zeros((0, 2, 2))}
         assert self.sensors is not None
-        self._check_radars(sensor, p["offset"])
-        rng = ground_ranges(self.sensors, sensor, p["slant_range"], p["bearing"],
-                            p["flight_level"])
-        x, y, R = np.empty(sensor.size), np.empty(sensor.size), np.empty((sensor.size, 2, 2))
-        for sid in np.unique(sensor).tolist():
+        self._check_radars(sensor, p["offset"], adsb)
+        x, y, R = np.empty(sensor.size), np.empty(sensor.size), np.zeros((sensor.size, 2, 2))
+        if adsb.any():  # WGS-84 positions, σ per axis from NACp/NUCp
+            x[adsb], y[adsb] = self.sensors.frame().to_local(p["lat"][adsb], p["lon"][adsb])
+            R[adsb, 0, 0] = R[adsb, 1, 1] = p["sigma"][adsb] ** 2
+        polar = ~adsb
+        rng = ground_ranges(self.sensors, sensor[polar], p["slant_range"][polar],
+                            p["bearing"][polar], p["flight_level"][polar])
+        for sid in np.unique(sensor[polar]).tolist():
             mine = sensor == sid
-            x[mine], y[mine], R[mine] = polar_plots(self.sensors, sid, rng[mine],
+            x[mine], y[mine], R[mine] = polar_plots(self.sensors, sid,
+                                                    rng[sensor[polar] == sid],
                                                     p["bearing"][mine])
         return {**out, "x": x, "y": y, "R": R}
 
-    def _adopt(self, radars: list[int]) -> None:
-        """Settle the radars not seen before: the sensors file's, else their CAT034 site
-        received so far, else skipped (until a site comes)."""
+    def _adopt(self, radars: list[int], adsb: list[int] = (),  # type: ignore[assignment]
+               first: tuple[float, float] | None = None) -> None:
+        """Settle the sensors not seen before: the sensors file's, else (radars) their
+        CAT034 site received so far or skipped until a site comes, (ADS-B stations) a
+        sensor of kind ``adsb`` (:func:`~mhtrack.io.asterix.sites.sensors_with_sites`)."""
         new = [r for r in radars if r not in self._seen]
-        if not new:
+        new_adsb = [r for r in adsb if r not in self._seen]
+        if not new and not new_adsb:
             return
         sites = self._decoder.sites if self._decoder is not None else {}
-        self.sensors, skipped = sensors_with_sites(self.sensors, sites, new, self.name)
-        self._seen.update(r for r in new if r not in skipped)
+        self.sensors, skipped = sensors_with_sites(self.sensors, sites, new, self.name,
+                                                   adsb=new_adsb, first_position=first)
+        self._seen.update(r for r in (*new, *new_adsb) if r not in skipped)
 
-    def _check_radars(self, sensor: np.ndarray, offset: np.ndarray) -> None:
-        """Every radar kept is a polar sensor of the sensors file with a lat/lon site."""
+    def _check_radars(self, sensor: np.ndarray, offset: np.ndarray, adsb: np.ndarray
+                      ) -> None:
+        """Every radar kept is a polar sensor with a lat/lon site, every ADS-B station a
+        sensor of kind ``adsb``."""
         assert self.sensors is not None
         for sid in np.unique(sensor).tolist():
             s = self.sensors.sensor(sid)
-            if s.kind != "polar" or s.lat is None:
-                at = int(offset[sensor == sid][0])
+            mine = sensor == sid
+            at = int(offset[mine][0])
+            if adsb[mine].any() and s.kind != "adsb":
+                raise InputError(f"{self.name}, byte {at}: sensor {sid} sends ADS-B "
+                                 f"reports (CAT021) but the sensors file makes it "
+                                 f"{s.kind!r}: give it kind = \"adsb\"", file=self.name)
+            if not adsb[mine].all() and (s.kind != "polar" or s.lat is None):
                 raise InputError(f"{self.name}, byte {at}: sensor {sid} of the sensors file "
                                  "is not a polar radar with a lat/lon site (its ASTERIX "
                                  "plots are range and bearing)", file=self.name)
@@ -213,15 +246,18 @@ class DatagramSource(Source):
         (every kept plot's ``x, y``). Reads the datagrams: only for a replayable input."""
         sweeps: list[tuple[Any, ...]] = []
         chunks = [{k: c[k] for k in ("sensor", "slant_range", "bearing", "flight_level",
-                                     "offset")}
+                                     "offset", "lat", "lon", "sigma") if k in c}
                   for c in self._decoded(Problems(), sweeps, convert=False)]
         cols = list(zip(*sweeps, strict=True)) if sweeps else [()] * 5
         marks = {k: np.array(c, dtype=d) for k, c, d in zip(
             ("time", "sensor", "kind", "azimuth", "period"), cols,
             (float, np.int64, np.int64, float, float), strict=True)}
         self._seen, self.sensors = set(), self.given
-        radars = sorted({int(s) for c in chunks for s in np.unique(c["sensor"]).tolist()})
-        self._adopt(radars)  # every site of the file is known now
+        radars: set[int] = set()
+        for c in chunks:
+            polar = ~np.isfinite(c["lat"]) if "lat" in c else np.ones(c["sensor"].size, bool)
+            radars.update(np.unique(c["sensor"][polar]).tolist())
+        self._adopt(sorted(radars))  # every site of the file is known now
         self._seen.update(radars)  # the radars left out stay out (one warning, later)
         xs, ys, kept = [], [], set()
         for c in chunks:

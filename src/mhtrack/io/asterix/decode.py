@@ -91,9 +91,11 @@ def read_recording(path: str | Path, *, fast: bool = True) -> Recording:
     times: list[float] = []
     axis = TimeAxis()
     for offset, when, payload in units(data, kind, name, decoder.categories, problems):
-        for _, what, found in decoder.blocks(payload, offset, problems, when):
-            if what == ADSB:
-                continue  # not in the plots table: a sensor of another kind
+        for at, what, found in decoder.blocks(payload, offset, problems, when):
+            if what == ADSB:  # not in the plots table: a sensor of another kind
+                if found:
+                    problems.add("adsb", at, len(found))
+                continue
             into = rows if what == PLOTS else marks
             into.extend(found)
             is_plot.extend([what == PLOTS] * len(found))

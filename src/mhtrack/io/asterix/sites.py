@@ -13,10 +13,13 @@ For each radar whose plots a recording holds:
   Airspace and Major Terminal Areas (SUR.ET1.ST01.1000-STD-01-01, 1997), SSR
   performance requirements: random range error σ ≤ 70 m, azimuth σ ≤ 0.08°, detection
   probability ≥ 97 % — the radar's own period from its CAT034 messages;
-* no site at all: skipped, the radars listed in one warning line.
+* no site at all: skipped, the radars listed in one warning line;
+* an ADS-B station (CAT021) the file does not list: a sensor of kind ``adsb``
+  (:data:`DEFAULT_ADSB`); its reports carry their own positions and accuracies.
 
 The local frame is the file's (its origin, else its first lat/lon site) or, without a
-sensors file, centred on the first radar's site (the lowest id).
+sensors file, centred on the first radar's site (the lowest id), else on the first
+ADS-B report.
 """
 
 from __future__ import annotations
@@ -30,6 +33,10 @@ from mhtrack.models.radars import RadarSensor, SensorSet
 DISAGREE_M = 100.0
 #: Errors of a radar known only from its CAT034 site (module docstring).
 DEFAULT_RADAR = {"pd": 0.97, "sigma_range": 70.0, "sigma_bearing_deg": 0.08}
+#: An ADS-B station the sensors file does not list: its reports' σ come from their
+#: NACp/NUCp (:mod:`~mhtrack.io.asterix.cat021`); ``pd`` is an assumption (a station that
+#: receives most of an aircraft's position squitters) — give it in the sensors file.
+DEFAULT_ADSB = {"pd": 0.95}
 
 #: ``sensor -> (lat deg, lon deg, height m, byte offset)`` as the decoder gathers them.
 Sites = dict[int, tuple[float, float, float, int]]
@@ -41,15 +48,20 @@ def radar_name(sensor: int) -> str:
 
 
 def sensors_with_sites(given: SensorSet | None, sites: Sites, radars: list[int] | tuple[int, ...],
-                       name: str, *, warn: bool = True
+                       name: str, *, warn: bool = True, adsb: list[int] | tuple[int, ...] = (),
+                       first_position: tuple[float, float] | None = None
                        ) -> tuple[SensorSet | None, list[int]]:
-    """The sensors to convert the plots of ``radars`` with, and the radars skipped (no
-    site known). ``given`` (the sensors file, or ``None``) wins; radars it lacks are
-    added from ``sites`` (I034/120). With ``warn``, one warning line per site that
-    disagrees with the file by more than :data:`DISAGREE_M` (naming ``name`` and the
-    byte of the I034/120). ``None`` when no radar has a site."""
+    """The sensors to convert the plots of ``radars`` and the reports of the ADS-B
+    stations ``adsb`` with, and the radars skipped (no site known). ``given`` (the
+    sensors file, or ``None``) wins; radars it lacks are added from ``sites``
+    (I034/120), ADS-B stations as sensors of kind ``adsb`` (:data:`DEFAULT_ADSB`). With
+    ``warn``, one warning line per site that disagrees with the file by more than
+    :data:`DISAGREE_M` (naming ``name`` and the byte of the I034/120). A set with no
+    geodetic reference is centred on ``first_position`` (the first ADS-B report).
+    ``None`` when no sensor is known."""
     known = {s.id: s for s in given.sensors} if given is not None else {}
-    added: list[RadarSensor] = []
+    added: list[RadarSensor] = [RadarSensor(a, "adsb", **DEFAULT_ADSB)  # type: ignore[arg-type]
+                                for a in sorted(set(adsb)) if a not in known]
     skipped: list[int] = []
     for sid in sorted(set(radars)):
         if sid in known:
@@ -69,9 +81,13 @@ def sensors_with_sites(given: SensorSet | None, sites: Sites, radars: list[int] 
                                      **DEFAULT_RADAR))  # type: ignore[arg-type]
         else:
             skipped.append(sid)
-    if given is None:
-        return (SensorSet(None, tuple(added)) if added else None), skipped
-    return (replace(given, sensors=(*given.sensors, *added)) if added else given), skipped
+    if not added:
+        return given, skipped
+    out = SensorSet(None, tuple(added)) if given is None else \
+        replace(given, sensors=(*given.sensors, *added))
+    if out.reference is None and first_position is not None:
+        out = replace(out, origin=first_position)
+    return out, skipped
 
 
 def skipped_line(name: str, skipped: list[int], n_plots: int, first: int) -> str:

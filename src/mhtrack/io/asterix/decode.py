@@ -122,7 +122,7 @@ class Decoder:
         self.specs = {48: _lib.cat048(), 34: _lib.cat034()}
         self.categories = {int(c) for c in gen.manifest["CATS"]} | {34, 48}
         self.sites: dict[int, tuple[float, float, float, int]] = {}
-        self.readers = {48: reader048(plot_row), 34: reader034(mark_row, self.sites)} \
+        self.readers = {48: reader048(plot_row), 34: reader034(self._mark, self.sites)} \
             if fast else {}
         self.duplicates = DuplicateFilter() if duplicates is True else \
             (duplicates or None)
@@ -170,14 +170,13 @@ class Decoder:
         records = self.specs[cat].cv_uap.parse(self.bits(raw))
         if isinstance(records, ValueError):
             return None
-        out = []
-        for rec in records:
-            if cat == 34:
-                site_row(rec, at, self.sites)
-            row = plot_row(rec, at, problems) if cat == 48 else mark_row(rec)
-            if row is not None:
-                out.append(row)
-        return out
+        read = plot_row if cat == 48 else self._mark
+        return [row for rec in records if (row := read(rec, at, problems)) is not None]
+
+    def _mark(self, rec: Any, at: int, problems: Problems) -> tuple[Any, ...] | None:
+        """A CAT034 record's sweep mark (:func:`mark_row`); its site to :attr:`sites`."""
+        site_row(rec, at, self.sites)
+        return mark_row(rec)
 
 
 def _plots_only(rows: list[tuple[Any, ...]], cat: int, at: int, problems: Problems

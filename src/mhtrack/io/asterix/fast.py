@@ -278,19 +278,13 @@ def reader048(slow_row: Callable[[Any, int, Problems], tuple[Any, ...] | None]
     return out
 
 
-def reader034(slow_row: Callable[[Any], tuple[Any, ...] | None],
+def reader034(slow_row: Callable[[Any, int, Problems], tuple[Any, ...] | None],
               sites: dict[int, tuple[float, float, float, int]]) -> FastRecords:
     """The fast reader of CAT034 north markers and sector crossings; each radar's first
-    I034/120 goes to ``sites`` (``sensor -> (lat, lon, height, byte offset)``)."""
-    from mhtrack.io.asterix.decode import site_row
-
+    I034/120 goes to ``sites`` (``sensor -> (lat, lon, height, byte offset)``), as
+    ``slow_row`` puts it there for the records libasterix reads."""
     r = _lib.cat034()
-
-    def slow(rec: Any, at: int, problems: Problems) -> tuple[Any, ...] | None:
-        site_row(rec, at, sites)
-        return slow_row(rec)
-
-    out = FastRecords(r, slow, cat034_row)
+    out = FastRecords(r, slow_row, cat034_row)
     out.sites = sites
     rec = r.cv_record
     out.fields = {

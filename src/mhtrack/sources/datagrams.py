@@ -243,28 +243,48 @@ class DatagramSource(Source):
         """One pass over the input: the radars (:meth:`_adopt`: the sensors file's, else
         their CAT034 sites), their periods from their CAT034 marks
         (:func:`~mhtrack.io.asterix.decode.sweep_periods`) and the :class:`Survey`
-        (every kept plot's ``x, y``). Reads the datagrams: only for a replayable input."""
+        (every kept plot's ``x, y``). The plots of radars the sensors file lists are
+        converted as they come (16 octets a plot kept); the others wait, as decoded,
+        for the sites of the whole input. Reads the datagrams: only for a replayable
+        input."""
         sweeps: list[tuple[Any, ...]] = []
-        chunks = [{k: c[k] for k in ("sensor", "slant_range", "bearing", "flight_level",
-                                     "offset", "lat", "lon", "sigma") if k in c}
-                  for c in self._decoded(Problems(), sweeps, convert=False)]
-        cols = list(zip(*sweeps, strict=True)) if sweeps else [()] * 5
-        marks = {k: np.array(c, dtype=d) for k, c, d in zip(
-            ("time", "sensor", "kind", "azimuth", "period"), cols,
-            (float, np.int64, np.int64, float, float), strict=True)}
         self._seen, self.sensors = set(), self.given
+        listed = np.asarray([s.id for s in self.given.sensors if s.kind == "polar"]
+                            if self.given is not None else [], np.int64)
+        self._seen.update(listed.tolist())
+        xs, ys, kept, waiting = [], [], set(), []
+        for c in self._decoded(Problems(), sweeps, convert=False):
+            now = np.isin(c["sensor"], listed)
+            if "lat" in c:
+                now &= ~np.isfinite(c["lat"])
+            if now.any():
+                done = self._convert({k: c[k][now] for k in ("sensor", "slant_range",
+                                                              "bearing", "flight_level",
+                                                              "offset")})
+                xs.append(done["x"])
+                ys.append(done["y"])
+                kept.update(np.unique(done["sensor"]).tolist())
+            if not now.all():
+                waiting.append({k: v[~now] for k, v in c.items() if k in (
+                    "sensor", "slant_range", "bearing", "flight_level", "offset", "lat",
+                    "lon", "sigma")})
+        sites = self._decoder.sites if self._decoder is not None else {}
+        sensors_with_sites(self.given, sites, sorted(kept), self.name)  # warns if far
         radars: set[int] = set()
-        for c in chunks:
+        for c in waiting:
             polar = ~np.isfinite(c["lat"]) if "lat" in c else np.ones(c["sensor"].size, bool)
             radars.update(np.unique(c["sensor"][polar]).tolist())
-        self._adopt(sorted(radars))  # every site of the file is known now
+        self._adopt(sorted(radars))  # every site of the input is known now
         self._seen.update(radars)  # the radars left out stay out (one warning, later)
-        xs, ys, kept = [], [], set()
-        for c in chunks:
+        for c in waiting:
             done = self._convert(c)
             xs.append(done["x"])
             ys.append(done["y"])
             kept.update(np.unique(done["sensor"]).tolist())
+        cols = list(zip(*sweeps, strict=True)) if sweeps else [()] * 5
+        marks = {k: np.array(c, dtype=d) for k, c, d in zip(
+            ("time", "sensor", "kind", "azimuth", "period"), cols,
+            (float, np.int64, np.int64, float, float), strict=True)}
         x = np.concatenate(xs) if xs else np.zeros(0)
         y = np.concatenate(ys) if ys else np.zeros(0)
         return sweep_periods(marks), Survey(int(x.size), tuple(sorted(kept)), x, y)

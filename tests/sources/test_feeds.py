@@ -4,6 +4,7 @@ reports that are no plots are left out and counted (issue 28)."""
 
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -189,3 +190,33 @@ def test_adsb_reports_are_a_sensor_of_their_own(rec: Path, opensky2: Path,
     assert np.abs(z[order] - np.column_stack((x, y))).max() < 0.1  # 180/2^30 deg LSB
     sigma = np.array([NACP_EPU_M[int(k)] for k in nacp[keep]]) * R95_TO_SIGMA
     assert np.allclose(R[order][:, 0, 0], sigma**2) and np.all(R[:, 0, 1] == 0)
+
+
+@pytest.mark.parametrize("ars", ["absent", "zero"])
+def test_period_from_north_markers_without_i034_041(opensky2: Path, tmp_path: Path,
+                                                    ars: str) -> None:
+    """CAT034 without I034/041, or with a period of 0: the period is the north markers'
+    interval, never a refusal of a sensors file that has no period."""
+    import pyarrow.csv as pacsv
+
+    from mhtrack.io.asterix.encode import encode_blocks, plot_messages, sweep_messages
+
+    sensors = read_sensors(opensky2 / "sensors.toml")
+    tab = pacsv.read_csv(opensky2 / "plots.csv")
+    t, s, b, r = (tab.column(k).to_numpy() for k in ("time", "sensor", "bearing", "range"))
+    periods = {x.id: float(x.period) for x in sensors.sensors}
+    msgs = plot_messages(t, s, r, b, {})  # ground range as slant range: fine here
+    marks = sweep_messages(t, s, b, periods)
+    for m in marks:
+        if "041" in m.items:
+            if ars == "absent":
+                del m.items["041"]
+            else:
+                m.items["041"] = 0
+    (tmp_path / "rec.ast").write_bytes(b"".join(x for _, _, x in
+                                               encode_blocks(msgs + marks)))
+    bare = replace(sensors, sensors=tuple(replace(x, period=None) for x in sensors.sensors))
+    src = open_source(tmp_path / "rec.ast", sensors=bare)
+    assert len(list(src)) > 300
+    for x in src.sensors.sensors:  # north markers a period apart, each on a 1/128 s LSB
+        assert x.period == pytest.approx(periods[x.id], abs=1 / 128)

@@ -214,14 +214,14 @@ def _plots_only(rows: list[tuple[Any, ...]], cat: int, at: int, problems: Proble
 
 def sweep_periods(sweeps: dict[str, np.ndarray]) -> dict[int, float]:
     """Each radar's rotation period (s) from its CAT034 sweep marks (``time, sensor,
-    kind, period`` columns): the median I034/041 if sent, else the median interval
-    between its north markers; radars with fewer than two north markers and no I034/041
-    are left out."""
+    kind, period`` columns): the median I034/041 if sent (and > 0), else the median
+    interval between its north markers; radars with fewer than two north markers and no
+    I034/041 are left out."""
     out: dict[int, float] = {}
     s = sweeps
     for sensor in np.unique(s["sensor"]).tolist():
         mine = s["sensor"] == sensor
-        ars = s["period"][mine & np.isfinite(s["period"])]
+        ars = s["period"][mine & np.isfinite(s["period"]) & (s["period"] > 0)]
         north = np.sort(s["time"][mine & (s["kind"] == 1)])
         if ars.size:
             out[int(sensor)] = float(np.median(ars))

@@ -220,3 +220,34 @@ def test_period_from_north_markers_without_i034_041(opensky2: Path, tmp_path: Pa
     assert len(list(src)) > 300
     for x in src.sensors.sensors:  # north markers a period apart, each on a 1/128 s LSB
         assert x.period == pytest.approx(periods[x.id], abs=1 / 128)
+
+
+def test_frames_cut_at_the_radars_own_sectors(rec: Path, opensky2: Path) -> None:
+    """``sectors=True``: no frame of a radar spans one of its sector crossings or north
+    markers (a plot at the crossing's time, to the 1/128 s LSB, may be either side: its
+    arrival order decides), none is longer than today's rule allows, and the plots are
+    those of today's frames."""
+    from mhtrack.frames import frame_lengths
+    from mhtrack.io.asterix import read_recording
+    from mhtrack.sources.recording import AsterixSource
+
+    sensors = read_sensors(opensky2 / "sensors.toml")
+    ref, _ = _frames(rec, sensors)
+    src = AsterixSource(rec, sensors=sensors, sectors=True)
+    got = list(src)
+    sweeps = read_recording(rec).sweeps
+    length = frame_lengths({s.id: s.period for s in sensors.sensors})
+    crossings = 0
+    for f in got:
+        s = int(f.sensor[0])
+        marks = sweeps["time"][sweeps["sensor"] == s]
+        inside = (marks > f.t.min()) & (marks < f.t.max())
+        assert not inside.any(), (f.index, s)
+        assert f.t.max() - f.t.min() <= length[s]
+        crossings += int(((marks > f.t.min() - length[s]) & (marks <= f.t.min())).any())
+    assert crossings > len(got) // 2  # most frames open just after a crossing
+    assert len(got) > len(ref)  # cut at crossings as well as by length
+    z = lambda fs: np.concatenate([f.z for f in fs])  # noqa: E731
+    t = lambda fs: np.concatenate([f.t for f in fs])  # noqa: E731
+    assert np.array_equal(np.sort(t(got)), np.sort(t(ref)))
+    assert np.array_equal(np.sort(z(got), axis=0), np.sort(z(ref), axis=0))

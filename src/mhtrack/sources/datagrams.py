@@ -16,6 +16,14 @@ Radars: the sensors file's, else those whose site came in I034/120
 (:func:`~mhtrack.io.asterix.sites.sensors_with_sites`); the plots of a radar with no
 known site are skipped, and one warning line at the end lists those radars.
 
+With ``sectors=True`` a radar's frames are also cut at its own sectors: each plot is in
+the sector its radar's last CAT034/CAT002 north marker or sector crossing received
+before it opened (arrival order: a radar sends a sector's message before the next
+sector's plots), and a frame holds one sector's plots (still at most ``frame_s``: radars
+without sector messages keep today's rule). Off by default: the recordings ``mhtrack
+export`` writes carry sector crossings every 45°, and cutting there changes their frames
+(and tracks) from those of the plots table they came from.
+
 A plot's file row is its 0-based number in decoding order (the row ``mhtrack convert``
 gives it, skipped radars included). Frame lengths come from the sensors' periods
 (``SensorSet``); a radar without one gets frames of
@@ -60,7 +68,7 @@ class DatagramSource(Source):
 
     def __init__(self, datagrams: Iterable[Datagram], *, sensors: SensorSet | None = None,
                  name: str = "datagrams", reorder_window_s: float | None = None,
-                 fast: bool = True) -> None:
+                 fast: bool = True, sectors: bool = False) -> None:
         super().__init__()
         self.name = name
         self.given = sensors
@@ -70,6 +78,7 @@ class DatagramSource(Source):
         if not self.window_s >= 0:
             raise ValueError(f"reorder_window_s must be >= 0, got {reorder_window_s!r}")
         self.fast = fast
+        self.sectors = sectors
         self.problems = Problems()
         self._input = datagrams
         self._stream: TimedStream | None = None
@@ -96,6 +105,8 @@ class DatagramSource(Source):
         rows: list[tuple[Any, ...]] = []
         times: list[float] = []
         at_rows: list[int] = []
+        sector: dict[int, int] = {}  # sweep marks received so far, per radar
+        in_sector: list[int] = []
         n = 0
         for offset, payload, when in self._datagrams(problems):
             for at, what, found in decoder.blocks(payload, offset, problems, when):
@@ -103,24 +114,30 @@ class DatagramSource(Source):
                 if what == MARKS:
                     if sweeps is not None:
                         sweeps.extend((ti, *r[1:]) for ti, r in zip(t, found, strict=True))
+                    for r in found:
+                        sector[r[1]] = sector.get(r[1], 0) + 1
                     continue
                 rows.extend(found)
                 times.extend(t)
                 at_rows.extend([at] * len(found))
+                if self.sectors:
+                    in_sector.extend(sector.get(r[1], 0) for r in found)
                 if len(rows) >= CHUNK:
-                    yield self._chunk(rows, times, at_rows, n, convert)
+                    yield self._chunk(rows, times, at_rows, n, convert, in_sector)
                     n += len(rows)
-                    rows, times, at_rows = [], [], []
+                    rows, times, at_rows, in_sector = [], [], [], []
         if rows:
-            yield self._chunk(rows, times, at_rows, n, convert)
+            yield self._chunk(rows, times, at_rows, n, convert, in_sector)
 
     def _chunk(self, rows: list[tuple[Any, ...]], times: list[float], at: list[int],
-               n0: int, convert: bool) -> dict[str, np.ndarray]:
+               n0: int, convert: bool, in_sector: list[int]) -> dict[str, np.ndarray]:
         k = len(PLOT_COLUMNS)
         p = plot_columns([r[:k] for r in rows])
         p["time"] = np.array(times, float)
         p["offset"] = np.asarray(at, np.int64)
         p["file_row"] = np.arange(n0, n0 + len(rows), dtype=np.int64)
+        if self.sectors:
+            p["sector"] = np.asarray(in_sector, np.int64)
         if any(len(r) > k for r in rows):  # ADS-B reports: lat, lon, sigma
             extra = np.array([r[k:k + 3] if len(r) > k else (np.nan,) * 3 for r in rows],
                              float)
@@ -154,7 +171,7 @@ class DatagramSource(Source):
             p["sigma"] = sigma
         p = {k: v[ok] for k, v in p.items()}
         adsb, sensor = adsb[ok], p["sensor"]
-        out = {k: p[k] for k in ("time", "sensor", "file_row", "offset") if k in p}
+        out = {k: p[k] for k in ("time", "sensor", "file_row", "offset", "sector") if k in p}
         if not sensor.size:
             return {**out, "x": np.zeros(0), "y": np.zeros(0), "R": np.zeros((0, 2, 2))}
         assert self.sensors is not None

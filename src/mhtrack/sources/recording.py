@@ -39,9 +39,10 @@ class AsterixSource(DatagramSource):
     ``sensors`` may be ``None``: the radars' own CAT034 sites are used."""
 
     def __init__(self, path: str | Path, *, sensors: SensorSet | None = None,
-                 reorder_window_s: float | None = None, fast: bool = True) -> None:
+                 reorder_window_s: float | None = None, fast: bool = True,
+                 sectors: bool = False) -> None:
         super().__init__((), sensors=sensors, name=str(path),
-                         reorder_window_s=reorder_window_s, fast=fast)
+                         reorder_window_s=reorder_window_s, fast=fast, sectors=sectors)
         self.path = check_input_file(Path(path))
         self.categories = Decoder(fast=fast, duplicates=None).categories
         with self._mapped() as data:

@@ -33,7 +33,7 @@ gives it, skipped radars included). Frame lengths come from the sensors' periods
 from __future__ import annotations
 
 import logging
-from collections.abc import Iterable, Iterator
+from collections.abc import Iterable, Iterator, Sequence
 from typing import Any
 
 import numpy as np
@@ -190,7 +190,7 @@ class DatagramSource(Source):
                                                     p["bearing"][mine])
         return {**out, "x": x, "y": y, "R": R}
 
-    def _adopt(self, radars: list[int], adsb: list[int] = (),  # type: ignore[assignment]
+    def _adopt(self, radars: Sequence[int], adsb: Sequence[int] = (),
                first: tuple[float, float] | None = None) -> None:
         """Settle the sensors not seen before: the sensors file's, else (radars) their
         CAT034 site received so far or skipped until a site comes, (ADS-B stations) a

@@ -25,6 +25,7 @@ ADS-B report.
 from __future__ import annotations
 
 import logging
+from collections.abc import Sequence
 from dataclasses import replace
 
 from mhtrack.models.radars import RadarSensor, SensorSet
@@ -47,8 +48,8 @@ def radar_name(sensor: int) -> str:
     return f"{sensor} (SAC {sensor >> 8}, SIC {sensor & 0xFF})"
 
 
-def sensors_with_sites(given: SensorSet | None, sites: Sites, radars: list[int] | tuple[int, ...],
-                       name: str, *, warn: bool = True, adsb: list[int] | tuple[int, ...] = (),
+def sensors_with_sites(given: SensorSet | None, sites: Sites, radars: Sequence[int],
+                       name: str, *, warn: bool = True, adsb: Sequence[int] = (),
                        first_position: tuple[float, float] | None = None
                        ) -> tuple[SensorSet | None, list[int]]:
     """The sensors to convert the plots of ``radars`` and the reports of the ADS-B

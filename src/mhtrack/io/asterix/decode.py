@@ -31,7 +31,7 @@ from mhtrack.io.asterix.container import blocks
 from mhtrack.io.asterix.duplicates import DuplicateFilter
 from mhtrack.io.asterix.fast import reader034, reader048
 from mhtrack.io.asterix.framings import recognise, units
-from mhtrack.io.asterix.notplots import flags048, plot_type048, real_plots
+from mhtrack.io.asterix.notplots import flags048, plot_type048_of, reason
 from mhtrack.io.asterix.problems import Problems
 from mhtrack.io.asterix.timeaxis import TimeAxis
 
@@ -182,34 +182,30 @@ class Decoder:
 def _plots_only(rows: list[tuple[Any, ...]], cat: int, at: int, problems: Problems
                 ) -> list[tuple[Any, ...]]:
     """The rows that are plots of real targets (:func:`~mhtrack.io.asterix.notplots.
-    real_plots`), the others counted (``not_plot``, the first reason in the detail). Rows
-    hold from column 11 on: CAT048 ``typ`` and the I048/020 flags (the plot type made
-    here); CAT001 ``typ, plot_type, sim, rab, tst, track``; CAT021 ``typ, plot_type``,
+    reason`), the others counted (``not_plot``, the first one's reason in the detail).
+    Rows hold from column 11 on: CAT048 ``typ`` and the I048/020 flags (the plot type
+    made here); CAT001 ``typ, plot_type, sim, rab, tst, track``; CAT021 ``typ, plot_type``,
     the flags, ``lat, lon, sigma``. The result has :data:`PLOT_COLUMNS` (CAT021: then
     ``lat, lon, sigma``)."""
-    if not rows:
-        return rows
-    k = 11
-    if cat == 48:  # typ, sim, rab, tst
-        typ = [r[k] for r in rows]
-        flags = [typ, [r[k + 1] for r in rows], [r[k + 2] for r in rows],
-                 [r[k + 3] for r in rows]]
-        ptype = plot_type048(np.array(typ, np.int64)).tolist()
-        tail = [(t, p) for t, p in zip(typ, ptype, strict=True)]
-        track = None
-    elif cat == 1:  # typ, plot_type, sim, rab, tst, track
-        flags = [[r[k] for r in rows], *([r[k + j] for r in rows] for j in (2, 3, 4))]
-        tail = [(r[k], r[k + 1]) for r in rows]
-        track = np.array([r[k + 5] == 1 for r in rows])
-    else:  # CAT021: typ (-1), plot_type, sim, rab, tst, lat, lon, sigma
-        flags = [[-1] * len(rows), *([r[k + j] for r in rows] for j in (2, 3, 4))]
-        tail = [(-1, r[k + 1], *r[k + 5:]) for r in rows]
-        track = None
-    keep, counts = real_plots(*(np.array(f, np.int64) for f in flags), track=track)
-    if not keep.all():
-        first = next(reason for reason, n in counts.items() if n)
-        problems.add("not_plot", at, int((~keep).sum()), detail=f"first: {first}")
-    return [(*r[:11], *t) for r, t, ok in zip(rows, tail, keep.tolist(), strict=True) if ok]
+    out, dropped, first = [], 0, ""
+    for r in rows:
+        if cat == 48:
+            why = reason(r[11], r[12], r[13], r[14])
+            row = (*r[:12], plot_type048_of(r[11]))
+        elif cat == 1:
+            why = reason(r[11], r[13], r[14], r[15], r[16])
+            row = r[:13]
+        else:
+            why = reason(-1, r[13], r[14], r[15])
+            row = (*r[:11], -1, r[12], *r[16:])
+        if why is None:
+            out.append(row)
+        else:
+            dropped += 1
+            first = first or why
+    if dropped:
+        problems.add("not_plot", at, dropped, detail=f"first: {first}")
+    return out
 
 
 def sweep_periods(sweeps: dict[str, np.ndarray]) -> dict[int, float]:

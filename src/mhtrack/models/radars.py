@@ -59,8 +59,10 @@ class RadarSensor:
     """A real sensor: a polar radar at a geodetic site (or a Cartesian position sensor).
 
     ``lat``/``lon`` (WGS-84 degrees) or ``position`` (x, y metres in the local frame) give
-    the site; ``alt`` its height (m, kept for output, unused by the 2-D conversions). Polar
-    sensors measure geodesic ground range (σ ``sigma_range`` m) and azimuth (σ
+    the site (a polar radar without one takes the site it sends in ASTERIX CAT034
+    I034/120 when its recording is read, :mod:`mhtrack.io.asterix.sites`; its plots in a
+    plots table are refused); ``alt`` its height (m, kept for output, unused by the 2-D
+    conversions). Polar sensors measure geodesic ground range (σ ``sigma_range`` m) and azimuth (σ
     ``sigma_bearing_deg``); Cartesian ones ``x, y`` with σ ``sigma`` m; ADS-B stations
     (``adsb``) relay WGS-84 positions, each with its own σ (``sigma``, optional, stands in
     for reports without an accuracy). ``pd`` is the
@@ -127,9 +129,6 @@ class RadarSensor:
             limits = {"sigma_range": (MAX_SIGMA, "m"),
                       "sigma_bearing_deg": (MAX_SIGMA_BEARING_DEG, "degrees")}
             other = ("sigma",)
-            if not self.has_site:
-                raise SensorFieldError(w, "lat", "a polar sensor needs its site: lat and lon, "
-                                       "or position = [x, y]")
         else:
             limits = {"sigma": (MAX_SIGMA, "m")}
             other = ("sigma_range", "sigma_bearing_deg")
@@ -179,7 +178,7 @@ class SensorSet:
             seen[s.id] = i
         if self.reference is None:
             for i, s in enumerate(self.sensors):
-                if s.kind == "polar":
+                if s.kind == "polar" and s.position is not None:
                     raise SensorFieldError(
                         f"sensors[{i}]", "position",
                         "a polar sensor placed by position needs [origin] (or a sensor with "

@@ -152,7 +152,8 @@ class DatagramSource(Source):
         first = (float(p["lat"][adsb][0]), float(p["lon"][adsb][0])) if adsb.any() else None
         self._adopt(np.unique(sensor[~adsb]).tolist(), np.unique(sensor[adsb]).tolist(),
                     first)
-        ids = self.sensors.ids if self.sensors is not None else ()
+        ids = [s.id for s in self.sensors.sensors if s.kind != "polar" or s.has_site] \
+            if self.sensors is not None else []  # a radar without a site is skipped
         ok = np.isin(sensor, np.asarray(ids, np.int64))
         for sid in np.unique(sensor[~ok]).tolist():
             mine = sensor == sid
@@ -266,8 +267,8 @@ class DatagramSource(Source):
         input."""
         sweeps: list[tuple[Any, ...]] = []
         self._seen, self.sensors = set(), self.given
-        listed = np.asarray([s.id for s in self.given.sensors if s.kind == "polar"]
-                            if self.given is not None else [], np.int64)
+        listed = np.asarray([s.id for s in self.given.sensors if s.kind == "polar" and
+                             s.has_site] if self.given is not None else [], np.int64)
         self._seen.update(listed.tolist())
         xs, ys, kept, waiting = [], [], set(), []
         for c in self._decoded(Problems(), sweeps, convert=False):

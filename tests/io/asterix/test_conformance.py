@@ -159,3 +159,17 @@ def test_sensors_file_lacking_the_radar_is_filled_from_cat034(
     assert (src.sensors.sensor(SIC12).lat, src.sensors.sensor(SIC12).lon) == SITE12
     assert {int(s) for f in got for s in f.sensor} == {25 * 256 + 11, SIC12}
     assert src.stats.skipped["no_site"] == 63 - 19 - 4  # SIC 11 has 4 plots, SIC 12 19
+
+
+def test_sensors_file_entry_without_a_site_takes_the_radars_own(
+        conformance_pcap: Path, tmp_path: Path) -> None:
+    """A radar listed with its errors only: the site (and height) from its I034/120, the
+    errors from the file."""
+    radar = RadarSensor(SIC12, "polar", pd=0.9, sigma_range=40.0, sigma_bearing_deg=0.05)
+    write_sensors(SensorSet(None, (radar,)), tmp_path / "errors_only.toml")
+    sensors = read_sensors(tmp_path / "errors_only.toml")
+    frames, src = _frames(conformance_pcap, sensors)
+    got = src.sensors.sensor(SIC12)
+    assert (got.lat, got.lon, got.alt) == (*SITE12, 780.0)
+    assert (got.sigma_range, got.sigma_bearing_deg, got.pd) == (40.0, 0.05, 0.9)
+    assert src.stats.plots_out == 19 and {int(s) for f in frames for s in f.sensor} == {SIC12}

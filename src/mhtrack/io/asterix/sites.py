@@ -6,7 +6,9 @@ For each radar whose plots a recording holds:
 
 * listed in the sensors file: the file's entry is used; where the radar also sent its
   site in I034/120 and the two are more than :data:`DISAGREE_M` apart (geodesic distance
-  on WGS-84), one warning line says so (the file wins);
+  on WGS-84), one warning line says so (the file wins); an entry without a site (a polar
+  radar with its errors only) takes the I034/120 site (and height, unless it gives
+  ``alt``);
 * not listed, or no sensors file, but its I034/120 was received: a polar radar at that
   site (height from I034/120) with the errors and detection probability of
   :data:`DEFAULT_RADAR` — the EUROCONTROL Standard for Radar Surveillance in En-Route
@@ -64,7 +66,16 @@ def sensors_with_sites(given: SensorSet | None, sites: Sites, radars: Sequence[i
     added: list[RadarSensor] = [RadarSensor(a, "adsb", **DEFAULT_ADSB)  # type: ignore[arg-type]
                                 for a in sorted(set(adsb)) if a not in known]
     skipped: list[int] = []
+    filled: dict[int, RadarSensor] = {}
     for sid in sorted(set(radars)):
+        if sid in known and known[sid].kind == "polar" and not known[sid].has_site:
+            if sid in sites:  # the file gives the errors, the radar its site
+                lat, lon, hgt, _ = sites[sid]
+                s = known[sid]
+                filled[sid] = replace(s, lat=lat, lon=lon, alt=hgt if s.alt is None else s.alt)
+            else:
+                skipped.append(sid)
+            continue
         if sid in known:
             s = known[sid]
             if warn and sid in sites and s.lat is not None:
@@ -82,10 +93,10 @@ def sensors_with_sites(given: SensorSet | None, sites: Sites, radars: Sequence[i
                                      **DEFAULT_RADAR))  # type: ignore[arg-type]
         else:
             skipped.append(sid)
-    if not added:
+    if not added and not filled:
         return given, skipped
-    out = SensorSet(None, tuple(added)) if given is None else \
-        replace(given, sensors=(*given.sensors, *added))
+    out = SensorSet(None, tuple(added)) if given is None else replace(
+        given, sensors=(*(filled.get(s.id, s) for s in given.sensors), *added))
     if out.reference is None and first_position is not None:
         out = replace(out, origin=first_position)
     return out, skipped

@@ -42,7 +42,7 @@ def test_export_convert(sim: Path, tmp_path: Path) -> None:
     t = pacsv.read_csv(out)
     assert t.column_names == ["time", "sensor", "sac", "sic", "slant_range", "bearing",
                               "flight_level", "mode_3a", "address", "callsign",
-                              "track_number", "typ", "range"]
+                              "track_number", "typ", "plot_type", "range"]
     assert t.num_rows == 2000
 
 

@@ -129,8 +129,6 @@ CASES = [
     ("pd above one", {20: "pd = 1.5"}, 20, "key 'sensors[1].pd': must be in (0, 1], got 1.5"),
     ("pd nan", {12: "pd = nan"}, 12, "key 'sensors[0].pd': must be finite, got nan"),
     ("duplicate id", {17: "id = 1"}, 17, "key 'sensors[1].id': duplicate id 1 (also sensors[0])"),
-    ("polar without site", {7: None, 8: None}, 4,
-     "key 'sensors[0].lat': a polar sensor needs its site: lat and lon, or position = [x, y]"),
     ("lat without lon", {8: None}, 4,
      "key 'sensors[0].lon': missing: lat and lon give the site together"),
     ("site twice", {9: "position = [1.0, 2.0]"}, 9,
@@ -141,7 +139,7 @@ CASES = [
     ("sigma on polar", {9: "sigma = 5.0"}, 9,
      "key 'sensors[0].sigma': not used by a polar sensor"),
     ("kind", {18: 'kind = "optical"'}, 18,
-     "key 'sensors[1].kind': must be 'polar' or 'cartesian', got 'optical'"),
+     "key 'sensors[1].kind': must be 'polar', 'cartesian' or 'adsb', got 'optical'"),
     ("pd string", {12: 'pd = "0.9"'}, 12,
      "key 'sensors[0].pd': expected a number, got string '0.9'"),
     ("id float", {17: "id = 2.0"}, 17, "key 'sensors[1].id': expected an integer, got float 2.0"),
@@ -232,3 +230,17 @@ def test_dataclasses_validate_for_python_callers():
     assert (e.value.index, e.value.key) == (1, "id")
     with pytest.raises(ValueError, match="no geodetic reference"):
         SensorSet(None, (RadarSensor(1, "cartesian", sigma=1.0, pd=1.0),)).frame()
+
+
+def test_polar_sensor_without_site_reads_and_its_table_plots_are_refused(tmp_path):
+    """A polar radar listed with its errors only (its site to come from its ASTERIX
+    CAT034 I034/120) reads; its range/bearing plots in a table are refused, one line."""
+    from mhtrack.io.timed_plots import read_timed_plots
+
+    s = read_sensors(write(tmp_path, edit({7: None, 8: None})))
+    assert s.sensor(1).kind == "polar" and not s.sensor(1).has_site
+    plots = tmp_path / "plots.csv"
+    plots.write_text("time,sensor,range,bearing\n0.5,1,1000.0,10.0\n")
+    with pytest.raises(InputError, match=r"plots\.csv, line 2, column 'sensor': sensor 1 is "
+                       r"a polar radar without a site in the sensors file"):
+        read_timed_plots(plots, s)

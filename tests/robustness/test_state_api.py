@@ -215,7 +215,8 @@ def test_any_meta_field_made_hostile_loads_or_raises_input_error(
 
 def _hostile_array(kind: int, a: np.ndarray) -> np.ndarray | None:
     with np.errstate(all="ignore"):
-        return [None, a[:0], np.full(a.shape, np.nan), np.zeros_like(a), ~a if a.dtype == bool else -np.abs(a) - 1,
+        negative = ~a if a.dtype == bool else -np.abs(a) - 1
+        return [None, a[:0], np.full(a.shape, np.nan), np.zeros_like(a), negative,
                 np.full(a.shape, 2**62, np.int64), np.full(a.shape, 1e300),
                 a.astype(np.float32) if a.dtype.kind in "fiu" else a, a[:1], np.array(3),
                 np.concatenate([a, a[:1]]) if a.ndim and a.size else a][kind]

@@ -91,3 +91,42 @@ def test_frames_come_out_while_the_stream_runs() -> None:
         if g[4] != -1:
             now = t[3 * g[4] - 1]  # stream time when it came out
             assert now - g[2] <= 1.5 + 0.1 + 1e-9
+
+
+def _brute_sectors(t, s, sec, lengths) -> list[list[int]]:
+    """Frames by the rule, plot by plot: a sensor's frame takes its plots while they are
+    in the frame's first plot's sector and within its length; ordered by (end, sensor)."""
+    open_: dict[int, list[int]] = {}
+    done = []
+    for i in range(t.size):
+        k = int(s[i])
+        f = open_.get(k)
+        if f is not None and (sec[i] != sec[f[0]] or t[i] - t[f[0]] > lengths[k]):
+            done.append(f)
+            f = None
+        if f is None:
+            f = open_[k] = []
+        f.append(i)
+    done += list(open_.values())
+    done.sort(key=lambda f: (t[f[-1]], int(s[f[0]]), f[0]))
+    return done
+
+
+@settings(max_examples=200, deadline=None)
+@given(streams(), st.data())
+def test_sector_cuts_as_the_rule_says(stream, data) -> None:
+    t, s, lengths, cuts = stream
+    sec = np.zeros(t.size, np.int64)  # each sensor's sector count never goes back
+    for k in range(1, 5):
+        mine = np.flatnonzero(s == k)
+        steps = data.draw(st.lists(st.sampled_from([0, 0, 1]), min_size=mine.size,
+                                   max_size=mine.size))
+        sec[mine] = np.cumsum(steps)
+    fr = Framer(lengths)
+    bounds = [0, *sorted(set(c for c in cuts if 0 < c < t.size)), t.size]
+    got = []
+    for a, b in itertools.pairwise(bounds):
+        got += [f.cols["pos"].tolist() for f in fr.push(
+            {"time": t[a:b], "sensor": s[a:b], "sector": sec[a:b], "pos": np.arange(a, b)})]
+    got += [f.cols["pos"].tolist() for f in fr.flush()]
+    assert got == _brute_sectors(t, s, sec, lengths)

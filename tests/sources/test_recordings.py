@@ -21,7 +21,7 @@ from recording_table import recording_table
 
 from mhtrack.errors import InputError
 from mhtrack.io.asterix import export
-from mhtrack.io.asterix.container import datagrams
+from mhtrack.io.asterix.framings import units
 from mhtrack.io.asterix.problems import Problems
 from mhtrack.io.sensors import read_sensors, write_sensors
 from mhtrack.records import Scan
@@ -82,7 +82,8 @@ def test_same_frames_as_today(opensky2: Path, recs: dict[str, Path], suffix: str
 
 def test_datagrams_from_anywhere(opensky2: Path, recs: dict[str, Path]) -> None:
     data = recs[".pcap"].read_bytes()
-    grams = [(bytes(p), when) for _, p, when in datagrams(data, "pcap", "x", Problems())]
+    grams = [(bytes(p), when) for _, when, p in units(data, "pcap", "x", {34, 48},
+                                                       Problems())]
     sensors = read_sensors(opensky2 / "sensors.toml")
     ref, _ = _frames(recs[".pcap"], opensky2 / "sensors.toml")
     got = list(DatagramSource(grams, sensors=sensors, name="udp"))
@@ -220,13 +221,25 @@ def test_13_hour_gap(opensky2: Path, tmp_path: Path, suffix: str) -> None:
 
 
 def test_radar_missing_from_sensors_file(opensky2: Path, recs: dict[str, Path],
-                                         tmp_path: Path) -> None:
+                                         tmp_path: Path,
+                                         caplog: pytest.LogCaptureFixture) -> None:
+    """A radar neither in the sensors file nor sending its site (I034/120) is skipped,
+    one warning line; the other radars' frames are those of the full sensors file."""
     sensors = read_sensors(opensky2 / "sensors.toml")
     write_sensors(replace(sensors, sensors=sensors.sensors[:2]), tmp_path / "two.toml")
-    with pytest.raises(InputError) as e:
-        _frames(recs[".pcap"], tmp_path / "two.toml")
-    assert str(e.value).startswith(f"{recs['.pcap']}, byte ")
-    assert "radar 3 (SAC 0, SIC 3) is not in the sensors file (it lists 1, 2)" in str(e.value)
+    with caplog.at_level(logging.WARNING, logger="mhtrack"):
+        got, src = _frames(recs[".pcap"], tmp_path / "two.toml")
+    ref, _ = _frames(recs[".pcap"], opensky2 / "sensors.toml")
+    mine = [f for f in ref if f.sensor[0] != 3]
+    assert len(got) == len(mine) and all(
+        np.array_equal(a.z, b.z) and np.array_equal(a.t, b.t) for a, b in
+        zip(got, mine, strict=True))
+    n3 = sum(len(f.sensor) for f in ref if f.sensor[0] == 3)
+    assert n3 > 0 and src.stats.skipped["no_site"] == n3
+    lines = [r.getMessage() for r in caplog.records if r.levelno == logging.WARNING]
+    assert len(lines) == 1 and lines[0].startswith(f"{recs['.pcap']}: 1 radar(s) without a "
+                                                   f"known site skipped, {n3} plots")
+    assert "3 (SAC 0, SIC 3)" in lines[0]
 
 
 def test_damaged_recording_warns_and_goes_on(recs: dict[str, Path], opensky2: Path,
@@ -238,10 +251,13 @@ def test_damaged_recording_warns_and_goes_on(recs: dict[str, Path], opensky2: Pa
         got, src = _frames(tmp_path / "cut.pcap", opensky2 / "sensors.toml")
     ref, _ = _frames(recs[".pcap"], opensky2 / "sensors.toml")
     assert len(got) > 300 and src.stats.plots_out <= sum(len(f) for f in ref)
-    assert src.stats.skipped == {"truncated_packet": 1}
+    start = len(data) - 30 - _last(data)  # the cut packet's record
+    assert src.stats.skipped == {"resync": 1, "skipped_octets": len(data) - 30 - start}
     lines = [r.getMessage() for r in caplog.records if r.levelno == logging.WARNING]
-    assert lines == [f"{tmp_path / 'cut.pcap'}: 1 truncated pcap packet(s) at the end of "
-                     f"the file skipped (first at byte {len(data) - 30 - _last(data)})"]
+    assert lines == [f"{tmp_path / 'cut.pcap'}: 1 damaged framing record(s) or packet(s): "
+                     f"reading went on at the next valid one (first at byte {start})",
+                     f"{tmp_path / 'cut.pcap'}: {_last(data)} octet(s) of damaged framing "
+                     f"skipped (first at byte {start})"]
 
 
 def _last(data: bytes) -> int:
@@ -250,5 +266,6 @@ def _last(data: bytes) -> int:
 
 
 def test_not_a_recording_without_sensors(recs: dict[str, Path]) -> None:
-    with pytest.raises(InputError, match="give its radars with a sensors file"):
-        open_source(recs[".ast"])
+    with pytest.raises(InputError, match=r"no plot with a measured position of a radar "
+                       r"with a known site \(radars 1 \(SAC 0, SIC 1\), "):
+        open_source(recs[".ast"]).survey()  # simulated: no I034/120, no sensors file

@@ -233,6 +233,12 @@ def _convert(
         f.fail(f"missing columns 'range', 'bearing', needed by polar sensor(s) {used}")
     f.check(polar & ~has_rb, "range", lambda r: f"value is missing (sensor "
             f"{num(sensor[r])} is a polar radar: its plots are range and bearing)")
+    siteless = np.isin(sensor, [s.id for s in sensors.sensors
+                                if s.kind == "polar" and not s.has_site])
+    f.check(siteless, "sensor", lambda r: (
+        f"sensor {num(sensor[r])} is a polar radar without a site in the sensors file: "
+        "give its lat and lon (or position) to place its range/bearing plots (an ASTERIX "
+        "recording takes it from the radar's CAT034 I034/120)"))
 
     def not_polar(r: int) -> str:
         s = kinds[int(sensor[r])]

@@ -24,8 +24,10 @@ if TYPE_CHECKING:
     from mhtrack.models.geodesy import LocalFrame
 
 
-#: The kinds of real sensor a sensors file may declare.
-RADAR_KINDS = ("polar", "cartesian")
+#: The kinds of real sensor a sensors file may declare: a rotating radar (range and
+#: azimuth), a Cartesian position sensor, an ADS-B ground station (CAT021: each report
+#: its own WGS-84 position and accuracy).
+RADAR_KINDS = ("polar", "cartesian", "adsb")
 #: Lowest and highest site altitude (m): no land lies below the Dead Sea shore (−430 m),
 #: and above 100 km (the Kármán line) a sensor is a satellite, not a site.
 MIN_ALT_M, MAX_ALT_M = -500.0, 100_000.0
@@ -72,9 +74,13 @@ class RadarSensor:
     """A real sensor: a polar radar at a geodetic site (or a Cartesian position sensor).
 
     ``lat``/``lon`` (WGS-84 degrees) or ``position`` (x, y metres in the local frame) give
-    the site; ``alt`` its height (m, kept for output, unused by the 2-D conversions). Polar
-    sensors measure geodesic ground range (σ ``sigma_range`` m) and azimuth (σ
-    ``sigma_bearing_deg``); Cartesian ones ``x, y`` with σ ``sigma`` m. ``pd`` is the
+    the site (a polar radar without one takes the site it sends in ASTERIX CAT034
+    I034/120 when its recording is read, :mod:`mhtrack.io.asterix.sites`; its plots in a
+    plots table are refused); ``alt`` its height (m, kept for output, unused by the 2-D
+    conversions). Polar sensors measure geodesic ground range (σ ``sigma_range`` m) and azimuth (σ
+    ``sigma_bearing_deg``); Cartesian ones ``x, y`` with σ ``sigma`` m; ADS-B stations
+    (``adsb``) relay WGS-84 positions, each with its own σ (``sigma``, optional, stands in
+    for reports without an accuracy). ``pd`` is the
     detection probability, ``period`` the rotation period (s), ``max_range`` the
     instrumented range (m). Out-of-domain fields raise :class:`SensorFieldError`.
     """
@@ -99,7 +105,8 @@ class RadarSensor:
             raise SensorFieldError(w, "id", f"must be an integer, got {self.id!r}")
         object.__setattr__(self, "id", int(self.id))
         if self.kind not in RADAR_KINDS:
-            raise SensorFieldError(w, "kind", f"must be 'polar' or 'cartesian', got {self.kind!r}")
+            raise SensorFieldError(w, "kind", "must be 'polar', 'cartesian' or 'adsb', got "
+                                   f"{self.kind!r}")
         for key in ("pd", "lat", "lon", "alt", "sigma_range", "sigma_bearing_deg", "sigma",
                     "period", "max_range"):
             v = getattr(self, key)
@@ -150,12 +157,11 @@ class RadarSensor:
                       "sigma_bearing_deg": (MIN_SIGMA_BEARING_DEG, MAX_SIGMA_BEARING_DEG,
                                             "degrees")}
             other = ("sigma",)
-            if not self.has_site:
-                raise SensorFieldError(w, "lat", "a polar sensor needs its site: lat and lon, "
-                                       "or position = [x, y]")
         else:
             limits = {"sigma": (MIN_SIGMA_M, MAX_SIGMA, "m")}
             other = ("sigma_range", "sigma_bearing_deg")
+            if self.kind == "adsb" and self.sigma is None:
+                limits = {}  # each report's σ from its NACp/NUCp; ``sigma`` a fallback
         for key in other:
             if getattr(self, key) is not None:
                 raise SensorFieldError(w, key, f"not used by a {self.kind} sensor")
@@ -201,7 +207,7 @@ class SensorSet:
         self._check_distances()
         if self.reference is None:
             for i, s in enumerate(self.sensors):
-                if s.kind == "polar":
+                if s.kind == "polar" and s.position is not None:
                     raise SensorFieldError(
                         f"sensors[{i}]", "position",
                         "a polar sensor placed by position needs [origin] (or a sensor with "

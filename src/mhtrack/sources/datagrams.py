@@ -2,23 +2,38 @@
 file's packets) decoded in memory, chunk by chunk, into frames (``docs/sources.md``).
 
 Each datagram's data blocks are decoded by :class:`~mhtrack.io.asterix.decode.Decoder`
-(CAT048 plots, CAT034 sweep marks; other parts counted and skipped, one warning line per
-kind at the end); times of day go on one monotonic axis
-(:class:`~mhtrack.io.asterix.timeaxis.TimeAxis`, with the datagrams' capture times where
-given); every :data:`CHUNK` plots are converted to the local frame — ground range
-(:func:`~mhtrack.io.asterix.api.ground_ranges`) then
+(a block received twice within the duplicate window is dropped — redundant LANs —;
+CAT048 and CAT001 plots, reports that are no plots left out; CAT034/CAT002 sweep marks
+and sites; other parts counted and skipped, one warning line per kind at the end); times
+of day go on one monotonic axis (:class:`~mhtrack.io.asterix.timeaxis.TimeAxis`, with the
+datagrams' capture times where given); every :data:`CHUNK` plots are converted to the
+local frame — ground range (:func:`~mhtrack.io.asterix.api.ground_ranges`) then
 :func:`~mhtrack.io.timed_plots.polar_plots`, the conversion of ``mhtrack convert`` +
 ``read_timed_plots`` — and pushed through the re-order buffer and the framer
 (:class:`~mhtrack.sources.timed.TimedStream`).
 
+Radars: the sensors file's, else those whose site came in I034/120
+(:func:`~mhtrack.io.asterix.sites.sensors_with_sites`); the plots of a radar with no
+known site are skipped, and one warning line at the end lists those radars.
+
+With ``sectors=True`` a radar's frames are also cut at its own sectors: each plot is in
+the sector its radar's last CAT034/CAT002 north marker or sector crossing received
+before it opened (arrival order: a radar sends a sector's message before the next
+sector's plots), and a frame holds one sector's plots (still at most ``frame_s``: radars
+without sector messages keep today's rule). Off by default: the recordings ``mhtrack
+export`` writes carry sector crossings every 45°, and cutting there changes their frames
+(and tracks) from those of the plots table they came from.
+
 A plot's file row is its 0-based number in decoding order (the row ``mhtrack convert``
-gives it). Frame lengths come from the sensors' periods (``SensorSet``); a radar without
-one gets frames of :data:`~mhtrack.frames.DEFAULT_FRAME_S`.
+gives it, skipped radars included). Frame lengths come from the sensors' periods
+(``SensorSet``); a radar without one gets frames of
+:data:`~mhtrack.frames.DEFAULT_FRAME_S`.
 """
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Iterator
+import logging
+from collections.abc import Iterable, Iterator, Sequence
 from typing import Any
 
 import numpy as np
@@ -26,14 +41,15 @@ import numpy as np
 from mhtrack.errors import InputError
 from mhtrack.frames import frame_lengths
 from mhtrack.io.asterix.api import ground_ranges
-from mhtrack.io.asterix.decode import Decoder, plot_columns, sweep_periods
+from mhtrack.io.asterix.decode import MARKS, PLOT_COLUMNS, Decoder, plot_columns, sweep_periods
 from mhtrack.io.asterix.problems import Problems
+from mhtrack.io.asterix.sites import sensors_with_sites, skipped_line
 from mhtrack.io.asterix.timeaxis import TimeAxis
 from mhtrack.io.timed_plots import DEFAULT_REORDER_WINDOW_S, polar_plots
 from mhtrack.models.radars import SensorSet
 from mhtrack.records import Scan
 from mhtrack.sources.base import Source, SourceStats, Survey
-from mhtrack.sources.reorder import kept
+from mhtrack.sources.reorder import kept as kept_by_buffer
 from mhtrack.sources.timed import TimedStream
 
 #: Plots decoded before they are converted and pushed on (memory: a few hundred kB).
@@ -44,26 +60,32 @@ Datagram = bytes | tuple[bytes, float | None]
 class DatagramSource(Source):
     """Frames from datagrams of ASTERIX data blocks: each ``bytes``, or ``(bytes,
     capture time)`` with the capture time in POSIX seconds (or ``None``). ``sensors``
-    gives every radar's site, errors and (optionally) period; a radar missing from it is
-    an error. Errors and warnings name ``name`` and the byte offset in the stream of
-    datagrams (their payloads back to back)."""
+    gives radars' sites, errors and (optionally) periods; a radar it lacks is taken from
+    its CAT034 site (I034/120) or skipped (module docstring). Errors and warnings name
+    ``name`` and the byte offset in the stream of datagrams (their payloads back to
+    back)."""
 
     timed = True
 
-    def __init__(self, datagrams: Iterable[Datagram], *, sensors: SensorSet,
+    def __init__(self, datagrams: Iterable[Datagram], *, sensors: SensorSet | None = None,
                  name: str = "datagrams", reorder_window_s: float | None = None,
-                 fast: bool = True) -> None:
+                 fast: bool = True, sectors: bool = False) -> None:
         super().__init__()
         self.name = name
+        self.given = sensors
         self.sensors = sensors
         self.window_s = (DEFAULT_REORDER_WINDOW_S if reorder_window_s is None
                          else float(reorder_window_s))
         if not self.window_s >= 0:
             raise ValueError(f"reorder_window_s must be >= 0, got {reorder_window_s!r}")
         self.fast = fast
+        self.sectors = sectors
         self.problems = Problems()
         self._input = datagrams
         self._stream: TimedStream | None = None
+        self._decoder: Decoder | None = None
+        self._seen: set[int] = set()  # radars whose site was settled (kept or skipped)
+        self._skipped: dict[int, list[int]] = {}  # radar -> [plots, first byte]
 
     def _datagrams(self, problems: Problems) -> Iterator[tuple[int, Any, float | None]]:
         """``(byte offset, payload, capture time)`` of each datagram."""
@@ -73,72 +95,143 @@ class DatagramSource(Source):
             yield offset, payload, when
             offset += len(payload)
 
-    def _decoded(self, problems: Problems, sweeps: list[tuple[Any, ...]] | None = None
-                 ) -> Iterator[dict[str, np.ndarray]]:
-        """Chunks of decoded, converted plots (columns ``time, sensor, x, y, R, file_row,
-        offset``), in decoding order; sweep marks (time on the axis) go to ``sweeps``."""
-        decoder, axis = Decoder(fast=self.fast), TimeAxis()
+    def _decoded(self, problems: Problems, sweeps: list[tuple[Any, ...]] | None = None,
+                 convert: bool = True) -> Iterator[dict[str, np.ndarray]]:
+        """Chunks of decoded plots in decoding order: converted (columns ``time, sensor,
+        x, y, R, file_row, offset``; radars without a site left out) or, with ``convert``
+        false, as decoded (:data:`~mhtrack.io.asterix.decode.PLOT_COLUMNS` with the time
+        on the axis, ``offset``); sweep marks (time on the axis) go to ``sweeps``."""
+        self._decoder = decoder = Decoder(fast=self.fast)
+        axis = TimeAxis()
         rows: list[tuple[Any, ...]] = []
         times: list[float] = []
         at_rows: list[int] = []
+        sector: dict[int, int] = {}  # sweep marks received so far, per radar
+        in_sector: list[int] = []
         n = 0
         for offset, payload, when in self._datagrams(problems):
-            for at, cat, found in decoder.blocks(payload, offset, problems):
+            for at, what, found in decoder.blocks(payload, offset, problems, when):
                 t = axis.times_list([r[0] for r in found], when)
-                if cat == 34:
+                if what == MARKS:
                     if sweeps is not None:
                         sweeps.extend((ti, *r[1:]) for ti, r in zip(t, found, strict=True))
+                    for r in found:
+                        sector[r[1]] = sector.get(r[1], 0) + 1
                     continue
                 rows.extend(found)
                 times.extend(t)
                 at_rows.extend([at] * len(found))
+                if self.sectors:
+                    in_sector.extend(sector.get(r[1], 0) for r in found)
                 if len(rows) >= CHUNK:
-                    yield self._convert(rows, times, at_rows, n)
+                    yield self._chunk(rows, times, at_rows, n, convert, in_sector)
                     n += len(rows)
-                    rows, times, at_rows = [], [], []
+                    rows, times, at_rows, in_sector = [], [], [], []
         if rows:
-            yield self._convert(rows, times, at_rows, n)
+            yield self._chunk(rows, times, at_rows, n, convert, in_sector)
 
-    def _convert(self, rows: list[tuple[Any, ...]], times: list[float],
-                 at: list[int], n0: int) -> dict[str, np.ndarray]:
-        p = plot_columns(rows)
-        sensor, offset = p["sensor"], np.asarray(at, np.int64)
-        self._check_radars(sensor, offset)
-        rng = ground_ranges(self.sensors, sensor, p["slant_range"], p["bearing"],
-                            p["flight_level"])
-        x, y, R = np.empty(sensor.size), np.empty(sensor.size), np.empty((sensor.size, 2, 2))
-        for sid in np.unique(sensor).tolist():
+    def _chunk(self, rows: list[tuple[Any, ...]], times: list[float], at: list[int],
+               n0: int, convert: bool, in_sector: list[int]) -> dict[str, np.ndarray]:
+        k = len(PLOT_COLUMNS)
+        p = plot_columns([r[:k] for r in rows])
+        p["time"] = np.array(times, float)
+        p["offset"] = np.asarray(at, np.int64)
+        p["file_row"] = np.arange(n0, n0 + len(rows), dtype=np.int64)
+        if self.sectors:
+            p["sector"] = np.asarray(in_sector, np.int64)
+        if any(len(r) > k for r in rows):  # ADS-B reports: lat, lon, sigma
+            extra = np.array([r[k:k + 3] if len(r) > k else (np.nan,) * 3 for r in rows],
+                             float)
+            p["lat"], p["lon"], p["sigma"] = extra.T
+        return self._convert(p) if convert else p
+
+    def _convert(self, p: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+        """Plots of radars with a known site and ADS-B reports with an accuracy, in the
+        local frame; the others counted."""
+        sensor, offset = p["sensor"], p["offset"]
+        adsb = np.isfinite(p["lat"]) if "lat" in p else np.zeros(sensor.size, bool)
+        first = (float(p["lat"][adsb][0]), float(p["lon"][adsb][0])) if adsb.any() else None
+        self._adopt(np.unique(sensor[~adsb]).tolist(), np.unique(sensor[adsb]).tolist(),
+                    first)
+        ids = [s.id for s in self.sensors.sensors if s.kind != "polar" or s.has_site] \
+            if self.sensors is not None else []  # a radar without a site is skipped
+        ok = np.isin(sensor, np.asarray(ids, np.int64))
+        for sid in np.unique(sensor[~ok]).tolist():
             mine = sensor == sid
-            x[mine], y[mine], R[mine] = polar_plots(self.sensors, sid, rng[mine],
+            got = self._skipped.setdefault(sid, [0, int(offset[mine][0])])
+            got[0] += int(mine.sum())
+        if adsb.any():
+            assert self.sensors is not None
+            fallback = {s.id: np.nan if s.sigma is None else s.sigma
+                        for s in self.sensors.sensors}
+            sigma = np.where(np.isfinite(p["sigma"]), p["sigma"], np.array(
+                [fallback.get(int(s), np.nan) for s in sensor]))
+            blind = adsb & ok & ~np.isfinite(sigma)
+            if blind.any():
+                self.problems.add("no_accuracy", int(offset[blind][0]), int(blind.sum()))
+            ok &= ~blind
+            p["sigma"] = sigma
+        p = {k: v[ok] for k, v in p.items()}
+        adsb, sensor = adsb[ok], p["sensor"]
+        out = {k: p[k] for k in ("time", "sensor", "file_row", "offset", "sector") if k in p}
+        if not sensor.size:
+            return {**out, "x": np.zeros(0), "y": np.zeros(0), "R": np.zeros((0, 2, 2))}
+        assert self.sensors is not None
+        self._check_radars(sensor, p["offset"], adsb)
+        x, y, R = np.empty(sensor.size), np.empty(sensor.size), np.zeros((sensor.size, 2, 2))
+        if adsb.any():  # WGS-84 positions, σ per axis from NACp/NUCp
+            x[adsb], y[adsb] = self.sensors.frame().to_local(p["lat"][adsb], p["lon"][adsb])
+            R[adsb, 0, 0] = R[adsb, 1, 1] = p["sigma"][adsb] ** 2
+        polar = ~adsb
+        rng = ground_ranges(self.sensors, sensor[polar], p["slant_range"][polar],
+                            p["bearing"][polar], p["flight_level"][polar])
+        for sid in np.unique(sensor[polar]).tolist():
+            mine = sensor == sid
+            x[mine], y[mine], R[mine] = polar_plots(self.sensors, sid,
+                                                    rng[sensor[polar] == sid],
                                                     p["bearing"][mine])
-        return {"time": np.array(times, float), "sensor": sensor, "x": x, "y": y, "R": R,
-                "file_row": np.arange(n0, n0 + sensor.size, dtype=np.int64),
-                "offset": offset}
+        return {**out, "x": x, "y": y, "R": R}
 
-    def _check_radars(self, sensor: np.ndarray, offset: np.ndarray) -> None:
-        """Every radar is a polar sensor of the sensors file with a lat/lon site."""
-        ids = self.sensors.ids
-        missing = ~np.isin(sensor, np.asarray(ids, np.int64))
-        if missing.any():
-            s = int(sensor[missing][0])
-            raise InputError(
-                f"{self.name}, byte {int(offset[missing][0])}: radar {s} (SAC {s >> 8}, "
-                f"SIC {s & 0xFF}) is not in the sensors file (it lists "
-                f"{', '.join(map(str, ids))}); add it, id = SAC·256 + SIC", file=self.name)
+    def _adopt(self, radars: Sequence[int], adsb: Sequence[int] = (),
+               first: tuple[float, float] | None = None) -> None:
+        """Settle the sensors not seen before: the sensors file's, else (radars) their
+        CAT034 site received so far or skipped until a site comes, (ADS-B stations) a
+        sensor of kind ``adsb`` (:func:`~mhtrack.io.asterix.sites.sensors_with_sites`)."""
+        new = [r for r in radars if r not in self._seen]
+        new_adsb = [r for r in adsb if r not in self._seen]
+        if not new and not new_adsb:
+            return
+        sites = self._decoder.sites if self._decoder is not None else {}
+        self.sensors, skipped = sensors_with_sites(self.sensors, sites, new, self.name,
+                                                   adsb=new_adsb, first_position=first)
+        self._seen.update(r for r in (*new, *new_adsb) if r not in skipped)
+
+    def _check_radars(self, sensor: np.ndarray, offset: np.ndarray, adsb: np.ndarray
+                      ) -> None:
+        """Every radar kept is a polar sensor with a lat/lon site, every ADS-B station a
+        sensor of kind ``adsb``."""
+        assert self.sensors is not None
         for sid in np.unique(sensor).tolist():
             s = self.sensors.sensor(sid)
-            if s.kind != "polar" or s.lat is None:
-                at = int(offset[sensor == sid][0])
+            mine = sensor == sid
+            at = int(offset[mine][0])
+            if adsb[mine].any() and s.kind != "adsb":
+                raise InputError(f"{self.name}, byte {at}: sensor {sid} sends ADS-B "
+                                 f"reports (CAT021) but the sensors file makes it "
+                                 f"{s.kind!r}: give it kind = \"adsb\"", file=self.name)
+            if not adsb[mine].all() and (s.kind != "polar" or s.lat is None):
                 raise InputError(f"{self.name}, byte {at}: sensor {sid} of the sensors file "
                                  "is not a polar radar with a lat/lon site (its ASTERIX "
                                  "plots are range and bearing)", file=self.name)
 
     def _frame_lengths(self) -> dict[int, float]:
-        return frame_lengths({s.id: s.period for s in self.sensors.sensors})
+        sensors = self.sensors.sensors if self.sensors is not None else ()
+        return frame_lengths({s.id: s.period for s in sensors})
 
     def __iter__(self) -> Iterator[Scan]:
         self.stats = SourceStats()
         self.problems = problems = Problems()
+        self._skipped = {}
         self._stream = stream = TimedStream(
             self.name, self.stats, self._frame_lengths(), self.window_s,
             lambda first: f"byte {first['offset']} (plot {first['file_row']})")
@@ -147,6 +240,17 @@ class DatagramSource(Source):
         yield from stream.finish()
         self.stats.skipped = dict(problems.counts)
         problems.warn(self.name)
+        self._warn_skipped()
+
+    def _warn_skipped(self) -> None:
+        """One warning line listing the radars skipped for want of a site."""
+        if not self._skipped:
+            return
+        n = sum(c for c, _ in self._skipped.values())
+        first = min(at for _, at in self._skipped.values())
+        self.stats.skipped["no_site"] = n
+        logging.getLogger("mhtrack").warning(
+            "%s", skipped_line(self.name, sorted(self._skipped), n, first))
 
     def file_rows(self, rows: np.ndarray) -> np.ndarray:
         """Each plot's 0-based number in decoding order."""
@@ -155,22 +259,61 @@ class DatagramSource(Source):
         return self._stream.file_rows(rows)
 
     def periods_and_survey(self) -> tuple[dict[int, float], Survey]:
-        """One pass over the input: the radars' periods from their CAT034 marks
+        """One pass over the input: the radars (:meth:`_adopt`: the sensors file's, else
+        their CAT034 sites), their periods from their CAT034 marks
         (:func:`~mhtrack.io.asterix.decode.sweep_periods`) and the :class:`Survey`
-        (every plot's ``x, y``). Reads the datagrams: only for a replayable input."""
+        (every kept plot's ``x, y``). The plots of radars the sensors file lists are
+        converted as they come (16 octets a plot kept); the others wait, as decoded,
+        for the sites of the whole input. Reads the datagrams: only for a replayable
+        input."""
         sweeps: list[tuple[Any, ...]] = []
-        xs, ys, ts, sensors = [], [], [], set()
-        for cols in self._decoded(Problems(), sweeps):
-            xs.append(cols["x"])
-            ys.append(cols["y"])
-            ts.append(cols["time"])
-            sensors.update(np.unique(cols["sensor"]).tolist())
+        self._seen, self.sensors = set(), self.given
+        listed = np.asarray([s.id for s in self.given.sensors if s.kind == "polar" and
+                             s.has_site] if self.given is not None else [], np.int64)
+        self._seen.update(listed.tolist())
+        xs, ys, ts, rows, kept, waiting = [], [], [], [], set(), []
+        for c in self._decoded(Problems(), sweeps, convert=False):
+            now = np.isin(c["sensor"], listed)
+            if "lat" in c:
+                now &= ~np.isfinite(c["lat"])
+            if now.any():
+                done = self._convert({k: c[k][now] for k in (
+                    "sensor", "slant_range", "bearing", "flight_level", "offset", "time",
+                    "file_row")})
+                xs.append(done["x"])
+                ys.append(done["y"])
+                ts.append(done["time"])
+                rows.append(done["file_row"])
+                kept.update(np.unique(done["sensor"]).tolist())
+            if not now.all():
+                waiting.append({k: v[~now] for k, v in c.items() if k in (
+                    "sensor", "slant_range", "bearing", "flight_level", "offset", "lat",
+                    "lon", "sigma", "time", "file_row")})
+        sites = self._decoder.sites if self._decoder is not None else {}
+        sensors_with_sites(self.given, sites, sorted(kept), self.name)  # warns if far
+        radars: set[int] = set()
+        for c in waiting:
+            polar = ~np.isfinite(c["lat"]) if "lat" in c else np.ones(c["sensor"].size, bool)
+            radars.update(np.unique(c["sensor"][polar]).tolist())
+        self._adopt(sorted(radars))  # every site of the input is known now
+        self._seen.update(radars)  # the radars left out stay out (one warning, later)
+        for c in waiting:
+            done = self._convert(c)
+            xs.append(done["x"])
+            ys.append(done["y"])
+            ts.append(done["time"])
+            rows.append(done["file_row"])
+            kept.update(np.unique(done["sensor"]).tolist())
         cols = list(zip(*sweeps, strict=True)) if sweeps else [()] * 5
         marks = {k: np.array(c, dtype=d) for k, c, d in zip(
             ("time", "sensor", "kind", "azimuth", "period"), cols,
             (float, np.int64, np.int64, float, float), strict=True)}
         x = np.concatenate(xs) if xs else np.zeros(0)
         y = np.concatenate(ys) if ys else np.zeros(0)
-        on_time = kept(np.concatenate(ts) if ts else np.zeros(0), self.window_s)
-        return sweep_periods(marks), Survey(int(x.size), tuple(sorted(sensors)),
-                                            x[on_time], y[on_time])
+        # the plots the re-order buffer will let through, replayed in decoding order
+        order = np.argsort(np.concatenate(rows), kind="stable") if rows else np.zeros(0, int)
+        on_time = np.zeros(x.size, bool)
+        on_time[order] = kept_by_buffer(np.concatenate(ts)[order] if ts else np.zeros(0),
+                                        self.window_s)
+        return sweep_periods(marks), Survey(int(x.size), tuple(sorted(kept)), x[on_time],
+                                            y[on_time])

@@ -3,7 +3,9 @@ each given out as soon as no later plot can change it.
 
 Input: plots in time order (ties in input order), as batches of columns (``time``,
 ``sensor`` and any others). A sensor's frame starts at its first plot and takes the
-sensor's plots while ``t − start ≤ frame_s``; it is *closed* once a plot of that sensor
+sensor's plots while ``t − start ≤ frame_s`` — and, where the batches carry a ``sector``
+column (the radar's own sectors, counted from its CAT034 sector crossings), while their
+sector is the frame's first plot's; it is *closed* once a plot of that sensor
 falls beyond (it starts the next frame) or the stream's time ``T`` passes
 ``start + frame_s`` (every later plot has ``t ≥ T``). :func:`~mhtrack.frames.make_frames`
 numbers frames by (latest plot time ``end``, sensor id); a closed frame ``F`` therefore
@@ -30,10 +32,11 @@ from mhtrack.frames import DEFAULT_FRAME_S
 
 @dataclass
 class _Open:
-    """A sensor's frame being filled: its start, end and the plots' positions."""
+    """A sensor's frame being filled: its start, end, sector and the plots' positions."""
 
     start: float
     end: float
+    sector: int = 0
     parts: list[tuple[int, np.ndarray]] = field(default_factory=list)  # (batch id, rows)
 
 
@@ -82,19 +85,25 @@ class Framer:
         self._next_batch += 1
         self._batches[b] = {k: np.asarray(v) for k, v in cols.items()}
         sensor = np.asarray(cols["sensor"], np.int64)
+        sector = np.asarray(cols["sector"], np.int64) if "sector" in cols else None
         uses = 0
         for s in np.unique(sensor).tolist():
             rows = np.flatnonzero(sensor == s)
             ts = t[rows]
+            sec = sector[rows] if sector is not None else None
             fr = self._open.get(s)
             length = self._length(s)
             cut = 0
             while cut < rows.size:
                 if fr is None:
-                    fr = self._open[s] = _Open(float(ts[cut]), float(ts[cut]))
+                    fr = self._open[s] = _Open(float(ts[cut]), float(ts[cut]),
+                                               0 if sec is None else int(sec[cut]))
                 # plots of this frame: t − start ≤ length, computed as make_frames does
                 # (the difference of sorted times is sorted)
                 stop = cut + int(np.searchsorted(ts[cut:] - fr.start, length, side="right"))
+                if sec is not None:  # and of the frame's sector
+                    other = np.flatnonzero(sec[cut:stop] != fr.sector)
+                    stop = cut + int(other[0]) if other.size else stop
                 if stop > cut:
                     fr.parts.append((b, rows[cut:stop]))
                     fr.end = float(ts[stop - 1])

@@ -6,7 +6,6 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-from mhtrack.errors import InputError
 from mhtrack.io._source import PathArg
 from mhtrack.sources.base import Source
 
@@ -20,7 +19,9 @@ def open_source(path: PathArg, *, sensors: SensorSet | None = None,
                 reorder_window_s: float | None = None) -> Source:
     """The :class:`Source` of a plots table or an ASTERIX recording at ``path``.
 
-    ``sensors``: the radars of timed plots and recordings (a recording needs them);
+    ``sensors``: the radars of timed plots and recordings (a recording without them, or
+    with radars they lack, uses the sites the radars send in CAT034, and skips radars
+    without one: :mod:`mhtrack.io.asterix.sites`);
     ``scenario``: the sensors and scan times of a scan table; ``reorder_window_s``: the
     re-order window of timed plots (default
     :data:`~mhtrack.io.timed_plots.DEFAULT_REORDER_WINDOW_S`). Nothing else is guessed:
@@ -28,10 +29,6 @@ def open_source(path: PathArg, *, sensors: SensorSet | None = None,
     from mhtrack.io.asterix.api import is_recording
 
     if is_recording(path):
-        if sensors is None:
-            raise InputError(f"{path} is an ASTERIX recording: give its radars with a "
-                             "sensors file (id = SAC·256 + SIC, lat, lon, alt)",
-                             file=str(path))
         if scenario is not None:
             raise ValueError(f"{path} is an ASTERIX recording: its radars come from a "
                              "sensors file, not a scenario")

@@ -1,13 +1,14 @@
-"""An ASTERIX recording file (pcap, pcapng or raw data blocks) as a source: the container
-is read through an ``mmap`` of the file (:func:`mhtrack.io.asterix.container.datagrams`,
-with each packet's capture time) and its datagrams fed to
+"""An ASTERIX recording file as a source: its framing (pcap, pcapng, the recorder formats,
+raw data blocks: :func:`mhtrack.io.asterix.framings.recognise`, by content) is read
+through an ``mmap`` of the file (:func:`mhtrack.io.asterix.framings.units`, with each
+unit's capture time) and its units fed to
 :class:`~mhtrack.sources.datagrams.DatagramSource` — decoded in memory, chunk by chunk,
 never through a temporary file.
 
 Before the frames, one pass over the recording (:meth:`AsterixSource.survey`, done once)
-finds every radar (a radar the sensors file does not list is an error, as before any
-tracking), the rotation periods its CAT034 messages give (filled into the sensors where
-the file has none: they set the frame lengths, as
+finds every radar and its site (the sensors file's, else its own I034/120; radars with
+neither are skipped, one warning line), the rotation periods its CAT034 messages give
+(filled into the sensors where the file has none: they set the frame lengths, as
 :func:`~mhtrack.io.asterix.api.sensors_with_periods` does) and every plot's ``x, y``.
 """
 
@@ -21,9 +22,10 @@ from typing import Any
 
 from mhtrack.errors import InputError
 from mhtrack.io.asterix.api import sensors_with_periods
-from mhtrack.io.asterix.container import container, datagrams
 from mhtrack.io.asterix.decode import Decoder
+from mhtrack.io.asterix.framings import recognise, units
 from mhtrack.io.asterix.problems import Problems
+from mhtrack.io.asterix.sites import radar_name
 from mhtrack.io.paths import check_input_file
 from mhtrack.models.radars import SensorSet
 from mhtrack.records import Scan
@@ -33,16 +35,18 @@ from mhtrack.sources.datagrams import DatagramSource
 
 class AsterixSource(DatagramSource):
     """Frames from a recording file; errors name the file and the byte offset there.
-    ``container`` is ``"pcap"``, ``"pcapng"`` or ``"raw"`` (by content)."""
+    ``container`` is its framing (:func:`~mhtrack.io.asterix.framings.recognise`).
+    ``sensors`` may be ``None``: the radars' own CAT034 sites are used."""
 
-    def __init__(self, path: str | Path, *, sensors: SensorSet,
-                 reorder_window_s: float | None = None, fast: bool = True) -> None:
+    def __init__(self, path: str | Path, *, sensors: SensorSet | None = None,
+                 reorder_window_s: float | None = None, fast: bool = True,
+                 sectors: bool = False) -> None:
         super().__init__((), sensors=sensors, name=str(path),
-                         reorder_window_s=reorder_window_s, fast=fast)
+                         reorder_window_s=reorder_window_s, fast=fast, sectors=sectors)
         self.path = check_input_file(Path(path))
-        self.given = sensors
+        self.categories = Decoder(fast=fast, duplicates=None).categories
         with self._mapped() as data:
-            self.container = container(data, self.name, Decoder(fast=fast).categories)
+            self.container = recognise(data, self.name, self.categories)
         self._survey: Survey | None = None
 
     @contextmanager
@@ -57,17 +61,23 @@ class AsterixSource(DatagramSource):
 
     def _datagrams(self, problems: Problems) -> Iterator[tuple[int, Any, float | None]]:
         with self._mapped() as data:
-            yield from datagrams(data, self.container, self.name, problems)
+            for offset, when, payload in units(data, self.container, self.name,
+                                               self.categories, problems):
+                yield offset, payload, when
 
     def survey(self) -> Survey:
         """The recording's radars, plots' ``x, y`` and periods (one pass, kept)."""
         if self._survey is None:
             periods, survey = self.periods_and_survey()
             if survey.n_plots == 0:
-                raise InputError(f"{self.name}: no CAT048 plot with a measured position "
-                                 f"(I048/040) in this {self.container} recording",
-                                 file=self.name)
-            self.sensors = sensors_with_periods(self.given, periods)
+                radars = ", ".join(map(radar_name, sorted(self._seen)))
+                why = "" if not radars else (
+                    f" of a radar with a known site (radars {radars}: none in the sensors "
+                    "file or with a CAT034 site I034/120)")
+                raise InputError(f"{self.name}: no plot with a measured position{why} in "
+                                 f"this {self.container} recording", file=self.name)
+            assert self.sensors is not None
+            self.sensors = sensors_with_periods(self.sensors, periods)
             self._survey = survey
         return self._survey
 

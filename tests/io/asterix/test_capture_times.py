@@ -8,7 +8,7 @@ import struct
 
 import pytest
 
-from mhtrack.io.asterix.container import datagrams
+from mhtrack.io.asterix.framings import units
 from mhtrack.io.asterix.problems import Problems
 from mhtrack.io.asterix.writer import datagram
 
@@ -17,7 +17,7 @@ FRAME = datagram(BLOCK, 513, 1)
 
 
 def _times(data: bytes, kind: str) -> list[float | None]:
-    return [when for _, _, when in datagrams(data, kind, "x", Problems())]
+    return [when for _, when, _ in units(data, kind, "x", {48}, Problems())]
 
 
 @pytest.mark.parametrize(("magic", "unit"), [(0xA1B2C3D4, 1e-6), (0xA1B23C4D, 1e-9)])

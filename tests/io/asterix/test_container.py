@@ -98,3 +98,26 @@ def test_is_recording_by_content(tmp_path: Path) -> None:
     table.write_bytes(b"".join(_blocks()))  # a table by its name, whatever it holds
     assert is_recording(raw)
     assert not is_recording(text) and not is_recording(table)
+
+
+def test_every_framing_is_a_recording_by_content(tmp_path: Path) -> None:
+    """GPS, Final, ORADIS, pcapng and 802.3/LLC captures under a name that says nothing
+    (``.bin``) are recordings, each read back to the same plots."""
+    from mhtrack.io.asterix import is_recording, wrap
+
+    blocks = _blocks()
+    times = [10.0 + k for k in range(len(blocks))]  # capture times of the same day
+    files = {"gps": wrap.gps(blocks, times), "final": wrap.final(blocks, times),
+             "oradis": wrap.oradis(blocks, times),
+             "pcapng": wrap.pcapng(wrap.udp_frames(blocks, 513), times),
+             "llc": wrap.pcap([wrap.llc_frame(b, 513) for b in blocks], times)}
+    (tmp_path / "raw.ast").write_bytes(b"".join(blocks))
+    ref = read_recording(tmp_path / "raw.ast")
+    for kind, data in files.items():
+        path = tmp_path / f"{kind}.bin"
+        path.write_bytes(data)
+        assert is_recording(path), kind
+        rec = read_recording(path)
+        assert rec.container == ("pcap" if kind == "llc" else kind)
+        assert np.array_equal(rec.plots["slant_range"], ref.plots["slant_range"]), kind
+        assert np.array_equal(rec.plots["time"], ref.plots["time"]), kind

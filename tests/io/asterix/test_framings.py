@@ -15,7 +15,7 @@ from hypothesis import strategies as st
 
 import mhtrack.io.asterix._lib as _lib
 from mhtrack.errors import InputError
-from mhtrack.io.asterix import container, wrap
+from mhtrack.io.asterix import wrap
 from mhtrack.io.asterix.decode import plot_row
 from mhtrack.io.asterix.encode import encode_blocks, lsb, plot_messages
 from mhtrack.io.asterix.framings import recognise, units
@@ -137,15 +137,23 @@ def test_pyasteryx_reads_the_unwrapped_blocks(monkeypatch: pytest.MonkeyPatch,
     assert np.abs(rho - p["slant"]).max() <= lsb()["rho_nm"] * 1852.0
 
 
-def test_the_former_container_path_on_the_real_capture(conformance_pcap: Path) -> None:
+def test_the_real_capture_as_pyasteryx_reads_it(conformance_pcap: Path) -> None:
+    """Every UDP payload of the real capture, as pyasteryx's own pcap reader gives them,
+    each at its offset in the file, with the packet's capture time."""
+    pyasteryx = pytest.importorskip("pyasteryx", reason="pyasteryx (extra [reference]) "
+                                    "not installed")
+    from pyasteryx.io import iter_pcap_payloads
+
     data = conformance_pcap.read_bytes()
     problems = Problems()
     got = list(units(data, "pcap", "c", _cats(), problems))
-    old = list(container.payloads(data, "pcap", "c", Problems()))
-    assert [(u[0], u[2]) for u in got] == old and len(got) == 100
-    assert not problems.counts
-    t = np.array([u[1] for u in got])
-    assert np.all(np.isfinite(t)) and t.min() > 1e9  # POSIX seconds of a real capture
+    assert [u[2] for u in got] == list(iter_pcap_payloads(conformance_pcap))
+    assert len(got) == 100 and not problems.counts and pyasteryx
+    for offset, when, octets in got:
+        assert data[offset:offset + len(octets)] == octets
+        head = offset - 42  # Ethernet 14 + IPv4 20 + UDP 8 octets before the payload
+        sec, usec = struct.unpack_from("<II", data, head - 16)
+        assert when == sec + usec * 1e-6
 
 
 def test_no_recording_refused_at_byte_0() -> None:

@@ -56,15 +56,19 @@ def test_truncated_block_raw(tmp_path: Path) -> None:
     data = b"".join(blocks)[:-7]  # the last block cut short
     rec = _read(tmp_path, "cut.ast", data)
     assert len(rec) == (N_BLOCKS - 1) * PER_BLOCK
-    assert rec.problems.counts == {"truncated_block": 1}
-    assert rec.problems.first["truncated_block"] == sum(map(len, blocks[:-1]))
+    at = sum(map(len, blocks[:-1]))  # the raw stream's last record is damaged
+    assert rec.problems.counts == {"resync": 1, "skipped_octets": len(data) - at}
+    assert rec.problems.first["resync"] == at
 
 
 def test_truncated_pcap_packet(tmp_path: Path) -> None:
     frames = [datagram(b, 258, i) for i, b in enumerate(_blocks())]
-    rec = _read(tmp_path, "cut.pcap", _pcap(frames)[:-10])
+    data = _pcap(frames)
+    rec = _read(tmp_path, "cut.pcap", data[:-10])
     assert len(rec) == (N_BLOCKS - 1) * PER_BLOCK
-    assert rec.problems.counts == {"truncated_packet": 1}
+    at = len(data) - 16 - len(frames[-1])  # the last packet record
+    assert rec.problems.counts == {"resync": 1, "skipped_octets": len(data) - 10 - at}
+    assert rec.problems.first["resync"] == at
 
 
 @pytest.mark.parametrize("delta", [+4, -2])
@@ -101,8 +105,8 @@ def test_random_bytes_after_good_blocks(tmp_path: Path) -> None:
     junk = bytes([48, 0, 2]) + b"\xff" * 50  # a block header with length 2: stream lost
     rec = _read(tmp_path, "tail.ast", b"".join(blocks) + junk)
     assert len(rec) == N_BLOCKS * PER_BLOCK
-    assert rec.problems.counts == {"bad_length": 1}
-    assert rec.problems.first["bad_length"] == sum(map(len, blocks))
+    assert rec.problems.counts == {"resync": 1, "skipped_octets": len(junk)}
+    assert rec.problems.first["resync"] == sum(map(len, blocks))
 
 
 def test_non_udp_packets_skipped(tmp_path: Path) -> None:
@@ -126,7 +130,10 @@ def test_one_warning_line_per_kind(tmp_path: Path, caplog: pytest.LogCaptureFixt
     with caplog.at_level(logging.WARNING, logger="mhtrack"):
         rec.problems.warn("two.ast")
     lines = [r.getMessage() for r in caplog.records]
-    assert len(lines) == 2
-    assert lines[0].startswith("two.ast: 1 truncated data block")
-    assert "2 data block(s) of categories not read here" in lines[1]
-    assert "(first at byte 0; category 62)" in lines[1]
+    assert len(lines) == 3
+    assert "2 data block(s) of categories not read here" in lines[0]
+    assert "(first at byte 0; category 62)" in lines[0]
+    at = 2 * len(cat62) + sum(map(len, blocks))
+    assert lines[1] == f"two.ast: 1 damaged framing record(s) or packet(s): reading went " \
+        f"on at the next valid one (first at byte {at})"
+    assert lines[2].startswith(f"two.ast: {len(blocks[0]) - 3} octet(s) of damaged framing")

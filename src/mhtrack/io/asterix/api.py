@@ -14,10 +14,10 @@ from mhtrack.errors import InputError
 from mhtrack.io._frame import FLOAT, INT, TIME, float_array, int_array, read_frame, write_frame
 from mhtrack.io._source import FORMATS
 from mhtrack.io._times import seconds
-from mhtrack.io.asterix.container import PCAP_MAGICS, PCAPNG_MAGIC
 from mhtrack.io.asterix.decode import FL_M, PLOT_COLUMNS, Recording, read_recording
 from mhtrack.io.asterix.earth import ground_range, slant_range
 from mhtrack.io.asterix.encode import encode_blocks, plot_messages, sweep_messages
+from mhtrack.io.asterix.notplots import PLOT_TYPES
 from mhtrack.io.asterix.writer import write_blocks
 from mhtrack.models.radars import SensorSet
 from mhtrack.names import EXPORT_CATEGORIES
@@ -29,37 +29,57 @@ _TEXT = ("mode_3a", "address", "callsign")
 
 def is_recording(path: str | Path) -> bool:
     """Whether ``path`` is to be read as an ASTERIX recording: not a ``.csv``/``.parquet``
-    table, and starting like a pcap, a pcapng or an ASTERIX data block (a category, then a
-    length of 3 octets or more that fits in the file, see :func:`_blocks_chain`) — or
-    named like a recording
-    (``.ast``, ``.pcap``, ...), so that a damaged one gets the decoder's message."""
+    table, and its first 64 KiB recognised as a framing
+    (:func:`~mhtrack.io.asterix.framings.recognise`: pcap, pcapng, Final, ORADIS, GPS; a
+    raw stream only when its first data block is of a category mhtrack reads and its
+    records decode to exactly its length, :func:`_blocks_chain`) — or named like a
+    recording (``.ast``, ``.pcap``, ...), so that a damaged one gets the decoder's
+    message."""
+    from mhtrack.io.asterix.framings import PCAP_MAGICS, PCAPNG_MAGIC, recognise
+
     p = Path(path)
     if p.suffix.lower() in FORMATS or not p.is_file():
         return False
     with p.open("rb") as fh:
         head = fh.read(1 << 16)
-    if head[:4] in PCAP_MAGICS or head[:4] == PCAPNG_MAGIC or _blocks_chain(head,
-                                                                            p.stat().st_size):
+    if head[:4] in PCAP_MAGICS or head[:4] == PCAPNG_MAGIC:
         return True
-    return p.suffix.lower() in (".ast", ".asterix", ".pcap", ".pcapng", ".raw", ".ff")
+    try:
+        kind = recognise(head, str(p), _READ)
+    except InputError:
+        kind = ""
+    if kind in ("final", "oradis", "gps") or (kind == "raw" and _blocks_chain(
+            head, p.stat().st_size)):
+        return True
+    return p.suffix.lower() in (".ast", ".asterix", ".pcap", ".pcapng", ".raw", ".ff",
+                                ".gps")
+
+
+#: Categories whose data blocks mhtrack reads.
+_READ = {1, 2, 21, 34, 48, 62}
 
 
 def _blocks_chain(head: bytes, size: int) -> bool:
-    """The file starts with a data block of a category mhtrack reads (34, 48, 62), whose
-    length fits in the file and whose records libasterix decodes to exactly that length
-    (without libasterix: the header alone)."""
-    if len(head) < 3 or head[0] not in (34, 48, 62):
+    """The file starts with a data block of a category mhtrack reads (:data:`_READ`),
+    whose length fits in the file and whose records libasterix decodes to exactly that
+    length (without libasterix: the header alone)."""
+    if len(head) < 3 or head[0] not in _READ:
         return False
     length = int.from_bytes(head[1:3], "big")
     if not 3 <= length <= min(size, len(head)):
         return False
     try:
-        base, _ = _lib.modules()
+        base, gen = _lib.modules()
     except _lib.MissingExtra:
         return True
-    spec = {34: _lib.cat034, 48: _lib.cat048, 62: _lib.cat062}[head[0]]()
-    return not isinstance(spec.cv_uap.parse(base.Bits.from_bytes(head[3:length])),
-                          ValueError)
+    spec = {34: _lib.cat034, 48: _lib.cat048, 62: _lib.cat062}.get(head[0])
+    uap = spec().cv_uap if spec is not None else {
+        1: gen.Cat_001_1_4, 2: gen.Cat_002_1_2, 21: gen.Cat_021_2_6}[head[0]].cv_uap
+    if head[0] == 1:
+        from mhtrack.io.asterix.cat001 import records001
+
+        return not isinstance(records001(head[3:length]), ValueError)
+    return not isinstance(uap.parse(base.Bits.from_bytes(head[3:length])), ValueError)
 
 
 def add_ground_range(rec: Recording, sensors: SensorSet) -> np.ndarray:
@@ -97,6 +117,9 @@ def plot_columns(rec: Recording, sensors: SensorSet | None = None) -> dict[str, 
         v = p[name]
         if name in _TEXT:
             cols[name] = pa.array(v.tolist(), type=pa.string(), mask=v == "")
+        elif name == "plot_type":  # the name of the type: primary, secondary, ...
+            cols[name] = pa.array([PLOT_TYPES.get(int(k), "none") for k in v.tolist()],
+                                  type=pa.string())
         elif v.dtype.kind == "i":
             cols[name] = int_array(v, v < 0 if name in ("track_number", "typ") else None)
         else:

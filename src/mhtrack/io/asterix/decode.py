@@ -1,11 +1,17 @@
-"""CAT048 target reports and CAT034 service messages of a recording, decoded by
-libasterix into columns (docs/file-formats.md, "ASTERIX recordings").
+"""Target reports and service messages of a recording, decoded by libasterix into columns
+(docs/file-formats.md, "ASTERIX recordings").
 
 One plot per CAT048 record with I048/040 (measured position), I048/010 (data source) and
-I048/140 (time of day); the others are counted and skipped. CAT034 north markers
-(I034/000 = 1) and sector crossings (= 2) become the radars' sweep marks. Blocks of other
-categories, and blocks whose records do not decode to exactly their length, are counted
-and skipped (libasterix's strict parsing: the records must fill the block).
+I048/140 (time of day), and per CAT001 plot record (its truncated time of day restored,
+:mod:`~mhtrack.io.asterix.cat001`); the others are counted and skipped. Reports that are
+no plot of a real target (no detection, test target, field monitor, simulated:
+:mod:`~mhtrack.io.asterix.notplots`) are counted and left out; the plot type is kept
+(``plot_type``). CAT034 (CAT002) north markers (I034/000 = 1) and sector crossings (= 2)
+become the radars' sweep marks, and I034/120 the radars' sites. CAT021 ADS-B reports are
+decoded by :mod:`~mhtrack.io.asterix.cat021`. A data block received twice (redundant LANs)
+is kept once (:mod:`~mhtrack.io.asterix.duplicates`). Blocks of other categories (CAT062
+system tracks among them: not plots), and blocks whose records do not decode to exactly
+their length, are counted and skipped (libasterix's strict parsing).
 """
 
 from __future__ import annotations
@@ -18,8 +24,14 @@ from typing import Any
 import numpy as np
 
 import mhtrack.io.asterix._lib as _lib
-from mhtrack.io.asterix.container import blocks, container, datagrams
+from mhtrack.io.asterix.cat001 import TimeRestorer, block001, block002
+from mhtrack.io.asterix.cat021 import block021
+from mhtrack.io.asterix.columns import columns
+from mhtrack.io.asterix.container import blocks
+from mhtrack.io.asterix.duplicates import DuplicateFilter
 from mhtrack.io.asterix.fast import reader034, reader048
+from mhtrack.io.asterix.framings import recognise, units
+from mhtrack.io.asterix.notplots import flags048, plot_type048_of, reason
 from mhtrack.io.asterix.problems import Problems
 from mhtrack.io.asterix.timeaxis import TimeAxis
 
@@ -30,7 +42,9 @@ FL_M = 30.48
 
 #: The plot columns, in output order (docs/file-formats.md).
 PLOT_COLUMNS = ("time", "sensor", "sac", "sic", "slant_range", "bearing", "flight_level",
-                "mode_3a", "address", "callsign", "track_number", "typ")
+                "mode_3a", "address", "callsign", "track_number", "typ", "plot_type")
+#: Kinds of rows :meth:`Decoder.blocks` yields.
+PLOTS, MARKS, ADSB = "plots", "marks", "adsb"
 
 
 @dataclass
@@ -38,13 +52,15 @@ class Recording:
     """A decoded recording: ``plots`` (name -> array, :data:`PLOT_COLUMNS`; missing values
     NaN for floats, ``-1`` for ints, ``""`` for text), ``sweeps`` (``time, sensor, kind``
     1 north marker / 2 sector crossing, ``azimuth`` deg, NaN for north markers;
-    ``period`` s from I034/041, NaN when absent), the container and the skipped parts."""
+    ``period`` s from I034/041, NaN when absent), ``sites`` (each radar's I034/120:
+    :attr:`Decoder.sites`), the framing and the skipped parts."""
 
     name: str
     container: str
     plots: dict[str, np.ndarray]
     sweeps: dict[str, np.ndarray]
     problems: Problems = field(default_factory=Problems)
+    sites: dict[int, tuple[float, float, float, int]] = field(default_factory=dict)
 
     def __len__(self) -> int:
         return int(self.plots["time"].size)
@@ -56,83 +72,152 @@ class Recording:
 
 
 def read_recording(path: str | Path, *, fast: bool = True) -> Recording:
-    """Decode the CAT048 plots and CAT034 sweep marks of a pcap, pcapng or raw ASTERIX
-    file (recognised by content). Malformed parts are counted in ``problems`` (the caller
-    warns); a file that is no recording raises :class:`~mhtrack.errors.InputError`.
-    ``fast=False`` decodes every record with libasterix alone (the reference path of
-    :mod:`~mhtrack.io.asterix.fast`). Times are on one monotonic axis
-    (:mod:`~mhtrack.io.asterix.timeaxis`, capture times where the container has them)."""
+    """Decode the plots (CAT048, CAT001), sweep marks (CAT034, CAT002) and sites (I034/120)
+    of a recording in any framing :func:`~mhtrack.io.asterix.framings.recognise` knows.
+    Malformed parts, duplicates and reports that are no plots are counted in ``problems``
+    (the caller warns); a file that is no recording raises
+    :class:`~mhtrack.errors.InputError`. ``fast=False`` decodes every record with
+    libasterix alone (the reference path of :mod:`~mhtrack.io.asterix.fast`). Times are
+    on one monotonic axis (:mod:`~mhtrack.io.asterix.timeaxis`, capture times where the
+    framing has them)."""
     name = str(path)
     data = Path(path).read_bytes()
     decoder = Decoder(fast=fast)
-    kind = container(data, name, decoder.categories)
+    kind = recognise(data, name, decoder.categories)
     problems = Problems()
     rows: list[tuple[Any, ...]] = []
     marks: list[tuple[Any, ...]] = []
     is_plot: list[bool] = []
     times: list[float] = []
     axis = TimeAxis()
-    for offset, payload, when in datagrams(data, kind, name, problems):
-        for _, cat, found in decoder.blocks(payload, offset, problems):
-            into = rows if cat == 48 else marks
+    for offset, when, payload in units(data, kind, name, decoder.categories, problems):
+        for at, what, found in decoder.blocks(payload, offset, problems, when):
+            if what == ADSB:  # not in the plots table: a sensor of another kind
+                if found:
+                    problems.add("adsb", at, len(found))
+                continue
+            into = rows if what == PLOTS else marks
             into.extend(found)
-            is_plot.extend([cat == 48] * len(found))
+            is_plot.extend([what == PLOTS] * len(found))
             times.extend(axis.times_list([r[0] for r in found], when))
     plots, sweeps = _columns(rows, marks, np.array(is_plot, bool),
                              np.array(times, float))
-    return Recording(name, kind, plots, sweeps, problems)
+    return Recording(name, kind, plots, sweeps, problems, dict(decoder.sites))
 
 
 class Decoder:
-    """Decodes the CAT048 plots and CAT034 sweep marks of data blocks, block by block
-    (through :mod:`~mhtrack.io.asterix.fast` unless ``fast=False``)."""
+    """Decodes data blocks, block by block, into plot rows (:data:`PLOT_COLUMNS`: CAT048
+    through :mod:`~mhtrack.io.asterix.fast` unless ``fast=False``, CAT001), sweep marks
+    (CAT034, CAT002) and ADS-B rows (CAT021, :data:`~mhtrack.io.asterix.cat021.COLUMNS`
+    less the flags). A block already received within the duplicate window
+    (``duplicates``; ``None``: none dropped) is counted (``duplicate``) and skipped;
+    reports that are no plots are counted (``not_plot``) and left out. :attr:`sites`
+    gathers each radar's I034/120: ``sensor -> (lat, lon, height m, byte offset)``, the
+    first one sent."""
 
-    def __init__(self, *, fast: bool = True) -> None:
+    def __init__(self, *, fast: bool = True,
+                 duplicates: DuplicateFilter | bool | None = True) -> None:
         base, gen = _lib.modules()
         self.bits = base.Bits.from_bytes
         self.specs = {48: _lib.cat048(), 34: _lib.cat034()}
         self.categories = {int(c) for c in gen.manifest["CATS"]} | {34, 48}
-        self.readers = {48: reader048(plot_row), 34: reader034(mark_row)} if fast else {}
+        self.sites: dict[int, tuple[float, float, float, int]] = {}
+        self.readers = {48: reader048(plot_row), 34: reader034(self._mark, self.sites)} \
+            if fast else {}
+        self.duplicates = DuplicateFilter() if duplicates is True else \
+            (duplicates or None)
+        self.restorer = TimeRestorer()
 
-    def blocks(self, payload: bytes, offset: int, problems: Problems
-               ) -> Iterator[tuple[int, int, list[tuple[Any, ...]]]]:
-        """``(file offset, category, rows)`` of each CAT048 or CAT034 block of one
-        datagram: plot rows (:func:`plot_row`) or sweep marks (:func:`mark_row`), in
-        record order; other blocks are counted in ``problems`` and skipped."""
+    def blocks(self, payload: bytes, offset: int, problems: Problems,
+               when: float | None = None
+               ) -> Iterator[tuple[int, str, list[tuple[Any, ...]]]]:
+        """``(file offset, kind, rows)`` of each data block of one unit (captured at
+        ``when``, POSIX s or ``None``): kind :data:`PLOTS`, :data:`MARKS` or
+        :data:`ADSB`, rows in record order; other blocks are counted in ``problems`` and
+        skipped."""
         for at, cat, raw in blocks(payload, offset, problems):
-            if cat not in (48, 34):
+            if cat not in (48, 34, 1, 2, 21):
                 problems.add("unknown_category", at, detail=f"category {cat}")
                 continue
-            if cat in self.readers:
-                found = self.readers[cat].block(raw, at, problems)
-                if found is None:
-                    problems.add("undecodable", at, detail=f"category {cat}: records do "
-                                 "not fill the block")
+            if self.duplicates is not None:
+                start = at - offset
+                if not self.duplicates.keep(payload[start:start + 3 + len(raw)], when):
+                    problems.add("duplicate", at)
                     continue
-                yield at, cat, found
+            found = self._records(cat, raw, at, when, problems)
+            if found is None:
+                problems.add("undecodable", at, detail=f"category {cat}: records do "
+                             "not fill the block")
                 continue
-            records = self.specs[cat].cv_uap.parse(self.bits(raw))
-            if isinstance(records, ValueError):
-                problems.add("undecodable", at, detail=f"category {cat}: {records}")
-                continue
-            out = []
-            for rec in records:
-                row = plot_row(rec, at, problems) if cat == 48 else mark_row(rec)
-                if row is not None:
-                    out.append(row)
-            yield at, cat, out
+            if cat in (34, 2):
+                yield at, MARKS, found
+            elif cat == 21:
+                yield at, ADSB, _plots_only(found, cat, at, problems)
+            else:
+                yield at, PLOTS, _plots_only(found, cat, at, problems)
+
+    def _records(self, cat: int, raw: bytes, at: int, when: float | None,
+                 problems: Problems) -> list[tuple[Any, ...]] | None:
+        """The rows of one block's records (``None``: they do not fill the block)."""
+        if cat == 1:
+            return block001(raw, at, when, self.restorer, problems)
+        if cat == 2:
+            return block002(raw, self.restorer)
+        if cat == 21:
+            return block021(raw, at, problems)
+        if cat in self.readers:
+            return self.readers[cat].block(raw, at, problems)
+        records = self.specs[cat].cv_uap.parse(self.bits(raw))
+        if isinstance(records, ValueError):
+            return None
+        read = plot_row if cat == 48 else self._mark
+        return [row for rec in records if (row := read(rec, at, problems)) is not None]
+
+    def _mark(self, rec: Any, at: int, problems: Problems) -> tuple[Any, ...] | None:
+        """A CAT034 record's sweep mark (:func:`mark_row`); its site to :attr:`sites`."""
+        site_row(rec, at, self.sites)
+        return mark_row(rec)
+
+
+def _plots_only(rows: list[tuple[Any, ...]], cat: int, at: int, problems: Problems
+                ) -> list[tuple[Any, ...]]:
+    """The rows that are plots of real targets (:func:`~mhtrack.io.asterix.notplots.
+    reason`), the others counted (``not_plot``, the first one's reason in the detail).
+    Rows hold from column 11 on: CAT048 ``typ`` and the I048/020 flags (the plot type
+    made here); CAT001 ``typ, plot_type, sim, rab, tst, track``; CAT021 ``typ, plot_type``,
+    the flags, ``lat, lon, sigma``. The result has :data:`PLOT_COLUMNS` (CAT021: then
+    ``lat, lon, sigma``)."""
+    out, dropped, first = [], 0, ""
+    for r in rows:
+        if cat == 48:
+            why = reason(r[11], r[12], r[13], r[14])
+            row = (*r[:12], plot_type048_of(r[11]))
+        elif cat == 1:
+            why = reason(r[11], r[13], r[14], r[15], r[16])
+            row = r[:13]
+        else:
+            why = reason(-1, r[13], r[14], r[15])
+            row = (*r[:11], -1, r[12], *r[16:])
+        if why is None:
+            out.append(row)
+        else:
+            dropped += 1
+            first = first or why
+    if dropped:
+        problems.add("not_plot", at, dropped, detail=f"first: {first}")
+    return out
 
 
 def sweep_periods(sweeps: dict[str, np.ndarray]) -> dict[int, float]:
     """Each radar's rotation period (s) from its CAT034 sweep marks (``time, sensor,
-    kind, period`` columns): the median I034/041 if sent, else the median interval
-    between its north markers; radars with fewer than two north markers and no I034/041
-    are left out."""
+    kind, period`` columns): the median I034/041 if sent (and > 0), else the median
+    interval between its north markers; radars with fewer than two north markers and no
+    I034/041 are left out."""
     out: dict[int, float] = {}
     s = sweeps
     for sensor in np.unique(s["sensor"]).tolist():
         mine = s["sensor"] == sensor
-        ars = s["period"][mine & np.isfinite(s["period"])]
+        ars = s["period"][mine & np.isfinite(s["period"]) & (s["period"] > 0)]
         north = np.sort(s["time"][mine & (s["kind"] == 1)])
         if ars.size:
             out[int(sensor)] = float(np.median(ars))
@@ -150,7 +235,10 @@ def _sub(item: Any, name: str) -> Any:
 
 
 def plot_row(rec: Any, at: int, problems: Problems) -> tuple[Any, ...] | None:
-    """One plot row from a CAT048 record, or ``None`` (counted) without 040/140/010."""
+    """One report row from a CAT048 record — :data:`PLOT_COLUMNS` up to
+    ``track_number``, then I048/020's ``typ, sim, rab, tst``
+    (:func:`~mhtrack.io.asterix.notplots.flags048`) — or ``None`` (counted) without
+    040/140/010."""
     i040 = rec.get_item("040")
     if i040 is None:
         problems.add("no_position", at)
@@ -170,12 +258,22 @@ def plot_row(rec: Any, at: int, problems: Problems) -> tuple[Any, ...] | None:
     address = f"{i220.variation.content.as_uint():06X}" if i220 is not None else ""
     callsign = i240.variation.content.as_string().strip() if i240 is not None else ""
     tn = _sub(i161, "TRN").variation.content.as_uint() if i161 is not None else -1
-    i020 = rec.get_item("020")
-    typ = -1
-    if i020 is not None and (t := i020.variation.get_item("TYP")) is not None:
-        typ = t.variation.content.as_uint()
     return (_q(i140, "s"), sac * 256 + sic, sac, sic, rho, theta, fl, m3a, address,
-            callsign, tn, typ)
+            callsign, tn, *flags048(rec))
+
+
+def site_row(rec: Any, at: int, sites: dict[int, tuple[float, float, float, int]]
+             ) -> None:
+    """Keep a CAT034 record's I034/120 (height m, WGS-84 lat, lon) in ``sites`` under its
+    I034/010 data source, the first one sent (at byte ``at``)."""
+    i010, i120 = rec.get_item("010"), rec.get_item("120")
+    if i010 is None or i120 is None:
+        return
+    sensor = _sub(i010, "SAC").variation.content.as_uint() * 256 + \
+        _sub(i010, "SIC").variation.content.as_uint()
+    if sensor not in sites:
+        sites[sensor] = (_q(_sub(i120, "LAT"), "°"), _q(_sub(i120, "LON"), "°"),
+                         _q(_sub(i120, "HGT"), "m"), at)
 
 
 def mark_row(rec: Any) -> tuple[Any, ...] | None:
@@ -211,9 +309,6 @@ def _columns(rows: list[tuple[Any, ...]], marks: list[tuple[Any, ...]],
 
 
 def plot_columns(rows: list[tuple[Any, ...]]) -> dict[str, np.ndarray]:
-    """:data:`PLOT_COLUMNS` of plot rows (:func:`plot_row`); ``time`` is the time of day."""
-    kinds = (float, np.int64, np.int64, np.int64, float, float, float, object, object,
-             object, np.int64, np.int64)
-    cols = list(zip(*rows, strict=True)) if rows else [()] * len(PLOT_COLUMNS)
-    return {name: np.array(c, dtype=k) for name, c, k in zip(PLOT_COLUMNS, cols, kinds,
-                                                             strict=True)}
+    """:data:`PLOT_COLUMNS` of plot rows (:meth:`Decoder.blocks`); ``time`` is the time of
+    day."""
+    return columns(rows, PLOT_COLUMNS)

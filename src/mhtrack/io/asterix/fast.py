@@ -20,7 +20,7 @@ libasterix, once:
   :data:`MAX_VARIANTS` per item, then always parsed);
 * a **needed fixed-size field** (I048/010 SAC, SIC; 140; 040 RHO, THETA; 090 FL; 161 TRN;
   220) is read as ``raw × LSB`` with its bit offset, size, signedness and LSB taken from
-  libasterix's spec classes (:func:`field`); text items (070, 240) and 020's TYP are
+  libasterix's spec classes (:func:`field`); text items (070, 240) and 020's flags are
   decoded by libasterix once per distinct encoding.
 
 Each new layout is checked: its first record decoded this way must equal libasterix's
@@ -35,6 +35,7 @@ from dataclasses import dataclass
 from typing import Any
 
 import mhtrack.io.asterix._lib as _lib
+from mhtrack.io.asterix.notplots import flags048_item
 from mhtrack.io.asterix.problems import Problems
 
 #: Distinct encodings remembered per variable-size item (then libasterix parses each).
@@ -116,6 +117,7 @@ class FastRecords:
                       for name, nsp in self.record.cv_items_dict.items()}
         self.text: dict[tuple[str, bytes], Any] = {}
         self.fields: dict[str, Field] = {}
+        self.sites: dict[int, tuple[float, float, float, int]] = {}
 
     def block(self, raw: bytes, at: int, problems: Problems) -> list[tuple[Any, ...]] | None:
         """Rows of one block's records, or ``None`` if they do not decode to exactly
@@ -232,16 +234,23 @@ def cat048_row(self: FastRecords, raw: bytes, spans: dict[str, tuple[int, int]],
         callsign = self._decoded("240", raw[slice(*_range(spans["240"]))], _callsign)
     address = f"{f['address'].read(raw, spans['220'][0]):06X}" if "220" in spans else ""
     tn = f["trn"].read(raw, spans["161"][0]) if "161" in spans else -1
-    typ = self._decoded("020", raw[slice(*_range(spans["020"]))], _typ) \
-        if "020" in spans else -1
+    flags = self._decoded("020", raw[slice(*_range(spans["020"]))], flags048_item) \
+        if "020" in spans else (-1, -1, -1, -1)
     return (f["tod"].read(raw, spans["140"][0]), sac * 256 + sic, sac, sic, rho, theta,
-            fl, m3a, address, callsign, tn, typ)
+            fl, m3a, address, callsign, tn, *flags)
 
 
 def cat034_row(self: FastRecords, raw: bytes, spans: dict[str, tuple[int, int]], at: int,
                problems: Problems) -> tuple[Any, ...] | None:
     """The same mark as :func:`~mhtrack.io.asterix.decode.mark_row`."""
     f = self.fields
+    if "010" in spans and "120" in spans:
+        sensor = f["sac"].read(raw, spans["010"][0]) * 256 + f["sic"].read(raw,
+                                                                          spans["010"][0])
+        if sensor not in self.sites:
+            q = spans["120"][0]
+            self.sites[sensor] = (f["lat"].read(raw, q), f["lon"].read(raw, q),
+                                  f["hgt"].read(raw, q), at)
     if "000" not in spans or "010" not in spans or "030" not in spans:
         return None
     kind = f["kind"].read(raw, spans["000"][0])
@@ -269,15 +278,21 @@ def reader048(slow_row: Callable[[Any, int, Problems], tuple[Any, ...] | None]
     return out
 
 
-def reader034(slow_row: Callable[[Any], tuple[Any, ...] | None]) -> FastRecords:
-    """The fast reader of CAT034 north markers and sector crossings."""
+def reader034(slow_row: Callable[[Any, int, Problems], tuple[Any, ...] | None],
+              sites: dict[int, tuple[float, float, float, int]]) -> FastRecords:
+    """The fast reader of CAT034 north markers and sector crossings; each radar's first
+    I034/120 goes to ``sites`` (``sensor -> (lat, lon, height, byte offset)``), as
+    ``slow_row`` puts it there for the records libasterix reads."""
     r = _lib.cat034()
-    out = FastRecords(r, lambda rec, at, problems: slow_row(rec), cat034_row)
+    out = FastRecords(r, slow_row, cat034_row)
+    out.sites = sites
     rec = r.cv_record
     out.fields = {
         "kind": field(rec, "000"), "sac": field(rec, "010", "SAC"),
         "sic": field(rec, "010", "SIC"), "tod": field(rec, "030"),
         "azimuth": field(rec, "020"), "period": field(rec, "041"),
+        "lat": field(rec, "120", "LAT"), "lon": field(rec, "120", "LON"),
+        "hgt": field(rec, "120", "HGT"),
     }
     return out
 
@@ -302,6 +317,3 @@ def _callsign(item: Any) -> str:
     return str(item.variation.content.as_string()).strip()
 
 
-def _typ(item: Any) -> int:
-    t = item.variation.get_item("TYP")
-    return -1 if t is None else int(t.variation.content.as_uint())

@@ -7,14 +7,16 @@ Layouts (octets; multi-octet fields big-endian unless said):
 * **pcap** (libpcap: magic ``a1b2c3d4`` µs / ``a1b23c4d`` ns, either byte order; 24-octet
   header, then per packet ``ts_sec, ts_frac, incl_len, orig_len`` and the packet) and
   **pcapng** (blocks of type, total length, body, total length again; interface
-  descriptions give the link type and ``if_tsresol``, option 9: 10⁻ⁿ s, or 2⁻ⁿ s with the
-  high bit set; enhanced packet blocks a 64-bit timestamp in those units). Time: POSIX s.
+  descriptions give the link type, ``if_tsresol``, option 9: 10⁻ⁿ s, or 2⁻ⁿ s with the
+  high bit set, and ``if_tsoffset``, option 14: seconds added; enhanced packet blocks a
+  64-bit timestamp in those units; simple packet blocks none). Time: POSIX s.
   Inside each packet: :mod:`mhtrack.io.asterix.link`.
 * **ORADIS**: per record 2 octets byte count (the whole record, header included), 4 octets
   of time (whose unit no public source gives: not read), then one or more data blocks;
   found as a file or as the payload of UDP datagrams (:func:`unwrap`).
 * **GPS** recorder format: a 2 200-octet file header, then each data block followed by 10
-  octets whose octets 6–8 are the time of day in 1/128 s. Time: seconds of the day.
+  octets whose octets 6–8 are the time of day in 1/128 s. Time: seconds of the day, plus
+  a day each time it steps back by more than 12 h (midnight), so that it never goes back.
 * **Final** format: per record 2 octets byte count (the whole record), board number, line
   number, recording day, 3 octets time of day in 0.01 s, one or more data blocks, then the
   padding ``A5 A5 A5 A5``. Time: ``day × 86 400 + time of day`` s (the day a counter of the
@@ -250,6 +252,7 @@ def _stream(data: bytes, kind: str, cats: set[int], problems: Problems) -> Itera
         problems.add("skipped_octets", 0, len(data))
         return
     check = _AT[kind]
+    day, last = 0, None  # GPS: days counted where its time of day steps back over 12 h
     for p, step in _walk(data, _START[kind], lambda q: check(data, q, cats), problems):
         if kind == "final":
             tod = int.from_bytes(data[p + 5:p + 8], "big") * 0.01
@@ -259,8 +262,11 @@ def _stream(data: bytes, kind: str, cats: set[int], problems: Problems) -> Itera
             yield p + ORADIS_HEADER, None, data[p + ORADIS_HEADER:p + step]
         elif kind == "gps":
             end = p + step
-            yield p, int.from_bytes(data[end - 4:end - 1], "big") / 128.0, \
-                data[p:end - GPS_TRAILER]
+            tod = int.from_bytes(data[end - 4:end - 1], "big") / 128.0
+            if last is not None and tod < last - DAY_S / 2:
+                day += 1
+            last = tod
+            yield p, tod + day * DAY_S, data[p:end - GPS_TRAILER]
         else:
             yield p, None, data[p:p + step]
 
@@ -312,24 +318,27 @@ def _pcap(data: bytes, name: str, problems: Problems) -> Iterator[Unit]:
             yield found[0], sec + frac * unit, found[1]
 
 
-def _tsresol(data: bytes, e: str, start: int, end: int) -> int:
-    """Timestamp units per second from the ``if_tsresol`` option (code 9) of an interface
-    description's options, else 10⁶ (µs)."""
-    p = start
+def _clock(data: bytes, e: str, start: int, end: int) -> tuple[float, float]:
+    """``(seconds per timestamp unit, offset s)`` of a pcapng interface from its options
+    ``if_tsresol`` (code 9: 10⁻ᵛ s, or 2⁻ᵛ s with the high bit set; default 10⁻⁶) and
+    ``if_tsoffset`` (code 14: seconds added to every timestamp)."""
+    unit, offset, p = 1e-6, 0.0, start
     while end - p >= 4:
         code, length = struct.unpack_from(e + "HH", data, p)
         if code == 0:
             break
         if code == 9 and length >= 1:
             v = data[p + 4]
-            return 2 ** (v & 0x7F) if v & 0x80 else 10 ** v
+            unit = 2.0 ** -(v & 0x7F) if v & 0x80 else 10.0 ** -v
+        elif code == 14 and length >= 8 and p + 12 <= end:
+            offset = float(struct.unpack_from(e + "q", data, p + 4)[0])
         p += 4 + length + (-length % 4)
-    return 10**6
+    return unit, offset
 
 
 def _pcapng(data: bytes, name: str, problems: Problems) -> Iterator[Unit]:
     state = {"e": "<"}
-    links: list[tuple[int, int]] = []
+    links: list[tuple[int, tuple[float, float]]] = []
 
     def at(p: int) -> int:
         if len(data) - p < 12:
@@ -357,7 +366,7 @@ def _pcapng(data: bytes, name: str, problems: Problems) -> Iterator[Unit]:
         if btype == 1 and total >= 20:
             link = struct.unpack_from(e + "H", data, p + 8)[0]
             _check_link(link, name, p + 8)
-            links.append((link, _tsresol(data, e, p + 16, p + total - 4)))
+            links.append((link, _clock(data, e, p + 16, p + total - 4)))
         elif btype in (6, 3, 2) and total >= 16:
             if btype == 3:
                 iface, cap, start, ts = 0, total - 16, p + 12, None
@@ -369,9 +378,9 @@ def _pcapng(data: bytes, name: str, problems: Problems) -> Iterator[Unit]:
                 problems.add("non_udp", p, detail=f"packet on interface {iface}, which no "
                              "interface description block declared")
                 continue
-            link, resol = links[iface]
+            link, (unit, offset) = links[iface]
             found = payload(data, start, min(start + cap, p + total - 4), link)
             if found is None:
                 problems.add("non_udp", p)
             else:
-                yield found[0], None if ts is None else ts / resol, found[1]
+                yield found[0], None if ts is None else ts * unit + offset, found[1]

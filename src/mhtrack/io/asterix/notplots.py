@@ -41,6 +41,14 @@ def plot_type048(typ: np.ndarray) -> np.ndarray:
     return np.where((typ >= 0) & (typ <= 7), TYP048[np.clip(typ, 0, 7)], 0)
 
 
+def plot_type048_of(typ: int) -> int:
+    """:func:`plot_type048` of one TYP value (plain Python, per report)."""
+    return _TYP048[typ] if 0 <= typ <= 7 else 0
+
+
+_TYP048 = TYP048.tolist()
+
+
 def _sub(var: Any, name: str) -> int:
     """A sub-item's value of an extended item, ``0`` when its extent was not sent."""
     try:
@@ -54,8 +62,11 @@ def flags048(rec: Any) -> tuple[int, int, int, int]:
     """``(typ, sim, rab, tst)`` of a libasterix CAT048 record's I048/020 (``-1`` each
     without the item; TST 0 when the first extension is not sent)."""
     i020 = rec.get_item("020")
-    if i020 is None:
-        return -1, -1, -1, -1
+    return (-1, -1, -1, -1) if i020 is None else flags048_item(i020)
+
+
+def flags048_item(i020: Any) -> tuple[int, int, int, int]:
+    """``(typ, sim, rab, tst)`` of a libasterix I048/020 item."""
     v = i020.variation
     return _sub(v, "TYP"), _sub(v, "SIM"), _sub(v, "RAB"), _sub(v, "TST")
 
@@ -69,18 +80,33 @@ def flags048_octets(octets: bytes) -> tuple[int, int, int, int]:
     return first >> 5, (first >> 4) & 1, (first >> 1) & 1, tst
 
 
+def reason(typ: int, sim: int, rab: int, tst: int, track: int = 0) -> str | None:
+    """Why a report is no plot of a real target — the first of :data:`REASONS` that holds
+    — or ``None`` for a plot (flags ``-1``: unknown, kept). Plain Python: the decoder
+    asks once per report."""
+    if typ == 0:
+        return "no_detection"
+    if track == 1:
+        return "track"
+    if tst == 1:
+        return "test"
+    if rab == 1:
+        return "field_monitor"
+    if sim == 1:
+        return "simulated"
+    return None
+
+
 def real_plots(typ: np.ndarray, sim: np.ndarray, rab: np.ndarray, tst: np.ndarray, *,
                track: np.ndarray | None = None) -> tuple[np.ndarray, dict[str, int]]:
     """The mask of reports that are plots of real targets, and the count of the others
-    by reason (:data:`REASONS`; every reason present, zeros included). ``typ`` is the
-    CAT048 TYP (CAT001: SSR/PSR, the same 0–3), ``-1`` where unknown (kept); ``track``
-    marks CAT001 track reports."""
-    typ, sim, rab, tst = (np.asarray(a, np.int64) for a in (typ, sim, rab, tst))
-    reasons = [typ == 0, np.zeros(typ.shape, bool) if track is None
-               else np.asarray(track, bool), tst == 1, rab == 1, sim == 1]
-    keep = np.ones(typ.shape, bool)
-    counts = {}
-    for name, bad in zip(REASONS, reasons, strict=True):
-        counts[name] = int((keep & bad).sum())
-        keep &= ~bad
-    return keep, counts
+    by reason (:data:`REASONS`; every reason present, zeros included), by :func:`reason`.
+    ``typ`` is the CAT048 TYP (CAT001: SSR/PSR, the same 0–3), ``-1`` where unknown
+    (kept); ``track`` marks CAT001 track reports."""
+    typ, sim, rab, tst = (np.asarray(a, np.int64).reshape(-1) for a in (typ, sim, rab, tst))
+    trk = np.zeros(typ.size, np.int64) if track is None else \
+        np.asarray(track, np.int64).reshape(-1)
+    why = [reason(*r) for r in zip(typ.tolist(), sim.tolist(), rab.tolist(), tst.tolist(),
+                                   trk.tolist(), strict=True)]
+    counts = {name: why.count(name) for name in REASONS}
+    return np.array([w is None for w in why], bool), counts

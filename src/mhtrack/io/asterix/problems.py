@@ -8,9 +8,8 @@ from dataclasses import dataclass, field
 
 #: What each kind of problem means, as the warning says it (``{n}`` the count).
 KINDS = {
-    "non_udp": "{n} packet(s) that are not IPv4/IPv6 UDP (ARP, TCP, IP fragments, ...) "
-               "skipped",
-    "truncated_packet": "{n} truncated pcap packet(s) at the end of the file skipped",
+    "non_udp": "{n} packet(s) that carry no ASTERIX (not UDP nor 802.3/LLC: ARP, TCP, IP "
+               "fragments, ...) skipped",
     "truncated_block": "{n} truncated data block(s) (length beyond the data) skipped",
     "bad_length": "{n} data block(s) whose length field is below 3 octets: the rest of "
                   "their datagram skipped",
@@ -27,6 +26,10 @@ KINDS = {
                  "LANs, re-sent packets) dropped",
     "impossible": "{n} report(s) with a physically impossible value (latitude beyond "
                   "±90°, time of day beyond a day, ...) refused",
+    "adsb": "{n} ADS-B report(s) (CAT021) not in the plots table (they are tracked from "
+            "the recording itself)",
+    "no_accuracy": "{n} ADS-B report(s) without a position accuracy (NACp/NUCp 0) and no "
+                   "sigma for their station in the sensors file skipped",
     "not_plot": "{n} report(s) that are not plots (no detection, test target, field "
                 "monitor, simulated) left out",
 }

@@ -10,6 +10,7 @@ import numpy as np
 import pyarrow.csv as pacsv
 import pytest
 from click.testing import CliRunner
+from site_sensors import sensors_toml
 
 from mhtrack.cli.main import cli
 from mhtrack.io import read_tracks
@@ -19,25 +20,7 @@ from mhtrack.pipeline import run as pipeline_run
 from mhtrack.records import PlotTable, TrackTable
 from mhtrack.sinks import FrameOutput
 
-SENSORS = """\
-[origin]
-lat = 46.8
-lon = 8.2
-[[sensors]]
-id = 1
-kind = "polar"
-lat = 46.4253
-lon = 6.0989
-sigma_range = 80.0
-sigma_bearing_deg = 0.15
-pd = 0.9
-period = 12.0
-[[sensors]]
-id = 2
-kind = "cartesian"
-sigma = 50.0
-pd = 1.0
-"""
+SENSORS = sensors_toml()
 HEADER = "time,sensor,range,bearing,x,y,lat,lon\n"
 GOOD = [
     "2024-05-01T12:00:03.250Z,1,150000,80.5,,,,",

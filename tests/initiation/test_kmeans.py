@@ -4,7 +4,12 @@ compatible clusters (the estimators and fused plots: ``test_fusion.py``)."""
 import numpy as np
 import pytest
 
-from mhtrack.initiation import dissimilarity_threshold, kmeans_lloyd, merge_compatible_clusters
+from mhtrack.initiation import (
+    Gate,
+    dissimilarity_threshold,
+    kmeans_lloyd,
+    merge_compatible_clusters,
+)
 
 
 def test_threshold_indexing_is_one_based_and_clipped():
@@ -37,8 +42,8 @@ def test_merge_joins_compatible_clusters_only():
     z = np.array([[0.0, 0.0], [10.0, 0.0], [60.0, 0.0], [2000.0, 0.0], [2050.0, 0.0]])
     sensor = np.array([1, 2, 3, 1, 1])
     labels = np.array([0, 0, 1, 2, 3])
-    out = merge_compatible_clusters(z, sensor, labels, eps=100.0)
+    out = merge_compatible_clusters(z, sensor, labels, Gate(100.0))
     assert out[0] == out[1] == out[2]  # {r1, r2} + {r3} at ~55 m: merged
     assert out[3] != out[4]  # two plots of radar 1, 50 m apart: never merged
-    far = merge_compatible_clusters(z, sensor, labels, eps=20.0)
+    far = merge_compatible_clusters(z, sensor, labels, Gate(20.0))
     assert far[2] != far[0]  # beyond ε: kept apart

@@ -18,7 +18,11 @@ import mhtrack.initiation.assignment as asg
 import mhtrack.initiation.neighbours as nb
 from mhtrack.initiation import AdaptiveKMeansFusion
 from mhtrack.initiation.assignment import allowed_pairs, gated_assignment
-from mhtrack.initiation.kmeans import adaptive_initial_centres, enforce_one_plot_per_sensor
+from mhtrack.initiation.kmeans import (
+    Gate,
+    adaptive_initial_centres,
+    enforce_one_plot_per_sensor,
+)
 from mhtrack.initiation.neighbours import SortedDistances, close_pairs, pair_distances
 from mhtrack.models.linalg2 import mahalanobis2
 
@@ -159,7 +163,7 @@ def test_kmeans_steps_equal_the_dense_implementation(seed, stat):
                                                            max_threshold=cap)
     with patched(*SPARSE):
         c, lab, eps = adaptive_initial_centres(z, s, R=Rr, gamma=gamma, max_threshold=cap)
-        fixed = enforce_one_plot_per_sensor(z, s, lab, eps, Rr, gamma)
+        fixed = enforce_one_plot_per_sensor(z, s, lab, Gate(eps, Rr, gamma))
     assert eps == eps_ref
     assert np.array_equal(lab, lab_ref)
     assert np.array_equal(c, c_ref, equal_nan=True)

@@ -11,6 +11,7 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 import pytest
 from geodesic_reference import WGS84
+from site_sensors import ORIGIN, SITE, sensors_toml
 
 from mhtrack.frames import frame_lengths, make_frames
 from mhtrack.io import read_plots, write_plots
@@ -18,27 +19,7 @@ from mhtrack.io.plots import file_rows, plots_to_file_rows, plots_to_table_rows
 from mhtrack.io.sensors import read_sensors
 from mhtrack.models.radars import RadarSensor, SensorSet
 
-ORIGIN = (46.8, 8.2)
-SITE = (46.4253, 6.0989)
-SENSORS = """\
-[origin]
-lat = 46.8
-lon = 8.2
-[[sensors]]
-id = 1
-kind = "polar"
-lat = 46.4253
-lon = 6.0989
-sigma_range = 80.0
-sigma_bearing_deg = 0.15
-pd = 0.9
-period = 12.0
-[[sensors]]
-id = 2
-kind = "cartesian"
-sigma = 50.0
-pd = 1.0
-"""
+SENSORS = sensors_toml()
 
 
 @pytest.fixture

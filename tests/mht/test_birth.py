@@ -12,11 +12,12 @@ from crossing_fixture import same_tracks
 
 from mhtrack.build import default_config, default_fusion, make_birth, make_tracker
 from mhtrack.clutter import KnownClutter
-from mhtrack.experiments.pipeline import fuse_scan, run_scenario
+from mhtrack.experiments.pipeline import run_scenario
 from mhtrack.mht import MHTConfig, MHTTracker
 from mhtrack.mht.births.initiator import followed_by
 from mhtrack.mht.births.sequence import score_upper_bound, sequence_score
 from mhtrack.mht.scoring import miss_increment
+from mhtrack.pipeline import fuse_scan
 from mhtrack.records import Scan, TrackTable
 from mhtrack.scenario import preset, simulate
 

@@ -10,6 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from click.testing import CliRunner
+from site_sensors import sensors_toml
 
 from mhtrack import build
 from mhtrack.cli.main import cli
@@ -17,20 +18,7 @@ from mhtrack.io import read_plots
 from mhtrack.io.sensors import read_sensors
 from mhtrack.models.linalg2 import det2
 
-SENSORS = """\
-[origin]
-lat = 46.8
-lon = 8.2
-[[sensors]]
-id = 1
-kind = "polar"
-lat = 46.4253
-lon = 6.0989
-sigma_range = 80.0
-sigma_bearing_deg = 0.15
-pd = 0.9
-period = 4.0
-"""
+SENSORS = sensors_toml(4.0, cartesian=False)
 
 
 def _files(tmp_path: Path, near: list[float]) -> tuple[Path, Path]:

@@ -153,14 +153,14 @@ def track(plots: Path, tracker: str, tracker_pd: float | None, meas_sigma: float
           progress: bool | None) -> None:
     """Run a tracker on a PLOTS file and write its tracks."""
     from mhtrack.io.paths import check_output_file
-    from mhtrack.pipeline import Pipeline
-    from mhtrack.sinks import TracksFileSink
+    from mhtrack.pipeline.run import Pipeline
+    from mhtrack.sinks.files import TracksFileSink
 
     check_output_file(out, inputs=(plots, scenario_file, sensors_file), what="tracks file")
     options = track_options(tracker, tracker_pd, meas_sigma, accel_sigma, imm_accel_sigma,
                             clutter_density, birth_density, nscan, birth, birth_theta,
                             fusion, output, clutter_frame=clutter_frame)
-    pipe = Pipeline.open(str(plots), options, scenario_file=scenario_file,
+    pipe = Pipeline.open(plots, options, scenario_file=scenario_file,
                          sensors_file=sensors_file, reorder_window_s=reorder_window_s)
     result = pipe.run([TracksFileSink(out, frame=pipe.frame, output=pipe.output)],
                       progress=progress_enabled(progress))

@@ -4,7 +4,8 @@ is run, timed and evaluated the same way by the CLI's ``track`` and ``run`` and 
 Monte-Carlo runner.
 
 The fusion of several sensors' scans and the row ids of fused plots are
-:mod:`mhtrack.pipeline.run`'s (:func:`fuse_scan`, :func:`fused`, re-exported here).
+:mod:`mhtrack.pipeline`'s (:func:`~mhtrack.pipeline.fuse_scan`,
+:func:`~mhtrack.pipeline.fused`).
 """
 
 from __future__ import annotations
@@ -25,8 +26,6 @@ from mhtrack.pipeline import (
     cap_scans,
     caps_acted,
     feed,
-    fuse_scan,
-    fused,
     mean_step_time,
     step_frames,
 )
@@ -38,7 +37,7 @@ if TYPE_CHECKING:  # loaded by run_scenario only (fast start of `mhtrack track`)
     from mhtrack.metrics import Evaluation
     from mhtrack.scenario import Scenario, Simulation
 
-__all__ = ["ScenarioRun", "TrackingRun", "fuse_scan", "fused", "run_scenario", "track"]
+__all__ = ["ScenarioRun", "TrackingRun", "run_scenario", "track"]
 
 
 @dataclass(frozen=True)

@@ -27,6 +27,7 @@ from mhtrack.initiation.fused import FUSED, FusedScan, fuse_clusters, majority_o
 from mhtrack.initiation.fusion import AdaptiveKMeansFusion, KMeansFusion, split_inconsistent
 from mhtrack.initiation.hough import HoughInitiator
 from mhtrack.initiation.kmeans import (
+    Gate,
     adaptive_initial_centres,
     dissimilarity_threshold,
     enforce_one_plot_per_sensor,
@@ -48,6 +49,7 @@ __all__ = [
     "AdaptiveKMeansFusion",
     "FusedScan",
     "Fuser",
+    "Gate",
     "HoughInitiator",
     "InitiatedTracks",
     "Initiator",

@@ -28,6 +28,7 @@ import numpy as np
 from mhtrack.initiation.base import Fuser
 from mhtrack.initiation.fused import WEIGHTINGS
 from mhtrack.initiation.kmeans import (
+    Gate,
     _means,
     adaptive_initial_centres,
     dissimilarity_threshold,
@@ -117,11 +118,11 @@ class _KMeansFuser(Fuser):
                 n_iter: int, adaptive: bool, R: np.ndarray | None = None,
                 gamma: float | None = None, enforce: bool = True) -> None:
         if len(z):
+            gate = Gate(eps, R, gamma)
             if enforce:
-                labels = enforce_one_plot_per_sensor(z, sensor, labels, eps, R, gamma,
-                                                     self.caps_)
+                labels = enforce_one_plot_per_sensor(z, sensor, labels, gate, self.caps_)
             if adaptive:
-                labels = merge_compatible_clusters(z, sensor, labels, eps, R, gamma)
+                labels = merge_compatible_clusters(z, sensor, labels, gate)
         k = int(labels.max()) + 1 if len(labels) else 0
         self.cluster_centers_, _ = _means(z, labels, k)
         self.labels_ = labels

@@ -78,6 +78,7 @@ imports this module (never the other way round). 2×2 algebra: :mod:`mhtrack.mod
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from functools import partial
 
 import numpy as np
@@ -229,23 +230,28 @@ def kmeans_lloyd(
     return c, labels, n_iter
 
 
-def enforce_one_plot_per_sensor(
-    z: np.ndarray,
-    sensor: np.ndarray,
-    labels: np.ndarray,
-    eps: float,
-    R: np.ndarray | None = None,
-    gamma: float | None = None,
-    caps: dict[str, int] | None = None,
-) -> np.ndarray:
+@dataclass(frozen=True)
+class Gate:
+    """When a plot and a centre, or two centres, may be one target's (module docstring):
+    within ``eps`` metres (P2's threshold ``ε(k)``) or, with the plots' covariances ``R``
+    (n, 2, 2) and a χ²₂ gate ``gamma``, when the Mahalanobis test ``d² ≤ gamma`` passes."""
+
+    eps: float
+    R: np.ndarray | None = None
+    gamma: float | None = None
+
+
+def enforce_one_plot_per_sensor(z: np.ndarray, sensor: np.ndarray, labels: np.ndarray,
+                                gate: Gate, caps: dict[str, int] | None = None) -> np.ndarray:
     """Labels in which no cluster holds two plots of one radar (P2 §1.2, §3.1).
 
     For each radar with offending clusters, its plots in those clusters are re-assigned by
-    :func:`_gated_assignment` (one plot per centre, minimal total cost, within ``eps`` or
-    the Mahalanobis gate ``gamma``) to the offending clusters and to the clusters holding
-    no plot of that radar; a plot left over opens its own cluster (a split). Other labels
-    are kept. Returns compact labels ``0..k−1``.
+    :func:`_gated_assignment` (one plot per centre, minimal total cost, within the
+    ``gate``) to the offending clusters and to the clusters holding no plot of that radar;
+    a plot left over opens its own cluster (a split). Other labels are kept. Returns
+    compact labels ``0..k−1``.
     """
+    eps, R, gamma = gate.eps, gate.R, gate.gamma
     z = np.asarray(z, float).reshape(-1, 2)
     sensor = np.asarray(sensor).reshape(-1)
     labels = np.asarray(labels, np.int64).copy()
@@ -278,14 +284,8 @@ def enforce_one_plot_per_sensor(
     return _compact(labels)
 
 
-def merge_compatible_clusters(
-    z: np.ndarray,
-    sensor: np.ndarray,
-    labels: np.ndarray,
-    eps: float,
-    R: np.ndarray | None = None,
-    gamma: float | None = None,
-) -> np.ndarray:
+def merge_compatible_clusters(z: np.ndarray, sensor: np.ndarray, labels: np.ndarray,
+                              gate: Gate) -> np.ndarray:
     """Merge clusters that hold no plot of a common radar and look like one target (ours).
 
     P2's threshold ``ε(k)`` is the largest within-cluster distance only when targets are
@@ -293,7 +293,7 @@ def merge_compatible_clusters(
     cluster of its own beside its target's. Two *compatible* clusters (no common radar:
     their union still has one plot per radar) are merged when their centres pass
 
-    * with the plots' covariances ``R`` and a gate ``gamma``: the Mahalanobis test
+    * with the plots' covariances ``R`` and a gate ``gamma`` (``gate``): the Mahalanobis test
       ``d² = Δᵀ (R̄_a + R̄_b)⁻¹ Δ ≤ γ`` (``Δ`` the centre difference, ``R̄ = (1/n²) Σ R_i``
       the covariance of a cluster mean; ``d²`` is χ²₂ when both are one target);
     * otherwise: ``‖Δ‖ ≤ eps``.
@@ -303,6 +303,7 @@ def merge_compatible_clusters(
     rounds repeat until none is left. In a burst the candidates are searched chunk by chunk
     (:func:`~mhtrack.initiation.neighbours.close_pairs`). Returns compact labels.
     """
+    eps, R, gamma = gate.eps, gate.R, gate.gamma
     z = np.asarray(z, float).reshape(-1, 2)
     labels = np.asarray(labels, np.int64).copy()
     maha = R is not None and gamma is not None

@@ -24,7 +24,7 @@ import numpy as np
 import pyarrow as pa
 
 from mhtrack.io._checks import num
-from mhtrack.io._frame import FLOAT, Frame, float_array
+from mhtrack.io._frame import FLOAT, Frame, float_array, int_array
 
 if TYPE_CHECKING:  # pyproj is imported only by whoever builds a frame
     from mhtrack.models.geodesy import LocalFrame
@@ -61,6 +61,15 @@ def state_columns(
     return {"x": float_array(x), "y": float_array(y), "lat": float_array(lat),
             "lon": float_array(lon), "vx": float_array(ve), "vy": float_array(vn),
             "vx_grid": float_array(vx), "vy_grid": float_array(vy)}
+
+
+def row_columns(key: tuple[str, np.ndarray], time: pa.Array, ident: tuple[str, np.ndarray],
+                state: tuple[np.ndarray, ...], frame: LocalFrame | None) -> dict[str, pa.Array]:
+    """The leading columns of a truth or tracks file, in order: ``key`` (``scan`` or
+    ``frame``), ``time``, the id column ``ident`` (``target_id`` or ``track_id``), then the
+    state ``x, y, vx, vy`` (:func:`state_columns`)."""
+    return {key[0]: int_array(key[1]), "time": time, ident[0]: int_array(ident[1]),
+            **state_columns(*state, frame)}
 
 
 def read_state(f: Frame, frame: LocalFrame | None) -> dict[str, np.ndarray]:

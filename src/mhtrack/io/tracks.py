@@ -7,6 +7,7 @@ east/north ``vx, vy`` (:mod:`mhtrack.io._geodetic`). See ``docs/file-formats.md`
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import replace
 from typing import TYPE_CHECKING
 
@@ -55,7 +56,10 @@ def tracks_from_truth(truth: TruthTable) -> TrackTable:
 def has_frames(path: PathArg) -> bool:
     """Whether a tracks file is numbered by ``frame`` (tracks of timed plots, each row at
     its state's own time) rather than by ``scan``."""
-    names = column_names(path)
+    return _numbered_by_frame(column_names(path))
+
+
+def _numbered_by_frame(names: Sequence[str]) -> bool:
     return "frame" in names and "scan" not in names
 
 
@@ -85,7 +89,7 @@ def read_tracks(
     """
     try:
         names = column_names(path)
-        timed = "frame" in names and "scan" not in names
+        timed = _numbered_by_frame(names)
         f = read_frame(path, COLUMNS, _geodetic.required(
             names, TIMED_REQUIRED if timed else REQUIRED), "tracks")
     except InputError as tracks_error:
@@ -155,14 +159,11 @@ def write_track_rows(table: TrackTable, path: PathArg, frame: LocalFrame | None 
     rows numbered by ``frame`` (tracks of timed plots), else by ``scan``; ``iso``: times
     as ISO-8601 (the plots' times were; :func:`~mhtrack.io._times.time_column`)."""
     plot = table.plot
-    cols = {
-        "frame" if timed else "scan": int_array(table.scan),
-        "time": time_column(table.time, iso, file_format(path)) if iso
-        else float_array(table.time),
-        "track_id": int_array(table.track_id),
-        **_geodetic.state_columns(table.x, table.y, table.vx, table.vy, frame),
-        "plot": int_array(plot, missing=plot == NO_PLOT),
-    }
+    time = time_column(table.time, iso, file_format(path)) if iso else float_array(table.time)
+    cols = _geodetic.row_columns(("frame" if timed else "scan", table.scan), time,
+                                 ("track_id", table.track_id),
+                                 (table.x, table.y, table.vx, table.vy), frame)
+    cols["plot"] = int_array(plot, missing=plot == NO_PLOT)
     if table.score is not None:
         cols["score"] = float_array(table.score)
     if table.tentative is not None:

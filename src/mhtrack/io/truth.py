@@ -16,7 +16,6 @@ from mhtrack.io._frame import (
     INT,
     column_names,
     float_array,
-    int_array,
     read_frame,
     write_frame,
 )
@@ -66,12 +65,6 @@ def read_truth(path: PathArg, *, frame: LocalFrame | None = None) -> TruthTable:
 def write_truth(table: TruthTable, path: PathArg, frame: LocalFrame | None = None) -> None:
     """Write ``table`` to a ``.csv`` or ``.parquet`` file; with ``frame``, also ``lat, lon``
     and east/north ``vx, vy`` (:func:`mhtrack.io._geodetic.state_columns`)."""
-    write_frame(
-        path,
-        {
-            "scan": int_array(table.scan),
-            "time": float_array(table.time),
-            "target_id": int_array(table.target_id),
-            **_geodetic.state_columns(table.x, table.y, table.vx, table.vy, frame),
-        },
-    )
+    write_frame(path, _geodetic.row_columns(
+        ("scan", table.scan), float_array(table.time), ("target_id", table.target_id),
+        (table.x, table.y, table.vx, table.vy), frame))

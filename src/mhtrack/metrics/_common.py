@@ -10,13 +10,18 @@ function checks raw tables and builds one when called on its own.
 from __future__ import annotations
 
 import math
-from collections.abc import Iterator
-from dataclasses import dataclass
+from collections.abc import Iterator, Sequence
+from dataclasses import dataclass, fields
+from typing import Any, TypeVar
 
 import numpy as np
 import numpy.typing as npt
 
 from mhtrack.records import PlotTable, TrackTable, TruthTable
+
+PerScan = TypeVar("PerScan")
+#: The array type of each kind of field of a metric's per-scan result.
+_DTYPES = {"float": np.float64, "int": np.int64}
 
 
 def check_cutoff(value: float, name: str) -> float:
@@ -64,22 +69,32 @@ def as_points(a: npt.ArrayLike, name: str) -> np.ndarray:
     return arr
 
 
+def checked_sets(X: npt.ArrayLike, Y: npt.ArrayLike, c: float,
+                 p: float) -> tuple[np.ndarray, np.ndarray, float, float]:
+    """A set metric's arguments checked: the cut-off ``c`` (finite, ``> 0``), the order ``p``
+    (finite, ``>= 1``), then the point sets ``X``, ``Y`` (:func:`as_points`)."""
+    c, p = check_cutoff(c, "c"), check_order(p, "p")
+    return as_points(X, "X"), as_points(Y, "Y"), c, p
+
+
 def pairwise_distance(X: np.ndarray, Y: np.ndarray) -> np.ndarray:
     """Euclidean distance matrix ``D[i, j] = ‖X[i] − Y[j]‖`` of shape ``(len(X), len(Y))``."""
     return np.hypot(X[:, None, 0] - Y[None, :, 0], X[:, None, 1] - Y[None, :, 1])
 
 
-def assign_capped(D: np.ndarray, c: float, p: float) -> tuple[np.ndarray, np.ndarray]:
-    """Optimal assignment minimising ``Σ min(d, c)^p`` (the OSPA/GOSPA base distance).
+def assigned_distances(X: np.ndarray, Y: np.ndarray, c: float, p: float) -> np.ndarray:
+    """The distances ``‖x_i − y_π(i)‖`` of the pairs of the optimal assignment ``π``
+    between ``X`` and ``Y`` minimising ``Σ min(d, c)^p`` (the OSPA/GOSPA base distance).
 
     The cost is computed in units of ``c`` (``(min(d, c)/c)^p`` ∈ [0, 1]) so that large
     ``c^p`` cannot overflow; the minimiser is the same.
     """
     from scipy.optimize import linear_sum_assignment
+    D = pairwise_distance(X, Y)
     if D.size == 0:
-        e = np.zeros(0, np.int64)
-        return e, e
-    return linear_sum_assignment((np.minimum(D, c) / c) ** p)
+        return np.zeros(0)
+    r, k = linear_sum_assignment((np.minimum(D, c) / c) ** p)
+    return D[r, k]
 
 
 def check_tables(tracks: object, truth: object) -> tuple[TrackTable, TruthTable]:
@@ -187,6 +202,16 @@ class ScanIndexed:
         return ScanIndexed(tracks, self.truth, self.scans,
                            ScanIndex(tracks.scan, tracks.track_id, self.scans),
                            self.truth_rows)
+
+
+def per_scan(cls: type[PerScan], result: type, scans: np.ndarray,
+             results: Sequence[Any]) -> PerScan:
+    """``cls(scan=scans, f=[r.f for r in results], …)`` for every field ``f`` of the
+    dataclass ``result`` (one result per scan): a metric's per-scan arrays, ``float``
+    fields as float64 and ``int`` fields as int64 (also when there is no scan)."""
+    return cls(scan=scans, **{  # type: ignore[call-arg]
+        f.name: np.array([getattr(r, f.name) for r in results], dtype=_DTYPES[str(f.type)])
+        for f in fields(result)})
 
 
 def all_scans(tracks: TrackTable, truth: TruthTable, scans: npt.ArrayLike | None) -> np.ndarray:

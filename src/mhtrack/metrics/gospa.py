@@ -13,15 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
-from mhtrack.metrics._common import (
-    ScanIndexed,
-    as_points,
-    assign_capped,
-    check_cutoff,
-    check_order,
-    checked_distance_input,
-    pairwise_distance,
-)
+from mhtrack.metrics import _common
 from mhtrack.records import TrackTable, TruthTable
 
 
@@ -80,25 +72,19 @@ def gospa(X: npt.ArrayLike, Y: npt.ArrayLike, c: float, p: float) -> GOSPAResult
         True positions (metres).
     Y : (n, 2) array_like
         Estimated positions (metres).
-    c : float
-        Cut-off distance, finite and ``> 0``.
-    p : float
-        Order, finite and ``>= 1``.
+    c, p : float
+        Cut-off distance (finite, ``> 0``) and order (finite, ``>= 1``).
 
     Returns
     -------
     GOSPAResult
     """
-    c = check_cutoff(c, "c")
-    p = check_order(p, "p")
-    return _gospa(as_points(X, "X"), as_points(Y, "Y"), c, p)
+    return _gospa(*_common.checked_sets(X, Y, c, p))
 
 
 def _gospa(X: np.ndarray, Y: np.ndarray, c: float, p: float) -> GOSPAResult:
     m, n = len(X), len(Y)
-    D = pairwise_distance(X, Y)
-    r, k = assign_capped(D, c, p)
-    d = D[r, k]
+    d = _common.assigned_distances(X, Y, c, p)
     d = d[d < c]
     n_assigned = len(d)
     n_missed, n_false = m - n_assigned, n - n_assigned
@@ -125,39 +111,12 @@ def gospa_per_scan(
 ) -> GOSPAPerScan:
     """GOSPA (α = 2) from the truth's to the tracks' positions at every scan.
 
-    Scans are the sorted union of ``truth.scan``, ``tracks.scan`` and ``scans``; a scan
-    with neither truth nor tracks has GOSPA 0. See :func:`gospa`.
-
-    Parameters
-    ----------
-    tracks : TrackTable
-    truth : TruthTable
-    c, p : float
-        Cut-off (``> 0``, metres) and order (``>= 1``).
-    scans : array_like of int, optional
-        Extra scan indices to evaluate.
-
-    Returns
-    -------
-    GOSPAPerScan
-    """
-    return gospa_indexed(*checked_distance_input(tracks, truth, c, p, scans))
+    The parameters and the scans evaluated are :func:`~mhtrack.metrics.ospa.ospa_per_scan`'s;
+    a scan with neither truth nor tracks has GOSPA 0. See :func:`gospa`."""
+    return gospa_indexed(*_common.checked_distance_input(tracks, truth, c, p, scans))
 
 
-def gospa_indexed(data: ScanIndexed, c: float, p: float) -> GOSPAPerScan:
+def gospa_indexed(data: _common.ScanIndexed, c: float, p: float) -> GOSPAPerScan:
     """:func:`gospa_per_scan` on checked, scan-indexed tables and checked ``c``, ``p``."""
-    res = [_gospa(X, Y, c, p) for X, Y in data.points()]
-
-    def col(name: str, dtype: type) -> np.ndarray:
-        return np.array([getattr(r, name) for r in res], dtype=dtype)
-
-    return GOSPAPerScan(
-        scan=data.scans,
-        distance=col("distance", np.float64),
-        localisation=col("localisation", np.float64),
-        missed=col("missed", np.float64),
-        false=col("false", np.float64),
-        n_assigned=col("n_assigned", np.int64),
-        n_missed=col("n_missed", np.int64),
-        n_false=col("n_false", np.int64),
-    )
+    results = [_gospa(X, Y, c, p) for X, Y in data.points()]
+    return _common.per_scan(GOSPAPerScan, GOSPAResult, data.scans, results)

@@ -14,12 +14,10 @@ import numpy.typing as npt
 
 from mhtrack.metrics._common import (
     ScanIndexed,
-    as_points,
-    assign_capped,
-    check_cutoff,
-    check_order,
+    assigned_distances,
     checked_distance_input,
-    pairwise_distance,
+    checked_sets,
+    per_scan,
 )
 from mhtrack.records import TrackTable, TruthTable
 
@@ -76,9 +74,7 @@ def ospa(X: npt.ArrayLike, Y: npt.ArrayLike, c: float, p: float) -> OSPAResult:
     -------
     OSPAResult
     """
-    c = check_cutoff(c, "c")
-    p = check_order(p, "p")
-    return _ospa(as_points(X, "X"), as_points(Y, "Y"), c, p)
+    return _ospa(*checked_sets(X, Y, c, p))
 
 
 def _ospa(X: np.ndarray, Y: np.ndarray, c: float, p: float) -> OSPAResult:
@@ -86,9 +82,8 @@ def _ospa(X: np.ndarray, Y: np.ndarray, c: float, p: float) -> OSPAResult:
     big = max(m, n)
     if big == 0:
         return OSPAResult(0.0, 0.0, 0.0)
-    D = pairwise_distance(X, Y)
-    r, k = assign_capped(D, c, p)
-    loc_u = float(np.sum((np.minimum(D[r, k], c) / c) ** p))  # Σ d^(c)^p / c^p
+    d = assigned_distances(X, Y, c, p)
+    loc_u = float(np.sum((np.minimum(d, c) / c) ** p))  # Σ d^(c)^p / c^p
     card_u = float(abs(m - n))  # c^p |n − m| / c^p
     return OSPAResult(
         distance=c * ((loc_u + card_u) / big) ** (1.0 / p),
@@ -129,10 +124,5 @@ def ospa_per_scan(
 
 def ospa_indexed(data: ScanIndexed, c: float, p: float) -> OSPAPerScan:
     """:func:`ospa_per_scan` on checked, scan-indexed tables and checked ``c``, ``p``."""
-    res = [_ospa(X, Y, c, p) for X, Y in data.points()]
-    return OSPAPerScan(
-        scan=data.scans,
-        distance=np.array([r.distance for r in res], dtype=np.float64),
-        localisation=np.array([r.localisation for r in res], dtype=np.float64),
-        cardinality=np.array([r.cardinality for r in res], dtype=np.float64),
-    )
+    results = [_ospa(X, Y, c, p) for X, Y in data.points()]
+    return per_scan(OSPAPerScan, OSPAResult, data.scans, results)

@@ -14,6 +14,7 @@ import dataclasses
 from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import dataclass
 from functools import cached_property
+from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -159,7 +160,7 @@ class Pipeline:
         self.fusion, self.frame = self.choices.fusion, self.choices.frame
 
     @classmethod
-    def open(cls, path: str, options: TrackOptions | None = None, *,
+    def open(cls, path: str | Path, options: TrackOptions | None = None, *,
              scenario_file: str | None = None, sensors_file: str | None = None,
              reorder_window_s: float | None = None) -> Pipeline:
         """A pipeline on a plots file or a recording (:func:`~mhtrack.pipeline.open_input`)."""

@@ -17,8 +17,6 @@ from mhtrack.experiments.p2.constants import (
     FUSION_PARAMS,
     INITIATOR_PARAMS,
     LOGIC_PARAMS,
-    RATE0,
-    SIGMA0,
     THETA0,
 )
 from mhtrack.experiments.p2.jobs import p2_scenario
@@ -32,7 +30,7 @@ def fig2_example(seed: int, settings: str = "best") -> ClusteringExample:
     """P2 Fig. 2: random vs adaptive K-means (with the fusion options of ``settings``) on
     the first scan of run 0 (no clutter) where random-start K-means gets ``k`` wrong (P2
     Fig. 2(a) shows such a failure); scan 0 if there is none."""
-    sc = p2_scenario(SIGMA0, 0.0)
+    sc = p2_scenario(clutter_rate=0.0)
     rs = run_seed(seed, 0, "words")
     number = 0
     for i, scan in enumerate(simulate(sc, rs).plots.scans()):
@@ -48,7 +46,7 @@ def fig12_15_example(seed: int, settings: str = "best") -> InitiationExample:
     """P2 Figs. 12–15: the four initiators on the first fused window of run 0 at
     σr = 20 m, λ = 50, θ = 20°, with the fusion and initiator options of ``settings``
     (those of the study's jobs)."""
-    return initiation_example(p2_scenario(SIGMA0, RATE0), seed, theta_deg=THETA0,
+    return initiation_example(p2_scenario(), seed, theta_deg=THETA0,
                               methods=tuple(FIGURE_NUMBERS), **LOGIC_PARAMS,
                               fusion_params=FUSION_PARAMS[settings],
                               initiator_params=INITIATOR_PARAMS[settings])

@@ -79,7 +79,7 @@ def test_a_full_queue_counts_its_drops() -> None:
     reader.start()
     _send(reader.addresses[0][1], [bytes([i]) for i in range(25)])
     reader.stop.set()
-    reader._thread.join()  # noqa: SLF001 - nothing read: the queue holds 10
+    reader._thread.join()
     got = [d for d, _ in reader]
     assert got == [bytes([i]) for i in range(10)]
     assert (reader.stats.datagrams, reader.stats.queue_dropped) == (10, 15)

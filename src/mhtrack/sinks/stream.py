@@ -67,13 +67,14 @@ class Cat062UdpSink(Sink):
             self._sock = None
 
 
-def _num(v: float) -> float | None:
-    return None if not math.isfinite(v) else round(v, 3)
+def _num(v: float, digits: int = 3) -> float | None:
+    return None if not math.isfinite(v) else round(v, digits)
 
 
 class JsonLinesSink(Sink):
     """One JSON object per online row, a line each, flushed after every frame:
-    ``frame, time, track_id, x, y, vx, vy`` (the local frame, m and m/s), ``lat, lon``
+    ``frame, time, track_id, x, y, vx, vy`` (the local frame, m and m/s, to 1 mm; time
+    to 1 µs), ``lat, lon``
     (with a ``frame``), ``coasting`` (no plot this frame) and ``tentative``."""
 
     def __init__(self, stream: TextIO, frame: LocalFrame | None = None) -> None:
@@ -88,7 +89,7 @@ class JsonLinesSink(Sink):
             lat, lon = self.frame.to_geodetic(t.x, t.y)
         tent = np.zeros(len(t), bool) if t.tentative is None else t.tentative.astype(bool)
         for i in range(len(t)):
-            row = {"frame": int(out.frame.index), "time": _num(float(t.time[i])),
+            row = {"frame": int(out.frame.index), "time": _num(float(t.time[i]), 6),
                    "track_id": int(t.track_id[i]), "x": _num(float(t.x[i])),
                    "y": _num(float(t.y[i])), "vx": _num(float(t.vx[i])),
                    "vy": _num(float(t.vy[i]))}

@@ -152,7 +152,7 @@ class _Threaded:
     def _run(self) -> None:
         try:
             self._receive()
-        except BaseException as e:  # noqa: BLE001 - handed to the iterating thread
+        except BaseException as e:
             self.error = e
 
     def start(self) -> None:

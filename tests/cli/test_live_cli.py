@@ -66,6 +66,14 @@ def _drain(sock: socket.socket) -> list[bytes]:
 
 
 def test_replay_into_live_equals_track_online(recording: Path) -> None:
+    diffs = replay_into_live(recording, "20")
+    assert set(diffs) == {"lat", "lon", "vx", "vy", "time"}
+
+
+def replay_into_live(recording: Path, speed: str) -> dict[str, float]:
+    """Replay ``recording/radar.pcap`` at ``speed`` into ``live``; assert the CAT062
+    equals ``recording/online.csv`` (module docstring); the largest difference of each
+    column."""
     rx = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
     rx.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 1 << 22)
     rx.bind(("127.0.0.1", 0))
@@ -80,7 +88,7 @@ def test_replay_into_live_equals_track_online(recording: Path) -> None:
         m = re.match(r"listening on (udp://127\.0\.0\.1:\d+)$", first.strip())
         assert m, f"live did not start: {first!r}"
         sent = subprocess.run([*CLI, "replay", str(recording / "radar.pcap"), "--to",
-                               m.group(1), "--speed", "20"], capture_output=True, text=True,
+                               m.group(1), "--speed", speed], capture_output=True, text=True,
                               env=_env(), check=True).stdout
         n_sent = int(re.search(r"sent (\d+) datagrams", sent).group(1))
         live.send_signal(signal.SIGTERM)  # replay is done: every datagram was delivered
@@ -134,3 +142,4 @@ def test_replay_into_live_equals_track_online(recording: Path) -> None:
     coasting = r["plot"].isna().to_numpy() | (r["plot"].fillna(0).to_numpy() < 0)
     assert [x["I062/080"]["CST"] for x in items] == coasting.astype(int).tolist()
     assert (recording / "live.ast").stat().st_size > 0
+    return diffs

@@ -92,3 +92,14 @@ def test_stdin_run_equals_the_pipeline_on_the_file(rec: Path) -> None:
     assert result.reader.datagrams == len(recording_datagrams(rec / "radar.ast"))
     assert live.source.stats.plots_in == live.source.stats.plots_out + \
         live.source.stats.late_dropped
+
+
+def test_stopped_before_any_datagram(rec: Path, tmp_path: Path) -> None:
+    stop = threading.Event()
+    live = Live(read_sensors(rec / "sensors.toml"), OPTIONS,
+                LiveOptions(listen=("udp://127.0.0.1:0",), out_file=tmp_path / "e.ast"),
+                stop=stop)
+    stop.set()
+    result = live.run()
+    assert (result.reader.datagrams, len(result.run.stats), result.sent_rows) == (0, 0, 0)
+    assert (tmp_path / "e.ast").read_bytes() == b""  # an empty recording, written

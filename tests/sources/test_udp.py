@@ -126,3 +126,39 @@ def test_sigterm_sets_the_stop_and_the_handler_comes_back() -> None:
         assert stop.is_set()
     assert got == [b"one", b"two"]
     assert signal.getsignal(signal.SIGTERM) is before
+
+
+MULTICAST = """
+import socket
+from mhtrack.sources.udp import UdpReader
+r = UdpReader(["udp://239.1.2.3:0"])
+r.start()
+with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as s:
+    s.setsockopt(socket.IPPROTO_IP, socket.IP_MULTICAST_TTL, 1)
+    for i in range(50):
+        s.sendto(b"m%d" % i, ("239.1.2.3", r.addresses[0][1]))
+r.stop.set()
+print(",".join(d.decode() for d, _ in r))
+"""
+
+
+def test_multicast_group_in_a_network_namespace_of_its_own() -> None:
+    """A multicast group joined and received — only inside a network namespace the test
+    makes (``unshare -n``, root), with just its loopback up: nothing leaves the host."""
+    import shutil
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    if os.geteuid() != 0 or shutil.which("unshare") is None or shutil.which("ip") is None:
+        pytest.skip("needs root, unshare and ip for a network namespace")
+    src = str(Path(__file__).resolve().parents[2] / "src")
+    setup = ("ip link set lo up && ip link set lo multicast on && "
+             "ip route add 224.0.0.0/4 dev lo && exec \"$0\" -c \"$1\"")
+    done = subprocess.run(["unshare", "-n", "sh", "-c", setup, sys.executable, MULTICAST],
+                          capture_output=True, text=True, timeout=120,
+                          env={**os.environ, "PYTHONPATH": src})
+    if done.returncode != 0 and "unshare" in done.stderr and "ermission" in done.stderr:
+        pytest.skip(f"no network namespace here: {done.stderr.strip()}")
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.strip() == ",".join(f"m{i}" for i in range(50))

@@ -150,7 +150,12 @@ class Live:
             datagrams = (d for d, _ in self.reader)
         self.source = DatagramSource(datagrams, sensors=sensors, name=name,
                                      reorder_window_s=live.reorder_window_s)
-        self.pipeline = Pipeline(self.source, options)
+        try:
+            self.pipeline = Pipeline(self.source, options)
+        except BaseException:
+            if isinstance(self.reader, UdpReader):
+                self.reader.close()
+            raise
         frame = self.pipeline.frame
         if frame is None and (live.out_udp or live.out_file is not None):
             raise ValueError("live: CAT062 output needs the sensors' geodetic reference")
@@ -158,7 +163,7 @@ class Live:
                     for to in live.out_udp]
         self.files = None if live.out_file is None else Cat062Sink(
             live.out_file, frame, output="online", sac=live.sac,  # type: ignore[arg-type]
-            sic=live.sic, part_frames=live.part_frames)
+            sic=live.sic, part_frames=live.part_frames, empty_ok=True)
         self.status = Status(self.reader.stats, lambda: self.source.stats)
         self.sinks: list[Sink] = [*self.udp, self.status]
         if self.files is not None:

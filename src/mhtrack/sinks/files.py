@@ -104,16 +104,18 @@ class Cat062Sink(_Rows):
     ``.pcap`` or raw ``.ast`` file: at the end, the bytes ``mhtrack export TRACKS
     --category 062`` writes of the tracks file of the same rows; or, with ``part_frames
     = n``, every ``n`` frames the rows of those frames to ``STEM.part0000.SUFFIX``, … (as
-    :class:`TracksFileSink`; a part with no rows is an empty recording)."""
+    :class:`TracksFileSink`; a part with no rows is an empty recording). A run with no
+    rows at all is an error, unless ``empty_ok`` (a live run stopped before any track:
+    an empty recording)."""
 
     def __init__(self, path: str | Path, frame: LocalFrame, *, output: str | None = None,
                  sac: int | None = None, sic: int | None = None,
-                 part_frames: int | None = None) -> None:
+                 part_frames: int | None = None, empty_ok: bool = False) -> None:
         super().__init__(output)
         if part_frames is not None and part_frames < 1:
             raise ValueError(f"part_frames must be at least 1, got {part_frames}")
         self.path, self.frame, self.sac, self.sic = Path(path), frame, sac, sic
-        self.part_frames = part_frames
+        self.part_frames, self.empty_ok = part_frames, empty_ok
         self.paths: list[Path] = []
         self.n_blocks = 0
         self._frames = 0
@@ -130,7 +132,7 @@ class Cat062Sink(_Rows):
                 self._flush()
             return
         tracks = self.rows.tracks()
-        if len(tracks) == 0:
+        if len(tracks) == 0 and not self.empty_ok:
             raise ValueError(f"{self.path}: no track rows (nothing to export)")
         self._write(self.path, tracks)
 

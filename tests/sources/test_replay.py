@@ -93,3 +93,21 @@ def test_replay_on_a_fake_clock(recordings: Path) -> None:
 def test_bad_speed() -> None:
     with pytest.raises(ValueError, match="speed must be above 0"):
         replay("x", "udp://127.0.0.1:9", speed=0.0)
+
+
+def test_a_stop_ends_a_long_wait(recordings: Path) -> None:
+    import threading
+
+    stop = threading.Event()
+    waits: list[float] = []
+
+    def clock() -> float:
+        return 0.0
+
+    def sleep(s: float) -> None:  # the first wait sets the stop: nothing more is sent
+        waits.append(s)
+        stop.set()
+
+    stats = replay(recordings / "r.pcap", "udp://127.0.0.1:9", speed=1e-6, stop=stop,
+                   clock=clock, sleep=sleep)
+    assert stats.datagrams == 1 and len(waits) == 1 and waits[0] > 1e5

@@ -95,9 +95,12 @@ def schedule(times: list[float], speed: float, loops: int | None
 def replay(path: str | Path, to: str | Endpoint, *, speed: float = 1.0,
            loops: int | None = 1, stop: threading.Event | None = None,
            clock: Callable[[], float] = time.monotonic,
-           sleep: Callable[[float], None] = time.sleep) -> ReplayStats:
+           sleep: Callable[[float], object] | None = None) -> ReplayStats:
     """Send the datagrams of recording ``path`` to ``to`` (``udp://HOST:PORT``) on the
-    :func:`schedule` of ``speed`` and ``loops``, until done or ``stop`` is set."""
+    :func:`schedule` of ``speed`` and ``loops``, until done or ``stop`` is set (a wait
+    ends at once when it is: default ``sleep`` is ``stop.wait``)."""
+    if sleep is None:
+        sleep = time.sleep if stop is None else stop.wait
     if not speed > 0:
         raise ValueError(f"speed must be above 0, got {speed!r}")
     if loops is not None and loops < 1:
@@ -114,6 +117,8 @@ def replay(path: str | Path, to: str | Endpoint, *, speed: float = 1.0,
             wait = start + due - clock()
             if wait > 0:
                 sleep(wait)
+                if stop is not None and stop.is_set():
+                    break
             sock.sendto(items[i][0], addr)
             stats.datagrams += 1
             stats.bytes += len(items[i][0])

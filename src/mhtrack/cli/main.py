@@ -90,6 +90,7 @@ def _register() -> None:
         data_commands,
         experiment_commands,
         initiation_commands,
+        live_commands,
         report_commands,
         reproduce_commands,
         track_commands,
@@ -97,7 +98,7 @@ def _register() -> None:
 
     modules = (data_commands, track_commands, clutter_commands, initiation_commands,
                experiment_commands, reproduce_commands, asterix_commands,
-               report_commands)
+               report_commands, live_commands)
     for module in modules:
         for command in module.COMMANDS:
             cli.add_command(command)

@@ -4,6 +4,7 @@ atomically (:mod:`mhtrack.io.atomic`) — at the end, or for a table in rolling 
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Iterator
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -85,26 +86,65 @@ class TracksFileSink(_Rows):
         self.paths.append(path)
 
 
+def cat062_blocks(tracks: TrackTable, frame: LocalFrame, name: str, *,
+                  sac: int | None = None, sic: int | None = None
+                  ) -> Iterator[tuple[float, int, bytes]]:
+    """``(time, data source, CAT062 data block)`` of tracker rows ``tracks``: the one
+    encoding path of every CAT062 sink (:func:`~mhtrack.io.asterix.cat062.table_messages`
+    then :func:`~mhtrack.io.asterix.encode.encode_blocks`, at most 40 records a block)."""
+    from mhtrack.io.asterix.cat062 import table_messages
+    from mhtrack.io.asterix.encode import encode_blocks
+
+    return encode_blocks(table_messages(tracks, frame, name, sac=sac, sic=sic))
+
+
 class Cat062Sink(_Rows):
     """The tracks as ASTERIX CAT062 system tracks from data source ``sac``/``sic``
-    (:func:`~mhtrack.io.asterix.cat062.table_messages`; positions through ``frame``),
-    written atomically at the end to a ``.pcap`` or raw ``.ast`` file: the bytes
-    ``mhtrack export TRACKS --category 062`` writes of the tracks file of the same rows."""
+    (:func:`cat062_blocks`; positions through ``frame``), written atomically to a
+    ``.pcap`` or raw ``.ast`` file: at the end, the bytes ``mhtrack export TRACKS
+    --category 062`` writes of the tracks file of the same rows; or, with ``part_frames
+    = n``, every ``n`` frames the rows of those frames to ``STEM.part0000.SUFFIX``, … (as
+    :class:`TracksFileSink`; a part with no rows is an empty recording). A run with no
+    rows at all is an error, unless ``empty_ok`` (a live run stopped before any track:
+    an empty recording)."""
 
     def __init__(self, path: str | Path, frame: LocalFrame, *, output: str | None = None,
-                 sac: int | None = None, sic: int | None = None) -> None:
+                 sac: int | None = None, sic: int | None = None,
+                 part_frames: int | None = None, empty_ok: bool = False) -> None:
         super().__init__(output)
+        if part_frames is not None and part_frames < 1:
+            raise ValueError(f"part_frames must be at least 1, got {part_frames}")
         self.path, self.frame, self.sac, self.sic = Path(path), frame, sac, sic
+        self.part_frames, self.empty_ok = part_frames, empty_ok
+        self.paths: list[Path] = []
         self.n_blocks = 0
+        self._frames = 0
+
+    def write(self, out: FrameOutput) -> None:
+        super().write(out)
+        self._frames += 1
+        if self.part_frames is not None and self._frames % self.part_frames == 0:
+            self._flush()
 
     def close(self) -> None:
-        from mhtrack.io.asterix.cat062 import table_messages
-        from mhtrack.io.asterix.encode import encode_blocks
+        if self.part_frames is not None:
+            if self._frames % self.part_frames or not self.paths:
+                self._flush()
+            return
+        tracks = self.rows.tracks()
+        if len(tracks) == 0 and not self.empty_ok:
+            raise ValueError(f"{self.path}: no track rows (nothing to export)")
+        self._write(self.path, tracks)
+
+    def _flush(self) -> None:
+        p = self.path
+        self._write(p.with_name(f"{p.stem}.part{len(self.paths):04d}{p.suffix}"),
+                    self.rows.tracks())
+        self.rows.clear()
+
+    def _write(self, path: Path, tracks: TrackTable) -> None:
         from mhtrack.io.asterix.writer import write_blocks
 
-        tracks = self.rows.tracks()
-        if len(tracks) == 0:
-            raise ValueError(f"{self.path}: no track rows (nothing to export)")
-        messages = table_messages(tracks, self.frame, str(self.path), sac=self.sac,
-                                  sic=self.sic)
-        self.n_blocks = write_blocks(self.path, encode_blocks(messages))
+        self.n_blocks += write_blocks(path, cat062_blocks(tracks, self.frame, str(path),
+                                                          sac=self.sac, sic=self.sic))
+        self.paths.append(path)

@@ -1,0 +1,116 @@
+"""``live`` and ``replay``: track ASTERIX from the network, and play a recording onto it
+(``docs/live.md``)."""
+
+from __future__ import annotations
+
+import math
+import threading
+from pathlib import Path
+
+import click
+
+from mhtrack.cli.asterix_commands import needs_libasterix
+from mhtrack.cli.track_commands import birth_options, track_options, tracker_options
+from mhtrack.names import CLUTTER_FRAMES, DEFAULT_CLUTTER_FRAME
+
+
+class Speed(click.ParamType):
+    """A replay speed: a number above 0, or ``max`` (infinity: no waiting)."""
+
+    name = "SPEED|max"
+
+    def convert(self, value: object, param: click.Parameter | None,
+                ctx: click.Context | None) -> float:
+        if value == "max":
+            return math.inf
+        try:
+            v = float(value)  # type: ignore[arg-type]
+        except (TypeError, ValueError):
+            v = math.nan
+        if not 0 < v < math.inf:
+            self.fail(f"{value!r} is not a number above 0 or 'max'", param, ctx)
+        return v
+
+
+@click.command()
+@click.argument("recording", type=click.Path(exists=True, dir_okay=False, path_type=Path))
+@click.option("--to", "to", required=True, help="Destination udp://HOST:PORT (IPv6: "
+              "udp://[ADDR]:PORT; a multicast group is sent to with TTL 1).")
+@click.option("--speed", type=Speed(), default=None,
+              help="Time scale: 1 real time, 10 ten times faster, max as fast as the socket "
+              "takes them [1].")
+@click.option("--loop", is_flag=True, help="Play the recording again and again until "
+              "Ctrl-C (times of day repeat: for load, not for one track picture).")
+@needs_libasterix
+def replay(recording: Path, to: str, speed: float | None, loop: bool) -> None:
+    """Send RECORDING's ASTERIX datagrams over UDP with their original spacing."""
+    from mhtrack.sources.replay import replay as play
+    from mhtrack.sources.udp import stop_on_signals
+
+    with stop_on_signals(threading.Event()) as stop:
+        stats = play(recording, to, loops=None if loop else 1, stop=stop,
+                     **({} if speed is None else {"speed": speed}))
+    click.echo(f"sent {stats.datagrams} datagrams ({stats.bytes} bytes, {stats.passes} "
+               f"passes) to {to}")
+
+
+@click.command()
+@click.option("--listen", "listen", multiple=True, help="udp://HOST:PORT to listen on "
+              "(a multicast group joins it; repeat for several LANs).")
+@click.option("--stdin", "stdin", type=click.Choice(["raw", "len32"]), default=None,
+              help="Read datagrams from stdin instead: raw ASTERIX data blocks back to back, "
+              "or each datagram after its length (4 octets, big-endian).")
+@click.option("--sensors", "sensors_file", required=True, type=click.Path(
+              exists=True, dir_okay=False, path_type=Path),
+              help="Sensors file: every radar's site, errors and rotation period.")
+@click.option("--day-from", type=click.Choice(["receive", "stream"]), default=None,
+              help="The day of each time of day: from the receive clock (live feeds), or "
+              "from the stream alone (a replayed recording) [receive].")
+@click.option("--out-udp", multiple=True, help="Send the system tracks as CAT062 to "
+              "udp://HOST:PORT (repeatable).")
+@click.option("--out", "out", type=click.Path(dir_okay=False, path_type=Path), default=None,
+              help="Write the system tracks as a CAT062 recording (.ast or .pcap).")
+@click.option("--part-frames", type=click.IntRange(min=1), default=None,
+              help="With --out: a new file STEM.partNNNN.SUFFIX every N frames.")
+@click.option("--json", "as_json", is_flag=True, help="Print each frame's tracks as JSON "
+              "lines on stdout.")
+@click.option("--status-every", type=click.FloatRange(min=0, min_open=True), default=None,
+              help="Print a status line on stderr every N seconds.")
+@click.option("--reorder-window", "reorder_window_s", type=click.FloatRange(min=0),
+              default=None, help="Plots may be out of time order by at most this many "
+              "seconds [2].")
+@tracker_options("--pd")
+@click.option("--clutter-frame", type=click.Choice(CLUTTER_FRAMES),
+              default=DEFAULT_CLUTTER_FRAME, show_default=True,
+              help="Estimate each radar's clutter in the local plane or in range and bearing.")
+@birth_options
+@needs_libasterix
+def live(listen: tuple[str, ...], stdin: str | None, sensors_file: Path,
+         day_from: str | None, out_udp: tuple[str, ...], out: Path | None,
+         part_frames: int | None, as_json: bool, status_every: float | None,
+         reorder_window_s: float | None, tracker: str, tracker_pd: float | None,
+         meas_sigma: float | None, accel_sigma: float | None,
+         imm_accel_sigma: float | None, clutter_density: float | None,
+         birth_density: float | None, nscan: int | None, clutter_frame: str, birth: str,
+         birth_theta: float | None, fusion: str | None) -> None:
+    """Track ASTERIX plots arriving over UDP (or stdin) until Ctrl-C or SIGTERM."""
+    from mhtrack.io.sensors import read_sensors
+    from mhtrack.pipeline.live import Live, LiveOptions
+    from mhtrack.sources.udp import stop_on_signals
+
+    options = track_options(tracker, tracker_pd, meas_sigma, accel_sigma, imm_accel_sigma,
+                            clutter_density, birth_density, nscan, birth, birth_theta,
+                            fusion, "online", clutter_frame=clutter_frame)
+    settings = LiveOptions(listen=listen, stdin=stdin, out_udp=out_udp, out_file=out,
+                           part_frames=part_frames, json=as_json,
+                           status_every_s=status_every, reorder_window_s=reorder_window_s,
+                           **({} if day_from is None else {"day_from": day_from}))
+    with stop_on_signals(threading.Event()) as stop:
+        run = Live(read_sensors(sensors_file), options, settings, stop=stop,
+                   emit=lambda line: click.echo(line, err=True))
+        click.echo(f"listening on {', '.join(run.listening)}", err=True)
+        result = run.run()
+    click.echo(result.describe(), err=True)
+
+
+COMMANDS = [live, replay]

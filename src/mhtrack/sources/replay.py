@@ -1,0 +1,126 @@
+"""A recording played back as a network feed: ``mhtrack replay REC --to udp://HOST:PORT``
+(``docs/live.md``).
+
+Each datagram of a pcap or pcapng recording is sent as it was captured (its ASTERIX
+payload, one UDP datagram), at its capture time; a raw recording (data blocks back to
+back) is sent one data block per datagram, at the time of day of the block's first
+CAT048/CAT034 record (on one axis across midnight, :class:`TimeAxis`; a block without
+one keeps the previous time). The spacing of the times is kept, divided by ``speed``
+(``math.inf``: as fast as the socket takes them). ``loops`` plays the file that many times
+(``None``: until ``stop``), each pass starting one mean spacing after the last.
+"""
+
+from __future__ import annotations
+
+import mmap
+import socket
+import threading
+import time
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass
+from pathlib import Path
+
+from mhtrack.io.asterix.container import blocks, container, datagrams
+from mhtrack.io.asterix.decode import Decoder
+from mhtrack.io.asterix.problems import Problems
+from mhtrack.io.asterix.timeaxis import TimeAxis
+from mhtrack.io.paths import check_input_file
+from mhtrack.sources.udp import Endpoint, parse_endpoint
+
+
+def recording_datagrams(path: str | Path) -> list[tuple[bytes, float]]:
+    """``(payload, time)`` of every datagram of the recording ``path`` (module
+    docstring), in file order; times in seconds (capture: POSIX; raw: the time axis)."""
+    path = check_input_file(Path(path))
+    name = str(path)
+    decoder, problems = Decoder(), Problems()
+    with path.open("rb") as fh:
+        size = path.stat().st_size
+        with (mmap.mmap(fh.fileno(), 0, access=mmap.ACCESS_READ) if size else
+              _Empty()) as data:
+            kind = container(data, name, decoder.categories)
+            raw: list[tuple[bytes, float | None]] = []
+            for at, payload, when in datagrams(data, kind, name, problems):
+                if kind == "raw":
+                    raw += [(bytes(payload[a - at:a - at + 3 + len(b)]), None)
+                            for a, _, b in blocks(payload, at, problems)]
+                else:
+                    raw.append((bytes(payload), when))
+    out, axis, last = [], TimeAxis(), 0.0
+    for payload, when in raw:
+        if when is None:
+            for _, _, found in decoder.blocks(payload, 0, Problems()):
+                if found:
+                    when = axis.times_list([found[0][0]])[0]
+                    break
+        last = last if when is None else float(when)
+        out.append((payload, last))
+    return out
+
+
+class _Empty:
+    def __enter__(self) -> bytes:
+        return b""
+
+    def __exit__(self, *exc: object) -> None:
+        return None
+
+
+@dataclass
+class ReplayStats:
+    """What a replay sent."""
+
+    datagrams: int = 0
+    bytes: int = 0
+    passes: int = 0
+
+
+def schedule(times: list[float], speed: float, loops: int | None
+             ) -> Iterator[tuple[int, float]]:
+    """``(datagram index, due time in s from the start)`` of a replay: the recording's
+    spacing divided by ``speed`` (``math.inf``: all due at 0), ``loops`` passes (``None``:
+    endless), each pass one mean spacing after the last datagram of the one before."""
+    if not times:
+        return
+    t0, span = times[0], times[-1] - times[0]
+    gap = span / (len(times) - 1) if len(times) > 1 else 0.0
+    n = 0
+    while loops is None or n < loops:
+        base = n * (span + gap)
+        for i, t in enumerate(times):
+            yield i, (base + max(t - t0, 0.0)) / speed
+        n += 1
+
+
+def replay(path: str | Path, to: str | Endpoint, *, speed: float = 1.0,
+           loops: int | None = 1, stop: threading.Event | None = None,
+           clock: Callable[[], float] = time.monotonic,
+           sleep: Callable[[float], object] | None = None) -> ReplayStats:
+    """Send the datagrams of recording ``path`` to ``to`` (``udp://HOST:PORT``) on the
+    :func:`schedule` of ``speed`` and ``loops``, until done or ``stop`` is set (a wait
+    ends at once when it is: default ``sleep`` is ``stop.wait``)."""
+    if sleep is None:
+        sleep = time.sleep if stop is None else stop.wait
+    if not speed > 0:
+        raise ValueError(f"speed must be above 0, got {speed!r}")
+    if loops is not None and loops < 1:
+        raise ValueError(f"loops must be at least 1, got {loops!r}")
+    ep = to if isinstance(to, Endpoint) else parse_endpoint(to)
+    items = recording_datagrams(path)
+    addr = socket.getaddrinfo(ep.host, ep.port, ep.family, socket.SOCK_DGRAM)[0][4][:2]
+    stats = ReplayStats()
+    with socket.socket(ep.family, socket.SOCK_DGRAM) as sock:
+        start = clock()
+        for i, due in schedule([t for _, t in items], speed, loops):
+            if stop is not None and stop.is_set():
+                break
+            wait = start + due - clock()
+            if wait > 0:
+                sleep(wait)
+                if stop is not None and stop.is_set():
+                    break
+            sock.sendto(items[i][0], addr)
+            stats.datagrams += 1
+            stats.bytes += len(items[i][0])
+            stats.passes += i == len(items) - 1
+    return stats

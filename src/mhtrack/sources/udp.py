@@ -1,0 +1,295 @@
+"""Datagrams from the network or stdin, with their receive times (``docs/live.md``).
+
+:class:`UdpReader` listens on one or more UDP endpoints (``udp://HOST:PORT``; a
+multicast group as HOST joins that group on every interface; IPv6 as
+``udp://[::1]:PORT``); several endpoints (redundant LANs) are merged in arrival order.
+:class:`StdinReader` reads a byte stream: ``raw`` — ASTERIX data blocks back to back (a
+``.ast`` file; each block one datagram, framed by its category octet and 2-octet length),
+or ``len32`` — each datagram preceded by its length as a 4-octet big-endian integer.
+
+Both are iterables of ``(datagram, receive time)`` (POSIX seconds, ``time.time()`` when
+the bytes were read) for :class:`~mhtrack.sources.datagrams.DatagramSource`. A thread
+drains the sockets into a queue as soon as datagrams arrive, so a slow tracker step does
+not overflow the kernel's socket buffer; the queue is bounded (``max_queued``), and a
+datagram that does not fit is dropped and counted (``stats.queue_dropped``), never
+silently. Setting the ``stop`` event (:func:`stop_on_signals`: SIGTERM, Ctrl-C) ends the
+iteration cleanly: the sockets are drained once more without waiting, every datagram
+already received is yielded, then the iteration ends — the source then finishes the
+frames it holds.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import ipaddress
+import os
+import queue
+import selectors
+import signal
+import socket
+import threading
+import time
+from collections.abc import Iterator
+from dataclasses import dataclass, field
+from typing import Any, BinaryIO
+from urllib.parse import urlsplit
+
+#: Receive buffer asked of the kernel per socket (bytes; Linux caps it at
+#: ``net.core.rmem_max`` unless run as root).
+DEFAULT_RCVBUF = 8 << 20
+#: Datagrams held between the receiving thread and the tracker at most.
+DEFAULT_MAX_QUEUED = 1_000_000
+#: How often (s) a blocked reader looks at its stop event.
+POLL_S = 0.05
+#: Largest UDP payload.
+MAX_DATAGRAM = 65535
+STDIN_FRAMINGS = ("raw", "len32")
+
+
+@dataclass(frozen=True)
+class Endpoint:
+    """A UDP address to listen on or send to: ``host`` (an IPv4 or IPv6 literal or a
+    name), ``port``; ``multicast`` when ``host`` is a multicast group."""
+
+    host: str
+    port: int
+
+    @property
+    def multicast(self) -> bool:
+        with contextlib.suppress(ValueError):
+            return ipaddress.ip_address(self.host).is_multicast
+        return False
+
+    @property
+    def family(self) -> int:
+        with contextlib.suppress(ValueError):
+            if ipaddress.ip_address(self.host).version == 6:
+                return socket.AF_INET6
+        return socket.AF_INET
+
+    def __str__(self) -> str:
+        host = f"[{self.host}]" if ":" in self.host else self.host
+        return f"udp://{host}:{self.port}"
+
+
+def parse_endpoint(url: str) -> Endpoint:
+    """``udp://HOST:PORT`` (IPv6 in brackets) as an :class:`Endpoint`; a
+    :class:`ValueError` naming ``url`` otherwise."""
+    parts = urlsplit(url)
+    try:
+        port = parts.port
+    except ValueError:
+        port = None
+    if parts.scheme != "udp" or not parts.hostname or port is None or parts.path:
+        raise ValueError(f"{url}: expected udp://HOST:PORT (IPv6: udp://[ADDR]:PORT)")
+    return Endpoint(parts.hostname, port)
+
+
+def listen_socket(ep: Endpoint, rcvbuf: int = DEFAULT_RCVBUF) -> socket.socket:
+    """A bound, non-blocking UDP socket for ``ep``: unicast binds ``host:port``; a
+    multicast group binds the port on every address and joins the group (default
+    interface)."""
+    sock = socket.socket(ep.family, socket.SOCK_DGRAM)
+    try:
+        sock.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, rcvbuf)
+        if ep.multicast:
+            sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+            group = socket.inet_pton(ep.family, ep.host)
+            if ep.family == socket.AF_INET6:
+                sock.bind(("::", ep.port))
+                sock.setsockopt(socket.IPPROTO_IPV6, socket.IPV6_JOIN_GROUP,
+                                group + (0).to_bytes(4, "little"))
+            else:
+                sock.bind(("", ep.port))
+                sock.setsockopt(socket.IPPROTO_IP, socket.IP_ADD_MEMBERSHIP,
+                                group + socket.inet_aton("0.0.0.0"))
+        else:
+            sock.bind((ep.host, ep.port))
+        sock.setblocking(False)
+    except OSError as e:
+        sock.close()
+        raise OSError(f"{ep}: cannot listen: {e.strerror or e}") from None
+    return sock
+
+
+@dataclass
+class ReaderStats:
+    """What a reader received so far."""
+
+    datagrams: int = 0
+    bytes: int = 0
+    #: Datagrams dropped because the queue to the tracker was full.
+    queue_dropped: int = 0
+    #: Datagrams received per endpoint (``str(endpoint)``, or ``"stdin"``).
+    per_input: dict[str, int] = field(default_factory=dict)
+
+
+class _Threaded:
+    """A receiving thread filling a bounded queue; iteration yields from the queue until
+    the thread has ended (stop set, or end of input) and the queue is empty."""
+
+    def __init__(self, stop: threading.Event | None, max_queued: int) -> None:
+        self.stop = threading.Event() if stop is None else stop
+        self.stats = ReaderStats()
+        self._queue: queue.Queue[tuple[bytes, float]] = queue.Queue(max_queued)
+        self._thread: threading.Thread | None = None
+        self.error: BaseException | None = None
+
+    def _put(self, data: bytes, when: float, where: str) -> None:
+        s = self.stats
+        try:
+            self._queue.put_nowait((data, when))
+        except queue.Full:
+            s.queue_dropped += 1
+            return
+        s.datagrams += 1
+        s.bytes += len(data)
+        s.per_input[where] = s.per_input.get(where, 0) + 1
+
+    def _receive(self) -> None:
+        raise NotImplementedError
+
+    def _run(self) -> None:
+        try:
+            self._receive()
+        except BaseException as e:
+            self.error = e
+
+    def start(self) -> None:
+        """Start receiving (iteration starts it too)."""
+        if self._thread is None:
+            self._thread = threading.Thread(target=self._run, name="mhtrack-receive",
+                                            daemon=True)
+            self._thread.start()
+
+    def __iter__(self) -> Iterator[tuple[bytes, float]]:
+        self.start()
+        assert self._thread is not None
+        while True:
+            try:
+                yield self._queue.get(timeout=POLL_S)
+                continue
+            except queue.Empty:
+                pass
+            if not self._thread.is_alive() and self._queue.empty():
+                break
+        self._thread.join()
+        if self.error is not None:
+            raise self.error
+
+
+class UdpReader(_Threaded):
+    """``(datagram, receive time)`` from the UDP ``endpoints`` (``udp://…`` strings or
+    :class:`Endpoint`), merged in arrival order, until ``stop`` is set (module
+    docstring). The sockets are bound when the reader is made (:attr:`addresses`: the
+    bound ``host, port`` of each, so port 0 picks a free port)."""
+
+    def __init__(self, endpoints: list[str | Endpoint], *, stop: threading.Event | None = None,
+                 rcvbuf: int = DEFAULT_RCVBUF, max_queued: int = DEFAULT_MAX_QUEUED) -> None:
+        super().__init__(stop, max_queued)
+        if not endpoints:
+            raise ValueError("no endpoint to listen on")
+        self.endpoints = [e if isinstance(e, Endpoint) else parse_endpoint(e)
+                          for e in endpoints]
+        self.sockets: list[socket.socket] = []
+        try:
+            for ep in self.endpoints:
+                self.sockets.append(listen_socket(ep, rcvbuf))
+        except OSError:
+            self.close()
+            raise
+        self.addresses = [s.getsockname()[:2] for s in self.sockets]
+        self.names = [str(Endpoint(ep.host, a[1])) for ep, a in
+                      zip(self.endpoints, self.addresses, strict=True)]
+
+    def _drain(self, sock: socket.socket, name: str) -> None:
+        while True:
+            try:
+                data = sock.recv(MAX_DATAGRAM)
+            except (BlockingIOError, InterruptedError):
+                return
+            self._put(data, time.time(), name)
+
+    def _receive(self) -> None:
+        with selectors.DefaultSelector() as sel:
+            for sock, name in zip(self.sockets, self.names, strict=True):
+                sel.register(sock, selectors.EVENT_READ, name)
+            while not self.stop.is_set():
+                for key, _ in sel.select(POLL_S):
+                    self._drain(key.fileobj, key.data)  # type: ignore[arg-type]
+            for sock, name in zip(self.sockets, self.names, strict=True):
+                self._drain(sock, name)  # what the kernel holds at the stop
+        self.close()
+
+    def close(self) -> None:
+        """Close the sockets."""
+        for s in self.sockets:
+            s.close()
+
+
+class StdinReader(_Threaded):
+    """``(datagram, receive time)`` from a binary stream (``framing``: ``raw`` or
+    ``len32``, module docstring) until its end or ``stop``. A stream that ends inside a
+    datagram raises :class:`ValueError` naming the byte offset."""
+
+    def __init__(self, stream: BinaryIO, *, framing: str = "raw",
+                 stop: threading.Event | None = None,
+                 max_queued: int = DEFAULT_MAX_QUEUED, name: str = "stdin") -> None:
+        super().__init__(stop, max_queued)
+        if framing not in STDIN_FRAMINGS:
+            raise ValueError(f"unknown stdin framing {framing!r} (expected "
+                             f"{', '.join(STDIN_FRAMINGS)})")
+        self.stream, self.framing, self.name = stream, framing, name
+
+    def _length(self, buf: bytearray | bytes) -> int | None:
+        """Bytes of the next datagram with its framing, once its header is in ``buf``."""
+        if self.framing == "raw":
+            return int.from_bytes(buf[1:3], "big") if len(buf) >= 3 else None
+        return 4 + int.from_bytes(buf[:4], "big") if len(buf) >= 4 else None
+
+    def _receive(self) -> None:
+        fd = self.stream.fileno()
+        buf, offset = bytearray(), 0
+        with selectors.DefaultSelector() as sel:
+            sel.register(fd, selectors.EVENT_READ)
+            while not self.stop.is_set():
+                if not sel.select(POLL_S):
+                    continue
+                chunk = os.read(fd, 1 << 16)
+                if not chunk:
+                    break
+                buf += chunk
+                now = time.time()
+                while (n := self._length(buf)) is not None and len(buf) >= n:
+                    if self.framing == "raw" and n < 3:
+                        raise ValueError(f"{self.name}, byte {offset}: data block length "
+                                         f"{n} is below 3")
+                    data = bytes(buf[:n] if self.framing == "raw" else buf[4:n])
+                    self._put(data, now, self.name)
+                    del buf[:n]
+                    offset += n
+        if buf and not self.stop.is_set():
+            raise ValueError(f"{self.name}, byte {offset}: the stream ends inside a "
+                             f"datagram ({len(buf)} bytes of it)")
+
+
+@contextlib.contextmanager
+def stop_on_signals(stop: threading.Event) -> Iterator[threading.Event]:
+    """While inside, SIGTERM and SIGINT (Ctrl-C) set ``stop`` instead of ending the
+    process; a second signal ends it as before. The previous handlers come back on
+    exit. From the main thread only (elsewhere: no handler is installed)."""
+    previous: dict[int, Any] = {}
+
+    def handler(signum: int, frame: Any) -> None:
+        if stop.is_set():  # a second Ctrl-C: give up at once
+            raise KeyboardInterrupt if signum == signal.SIGINT else SystemExit(128 + signum)
+        stop.set()
+
+    if threading.current_thread() is threading.main_thread():
+        for signum in (signal.SIGTERM, signal.SIGINT):
+            previous[signum] = signal.signal(signum, handler)
+    try:
+        yield stop
+    finally:
+        for signum, h in previous.items():
+            signal.signal(signum, h)

@@ -1,0 +1,105 @@
+"""The live assembly (:mod:`mhtrack.pipeline.live`): what it refuses, its status line
+worked by hand, and a run over stdin giving the online rows of the pipeline on the
+recording file."""
+
+from __future__ import annotations
+
+import dataclasses
+import io
+import json
+import os
+import threading
+from pathlib import Path
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+pytest.importorskip("asterix.generated", reason="libasterix not installed")
+
+from mhtrack.io.sensors import read_sensors
+from mhtrack.pipeline import Pipeline, TrackOptions
+from mhtrack.pipeline.live import Live, LiveOptions, Status
+from mhtrack.sinks import TrackCollector
+from mhtrack.sources.replay import recording_datagrams
+from mhtrack.sources.udp import ReaderStats
+
+OPTIONS = TrackOptions(output="online", new_target_density=1e-10)
+
+
+@pytest.fixture(scope="module")
+def rec(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    from click.testing import CliRunner
+
+    from mhtrack.cli.main import cli
+
+    out = tmp_path_factory.mktemp("live")
+    for args in (["simulate", "opensky-radars", "--seed", "2", "--scans", "5", "--out",
+                  str(out)],
+                 ["export", str(out / "plots.csv"), "--sensors", str(out / "sensors.toml"),
+                  "--out", str(out / "radar.ast")]):
+        r = CliRunner().invoke(cli, args)
+        assert r.exit_code == 0, r.output
+    return out
+
+
+def test_refusals(rec: Path) -> None:
+    sensors = read_sensors(rec / "sensors.toml")
+    with pytest.raises(ValueError, match="--birth-density"):
+        Live(sensors, TrackOptions(), LiveOptions(listen=("udp://127.0.0.1:0",)))
+    no_period = dataclasses.replace(sensors, sensors=tuple(
+        dataclasses.replace(s, period=None) if s.id == 2 else s for s in sensors.sensors))
+    with pytest.raises(ValueError, match=r"no period for radar\(s\) 2"):
+        Live(no_period, OPTIONS, LiveOptions(listen=("udp://127.0.0.1:0",)))
+    with pytest.raises(ValueError, match="one of them"):
+        Live(sensors, OPTIONS, LiveOptions())
+
+
+def test_status_line_by_hand() -> None:
+    reader = ReaderStats(datagrams=10, queue_dropped=1)
+    src = SimpleNamespace(plots_in=40, late_dropped=2)
+    st = Status(reader, lambda: src)
+    assert st.line(100.0) == ("live: 10 datagrams, 40 plots, 0 frames, 2 late drops, "
+                              "1 queue drops, 0 tracks")
+    reader.datagrams, src.plots_in = 30, 140
+    st._count(SimpleNamespace(online=[1, 2, 3]))
+    assert st.line(104.0) == ("live: 5.0 datagrams/s, 25.0 plots/s, 30 datagrams, 140 "
+                              "plots, 1 frames, 2 late drops, 1 queue drops, 3 tracks")
+
+
+def test_stdin_run_equals_the_pipeline_on_the_file(rec: Path) -> None:
+    sensors = read_sensors(rec / "sensors.toml")
+    ref = TrackCollector("online")
+    Pipeline.open(str(rec / "radar.ast"), OPTIONS,
+                  sensors_file=str(rec / "sensors.toml")).run([ref])
+    t = ref.tracks()
+    r, w = os.pipe()
+    data = (rec / "radar.ast").read_bytes()
+    writer = threading.Thread(target=lambda: (os.write(w, data), os.close(w)))
+    out = io.StringIO()
+    with os.fdopen(r, "rb", buffering=0) as rf:
+        live = Live(sensors, OPTIONS, LiveOptions(stdin="raw", day_from="stream", json=True),
+                    stdin=rf, stdout=out)
+        writer.start()
+        result = live.run()
+        writer.join()
+    rows = [json.loads(x) for x in out.getvalue().splitlines()]
+    assert len(rows) == len(t) > 0
+    assert [x["track_id"] for x in rows] == t.track_id.tolist()
+    assert np.allclose([x["x"] for x in rows], t.x, atol=5e-4, rtol=0)
+    assert np.allclose([x["time"] for x in rows], t.time, atol=1e-6, rtol=0)  # to 1 µs
+    # raw stdin: one datagram per data block of the file
+    assert result.reader.datagrams == len(recording_datagrams(rec / "radar.ast"))
+    assert live.source.stats.plots_in == live.source.stats.plots_out + \
+        live.source.stats.late_dropped
+
+
+def test_stopped_before_any_datagram(rec: Path, tmp_path: Path) -> None:
+    stop = threading.Event()
+    live = Live(read_sensors(rec / "sensors.toml"), OPTIONS,
+                LiveOptions(listen=("udp://127.0.0.1:0",), out_file=tmp_path / "e.ast"),
+                stop=stop)
+    stop.set()
+    result = live.run()
+    assert (result.reader.datagrams, len(result.run.stats), result.sent_rows) == (0, 0, 0)
+    assert (tmp_path / "e.ast").read_bytes() == b""  # an empty recording, written

@@ -92,6 +92,26 @@ def test_datagrams_from_anywhere(opensky2: Path, recs: dict[str, Path]) -> None:
     assert differences(ref, bare) == []
 
 
+def test_datagrams_one_block_at_a_time(opensky2: Path, recs: dict[str, Path]) -> None:
+    """``chunk=1`` (a live feed: each data block passed on as it arrives) gives the same
+    frames, and the first frame leaves before the input is read to its end."""
+    data = recs[".pcap"].read_bytes()
+    grams = [bytes(p) for _, _, p in units(data, "pcap", "x", {34, 48}, Problems())]
+    sensors = read_sensors(opensky2 / "sensors.toml")
+    ref = list(DatagramSource(grams, sensors=sensors))
+    read = [0]
+
+    def feed():  # type: ignore[no-untyped-def]
+        for g in grams:
+            read[0] += 1
+            yield g
+
+    frames = iter(DatagramSource(feed(), sensors=sensors, chunk=1))
+    first = next(frames)
+    assert read[0] < 200 < len(grams)  # well before the end: a few sectors' datagrams
+    assert differences(ref, [first, *frames]) == []
+
+
 def _packets(data: bytes) -> list[tuple[float, bytes]]:
     """(capture time, record) of each packet of a microsecond pcap."""
     out, pos = [], PCAP_HEAD

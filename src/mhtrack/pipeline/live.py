@@ -149,7 +149,8 @@ class Live:
         if live.day_from == "stream":
             datagrams = (d for d, _ in self.reader)
         self.source = DatagramSource(datagrams, sensors=sensors, name=name,
-                                     reorder_window_s=live.reorder_window_s)
+                                     reorder_window_s=live.reorder_window_s,
+                                     chunk=1)  # each data block on as it arrives
         try:
             self.pipeline = Pipeline(self.source, options)
         except BaseException:

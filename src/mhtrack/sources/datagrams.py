@@ -69,8 +69,14 @@ class DatagramSource(Source):
 
     def __init__(self, datagrams: Iterable[Datagram], *, sensors: SensorSet | None = None,
                  name: str = "datagrams", reorder_window_s: float | None = None,
-                 fast: bool = True, sectors: bool = False) -> None:
+                 fast: bool = True, sectors: bool = False, chunk: int = CHUNK) -> None:
         super().__init__()
+        if chunk < 1:
+            raise ValueError(f"chunk must be >= 1 plot, got {chunk!r}")
+        #: Plots converted and passed on together (a live feed passes each data block on
+        #: at once: ``chunk=1``; the results do not depend on it, the conversion is
+        #: element-wise).
+        self.chunk = int(chunk)
         self.name = name
         self.given = sensors
         self.sensors = sensors
@@ -123,7 +129,7 @@ class DatagramSource(Source):
                 at_rows.extend([at] * len(found))
                 if self.sectors:
                     in_sector.extend(sector.get(r[1], 0) for r in found)
-                if len(rows) >= CHUNK:
+                if len(rows) >= self.chunk:
                     yield self._chunk(rows, times, at_rows, n, convert, in_sector)
                     n += len(rows)
                     rows, times, at_rows, in_sector = [], [], [], []

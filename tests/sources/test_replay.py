@@ -11,8 +11,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from mhtrack.io.asterix.container import container, datagrams
 from mhtrack.io.asterix.decode import Decoder
+from mhtrack.io.asterix.framings import recognise, units
 from mhtrack.io.asterix.problems import Problems
 from mhtrack.sources.replay import recording_datagrams, replay, schedule
 
@@ -38,7 +38,9 @@ def recordings(opensky2: Path, tmp_path_factory: pytest.TempPathFactory) -> Path
 def test_pcap_and_raw_give_the_same_datagrams(recordings: Path) -> None:
     pcap = recording_datagrams(recordings / "r.pcap")
     data = (recordings / "r.pcap").read_bytes()
-    ref = list(datagrams(data, container(data, "r", Decoder().categories), "r", Problems()))
+    cats = Decoder().categories
+    ref = [(at, payload, when) for at, when, payload in units(
+        data, recognise(data, "r", cats), "r", cats, Problems())]
     assert [p for p, _ in pcap] == [bytes(p) for _, p, _ in ref]
     assert [t for _, t in pcap] == [t for _, _, t in ref]
     raw = recording_datagrams(recordings / "r.ast")

@@ -2,11 +2,12 @@
 (``docs/live.md``).
 
 Each datagram of a pcap or pcapng recording is sent as it was captured (its ASTERIX
-payload, one UDP datagram), at its capture time; a raw recording (data blocks back to
-back) is sent one data block per datagram, at the time of day of the block's first
-CAT048/CAT034 record (on one axis across midnight, :class:`TimeAxis`; a block without
-one keeps the previous time). The spacing of the times is kept, divided by ``speed``
-(``math.inf``: as fast as the socket takes them). ``loops`` plays the file that many times
+payload, one UDP datagram), at its capture time (the recorder formats: each record at its
+own time); a raw recording (data blocks back to back) is sent one data block per
+datagram, at the time of day of the block's first CAT048/CAT034 record (on one axis
+across midnight, :class:`TimeAxis`; a block without one keeps the previous time). The
+spacing of the times is kept, divided by ``speed`` (``math.inf``: as fast as the socket
+takes them). ``loops`` plays the file that many times
 (``None``: until ``stop``), each pass starting one mean spacing after the last.
 """
 
@@ -20,8 +21,8 @@ from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
-from mhtrack.io.asterix.container import blocks, container, datagrams
 from mhtrack.io.asterix.decode import Decoder
+from mhtrack.io.asterix.framings import recognise, units
 from mhtrack.io.asterix.problems import Problems
 from mhtrack.io.asterix.timeaxis import TimeAxis
 from mhtrack.io.paths import check_input_file
@@ -38,14 +39,9 @@ def recording_datagrams(path: str | Path) -> list[tuple[bytes, float]]:
         size = path.stat().st_size
         with (mmap.mmap(fh.fileno(), 0, access=mmap.ACCESS_READ) if size else
               _Empty()) as data:
-            kind = container(data, name, decoder.categories)
-            raw: list[tuple[bytes, float | None]] = []
-            for at, payload, when in datagrams(data, kind, name, problems):
-                if kind == "raw":
-                    raw += [(bytes(payload[a - at:a - at + 3 + len(b)]), None)
-                            for a, _, b in blocks(payload, at, problems)]
-                else:
-                    raw.append((bytes(payload), when))
+            kind = recognise(data, name, decoder.categories)
+            raw = [(bytes(payload), when) for _, when, payload in units(
+                data, kind, name, decoder.categories, problems)]  # raw: one block each
     out, axis, last = [], TimeAxis(), 0.0
     for payload, when in raw:
         if when is None:

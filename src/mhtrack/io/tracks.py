@@ -152,7 +152,7 @@ def write_tracks(
 
 #: Rows per Parquet row group of a tracks file: a file written at the end and one
 #: streamed as frames complete (:class:`mhtrack.sinks.TracksFileSink`) have the same bytes.
-ROW_GROUP = 16384
+ROW_GROUP = 4096
 
 
 def write_track_rows(table: TrackTable, path: PathArg, frame: LocalFrame | None = None, *,

@@ -163,7 +163,7 @@ def track(plots: Path, tracker: str, tracker_pd: float | None, meas_sigma: float
     pipe = Pipeline.open(plots, options, scenario_file=scenario_file,
                          sensors_file=sensors_file, reorder_window_s=reorder_window_s)
     result = pipe.run([TracksFileSink(out, frame=pipe.frame, output=pipe.output)],
-                      progress=progress_enabled(progress))
+                      progress=progress_enabled(progress), keep_stats=False)
     click.echo(f"{result.describe()} -> {out}")
     if pipe.birth_note is not None:
         click.echo(pipe.birth_note)

@@ -340,11 +340,13 @@ def _utf8_error(src: Source, names: list[str]) -> InputError | None:
     return None
 
 
-def write_frame(path: PathArg, columns: Mapping[str, pa.Array]) -> None:
+def write_frame(path: PathArg, columns: Mapping[str, pa.Array], *,
+                row_group_size: int | None = None) -> None:
     """Write ``columns`` (in order) to ``path`` as CSV or Parquet by its extension.
 
     CSV: a plain header line, then one line per row, numbers in shortest round-trip form,
-    nulls as empty cells, nothing quoted. Written atomically (:func:`atomic_path`)."""
+    nulls as empty cells, nothing quoted. Parquet: row groups of at most
+    ``row_group_size`` rows (default pyarrow's). Written atomically (:func:`atomic_path`)."""
     fmt = file_format(path)
     table = pa.table(dict(columns))
     try:
@@ -358,7 +360,7 @@ def write_frame(path: PathArg, columns: Mapping[str, pa.Array]) -> None:
                 import pyarrow.parquet as pq
 
                 with arrow_file(tmp, "wb") as fh:
-                    pq.write_table(table, fh)
+                    pq.write_table(table, fh, row_group_size=row_group_size)
     except OutputError as e:  # names the file already (disk full, permission, …)
         raise InputError(str(e), file=str(path)) from None
 

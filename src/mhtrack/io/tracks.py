@@ -33,6 +33,8 @@ from mhtrack.io.truth import read_truth
 from mhtrack.records import NO_PLOT, PlotTable, TrackTable, TruthTable
 
 if TYPE_CHECKING:
+    import pyarrow as pa
+
     from mhtrack.models.geodesy import LocalFrame
 
 REQUIRED = ("scan", "time", "track_id", "x", "y", "vx", "vy", "plot")
@@ -152,14 +154,30 @@ def write_tracks(
                      iso=plots is not None and plots.iso_times)
 
 
+#: Rows per Parquet row group of a tracks file: a file written at the end and one
+#: streamed as frames complete (:class:`mhtrack.sinks.TracksFileSink`) have the same bytes.
+ROW_GROUP = 4096
+
+
 def write_track_rows(table: TrackTable, path: PathArg, frame: LocalFrame | None = None, *,
-                     timed: bool = False, iso: bool = False) -> None:
+                     timed: bool = False, iso: bool = False,
+                     row_group_size: int = ROW_GROUP) -> None:
     """Write ``table`` whose ``plot`` already holds the input's own rows (a sink's
     :meth:`~mhtrack.sources.base.Source.file_rows`), as :func:`write_tracks` does; ``timed``:
     rows numbered by ``frame`` (tracks of timed plots), else by ``scan``; ``iso``: times
-    as ISO-8601 (the plots' times were; :func:`~mhtrack.io._times.time_column`)."""
+    as ISO-8601 (the plots' times were; :func:`~mhtrack.io._times.time_column`). Parquet
+    row groups of ``row_group_size`` rows."""
+    write_frame(path, track_columns(table, file_format(path), frame, timed=timed, iso=iso),
+                row_group_size=row_group_size)
+
+
+def track_columns(table: TrackTable, fmt: str, frame: LocalFrame | None = None, *,
+                  timed: bool = False, iso: bool = False) -> dict[str, pa.Array]:
+    """The columns :func:`write_track_rows` writes of ``table`` to a ``fmt`` (``"csv"`` or
+    ``"parquet"``) file; row by row, so the columns of consecutive slices are the slices
+    of the columns."""
     plot = table.plot
-    time = time_column(table.time, iso, file_format(path)) if iso else float_array(table.time)
+    time = time_column(table.time, iso, fmt) if iso else float_array(table.time)
     cols = _geodetic.row_columns(("frame" if timed else "scan", table.scan), time,
                                  ("track_id", table.track_id),
                                  (table.x, table.y, table.vx, table.vy), frame)
@@ -168,4 +186,4 @@ def write_track_rows(table: TrackTable, path: PathArg, frame: LocalFrame | None 
         cols["score"] = float_array(table.score)
     if table.tentative is not None:
         cols["tentative"] = int_array(table.tentative.astype(np.int64))
-    write_frame(path, cols)
+    return cols

@@ -11,6 +11,7 @@ order), so it stays a row of the source.
 from __future__ import annotations
 
 import dataclasses
+from collections import deque
 from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import dataclass
 from functools import cached_property
@@ -74,6 +75,8 @@ def step_frames(tracker: MHTTracker, frames: Iterable[Scan], *, fusion: str = "n
     online rows, the backfill and the step's statistics with the fusion's caps merged
     in. ``progress``: a tqdm bar of ``total`` frames."""
     fusion_caps: dict[int, dict[str, int]] = {}
+    depth = getattr(getattr(tracker, "config", None), "history_scans", None)
+    recent: deque[int] = deque(maxlen=max(int(depth or 0), 1))
     bar = tqdm(fused(frames, fusion, fusion_caps), total=total, desc=name, unit="scan",
                disable=not progress, leave=False)
     for scan in bar:
@@ -81,7 +84,10 @@ def step_frames(tracker: MHTTracker, frames: Iterable[Scan], *, fusion: str = "n
         stats = tracker.last_stats
         assert stats is not None  # set by every step
         stats.caps.update(fusion_caps.pop(stats.scan, {}))
-        yield FrameOutput(scan, online, tracker.last_backfill, stats)
+        # the next backfill reaches back to the oldest of the last ``depth`` frames
+        recent.append(int(scan.index))
+        yield FrameOutput(scan, online, tracker.last_backfill, stats,
+                          None if depth is None else recent[0])
 
 
 def mean_step_time(stats: Sequence[StepStats]) -> float:
@@ -112,32 +118,68 @@ def cap_scans(stats: Sequence[StepStats]) -> dict[str, list[int]]:
     return out
 
 
+class StatsSummary:
+    """What the run printout needs of the steps' statistics, summed step by step (the
+    number of steps, their total time, :func:`caps_acted`) without keeping them."""
+
+    def __init__(self) -> None:
+        self.n = 0
+        self.time_s = 0.0
+        self.caps: dict[str, int] = {}
+        self.cap_steps = 0
+
+    def add(self, s: StepStats) -> None:
+        """One more step."""
+        self.n += 1
+        self.time_s += s.time_s
+        for k, v in s.caps.items():
+            self.caps[k] = self.caps.get(k, 0) + v
+        self.cap_steps += bool(s.caps)
+
+    def caps_acted(self) -> dict[str, int]:
+        """As :func:`caps_acted` of the steps added."""
+        return {**self.caps, "scans": self.cap_steps} if self.caps else {}
+
+
 @dataclass(frozen=True)
 class RunResult:
     """What a pipeline run did (the tracks went to the sinks)."""
 
     tracker: str
+    #: Every step's statistics (empty when the run was asked not to keep them).
     stats: tuple[StepStats, ...]
     #: Distinct track ids reported.
     n_tracks: int
     #: Frames of timed plots (True) or synchronous scans.
     timed: bool = False
+    #: The steps summed (:class:`StatsSummary`); by default that of ``stats``.
+    summary: StatsSummary | None = None
+
+    def _summary(self) -> StatsSummary:
+        if self.summary is not None:
+            return self.summary
+        s = StatsSummary()
+        for x in self.stats:
+            s.add(x)
+        return s
 
     @property
     def t_avg(self) -> float:
         """Mean tracker time per scan (s)."""
-        return mean_step_time(self.stats)
+        if self.summary is None:
+            return mean_step_time(self.stats)
+        return self.summary.time_s / self.summary.n if self.summary.n else 0.0
 
     @property
     def caps(self) -> dict[str, int]:
         """:func:`caps_acted` of the run."""
-        return caps_acted(self.stats)
+        return caps_acted(self.stats) if self.summary is None else self.summary.caps_acted()
 
     def describe(self) -> str:
         """``TRACKER: N scans|frames, M tracks, T ms/scan[, caps acted: …]``."""
         caps = f", caps acted: {self.caps}" if self.caps else ""
         steps = "frames" if self.timed else "scans"
-        return (f"{self.tracker}: {len(self.stats)} {steps}, {self.n_tracks} tracks, "
+        return (f"{self.tracker}: {self._summary().n} {steps}, {self.n_tracks} tracks, "
                 f"{1e3 * self.t_avg:.2f} ms/scan{caps}")
 
 
@@ -188,30 +230,46 @@ class Pipeline:
                                name=self.options.tracker, progress=progress,
                                total=None if survey is None else survey.n_frames)
 
-    def run(self, sinks: Sequence[Sink] = (), *, progress: bool = False) -> RunResult:
+    def run(self, sinks: Sequence[Sink] = (), *, progress: bool = False,
+            keep_stats: bool = True) -> RunResult:
         """Step the tracker over every frame of the source into ``sinks`` (each
-        started before the first frame and closed after the last)."""
+        started before the first frame and closed after the last). ``keep_stats``:
+        keep every step's :class:`StepStats` in :attr:`RunResult.stats` (else only their
+        :class:`StatsSummary`: memory flat in the run's length)."""
+        summary = StatsSummary()
         stats, n_tracks = feed(self.outputs(progress=progress), sinks, self.source,
-                               backfill_ids=self.output == "history")
-        return RunResult(self.options.tracker, tuple(stats), n_tracks, self.source.timed)
+                               backfill_ids=self.output == "history", summary=summary,
+                               keep_stats=keep_stats)
+        return RunResult(self.options.tracker, tuple(stats), n_tracks, self.source.timed,
+                         summary)
 
 
 def feed(outputs: Iterable[FrameOutput], sinks: Sequence[Sink], source: Source | None = None,
-         *, backfill_ids: bool = True) -> tuple[list[StepStats], int]:
+         *, backfill_ids: bool = True, summary: StatsSummary | None = None,
+         keep_stats: bool = True) -> tuple[list[StepStats], int]:
     """Hand every frame's output to ``sinks`` (started with ``source`` first, closed
-    after the last frame); returns the steps' statistics and the number of distinct
-    track ids reported (with ``backfill_ids``, those of the backfill too)."""
+    after the last frame; on an error each is aborted, :meth:`Sink.abort`); returns the
+    steps' statistics (none without ``keep_stats``; ``summary`` sums them) and the number
+    of distinct track ids reported (with ``backfill_ids``, those of the backfill too)."""
     for sink in sinks:
         sink.start(source)
     stats: list[StepStats] = []
     ids: set[int] = set()
-    for out in outputs:
-        stats.append(out.stats)
-        ids.update(out.online.track_id.tolist())
-        if backfill_ids:
-            ids.update(out.backfill.track_id.tolist())
+    try:
+        for out in outputs:
+            if keep_stats:
+                stats.append(out.stats)
+            if summary is not None:
+                summary.add(out.stats)
+            ids.update(out.online.track_id.tolist())
+            if backfill_ids:
+                ids.update(out.backfill.track_id.tolist())
+            for sink in sinks:
+                sink.write(out)
         for sink in sinks:
-            sink.write(out)
-    for sink in sinks:
-        sink.close()
+            sink.close()
+    except BaseException:
+        for sink in sinks:
+            sink.abort()
+        raise
     return stats, len(ids)

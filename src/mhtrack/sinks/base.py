@@ -36,6 +36,9 @@ class FrameOutput:
     backfill: TrackTable
     #: The step's statistics, with the fusion's caps merged in.
     stats: StepStats
+    #: Every later output's rows have ``scan`` at least this (the backfill reaches back
+    #: ``MHTConfig.history_scans`` frames at most); ``None``: unknown.
+    settled: int | None = None
 
 
 class Sink(ABC):
@@ -53,6 +56,10 @@ class Sink(ABC):
 
     def close(self) -> None:  # noqa: B027 - optional hook
         """Called once after the last frame."""
+
+    def abort(self) -> None:  # noqa: B027 - optional hook
+        """Called instead of :meth:`close` when the run fails: a file sink removes what
+        it has half written (the file is left as it was)."""
 
 
 def check_output(output: str | None) -> str:

@@ -10,12 +10,13 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from mhtrack.io.tracks import write_track_rows
+from mhtrack.io.tracks import ROW_GROUP, write_track_rows
+from mhtrack.records import TrackTable
 from mhtrack.sinks.base import FrameOutput, Sink, TrackCollector
+from mhtrack.sinks.spill import SortedRows, TrackRowsWriter
 
 if TYPE_CHECKING:
     from mhtrack.models.geodesy import LocalFrame
-    from mhtrack.records import TrackTable
     from mhtrack.sources.base import Source
 
 
@@ -45,33 +46,81 @@ class TracksFileSink(_Rows):
     online), ``plot`` naming the input's rows, ``lat, lon`` and east/north velocities with
     ``frame``; ``frame`` in place of ``scan`` for timed input.
 
-    Without ``part_frames`` the file is written once, atomically, at the end — the
-    bytes :func:`~mhtrack.io.write_tracks` writes of the whole run. With ``part_frames =
-    n``, every ``n`` frames the rows produced in them (online rows, and with ``history``
-    the backfill of the tracks confirmed in them, which may lie in earlier parts' frames)
-    go to ``STEM.part0000.SUFFIX``, ``STEM.part0001.SUFFIX``, …, each written atomically
-    and each sorted as a whole run's rows are; :attr:`paths` lists the files written."""
+    Without ``part_frames`` the file appears once, atomically, at the end — the bytes
+    :func:`~mhtrack.io.write_tracks` writes of the whole run — but its rows are written
+    to its temporary as they become final, ``chunk_rows`` at a time
+    (:mod:`mhtrack.sinks.spill`), so memory stays flat in the run's length. With
+    ``part_frames = n``, every ``n`` frames the rows produced in them (online rows, and
+    with ``history`` the backfill of the tracks confirmed in them, which may lie in
+    earlier parts' frames) go to ``STEM.part0000.SUFFIX``, ``STEM.part0001.SUFFIX``, …,
+    each written atomically and each sorted as a whole run's rows are; :attr:`paths`
+    lists the files written."""
 
     def __init__(self, path: str | Path, *, frame: LocalFrame | None = None,
-                 output: str | None = None, part_frames: int | None = None) -> None:
+                 output: str | None = None, part_frames: int | None = None,
+                 chunk_rows: int = ROW_GROUP) -> None:
         super().__init__(output)
         if part_frames is not None and part_frames < 1:
             raise ValueError(f"part_frames must be at least 1, got {part_frames}")
+        if chunk_rows < 1:
+            raise ValueError(f"chunk_rows must be at least 1, got {chunk_rows}")
         self.path, self.frame, self.part_frames = Path(path), frame, part_frames
+        self.chunk_rows = chunk_rows
         self.paths: list[Path] = []
         self._frames = 0
+        self._sorter = SortedRows()
+        self._writer: TrackRowsWriter | None = None
+
+    def start(self, source: Source | None) -> None:
+        super().start(source)
+        if self.part_frames is None:
+            self._writer = TrackRowsWriter(self.path, self.frame, timed=self._timed,
+                                           iso=self._iso, chunk_rows=self.chunk_rows)
+
+    @property
+    def _timed(self) -> bool:
+        return self.source is not None and self.source.timed
+
+    @property
+    def _iso(self) -> bool:
+        return self.source is not None and self.source.iso_times
 
     def write(self, out: FrameOutput) -> None:
-        super().write(out)
         self._frames += 1
-        if self.part_frames is not None and self._frames % self.part_frames == 0:
-            self._flush()
+        if self.part_frames is not None:
+            super().write(out)
+            if self._frames % self.part_frames == 0:
+                self._flush()
+            return
+        if self._writer is None:
+            self.start(None)
+        assert self._writer is not None
+        history = self.rows.output == "history"
+        rows = [t for t in (out.online, out.backfill if history else None)
+                if t is not None and len(t)]
+        if not rows:
+            new = TrackTable.empty()
+        else:  # the input's own rows now (the source may forget older ones); no P kept
+            new = self._file_rows(dataclasses.replace(TrackTable.concat(rows), P=None))
+        if history:
+            self._writer.add(self._sorter.push(new, out.settled))
+        else:
+            self._writer.add(new)
 
     def close(self) -> None:
         if self.part_frames is None:
-            self._write(self.path)
+            if self._writer is None:
+                self.start(None)
+            assert self._writer is not None
+            self._writer.add(self._sorter.flush())
+            self._writer.commit()
+            self.paths.append(self.path)
         elif self._frames % self.part_frames or not self.paths:
             self._flush()
+
+    def abort(self) -> None:
+        if self._writer is not None:
+            self._writer.abort()
 
     def _flush(self) -> None:
         p = self.path
@@ -79,10 +128,8 @@ class TracksFileSink(_Rows):
         self.rows.clear()
 
     def _write(self, path: Path) -> None:
-        timed = self.source is not None and self.source.timed
-        iso = self.source is not None and self.source.iso_times
-        write_track_rows(self._file_rows(self.rows.tracks()), path, self.frame, timed=timed,
-                         iso=iso)
+        write_track_rows(self._file_rows(self.rows.tracks()), path, self.frame,
+                         timed=self._timed, iso=self._iso)
         self.paths.append(path)
 
 

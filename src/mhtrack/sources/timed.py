@@ -32,8 +32,9 @@ class TimedStream:
         self.where = where
         self.buffer = ReorderBuffer(window_s)
         self.framer = Framer(frame_s)
-        self._file_rows: list[np.ndarray] = []
-        self._rows = np.zeros(0, np.int64)
+        # file row of each running row: one int64 array grown by doubling (8 bytes a
+        # plot, no object per frame), the first ``_n_out`` entries valid
+        self._rows = np.zeros(1024, np.int64)
         self._n_out = 0
 
     def push(self, cols: Mapping[str, np.ndarray]) -> Iterator[Scan]:
@@ -64,8 +65,12 @@ class TimedStream:
         c = fr.cols
         n = len(c["time"])
         rows = np.arange(self._n_out, self._n_out + n, dtype=np.int64)
+        if self._n_out + n > self._rows.size:
+            grown = np.zeros(max(2 * self._rows.size, self._n_out + n), np.int64)
+            grown[:self._n_out] = self._rows[:self._n_out]
+            self._rows = grown
+        self._rows[self._n_out:self._n_out + n] = c["file_row"]
         self._n_out += n
-        self._file_rows.append(np.asarray(c["file_row"], np.int64))
         self.stats.plots_out += n
         self.stats.frames += 1
         return Scan(index=fr.index, time=fr.time, z=np.column_stack((c["x"], c["y"])),
@@ -74,11 +79,8 @@ class TimedStream:
 
     def file_rows(self, rows: np.ndarray) -> np.ndarray:
         """The ``file_row`` of each running row number (``-1`` stays ``-1``)."""
-        if self._file_rows:
-            self._rows = np.concatenate((self._rows, *self._file_rows))
-            self._file_rows = []
         rows = np.asarray(rows, np.int64)
         out = np.full(rows.shape, -1, np.int64)
         ok = rows >= 0
-        out[ok] = self._rows[rows[ok]]
+        out[ok] = self._rows[:self._n_out][rows[ok]]
         return out

@@ -21,17 +21,44 @@ if TYPE_CHECKING:
 
 
 class _Rows(Sink):
-    """Collects the rows an output mode keeps and the source's row mapping."""
+    """Collects the rows an output mode keeps and the source's row mapping; with
+    ``part_frames = n`` writes them every ``n`` frames to ``STEM.part0000.SUFFIX``, … of
+    ``path`` (:meth:`_write_part`, each part atomically), :attr:`paths` the files written."""
 
-    def __init__(self, output: str | None) -> None:
+    def __init__(self, output: str | None, path: str | Path,
+                 part_frames: int | None) -> None:
+        if part_frames is not None and part_frames < 1:
+            raise ValueError(f"part_frames must be at least 1, got {part_frames}")
         self.rows = TrackCollector(output)
         self.source: Source | None = None
+        self.path, self.part_frames = Path(path), part_frames
+        self.paths: list[Path] = []
+        self._frames = 0
 
     def start(self, source: Source | None) -> None:
         self.source = source
 
     def write(self, out: FrameOutput) -> None:
         self.rows.write(out)
+
+    def _part_frame(self, out: FrameOutput) -> None:
+        """Rolling parts: keep the frame's rows; a part is written every ``n`` frames."""
+        self.rows.write(out)
+        if self._frames % self.part_frames == 0:  # type: ignore[operator]
+            self._flush()
+
+    def _last_part(self) -> None:
+        """Rolling parts at the end: the frames since the last part (or one empty part)."""
+        if self._frames % self.part_frames or not self.paths:  # type: ignore[operator]
+            self._flush()
+
+    def _flush(self) -> None:
+        p = self.path
+        self._write_part(p.with_name(f"{p.stem}.part{len(self.paths):04d}{p.suffix}"))
+        self.rows.clear()
+
+    def _write_part(self, path: Path) -> None:
+        raise NotImplementedError
 
     def _file_rows(self, tracks: TrackTable) -> TrackTable:
         """``tracks`` with ``plot`` as the input's own rows (:meth:`Source.file_rows`)."""
@@ -59,15 +86,10 @@ class TracksFileSink(_Rows):
     def __init__(self, path: str | Path, *, frame: LocalFrame | None = None,
                  output: str | None = None, part_frames: int | None = None,
                  chunk_rows: int = ROW_GROUP) -> None:
-        super().__init__(output)
-        if part_frames is not None and part_frames < 1:
-            raise ValueError(f"part_frames must be at least 1, got {part_frames}")
+        super().__init__(output, path, part_frames)
         if chunk_rows < 1:
             raise ValueError(f"chunk_rows must be at least 1, got {chunk_rows}")
-        self.path, self.frame, self.part_frames = Path(path), frame, part_frames
-        self.chunk_rows = chunk_rows
-        self.paths: list[Path] = []
-        self._frames = 0
+        self.frame, self.chunk_rows = frame, chunk_rows
         self._sorter = SortedRows()
         self._writer: TrackRowsWriter | None = None
 
@@ -88,9 +110,7 @@ class TracksFileSink(_Rows):
     def write(self, out: FrameOutput) -> None:
         self._frames += 1
         if self.part_frames is not None:
-            super().write(out)
-            if self._frames % self.part_frames == 0:
-                self._flush()
+            self._part_frame(out)
             return
         if self._writer is None:
             self.start(None)
@@ -115,19 +135,14 @@ class TracksFileSink(_Rows):
             self._writer.add(self._sorter.flush())
             self._writer.commit()
             self.paths.append(self.path)
-        elif self._frames % self.part_frames or not self.paths:
-            self._flush()
+        else:
+            self._last_part()
 
     def abort(self) -> None:
         if self._writer is not None:
             self._writer.abort()
 
-    def _flush(self) -> None:
-        p = self.path
-        self._write(p.with_name(f"{p.stem}.part{len(self.paths):04d}{p.suffix}"))
-        self.rows.clear()
-
-    def _write(self, path: Path) -> None:
+    def _write_part(self, path: Path) -> None:
         write_track_rows(self._file_rows(self.rows.tracks()), path, self.frame,
                          timed=self._timed, iso=self._iso)
         self.paths.append(path)
@@ -158,36 +173,28 @@ class Cat062Sink(_Rows):
     def __init__(self, path: str | Path, frame: LocalFrame, *, output: str | None = None,
                  sac: int | None = None, sic: int | None = None,
                  part_frames: int | None = None, empty_ok: bool = False) -> None:
-        super().__init__(output)
-        if part_frames is not None and part_frames < 1:
-            raise ValueError(f"part_frames must be at least 1, got {part_frames}")
-        self.path, self.frame, self.sac, self.sic = Path(path), frame, sac, sic
-        self.part_frames, self.empty_ok = part_frames, empty_ok
-        self.paths: list[Path] = []
+        super().__init__(output, path, part_frames)
+        self.frame, self.sac, self.sic, self.empty_ok = frame, sac, sic, empty_ok
         self.n_blocks = 0
-        self._frames = 0
 
     def write(self, out: FrameOutput) -> None:
-        super().write(out)
         self._frames += 1
-        if self.part_frames is not None and self._frames % self.part_frames == 0:
-            self._flush()
+        if self.part_frames is not None:
+            self._part_frame(out)
+        else:
+            super().write(out)
 
     def close(self) -> None:
         if self.part_frames is not None:
-            if self._frames % self.part_frames or not self.paths:
-                self._flush()
+            self._last_part()
             return
         tracks = self.rows.tracks()
         if len(tracks) == 0 and not self.empty_ok:
             raise ValueError(f"{self.path}: no track rows (nothing to export)")
         self._write(self.path, tracks)
 
-    def _flush(self) -> None:
-        p = self.path
-        self._write(p.with_name(f"{p.stem}.part{len(self.paths):04d}{p.suffix}"),
-                    self.rows.tracks())
-        self.rows.clear()
+    def _write_part(self, path: Path) -> None:
+        self._write(path, self.rows.tracks())
 
     def _write(self, path: Path, tracks: TrackTable) -> None:
         from mhtrack.io.asterix.writer import write_blocks

@@ -19,11 +19,11 @@ import sys
 from pathlib import Path
 
 import numpy as np
-import pandas as pd
 import pytest
 
 pytest.importorskip("asterix.generated", reason="libasterix not installed")
 pyasteryx = pytest.importorskip("pyasteryx", reason="pyasteryx (extra [reference])")
+pd = pytest.importorskip("pandas", reason="pandas (extra [pandas])")
 
 from mhtrack.io.asterix.cat062 import lsb062  # noqa: E402
 

@@ -165,8 +165,9 @@ def track(plots: Path, tracker: str, tracker_pd: float | None, meas_sigma: float
     result = pipe.run([TracksFileSink(out, frame=pipe.frame, output=pipe.output)],
                       progress=progress_enabled(progress), keep_stats=False)
     click.echo(f"{result.describe()} -> {out}")
-    if pipe.birth_note is not None:
-        click.echo(pipe.birth_note)
+    for note in (pipe.birth_note, pipe.reach_note):
+        if note is not None:
+            click.echo(note)
 
 
 @click.command()

@@ -223,6 +223,20 @@ class Pipeline:
             return None
         return birth_density_note(self.config.new_target_density, self.choices.area_text)
 
+    @property
+    def reach_note(self) -> str | None:
+        """The line giving each radar's reach learned from its plots (radars without
+        ``max_range`` in the sensors file: :mod:`mhtrack.mht.reach`), min / median / max
+        over its sectors; ``None`` when no radar needed it."""
+        reach = getattr(self.tracker.coverage, "reach", None)
+        learned = {} if reach is None else reach.summary()
+        if not learned:
+            return None
+        parts = ", ".join(f"radar {sid} {lo / 1e3:.0f}/{med / 1e3:.0f}/{hi / 1e3:.0f} km"
+                          for sid, (lo, med, hi) in sorted(learned.items()))
+        return (f"reach learned from the plots (no max_range in the sensors file; min/"
+                f"median/max over {reach.sectors} sectors): {parts}")
+
     def outputs(self, *, progress: bool = False) -> Iterator[FrameOutput]:
         """The tracker's output frame by frame (the iterator form of a sink)."""
         survey = self.survey if progress else None

@@ -25,6 +25,8 @@ pytest.importorskip("asterix.generated", reason="libasterix not installed")
 pyasteryx = pytest.importorskip("pyasteryx", reason="pyasteryx (extra [reference])")
 pd = pytest.importorskip("pandas", reason="pandas (extra [pandas])")
 
+from udp_drain import drain  # noqa: E402
+
 from mhtrack.io.asterix.cat062 import lsb062  # noqa: E402
 
 CLI = [sys.executable, "-c", "from mhtrack.cli.main import main; main()"]
@@ -56,13 +58,7 @@ def recording(tmp_path_factory: pytest.TempPathFactory) -> Path:
 
 
 def _drain(sock: socket.socket) -> list[bytes]:
-    sock.setblocking(False)
-    got = []
-    while True:
-        try:
-            got.append(sock.recv(65535))
-        except BlockingIOError:
-            return got
+    return drain(sock)
 
 
 def test_replay_into_live_equals_track_online(recording: Path) -> None:

@@ -14,6 +14,8 @@ import pytest
 
 pytest.importorskip("asterix")
 
+from udp_drain import drain
+
 from mhtrack.io import write_plots
 from mhtrack.io.asterix.cat062 import lsb062, read_system_tracks
 from mhtrack.io.sensors import write_sensors
@@ -43,13 +45,7 @@ def run(tmp_path_factory: pytest.TempPathFactory) -> dict:
 
     result = pipe.run([udp, rows, parts, whole, JsonLinesSink(text, pipe.frame),
                        CallbackSink(lambda o: per_frame.append(len(o.online)))])
-    rx.setblocking(False)
-    got = []
-    while True:
-        try:
-            got.append(rx.recv(65535))
-        except BlockingIOError:
-            break
+    got = drain(rx)
     rx.close()
     return {"pipe": pipe, "udp": udp, "rows": rows.tracks(), "got": got, "parts": parts,
             "whole": whole, "text": text.getvalue(), "frames": len(result.stats),

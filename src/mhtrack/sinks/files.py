@@ -4,6 +4,7 @@ atomically (:mod:`mhtrack.io.atomic`) — at the end, or for a table in rolling 
 from __future__ import annotations
 
 import dataclasses
+from abc import abstractmethod
 from collections.abc import Iterator
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -57,8 +58,9 @@ class _Rows(Sink):
         self._write_part(p.with_name(f"{p.stem}.part{len(self.paths):04d}{p.suffix}"))
         self.rows.clear()
 
+    @abstractmethod
     def _write_part(self, path: Path) -> None:
-        raise NotImplementedError
+        """Write the collected rows as the part file ``path`` (atomically)."""
 
     def _file_rows(self, tracks: TrackTable) -> TrackTable:
         """``tracks`` with ``plot`` as the input's own rows (:meth:`Source.file_rows`)."""

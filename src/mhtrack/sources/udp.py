@@ -29,6 +29,7 @@ import signal
 import socket
 import threading
 import time
+from abc import ABC, abstractmethod
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 from typing import Any, BinaryIO
@@ -124,7 +125,7 @@ class ReaderStats:
     per_input: dict[str, int] = field(default_factory=dict)
 
 
-class _Threaded:
+class _Threaded(ABC):
     """A receiving thread filling a bounded queue; iteration yields from the queue until
     the thread has ended (stop set, or end of input) and the queue is empty."""
 
@@ -146,8 +147,9 @@ class _Threaded:
         s.bytes += len(data)
         s.per_input[where] = s.per_input.get(where, 0) + 1
 
+    @abstractmethod
     def _receive(self) -> None:
-        raise NotImplementedError
+        """Put what the input delivers on the queue (:meth:`_put`) until stop or its end."""
 
     def _run(self) -> None:
         try:

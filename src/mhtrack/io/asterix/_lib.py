@@ -61,3 +61,23 @@ def version() -> str:
         return dist_version("libasterix")
     except PackageNotFoundError:
         return "unknown"
+
+
+# --- item access shared by the category readers (libasterix's parsed records) ----------
+
+def quantity(item: Any, unit: str) -> float:
+    """An item's content as a physical quantity in ``unit`` (libasterix ``as_quantity``)."""
+    return float(item.variation.content.as_quantity(unit))
+
+
+def uint(item: Any) -> int:
+    """An item's content as an unsigned integer."""
+    return int(item.variation.content.as_uint())
+
+
+def sub_or_none(item: Any, name: str) -> Any:
+    """Subitem ``name`` of a compound or group item, or ``None`` where it is absent."""
+    try:
+        return item.variation.get_item(name)
+    except (KeyError, ValueError):
+        return None

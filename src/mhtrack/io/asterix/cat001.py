@@ -22,6 +22,7 @@ from typing import Any
 import numpy as np
 
 import mhtrack.io.asterix._lib as _lib
+from mhtrack.io.asterix._lib import sub_or_none, uint
 from mhtrack.io.asterix.problems import Problems
 from mhtrack.io.asterix.timeaxis import DAY_S
 
@@ -40,15 +41,10 @@ def specs() -> tuple[Any, Any]:
     return gen.Cat_001_1_4, gen.Cat_002_1_2
 
 
-def _uint(item: Any, name: str | None = None) -> int:
-    if name is not None:
-        try:
-            item = item.variation.get_item(name)
-        except (KeyError, ValueError):
-            return 0
-        if item is None:
-            return 0
-    return int(item.variation.content.as_uint())
+def _uint(item: Any, name: str) -> int:
+    """Subitem ``name`` of ``item`` as an unsigned integer, 0 where it is absent."""
+    found = sub_or_none(item, name)
+    return 0 if found is None else uint(found)
 
 
 def records001(raw: bytes) -> list[Any] | ValueError:
@@ -111,7 +107,7 @@ def mark_row002(rec: Any) -> tuple[Any, ...] | None:
     i000, i010, i030 = rec.get_item("000"), rec.get_item("010"), rec.get_item("030")
     if i000 is None or i010 is None or i030 is None:
         return None
-    kind = _uint(i000)
+    kind = uint(i000)
     if kind not in (1, 2):
         return None
     i020, i041 = rec.get_item("020"), rec.get_item("041")

@@ -30,6 +30,7 @@ from typing import Any
 import numpy as np
 
 import mhtrack.io.asterix._lib as _lib
+from mhtrack.io.asterix._lib import quantity, sub_or_none, uint
 from mhtrack.io.asterix.notplots import PLOT_TYPES
 from mhtrack.io.asterix.problems import Problems
 from mhtrack.io.asterix.timeaxis import DAY_S
@@ -66,12 +67,6 @@ def sigma_m(nacp: int, nucp: int, version: int) -> float:
     return math.nan
 
 
-def _get(item: Any, name: str) -> Any:
-    try:
-        return item.variation.get_item(name)
-    except (KeyError, ValueError):
-        return None
-
 
 def _first(rec: Any, *names: str) -> Any:
     for name in names:
@@ -80,12 +75,6 @@ def _first(rec: Any, *names: str) -> Any:
     return None
 
 
-def _uint(item: Any) -> int:
-    return int(item.variation.content.as_uint())
-
-
-def _q(item: Any, unit: str) -> float:
-    return float(item.variation.content.as_quantity(unit))
 
 
 def report_row(rec: Any, at: int, problems: Problems) -> tuple[Any, ...] | None:
@@ -100,30 +89,30 @@ def report_row(rec: Any, at: int, problems: Problems) -> tuple[Any, ...] | None:
     if i010 is None or tod_item is None:
         problems.add("no_time", at)
         return None
-    lat, lon = _q(_get(pos, "LAT"), "°"), _q(_get(pos, "LON"), "°")
-    tod = _q(tod_item, "s")
+    lat, lon = quantity(sub_or_none(pos, "LAT"), "°"), quantity(sub_or_none(pos, "LON"), "°")
+    tod = quantity(tod_item, "s")
     if abs(lat) > 90.0 or abs(lon) > 180.0 or not 0.0 <= tod < DAY_S:
         problems.add("impossible", at, detail=f"CAT021 lat {lat:g}, lon {lon:g}, "
                      f"time {tod:g} s")
         return None
-    sac, sic = _uint(_get(i010, "SAC")), _uint(_get(i010, "SIC"))
+    sac, sic = uint(sub_or_none(i010, "SAC")), uint(sub_or_none(i010, "SIC"))
     i090, i210 = rec.get_item("090"), rec.get_item("210")
     nacp = nucp = version = -1
     if i090 is not None:
-        nucp = _uint(_get(i090, "NUCPNIC"))
-        if (n := _get(i090, "NACP")) is not None:
-            nacp = _uint(n)
-    if i210 is not None and (vn := _get(i210, "VN")) is not None:
-        version = _uint(vn)
+        nucp = uint(sub_or_none(i090, "NUCPNIC"))
+        if (n := sub_or_none(i090, "NACP")) is not None:
+            nacp = uint(n)
+    if i210 is not None and (vn := sub_or_none(i210, "VN")) is not None:
+        version = uint(vn)
     i145, i080, i170 = rec.get_item("145"), rec.get_item("080"), rec.get_item("170")
     i161, i040 = rec.get_item("161"), rec.get_item("040")
-    fl = _q(i145, "FL") if i145 is not None else np.nan
-    address = f"{_uint(i080):06X}" if i080 is not None else ""
+    fl = quantity(i145, "FL") if i145 is not None else np.nan
+    address = f"{uint(i080):06X}" if i080 is not None else ""
     callsign = i170.variation.content.as_string().strip() if i170 is not None else ""
-    tn = _uint(_get(i161, "TRNUM")) if i161 is not None else -1
+    tn = uint(sub_or_none(i161, "TRNUM")) if i161 is not None else -1
     flags = [-1, -1, -1]
     if i040 is not None:
-        flags = [_uint(x) if (x := _get(i040, k)) is not None else 0
+        flags = [uint(x) if (x := sub_or_none(i040, k)) is not None else 0
                  for k in ("SIM", "RAB", "TST")]
     return (tod, sac * 256 + sic, sac, sic, np.nan, np.nan, fl, "", address, callsign, tn,
             -1, ADSB, *flags, lat, lon, sigma_m(nacp, nucp, version))

@@ -24,6 +24,7 @@ from typing import Any
 import numpy as np
 
 import mhtrack.io.asterix._lib as _lib
+from mhtrack.io.asterix._lib import quantity
 from mhtrack.io.asterix.cat001 import TimeRestorer, block001, block002
 from mhtrack.io.asterix.cat021 import block021
 from mhtrack.io.asterix.columns import columns
@@ -226,10 +227,6 @@ def sweep_periods(sweeps: dict[str, np.ndarray]) -> dict[int, float]:
     return out
 
 
-def _q(item: Any, unit: str) -> float:
-    return float(item.variation.content.as_quantity(unit))
-
-
 def _sub(item: Any, name: str) -> Any:
     return item.variation.get_item(name)
 
@@ -249,16 +246,16 @@ def plot_row(rec: Any, at: int, problems: Problems) -> tuple[Any, ...] | None:
         return None
     sac = _sub(i010, "SAC").variation.content.as_uint()
     sic = _sub(i010, "SIC").variation.content.as_uint()
-    rho = _q(_sub(i040, "RHO"), "NM") * NM_M
-    theta = _q(_sub(i040, "THETA"), "°")
+    rho = quantity(_sub(i040, "RHO"), "NM") * NM_M
+    theta = quantity(_sub(i040, "THETA"), "°")
     i090, i070 = rec.get_item("090"), rec.get_item("070")
-    fl = _q(_sub(i090, "FL"), "FL") if i090 is not None else np.nan
+    fl = quantity(_sub(i090, "FL"), "FL") if i090 is not None else np.nan
     m3a = _sub(i070, "MODE3A").variation.content.as_string() if i070 is not None else ""
     i220, i240, i161 = rec.get_item("220"), rec.get_item("240"), rec.get_item("161")
     address = f"{i220.variation.content.as_uint():06X}" if i220 is not None else ""
     callsign = i240.variation.content.as_string().strip() if i240 is not None else ""
     tn = _sub(i161, "TRN").variation.content.as_uint() if i161 is not None else -1
-    return (_q(i140, "s"), sac * 256 + sic, sac, sic, rho, theta, fl, m3a, address,
+    return (quantity(i140, "s"), sac * 256 + sic, sac, sic, rho, theta, fl, m3a, address,
             callsign, tn, *flags048(rec))
 
 
@@ -272,8 +269,8 @@ def site_row(rec: Any, at: int, sites: dict[int, tuple[float, float, float, int]
     sensor = _sub(i010, "SAC").variation.content.as_uint() * 256 + \
         _sub(i010, "SIC").variation.content.as_uint()
     if sensor not in sites:
-        sites[sensor] = (_q(_sub(i120, "LAT"), "°"), _q(_sub(i120, "LON"), "°"),
-                         _q(_sub(i120, "HGT"), "m"), at)
+        sites[sensor] = (quantity(_sub(i120, "LAT"), "°"), quantity(_sub(i120, "LON"), "°"),
+                         quantity(_sub(i120, "HGT"), "m"), at)
 
 
 def mark_row(rec: Any) -> tuple[Any, ...] | None:
@@ -288,9 +285,9 @@ def mark_row(rec: Any) -> tuple[Any, ...] | None:
     sac = _sub(i010, "SAC").variation.content.as_uint()
     sic = _sub(i010, "SIC").variation.content.as_uint()
     i020, i041 = rec.get_item("020"), rec.get_item("041")
-    azimuth = _q(i020, "°") if i020 is not None and kind == 2 else np.nan
-    period = _q(i041, "s") if i041 is not None else np.nan
-    return _q(i030, "s"), sac * 256 + sic, kind, azimuth, period
+    azimuth = quantity(i020, "°") if i020 is not None and kind == 2 else np.nan
+    period = quantity(i041, "s") if i041 is not None else np.nan
+    return quantity(i030, "s"), sac * 256 + sic, kind, azimuth, period
 
 
 def _columns(rows: list[tuple[Any, ...]], marks: list[tuple[Any, ...]],

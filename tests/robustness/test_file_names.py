@@ -78,6 +78,7 @@ def test_state_and_sensors_files_with_odd_names(tmp_path: Path) -> None:
 def test_run_report_montecarlo_and_study_page_in_odd_folders(tmp_path: Path) -> None:
     """The report pages print the folder's name: before, atomic_write's UTF-8 encoding
     failed on it ('surrogates not allowed') after all the work."""
+    pytest.importorskip("plotly", reason="the HTML report needs the extra [report]")
     run = tmp_path / ODD / "run"
     code, text = _run(["run", "crossing", "--scans", "4", "--out", str(run), "--report"])
     assert code == 0, text

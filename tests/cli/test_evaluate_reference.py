@@ -97,3 +97,6 @@ def test_truth_or_reference_not_both(tmp_path: Path) -> None:
     r = _run("evaluate", tmp_path / "t.csv", tmp_path / "t.csv", "--reference",
              tmp_path / "t.csv")
     assert r.exit_code == 2 and "give TRUTH or --reference REC" in r.output  # type: ignore[attr-defined]
+    r = _run("evaluate", tmp_path / "t.csv", "--reference", tmp_path / "t.csv", "--plots",
+             tmp_path / "t.csv")
+    assert r.exit_code == 2 and "apply to TRUTH only" in r.output  # type: ignore[attr-defined]

@@ -102,7 +102,9 @@ def _write_rotating(sim: Any, out: Path, fmt: str) -> None:
               "latest state predicted to them [default: truth-times for tracks numbered by "
               "frame (timed plots), else scans; docs/metrics.md].")
 @click.option("--max-age", "max_age_s", type=click.FloatRange(min=0), default=None,
-              help="At truth times: the oldest track state (s) still predicted [15].")
+              help="At truth times: the oldest track state (s) still predicted; with "
+              "--reference: the longest gap between a track's updates interpolated "
+              "across [15].")
 @click.option("--json", "as_json", is_flag=True, help="Print one JSON object.")
 @click.option("--out", "-o", "out", type=click.Path(dir_okay=False, path_type=Path),
               default=None, help="Write the table (.txt) or the JSON (.json) to FILE "
@@ -129,6 +131,9 @@ def evaluate(tracks: Path, truth: Path | None, reference: Path | None,
         raise click.UsageError("give TRUTH or --reference REC (one of them)")
     if reference_period is not None and reference is None:
         raise click.UsageError("--reference-period applies to --reference only")
+    if reference is not None and (plots is not None or at is not None):
+        raise click.UsageError("--plots and --at apply to TRUTH only (--reference scores "
+                               "at the reference's own times)")
     if out is not None:
         check_output_file(out, inputs=(tracks, truth or reference, plots),
                           suffixes=(".json", ".txt"), what="metrics", option="--out")

@@ -180,7 +180,7 @@ def _against_reference(tracks: Path, rec: Path, period: float | None,
     at the reference's times (:func:`mhtrack.metrics.reference.evaluate_reference`)."""
     import numpy as np
 
-    from mhtrack.io import read_tracks
+    from mhtrack.io import InputError, read_tracks
     from mhtrack.io._frame import column_names
     from mhtrack.io.reference import read_reference
     from mhtrack.io.sensors import read_sensors
@@ -205,9 +205,13 @@ def _against_reference(tracks: Path, rec: Path, period: float | None,
                  accept_truth=False)
         if len(tr):
             ref = ref.near(float(tr.time.min()))
-        ev, truth, used = evaluate_reference(
-            tr, ref.time, ref.key, ref.state, max_gap_s=max_age_s, period_s=period,
-            cutoff=cutoff, order=order, match_distance=match_distance, stages=run)
+        try:
+            ev, truth, used = evaluate_reference(
+                tr, ref.time, ref.key, ref.state, max_gap_s=max_age_s, period_s=period,
+                cutoff=cutoff, order=order, match_distance=match_distance, stages=run)
+        except ValueError as e:  # a reference that cannot be sampled: name the file
+            hint = " (--reference-period S)" if "period" in str(e) else ""
+            raise InputError(f"{rec}: {e}{hint}", file=str(rec)) from None
     finally:
         run.close()
     moved = f", moved by {ref.days:+d} day(s)" if ref.days else ""

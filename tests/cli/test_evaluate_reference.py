@@ -100,3 +100,21 @@ def test_truth_or_reference_not_both(tmp_path: Path) -> None:
     r = _run("evaluate", tmp_path / "t.csv", "--reference", tmp_path / "t.csv", "--plots",
              tmp_path / "t.csv")
     assert r.exit_code == 2 and "apply to TRUTH only" in r.output  # type: ignore[attr-defined]
+
+
+def test_reference_that_cannot_be_sampled_one_line(tmp_path: Path) -> None:
+    """A single update gives no update period: one line naming the file, until the
+    period is given."""
+    from mhtrack.io.asterix.encode import encode_blocks
+
+    rec = tmp_path / "one.ast"
+    rec.write_bytes(b"".join(b for _, _, b in encode_blocks([_message(1, 48.0, 1000.0)])))  # type: ignore[list-item]
+    tracks = tmp_path / "t.csv"
+    tracks.write_text("frame,time,track_id,lat,lon,vx,vy,plot\n0,1000.0,1,48.0,11.0,0,0,\n")
+    r = _run("evaluate", tracks, "--reference", rec)
+    assert r.exit_code == 2, r.output  # type: ignore[attr-defined]
+    assert r.output.strip().splitlines() == [  # type: ignore[attr-defined]
+        f"Error: {rec}: no reference track has two updates at different times: give the "
+        "reference's update period (--reference-period S)"]
+    r = _run("evaluate", tracks, "--reference", rec, "--reference-period", 4, "--json")
+    assert r.exit_code == 0 and json.loads(r.stdout)["n_matches"] == 1  # type: ignore[attr-defined]

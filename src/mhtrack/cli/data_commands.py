@@ -76,7 +76,14 @@ def _write_rotating(sim: Any, out: Path, fmt: str) -> None:
 
 @click.command()
 @click.argument("tracks", type=click.Path(dir_okay=False, path_type=Path))
-@click.argument("truth", type=click.Path(dir_okay=False, path_type=Path))
+@click.argument("truth", type=click.Path(dir_okay=False, path_type=Path), required=False)
+@click.option("--reference", "reference", type=click.Path(dir_okay=False, path_type=Path),
+              default=None, help="Score TRACKS against a reference system's tracks, an "
+              "ASTERIX CAT062 recording, instead of TRUTH (docs/metrics.md).")
+@click.option("--reference-period", "reference_period", type=click.FloatRange(
+              min=0, min_open=True), default=None, help="With --reference: the times the "
+              "reference is sampled at, every S seconds [default: its own median update "
+              "interval].")
 @click.option("--plots", type=click.Path(dir_okay=False, path_type=Path), default=None,
               help="Plots file (adds the scans it covers and plot-based metrics).")
 @click.option("--cutoff", type=click.FloatRange(min=0, min_open=True), default=500.0,
@@ -95,22 +102,24 @@ def _write_rotating(sim: Any, out: Path, fmt: str) -> None:
               "latest state predicted to them [default: truth-times for tracks numbered by "
               "frame (timed plots), else scans; docs/metrics.md].")
 @click.option("--max-age", "max_age_s", type=click.FloatRange(min=0), default=None,
-              help="At truth times: the oldest track state (s) still predicted [15].")
+              help="At truth times: the oldest track state (s) still predicted; with "
+              "--reference: the longest gap between a track's updates interpolated "
+              "across [15].")
 @click.option("--json", "as_json", is_flag=True, help="Print one JSON object.")
 @click.option("--out", "-o", "out", type=click.Path(dir_okay=False, path_type=Path),
               default=None, help="Write the table (.txt) or the JSON (.json) to FILE "
               "instead of stdout.")
 @progress_option
-def evaluate(tracks: Path, truth: Path, plots: Path | None, cutoff: float, order: float,
-             match_distance: float | None, sensors_file: Path | None, at: str | None,
-             max_age_s: float | None, as_json: bool, out: Path | None,
+def evaluate(tracks: Path, truth: Path | None, reference: Path | None,
+             reference_period: float | None, plots: Path | None, cutoff: float,
+             order: float, match_distance: float | None, sensors_file: Path | None,
+             at: str | None, max_age_s: float | None, as_json: bool, out: Path | None,
              progress: bool | None) -> None:
-    """Score TRACKS against TRUTH: OSPA, GOSPA, cardinality, CLEAR-MOT, coverage."""
+    """Score TRACKS against TRUTH (or a reference system's CAT062 tracks, --reference
+    REC): OSPA, GOSPA, cardinality, CLEAR-MOT, coverage."""
     import logging
 
     from mhtrack.io import read_plots, read_tracks, read_truth
-    from mhtrack.io.atomic import atomic_write
-    from mhtrack.io.jsonsafe import dumps
     from mhtrack.io.paths import check_output_file
     from mhtrack.io.sensors import read_sensors
     from mhtrack.io.tracks import has_frames
@@ -118,10 +127,23 @@ def evaluate(tracks: Path, truth: Path, plots: Path | None, cutoff: float, order
     from mhtrack.metrics.resample import DEFAULT_MAX_AGE_S, alignment
     from mhtrack.progress import Stages
 
+    if (truth is None) == (reference is None):
+        raise click.UsageError("give TRUTH or --reference REC (one of them)")
+    if reference_period is not None and reference is None:
+        raise click.UsageError("--reference-period applies to --reference only")
+    if reference is not None and (plots is not None or at is not None):
+        raise click.UsageError("--plots and --at apply to TRUTH only (--reference scores "
+                               "at the reference's own times)")
     if out is not None:
-        check_output_file(out, inputs=(tracks, truth, plots), suffixes=(".json", ".txt"),
-                          what="metrics", option="--out")
-
+        check_output_file(out, inputs=(tracks, truth or reference, plots),
+                          suffixes=(".json", ".txt"), what="metrics", option="--out")
+    age = DEFAULT_MAX_AGE_S if max_age_s is None else max_age_s
+    if reference is not None:
+        ev = _against_reference(tracks, reference, reference_period, sensors_file,
+                                cutoff, order, match_distance, age, progress)
+        _print(ev, as_json, out)
+        return
+    assert truth is not None
     if sensors_file is None and (truth.parent / "sensors.toml").is_file():
         sensors_file = truth.parent / "sensors.toml"
     sensor_set = read_sensors(sensors_file) if sensors_file is not None else None
@@ -139,12 +161,71 @@ def evaluate(tracks: Path, truth: Path, plots: Path | None, cutoff: float, order
                 _check_same_times(plots, pl, truth, gt)
         ev = run_evaluation(tr, gt, plots=pl, cutoff=cutoff, order=order,
                             match_distance=match_distance, at=at, stages=run,
-                            max_age_s=DEFAULT_MAX_AGE_S if max_age_s is None else max_age_s)
+                            max_age_s=age)
     finally:
         run.close()
     logging.getLogger("mhtrack.metrics").info(
         "evaluated %s against %s: %d scans, %d tracks, %d targets", tracks, truth,
         len(ev.scans), ev.n_tracks, ev.n_targets)
+    _print(ev, as_json, out)
+
+
+def _against_reference(tracks: Path, rec: Path, period: float | None,
+                       sensors_file: Path | None, cutoff: float, order: float,
+                       match_distance: float | None, max_age_s: float,
+                       progress: bool | None) -> Any:
+    """``evaluate TRACKS --reference REC``: the reference's CAT062 tracks as the truth
+    (:func:`mhtrack.io.reference.read_reference`, its skipped records warned, one line
+    per kind), our tracks placed in the same frame from their ``lat, lon``, both sampled
+    at the reference's times (:func:`mhtrack.metrics.reference.evaluate_reference`)."""
+    import numpy as np
+
+    from mhtrack.io import InputError, read_tracks
+    from mhtrack.io._frame import column_names
+    from mhtrack.io.reference import read_reference
+    from mhtrack.io.sensors import read_sensors
+    from mhtrack.metrics.reference import evaluate_reference
+    from mhtrack.progress import Stages
+
+    for beside in (tracks.parent, rec.parent):
+        if sensors_file is None and (beside / "sensors.toml").is_file():
+            sensors_file = beside / "sensors.toml"
+    sensor_set = read_sensors(sensors_file) if sensors_file is not None else None
+    frame = sensor_set.frame() if sensor_set is not None and \
+        sensor_set.reference is not None else None
+    geodetic = {"lat", "lon"} <= set(column_names(tracks))
+    if frame is None and not geodetic:
+        raise click.UsageError(f"{tracks} has no lat, lon: give the sensors file of its "
+                               "local frame (--sensors FILE) to place the reference in it")
+    run = Stages(2 + 8, "evaluate", progress_enabled(progress))  # 2 files, 8 metrics
+    try:
+        ref = run("read reference", read_reference, rec, frame)
+        ref.problems.warn(str(rec))
+        tr = run("read tracks", read_tracks, tracks, frame=ref.frame, geodetic=geodetic,
+                 accept_truth=False)
+        if len(tr):
+            ref = ref.near(float(tr.time.min()))
+        try:
+            ev, truth, used = evaluate_reference(
+                tr, ref.time, ref.key, ref.state, max_gap_s=max_age_s, period_s=period,
+                cutoff=cutoff, order=order, match_distance=match_distance, stages=run)
+        except ValueError as e:  # a reference that cannot be sampled: name the file
+            hint = " (--reference-period S)" if "period" in str(e) else ""
+            raise InputError(f"{rec}: {e}{hint}", file=str(rec)) from None
+    finally:
+        run.close()
+    moved = f", moved by {ref.days:+d} day(s)" if ref.days else ""
+    click.echo(f"{rec}: {len(ref)} CAT062 updates of {len(np.unique(truth.target_id))} "
+               f"reference tracks, sampled every {used:g} s at {len(np.unique(truth.scan))}"
+               f" times{moved}", err=True)
+    return ev
+
+
+def _print(ev: Any, as_json: bool, out: Path | None) -> None:
+    """The evaluation as a table or JSON, on stdout or written atomically to ``out``."""
+    from mhtrack.io.atomic import atomic_write
+    from mhtrack.io.jsonsafe import dumps
+
     if out is not None:
         text = (dumps(ev.to_dict()) if as_json else ev.to_table()) + "\n"
         click.echo(f"wrote {atomic_write(out, text)}")

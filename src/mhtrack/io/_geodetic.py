@@ -72,8 +72,12 @@ def row_columns(key: tuple[str, np.ndarray], time: pa.Array, ident: tuple[str, n
             **state_columns(*state, frame)}
 
 
-def read_state(f: Frame, frame: LocalFrame | None) -> dict[str, np.ndarray]:
-    """``x, y, vx, vy`` in the local frame from a file's columns (module docstring)."""
+def read_state(f: Frame, frame: LocalFrame | None, *, geodetic: bool = False
+               ) -> dict[str, np.ndarray]:
+    """``x, y, vx, vy`` in the local frame from a file's columns (module docstring); with
+    ``geodetic`` a file with ``lat, lon`` is converted with ``frame`` even when it has
+    ``x, y`` (whose frame may be another: a reference system's tracks are placed in
+    ``frame`` from WGS-84 too)."""
     if not (f.has("lat") and f.has("lon")):
         return {c: f.floats(c) for c in ("x", "y", "vx", "vy")}
     lat, lon = f.floats("lat"), f.floats("lon")
@@ -82,8 +86,8 @@ def read_state(f: Frame, frame: LocalFrame | None) -> dict[str, np.ndarray]:
     f.check(np.abs(lon) > 180, "lon", lambda r: f"longitude {num(lon[r])} is outside "
             "[-180, 180] degrees")
     ve, vn = f.floats("vx"), f.floats("vy")
-    grid = f.has("vx_grid") and f.has("vy_grid")
-    xy = f.has("x") and f.has("y")
+    grid = f.has("vx_grid") and f.has("vy_grid") and not geodetic
+    xy = f.has("x") and f.has("y") and not geodetic
     if not (grid and xy) and frame is None:
         missing = " and ".join(p for p, ok in (("x, y", xy), ("vx_grid, vy_grid", grid))
                                if not ok)

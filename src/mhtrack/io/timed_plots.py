@@ -22,7 +22,7 @@ from mhtrack.io._checks import num
 from mhtrack.io._frame import FLOAT, INT, TIME, Frame, read_frame
 from mhtrack.io._source import PathArg
 from mhtrack.io._times import is_iso, seconds
-from mhtrack.models.radars import SensorSet
+from mhtrack.models.radars import RadarSensor, SensorSet
 from mhtrack.records import MAX_COORDINATE, PlotTable
 
 #: Rows may come out of time order by at most this much (s) by default (network jitter
@@ -34,7 +34,7 @@ MAX_RANGE_M = 2e7
 
 REQUIRED = ("time", "sensor")
 COLUMNS = {"time": TIME, "sensor": INT, "range": FLOAT, "bearing": FLOAT, "x": FLOAT,
-           "y": FLOAT, "lat": FLOAT, "lon": FLOAT, "origin": INT}
+           "y": FLOAT, "lat": FLOAT, "lon": FLOAT, "sigma": FLOAT, "origin": INT}
 #: Position column pairs, in the order a row's position is taken from them.
 PAIRS = (("range", "bearing"), ("x", "y"), ("lat", "lon"))
 _NEEDS_SENSORS = "read them with a sensors file (mhtrack track --sensors FILE)"
@@ -258,8 +258,28 @@ def _convert(
                                                     bearing[rows])  # type: ignore[index]
         else:
             x[rows], y[rows] = _cartesian(f, sensors, rows, s.id, lat, lon)
-            R[rows] = np.eye(2) * float(s.sigma) ** 2  # type: ignore[arg-type]
+            R[rows] = np.eye(2) * _sigmas(f, s, rows)[:, None, None] ** 2
     return x, y, R
+
+
+def _sigmas(f: Frame, s: RadarSensor, rows: np.ndarray) -> np.ndarray:
+    """σ (m per axis) of a Cartesian or ADS-B sensor's rows: an ADS-B report's own
+    ``sigma`` (the column ``mhtrack convert`` writes, from its NACp/NUCp) where given,
+    else the sensor's ``sigma``; a row with neither is refused."""
+    sig = np.full(rows.size, np.nan if s.sigma is None else float(s.sigma))
+    own = _floats_or_none(f, "sigma") if s.kind == "adsb" else None
+    if own is not None:
+        mine = np.zeros(f.n, bool)
+        mine[rows] = True
+        f.check(mine & ~(own > 0) & ~np.isnan(own), "sigma", lambda r: (
+            f"sigma {num(own[r])} m is not > 0"))  # type: ignore[index]
+        sig = np.where(np.isnan(own[rows]), sig, own[rows])
+    bad = np.zeros(f.n, bool)
+    bad[rows] = np.isnan(sig)
+    f.check(bad, "sigma" if own is not None else "sensor", lambda r: (
+        f"no accuracy: sensor {s.id} is an ADS-B station without a sigma in the sensors "
+        "file, and this report gives none (NACp/NUCp 0)"))
+    return sig
 
 
 def _cartesian(f: Frame, sensors: SensorSet, rows: np.ndarray, sensor_id: int,

@@ -67,7 +67,7 @@ def _numbered_by_frame(names: Sequence[str]) -> bool:
 
 def read_tracks(
     path: PathArg, *, accept_truth: bool = True, frame: LocalFrame | None = None,
-    plots: PlotTable | None = None,
+    plots: PlotTable | None = None, geodetic: bool = False,
 ) -> TrackTable:
     """Read and validate a tracks file (``.csv`` or ``.parquet``).
 
@@ -84,6 +84,8 @@ def read_tracks(
     (:func:`mhtrack.io._geodetic.read_state`). With ``plots`` (the table read from the
     plots file the tracks refer to) the ``plot`` column's file rows become that table's
     rows (:func:`~mhtrack.io.plots.plots_to_table_rows`; a timed file is re-sorted).
+    With ``geodetic`` a file with ``lat, lon`` is placed in ``frame`` from them, not from
+    its ``x, y`` (:func:`mhtrack.io._geodetic.read_state`).
 
     Raises
     ------
@@ -105,7 +107,7 @@ def read_tracks(
     scan = f.ints("frame" if timed else "scan")
     time = seconds(f)  # seconds, or ISO-8601 times as POSIX seconds
     tid = f.ints("track_id")
-    cols = _geodetic.read_state(f, frame)
+    cols = _geodetic.read_state(f, frame, geodetic=geodetic)
     plot = f.ints("plot", nullable=True, fill=NO_PLOT)
     written = ~f.nulls("plot")
     miss = "leave the cell empty" if f.src.format == "csv" else "use null"

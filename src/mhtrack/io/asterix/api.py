@@ -14,7 +14,13 @@ from mhtrack.errors import InputError
 from mhtrack.io._frame import FLOAT, INT, TIME, float_array, int_array, read_frame, write_frame
 from mhtrack.io._source import FORMATS
 from mhtrack.io._times import seconds
-from mhtrack.io.asterix.decode import FL_M, PLOT_COLUMNS, Recording, read_recording
+from mhtrack.io.asterix.decode import (
+    ADSB_EXTRA,
+    FL_M,
+    PLOT_COLUMNS,
+    Recording,
+    read_recording,
+)
 from mhtrack.io.asterix.earth import ground_range, slant_range
 from mhtrack.io.asterix.encode import encode_blocks, plot_messages, sweep_messages
 from mhtrack.io.asterix.notplots import PLOT_TYPES
@@ -109,11 +115,12 @@ def ground_ranges(sensors: SensorSet, sensor: np.ndarray, slant: np.ndarray,
 
 
 def plot_columns(rec: Recording, sensors: SensorSet | None = None) -> dict[str, pa.Array]:
-    """The plots table of a recording, columns in output order (``range`` last, with
-    ``sensors``); empty text and ``-1`` ints become empty cells."""
+    """The plots table of a recording, columns in output order: :data:`PLOT_COLUMNS`,
+    then ``lat, lon, sigma`` when it holds ADS-B reports, ``range`` last (with
+    ``sensors``); empty text, ``-1`` ints and NaN become empty cells."""
     p = rec.plots
     cols: dict[str, pa.Array] = {}
-    for name in PLOT_COLUMNS:
+    for name in (*PLOT_COLUMNS, *(c for c in ADSB_EXTRA if c in p)):
         v = p[name]
         if name in _TEXT:
             cols[name] = pa.array(v.tolist(), type=pa.string(), mask=v == "")
@@ -137,27 +144,37 @@ class Converted:
     recording: Recording
 
     def describe(self) -> str:
-        """One line: container, plots, radars (SAC/SIC), CAT034 sweep marks and periods."""
+        """One line: container, plots, radars (SAC/SIC), ADS-B reports and stations (when
+        any), CAT034 sweep marks and periods."""
         rec = self.recording
-        radars = ", ".join(f"{s >> 8}/{s & 0xFF}"
-                           for s in sorted(set(rec.plots["sensor"].tolist())))
-        periods = ", ".join(f"{s}: {p:.3g} s" for s, p in sorted(rec.periods().items()))
-        return (f"{rec.container} recording: {self.n_plots} plots from radars (SAC/SIC) "
-                f"{radars}; {rec.sweeps['time'].size} CAT034 sweep marks"
-                + (f" (periods {periods})" if periods else ""))
+        p = rec.plots
+        adsb = np.isfinite(p["lat"]) if "lat" in p else np.zeros(len(rec), bool)
+
+        def ids(rows: np.ndarray) -> str:
+            return ", ".join(f"{s >> 8}/{s & 0xFF}"
+                             for s in sorted(set(p["sensor"][rows].tolist())))
+
+        periods = ", ".join(f"{s}: {v:.3g} s" for s, v in sorted(rec.periods().items()))
+        stations = (f"; {int(adsb.sum())} ADS-B reports (CAT021) from stations "
+                    f"{ids(adsb)}" if adsb.any() else "")
+        return (f"{rec.container} recording: {self.n_plots - int(adsb.sum())} plots from "
+                f"radars (SAC/SIC) {ids(~adsb)}{stations}; {rec.sweeps['time'].size} CAT034 "
+                "sweep marks" + (f" (periods {periods})" if periods else ""))
 
 
 def convert(source: str | Path, out: str | Path, sensors: SensorSet | None = None, *,
             recording: Recording | None = None) -> Converted:
     """Decode ``source`` (warning one line per kind of part skipped) and write its plots
-    to ``out`` (CSV or Parquet); ``recording``: ``source`` already decoded."""
+    and ADS-B reports to ``out`` (CSV or Parquet; :func:`plot_columns`); ``recording``:
+    ``source`` already decoded."""
     if recording is None:
         recording = read_recording(source)
         recording.problems.warn(str(source))
     rec = recording
     if len(rec) == 0:
         raise InputError(f"{source}: no CAT048 plot with a measured position (I048/040) "
-                         f"in this {rec.container} recording", file=str(source))
+                         f"nor CAT021 report in this {rec.container} recording",
+                         file=str(source))
     write_frame(out, plot_columns(rec, sensors))
     return Converted(len(rec), rec)
 

@@ -44,14 +44,18 @@ FL_M = 30.48
 #: The plot columns, in output order (docs/file-formats.md).
 PLOT_COLUMNS = ("time", "sensor", "sac", "sic", "slant_range", "bearing", "flight_level",
                 "mode_3a", "address", "callsign", "track_number", "typ", "plot_type")
+#: The columns an ADS-B report (CAT021) adds to :data:`PLOT_COLUMNS`: WGS-84 position
+#: (deg) and its σ per axis (m, from NACp/NUCp, :mod:`~mhtrack.io.asterix.cat021`).
+ADSB_EXTRA = ("lat", "lon", "sigma")
 #: Kinds of rows :meth:`Decoder.blocks` yields.
 PLOTS, MARKS, ADSB = "plots", "marks", "adsb"
 
 
 @dataclass
 class Recording:
-    """A decoded recording: ``plots`` (name -> array, :data:`PLOT_COLUMNS`; missing values
-    NaN for floats, ``-1`` for ints, ``""`` for text), ``sweeps`` (``time, sensor, kind``
+    """A decoded recording: ``plots`` (name -> array, :data:`PLOT_COLUMNS`, then
+    :data:`ADSB_EXTRA` when it holds ADS-B reports; missing values NaN for floats, ``-1``
+    for ints, ``""`` for text), ``sweeps`` (``time, sensor, kind``
     1 north marker / 2 sector crossing, ``azimuth`` deg, NaN for north markers;
     ``period`` s from I034/041, NaN when absent), ``sites`` (each radar's I034/120:
     :attr:`Decoder.sites`), the framing and the skipped parts."""
@@ -73,8 +77,10 @@ class Recording:
 
 
 def read_recording(path: str | Path, *, fast: bool = True) -> Recording:
-    """Decode the plots (CAT048, CAT001), sweep marks (CAT034, CAT002) and sites (I034/120)
-    of a recording in any framing :func:`~mhtrack.io.asterix.framings.recognise` knows.
+    """Decode the plots (CAT048, CAT001), ADS-B reports (CAT021: rows of ``plots`` in file
+    order, with ``lat, lon, sigma`` columns, NaN on the radars' rows, present only when
+    the recording has any), sweep marks (CAT034, CAT002) and sites (I034/120) of a
+    recording in any framing :func:`~mhtrack.io.asterix.framings.recognise` knows.
     Malformed parts, duplicates and reports that are no plots are counted in ``problems``
     (the caller warns); a file that is no recording raises
     :class:`~mhtrack.errors.InputError`. ``fast=False`` decodes every record with
@@ -92,14 +98,10 @@ def read_recording(path: str | Path, *, fast: bool = True) -> Recording:
     times: list[float] = []
     axis = TimeAxis()
     for offset, when, payload in units(data, kind, name, decoder.categories, problems):
-        for at, what, found in decoder.blocks(payload, offset, problems, when):
-            if what == ADSB:  # not in the plots table: a sensor of another kind
-                if found:
-                    problems.add("adsb", at, len(found))
-                continue
-            into = rows if what == PLOTS else marks
+        for _, what, found in decoder.blocks(payload, offset, problems, when):
+            into = marks if what == MARKS else rows  # ADS-B reports beside the plots
             into.extend(found)
-            is_plot.extend([what == PLOTS] * len(found))
+            is_plot.extend([what != MARKS] * len(found))
             times.extend(axis.times_list([r[0] for r in found], when))
     plots, sweeps = _columns(rows, marks, np.array(is_plot, bool),
                              np.array(times, float))
@@ -306,6 +308,12 @@ def _columns(rows: list[tuple[Any, ...]], marks: list[tuple[Any, ...]],
 
 
 def plot_columns(rows: list[tuple[Any, ...]]) -> dict[str, np.ndarray]:
-    """:data:`PLOT_COLUMNS` of plot rows (:meth:`Decoder.blocks`); ``time`` is the time of
+    """:data:`PLOT_COLUMNS` of plot rows (:meth:`Decoder.blocks`), then :data:`ADSB_EXTRA`
+    when a row is an ADS-B report (NaN on the radars' rows); ``time`` is the time of
     day."""
-    return columns(rows, PLOT_COLUMNS)
+    k = len(PLOT_COLUMNS)
+    out = columns([r[:k] for r in rows], PLOT_COLUMNS)
+    if any(len(r) > k for r in rows):
+        extra = np.array([r[k:k + 3] if len(r) > k else (np.nan,) * 3 for r in rows], float)
+        out.update(zip(ADSB_EXTRA, extra.T, strict=True))
+    return out

@@ -26,8 +26,6 @@ KINDS = {
                  "LANs, re-sent packets) dropped",
     "impossible": "{n} report(s) with a physically impossible value (latitude beyond "
                   "±90°, time of day beyond a day, ...) refused",
-    "adsb": "{n} ADS-B report(s) (CAT021) not in the plots table (they are tracked from "
-            "the recording itself)",
     "no_accuracy": "{n} ADS-B report(s) without a position accuracy (NACp/NUCp 0) and no "
                    "sigma for their station in the sensors file skipped",
     "not_plot": "{n} report(s) that are not plots (no detection, test target, field "

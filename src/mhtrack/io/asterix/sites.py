@@ -11,10 +11,7 @@ For each radar whose plots a recording holds:
   ``alt``);
 * not listed, or no sensors file, but its I034/120 was received: a polar radar at that
   site (height from I034/120) with the errors and detection probability of
-  :data:`DEFAULT_RADAR` — the EUROCONTROL Standard for Radar Surveillance in En-Route
-  Airspace and Major Terminal Areas (SUR.ET1.ST01.1000-STD-01-01, 1997), SSR
-  performance requirements: random range error σ ≤ 70 m, azimuth σ ≤ 0.08°, detection
-  probability ≥ 97 % — the radar's own period from its CAT034 messages;
+  :data:`DEFAULT_RADAR` (below) and the radar's own period from its CAT034 messages;
 * no site at all: skipped, the radars listed in one warning line;
 * an ADS-B station (CAT021) the file does not list: a sensor of kind ``adsb``
   (:data:`DEFAULT_ADSB`); its reports carry their own positions and accuracies.
@@ -22,6 +19,27 @@ For each radar whose plots a recording holds:
 The local frame is the file's (its origin, else its first lat/lon site) or, without a
 sensors file, centred on the first radar's site (the lowest id), else on the first
 ADS-B report.
+
+:data:`DEFAULT_RADAR`, the figures a secondary radar should meet: EUROCONTROL Standard
+Document for Radar Surveillance in En-Route Airspace and Major Terminal Areas,
+SUR.ET1.ST01.1000-STD-01-01, Edition 1.0 (Released Issue), March 1997, chapter 6 (SSR
+requirements §6.3, Recommendations in the document's terms, §6.3.1):
+
+* ``pd`` 0.97 — §6.3.2.1, "Overall probability of detection: > 97 %" (checked against a
+  verbatim quotation of the document; its PSR counterpart, §6.4.2.1, is > 90 %);
+* ``sigma_range`` 70 m and ``sigma_bearing_deg`` 0.08° — the SSR random errors (standard
+  deviations of slant range and azimuth) of §6.3.3. These two were **not** found in the
+  text that could be consulted here (the stored copies hold the document's front pages
+  and its PSR figures, §6.4.3.1: random σ 120 m in slant range and 0.15° in azimuth,
+  systematic 100 m, 0.1°, 1 m/NM, 100 ms); they are kept, marked unverified, and a
+  sensors file entry overrides them. Being bounds a compliant radar should meet, they
+  overstate the errors of a good monopulse SSR, never understate them.
+
+The successor in substance, the EUROCONTROL Specification for ATM Surveillance System
+Performance (ESASSP, EUROCONTROL-SPEC-0147, Edition 1.1 2015 / 1.2 2021), states
+requirements on the whole surveillance chain (horizontal position RMS error,
+probability of update) for 3 NM and 5 NM separation, not per-radar σ, so it gives no
+figure for this default.
 """
 
 from __future__ import annotations
@@ -34,7 +52,8 @@ from mhtrack.models.radars import RadarSensor, SensorSet
 
 #: A sensors file's site and the radar's own I034/120 differ by more than this (m): warn.
 DISAGREE_M = 100.0
-#: Errors of a radar known only from its CAT034 site (module docstring).
+#: Errors of a radar known only from its CAT034 site: SUR.ET1.ST01.1000-STD-01-01 (1997)
+#: §6.3.2.1 (pd) and §6.3.3 (σ, unverified here; module docstring).
 DEFAULT_RADAR = {"pd": 0.97, "sigma_range": 70.0, "sigma_bearing_deg": 0.08}
 #: An ADS-B station the sensors file does not list: its reports' σ come from their
 #: NACp/NUCp (:mod:`~mhtrack.io.asterix.cat021`); ``pd`` is an assumption (a station that

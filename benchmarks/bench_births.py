@@ -36,10 +36,10 @@ def false_tracks(tracks: Path, plots: Path) -> int:
     """Track ids none of whose rows holds a target's plot."""
     t = pd.read_csv(tracks, usecols=["track_id", "plot"])
     origin = pd.read_csv(plots, usecols=["origin"])["origin"].to_numpy()
-    p = t["plot"].to_numpy()
+    p = t["plot"].to_numpy(float)  # empty (NaN) on a miss row
     on_target = np.zeros(len(t), bool)
-    has = p >= 0
-    on_target[has] = origin[p[has]] >= 0
+    has = np.isfinite(p) & (p >= 0)
+    on_target[has] = origin[p[has].astype(np.int64)] >= 0
     by_id = pd.Series(on_target).groupby(t["track_id"].to_numpy()).any()
     return int((~by_id).sum())
 

@@ -67,19 +67,28 @@ def rotation_slots(t: np.ndarray, t0: float, tf: float, period: float, n_slots: 
 
 def followed(cand: np.ndarray, leaves: np.ndarray) -> np.ndarray:
     """Mask of candidate windows (n, W) whose last two plots (any columns) some leaf window
-    (m, W) holds, in any of its columns (a tree's columns are its own looks)."""
+    (m, W) holds, in any of its columns (a tree's columns are its own looks). Candidates
+    must have a plot in the last column; the leaves holding it are found by a sorted
+    search, so no (n, m) array is built."""
     n = len(cand)
     out = np.zeros(n, bool)
     if n == 0 or len(leaves) == 0:
         return out
     on = cand >= 0
     rank = np.cumsum(on[:, ::-1], axis=1)[:, ::-1] * on  # 1 = last plot, 2 = previous
-    last = cand[:, -1]
     prev = np.where((rank == 2).any(axis=1), cand[np.arange(n), np.argmax(rank == 2, axis=1)],
                     NO_PLOT)
-    holds_last = (leaves[None, :, :] == last[:, None, None]).any(axis=2)  # (n, m)
-    holds_prev = (leaves[None, :, :] == prev[:, None, None]).any(axis=2) | (prev < 0)[:, None]
-    return (holds_last & holds_prev).any(axis=1)
+    li, col = np.nonzero(leaves >= 0)
+    pid = leaves[li, col]
+    order = np.argsort(pid, kind="stable")
+    pid, li = pid[order], li[order]
+    lo = np.searchsorted(pid, cand[:, -1], "left")
+    k = np.searchsorted(pid, cand[:, -1], "right") - lo
+    ci = np.repeat(np.arange(n), k)
+    lj = li[np.repeat(lo - np.cumsum(k) + k, k) + np.arange(int(k.sum()))]
+    ok = (prev[ci] < 0) | (leaves[lj] == prev[ci, None]).any(axis=1)
+    out[ci[ok]] = True
+    return out
 
 
 class TimedInitiatorBirth(InitiatorBirth):
@@ -123,7 +132,8 @@ class TimedInitiatorBirth(InitiatorBirth):
         self.R = np.concatenate((self.R, R))
         self.rows = np.concatenate((self.rows, rows.astype(np.int64)))
         self.kappa = np.concatenate((self.kappa, kappa))
-        horizon = np.array([self._period(int(s)) for s in self.sensor]) * (self.n_scans + 1)
+        ids, inv = np.unique(self.sensor, return_inverse=True)
+        horizon = np.array([self._period(int(s)) for s in ids])[inv] * (self.n_scans + 1)
         keep = self.t >= (t.max() if len(t) else -np.inf) - horizon
         if not keep.all():
             self._keep(keep)

@@ -170,9 +170,8 @@ class TimedInitiatorBirth(InitiatorBirth):
         cur = np.arange(len(self.t) - len(z), len(self.t))
         parts = [earlier[slot == s] for s in range(N - 1)] + [cur]
         idx_all = np.concatenate(parts)
-        Rb = self.R
         scans = [Scan(s, float(nominal[s]), self.z[p], np.full(len(p), sid, np.int64),
-                      self.rows[p], Rb[p], None, self.t[p]) for s, p in enumerate(parts)]
+                      self.rows[p], self.R[p], None, self.t[p]) for s, p in enumerate(parts)]
         w = Window.from_scans(scans)
         tracks = self._initiator(N).initiate(w)
         flat = tracks.flat

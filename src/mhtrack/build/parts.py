@@ -36,8 +36,9 @@ from mhtrack.clutter.per_sensor import PerSensorClutter
 from mhtrack.clutter.polar import PolarClutter
 from mhtrack.initiation.fusion import AdaptiveKMeansFusion, KMeansFusion
 from mhtrack.mht import MHTConfig, MHTTracker
-from mhtrack.mht.births import Birth, InitiatorBirth, default_birth
+from mhtrack.mht.births import Birth, InitiatorBirth, TimedInitiatorBirth, default_birth
 from mhtrack.mht.coverage import Coverage, Everywhere, RadarCoverage
+from mhtrack.mht.gating import gate_threshold
 from mhtrack.mht.scoring import miss_increment
 from mhtrack.mht.sprt import sprt_thresholds
 from mhtrack.models.motion import MotionModel
@@ -134,6 +135,7 @@ def make_tracker(
     if sensors is None:
         return _assemble(config, make_clutter_estimator(estimator, kappa=kappa, **params),
                          Everywhere(config.p_detection), recipe)
+    periods = {s.id: s.period for s in sensors.sensors}
     config = config_with(config, confirm_min_plots=max(config.confirm_min_plots,
                                                        TIMED_CONFIRM_MIN_PLOTS))
     if clutter_frame not in names.CLUTTER_FRAMES:
@@ -148,17 +150,18 @@ def make_tracker(
         lambda: make_clutter_estimator(estimator, kappa=kappa, **params),
         {s.id: s.period for s in sensors.sensors},
         initial=DEFAULT_CLUTTER_DENSITY if kappa is None else kappa, wrap=wrap)
-    return _assemble(config, clutter, RadarCoverage(sensors), recipe)
+    return _assemble(config, clutter, RadarCoverage(sensors), recipe, periods)
 
 
 def _assemble(config: MHTConfig, clutter: ClutterEstimator, coverage: Coverage,
-              recipe: dict[str, Any]) -> MHTTracker:
+              recipe: dict[str, Any], periods: dict[int, float | None] | None = None
+              ) -> MHTTracker:
     """The tracker of ``config`` with its parts: the configuration's motion model, the
     birth ``config.birth`` names (:func:`make_birth`, scored with the coverage's
-    ``P_D``), and the builder's ``recipe``."""
+    ``P_D``; ``periods`` of timed plots' radars), and the builder's ``recipe``."""
     motion = config.motion
     trk = MHTTracker(config, clutter, motion=motion, coverage=coverage,
-                     birth=make_birth(config, motion, coverage.plot_pd))
+                     birth=make_birth(config, motion, coverage.plot_pd, periods))
     trk.recipe = recipe
     return trk
 
@@ -166,17 +169,26 @@ def _assemble(config: MHTConfig, clutter: ClutterEstimator, coverage: Coverage,
 # ------------------------------------------------------------------------ births
 
 def _initiator_birth(method: str) -> Callable[..., Birth]:
-    """The birth of P2's initiator ``method`` over the last scans (:class:`InitiatorBirth`)."""
+    """The birth of P2's initiator ``method`` over the last scans (:class:`InitiatorBirth`),
+    or, with the radars' ``periods`` (timed plots), over each radar's last rotations
+    (:class:`TimedInitiatorBirth`, the logic's χ² gate at the tracker's ``P_G``)."""
     def make(cfg: MHTConfig, motion: MotionModel,
-             plot_pd: Callable[[Scan], float] | None) -> Birth:
-        return InitiatorBirth(
-            method, motion, theta_deg=cfg.birth_theta_deg, width=cfg.n_scan + 1,
+             plot_pd: Callable[[Scan], float] | None,
+             periods: dict[int, float | None] | None = None) -> Birth:
+        pg = cfg.gate_probability if cfg.miss_uses_gate_probability else None
+        params = dict(
+            theta_deg=cfg.birth_theta_deg, width=cfg.n_scan + 1,
             p_detection=cfg.p_detection, new_target_density=cfg.new_target_density,
-            miss_dl=miss_increment(cfg.p_detection, cfg.gate_probability
-                                   if cfg.miss_uses_gate_probability else None),
+            miss_dl=miss_increment(cfg.p_detection, pg),
             v_max=cfg.v_max, floor=sprt_thresholds(cfg.alpha, cfg.beta)[1],
             max_per_scan=cfg.max_births_per_scan, prune_drop=cfg.prune_drop,
             max_leaves_per_tree=cfg.max_leaves_per_tree)
+        if periods is None:
+            return InitiatorBirth(method, motion, **params)
+        return TimedInitiatorBirth(
+            method, motion, periods=periods,
+            plot_pd=plot_pd if plot_pd is not None else lambda scan: cfg.p_detection,
+            gate_probability=pg, gate_chi2=gate_threshold(cfg.gate_probability), **params)
     return make
 
 
@@ -186,14 +198,18 @@ BIRTH_FACTORIES: dict[str, Callable[..., Birth]] = {
 
 
 def make_birth(cfg: MHTConfig, motion: MotionModel,
-               plot_pd: Callable[[Scan], float] | None = None) -> Birth:
+               plot_pd: Callable[[Scan], float] | None = None,
+               periods: dict[int, float | None] | None = None) -> Birth:
     """The birth process ``cfg.birth`` (:data:`BIRTH_FACTORIES`) with the configuration's
     parameters; new trees start only above the SPRT deletion threshold ``ln(β/(1−α))``.
-    ``plot_pd``: the ``P_D`` of a scan's sensor for the every-plot birth score (``None``:
-    ``cfg.p_detection``)."""
+    ``plot_pd``: the ``P_D`` of a scan's sensor for the birth score (``None``:
+    ``cfg.p_detection``). ``periods``: rotation period per sensor id of timed plots
+    (frames of one sensor each); P2's initiators then work on each radar's rotations."""
     if cfg.birth not in BIRTH_FACTORIES:
         raise ValueError(f"unknown birth {cfg.birth!r} "
                          f"(expected one of {', '.join(BIRTH_FACTORIES)})")
+    if periods is not None and cfg.birth != names.EVERY_PLOT:
+        return BIRTH_FACTORIES[cfg.birth](cfg, motion, plot_pd, periods)
     return BIRTH_FACTORIES[cfg.birth](cfg, motion, plot_pd)
 
 

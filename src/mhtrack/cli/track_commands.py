@@ -67,7 +67,8 @@ def birth_options(f: Callable[..., Any]) -> Callable[..., Any]:
     opts = [
         click.option("--birth", type=click.Choice(BIRTHS), default=EVERY_PLOT,
                      show_default=True, help="Which plots start new track trees: every plot "
-                     "(P1), or tracks initiated by a P2 initiator over the last 4 scans."),
+                     "(P1), or tracks initiated by a P2 initiator over the last 4 scans (timed "
+                     "plots: each radar's last 4 rotations)."),
         click.option("--birth-theta", "birth_theta", type=click.FloatRange(0, 180),
                      default=None, help="Angle limit θ (degrees) of the modified "
                      "initiators [20]."),

@@ -21,7 +21,8 @@ acceleration and angle" constraints): each detected cell gives every sequence of
 one per scan (at most ``N − votes`` scans without one), that satisfies, over its
 consecutive plots ``z_a → z_b`` (times ``t_a < t_b``):
 
-* velocity: ``v_min ≤ ‖z_b − z_a‖ / (t_b − t_a) ≤ v_max`` (ours: 50, 400 m/s);
+* velocity: ``v_min ≤ ‖z_b − z_a‖ / (t_b − t_a) ≤ v_max`` (ours: 50, 400 m/s; ``t`` the
+  plot's scan time, or its own time when the window has one, :attr:`Window.t`);
 * acceleration (``accel_max`` given; P2 §3.2 names the constraint without a formula or
   a value): the speeds of consecutive legs ``v₁ = ‖z_q − z_p‖/(t_q − t_p)``,
   ``v₂ = ‖z − z_q‖/(t − t_q)`` change by ``|v₂ − v₁| ≤ a_max · (t − t_p)/2`` (the time
@@ -197,7 +198,7 @@ class HoughInitiator(Initiator):
         np.add.at(cnt, (cell_of, s), 1)
         off = (np.cumsum(cnt.ravel()) - cnt.ravel()).reshape(n_cells, N)
         max_miss = N - self.votes
-        z, t = w.z, w.times
+        z, tp = w.z, w.plot_times()  # each plot's time (its scan's, or its own)
         dirs = np.column_stack((-np.sin(theta), np.cos(theta)))  # along-line unit vectors
         path = np.full((0, N), NO_PLOT, np.int64)
         g = np.zeros(0, np.int64)  # cell of each partial sequence
@@ -212,7 +213,7 @@ class HoughInitiator(Initiator):
                 j = plot[np.repeat(off[g, c] - np.cumsum(k) + k, k) + np.arange(int(k.sum()))]
                 # velocity: v_min·Δt ≤ ‖leg‖ ≤ v_max·Δt
                 leg = z[j] - z[last[q]]
-                dt = t[c] - t[w.slot[last[q]]]
+                dt = tp[j] - tp[last[q]]
                 d2 = leg[:, 0] ** 2 + leg[:, 1] ** 2
                 ok = (d2 >= (self.v_min * dt) ** 2) & (d2 <= (self.v_max * dt) ** 2)
                 q, j, leg, d2, dt = q[ok], j[ok], leg[ok], d2[ok], dt[ok]
@@ -226,8 +227,7 @@ class HoughInitiator(Initiator):
                     ok = np.ones(len(q), bool)
                 if self.accel_max is not None:
                     # acceleration: |v₂ − v₁| ≤ a_max · (t − t_p)/2
-                    t_last = t[w.slot[last[q]]]
-                    dt1 = t_last - t[w.slot[np.maximum(prev[q], 0)]]
+                    dt1 = tp[last[q]] - tp[np.maximum(prev[q], 0)]
                     with np.errstate(divide="ignore", invalid="ignore"):
                         v1 = np.hypot(pleg[:, 0], pleg[:, 1]) / dt1
                     dv = np.abs(np.sqrt(d2) / dt - v1)

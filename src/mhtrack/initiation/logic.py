@@ -45,6 +45,7 @@ from mhtrack.initiation.window import (
     previous_plot,
     remove_dominated,
 )
+from mhtrack.models.linalg2 import inv2
 
 
 def leg_angle(new: np.ndarray, prev: np.ndarray) -> np.ndarray:
@@ -70,6 +71,64 @@ def _ball(tree: cKDTree, centres: np.ndarray, radius: np.ndarray | float,
     return q, j
 
 
+def _second_timed(tree: cKDTree, tp: np.ndarray, z: np.ndarray, rows: np.ndarray,
+                  last: np.ndarray, v_min: float, v_max: float
+                  ) -> tuple[np.ndarray, np.ndarray]:
+    """Velocity gate of the second plot with each plot at its own time ``tp``: the pairs
+    ``(query row, slot row)`` with ``v_min·Δt ≤ ‖z − z_a‖ ≤ v_max·Δt``, ``Δt > 0``."""
+    dt_max = np.maximum(tp[rows].max() - tp[last], 0.0)
+    q, j = _ball(tree, z[last], v_max * dt_max)
+    dt = tp[rows[j]] - tp[last[q]]
+    d = np.hypot(*(z[rows[j]] - z[last[q]]).T)
+    ok = (dt > 0) & (d >= v_min * dt) & (d <= v_max * dt)
+    return q[ok], j[ok]
+
+
+def _lmax(R: np.ndarray) -> np.ndarray:
+    """Largest eigenvalue of 2×2 symmetric matrices (…, 2, 2)."""
+    h = 0.5 * (R[..., 0, 0] + R[..., 1, 1])
+    d = 0.5 * (R[..., 0, 0] - R[..., 1, 1])
+    return h + np.hypot(d, R[..., 0, 1])
+
+
+def _later_timed(tree: cKDTree, w: Window, rows: np.ndarray, a: np.ndarray, b: np.ndarray,
+                 gate_radius: float, gate_chi2: float | None
+                 ) -> tuple[np.ndarray, np.ndarray]:
+    """Position gate of a later plot with each plot at its own time (``w.t``): the
+    straight line through ``z_a, z_b`` predicts ``ẑ = z_b + (z_b − z_a)(t − t_b)/(t_b − t_a)``
+    at the plot's time ``t``; the plot is taken when ``‖z − ẑ‖ ≤ r`` or, with ``gate_chi2``
+    ``γ``, ``νᵀS⁻¹ν ≤ γ`` with the prediction's covariance
+    ``S = (1 + s)² R_b + s² R_a + R``, ``s = (t − t_b)/(t_b − t_a)`` (the three plots'
+    errors, independent). Returns ``(query row, slot row)`` pairs."""
+    tp, z = w.t, w.z
+    assert tp is not None
+    ta, tb = tp[a], tp[b]
+    span = tb - ta
+    vel = (z[b] - z[a]) / span[:, None]
+    tlo, thi = float(tp[rows].min()), float(tp[rows].max())
+    centre = z[b] + vel * (0.5 * (tlo + thi) - tb)[:, None]
+    radius = np.full(len(a), float(gate_radius))
+    if gate_chi2 is not None:
+        s_hi = (thi - tb) / span
+        bound = ((1 + s_hi) ** 2 * _lmax(w.R[b]) + s_hi**2 * _lmax(w.R[a])
+                 + float(_lmax(w.R[rows]).max()))
+        radius = np.maximum(radius, np.sqrt(gate_chi2 * bound))
+    radius = radius + np.hypot(vel[:, 0], vel[:, 1]) * 0.5 * (thi - tlo)
+    q, j = _ball(tree, centre, radius)
+    if len(q) == 0:
+        return q, j
+    aq, bq, jr = a[q], b[q], rows[j]
+    s = (tp[jr] - tb[q]) / span[q]
+    nu = z[jr] - (z[bq] + (z[bq] - z[aq]) * s[:, None])
+    ok = np.hypot(nu[:, 0], nu[:, 1]) <= gate_radius
+    if gate_chi2 is not None:
+        S = ((1 + s)[:, None, None] ** 2 * w.R[bq] + (s**2)[:, None, None] * w.R[aq]
+             + w.R[jr])
+        d2 = np.einsum("ka,kab,kb->k", nu, inv2(S), nu)
+        ok |= d2 <= gate_chi2
+    return q[ok], j[ok]
+
+
 class LogicInitiator(Initiator):
     """M/N logic initiation, plain (P2's 3/4 logic) or modified with the angle constraint
     ``α ≤ θ`` (P2 §2.1) — see the module docstring.
@@ -80,11 +139,15 @@ class LogicInitiator(Initiator):
     gate_radius : ``r`` (m) of the position gate (P2: 300).
     v_min, v_max : velocity gate (m/s) of the second plot (ours: 50, 400).
     n_scans, min_plots : ``N`` and ``M`` (P2: 4 and 3).
+    gate_chi2 : with plots at their own times (timed plots, :attr:`Window.t`), also take a
+        later plot inside the χ² gate ``γ`` of the prediction's covariance (ours: a far
+        radar's cross-range σ exceeds ``r``; :func:`_later_timed`); ``None``: P2's radius only.
     """
 
     def __init__(self, *, angle_limit_deg: float | None = None, gate_radius: float = 300.0,
                  v_min: float = 50.0, v_max: float = 400.0, n_scans: int = 4,
-                 min_plots: int = 3) -> None:
+                 min_plots: int = 3, gate_chi2: float | None = None) -> None:
+        self.gate_chi2 = gate_chi2
         self.angle_limit_deg = angle_limit_deg
         self.gate_radius = gate_radius
         self.v_min = v_min
@@ -100,6 +163,9 @@ class LogicInitiator(Initiator):
         a = self.angle_limit_deg
         if a is not None and not 0 <= a <= 180:
             raise ValueError(f"angle_limit_deg must be in [0, 180] or None, got {a!r}")
+        g = self.gate_chi2
+        if g is not None and not g > 0:
+            raise ValueError(f"gate_chi2 must be > 0 or None, got {g!r}")
 
     def find_tracks(self, w: Window) -> np.ndarray:
         """The window's tracks at this initiator's angle limit (θ = π, no limit, for the
@@ -107,13 +173,15 @@ class LogicInitiator(Initiator):
         theta = np.pi if self.angle_limit_deg is None else np.radians(self.angle_limit_deg)
         path, lo, hi = branch_tracks(w, np.array([theta]), gate_radius=self.gate_radius,
                                      v_min=self.v_min, v_max=self.v_max,
-                                     n_scans=self.n_scans, min_plots=self.min_plots)
+                                     n_scans=self.n_scans, min_plots=self.min_plots,
+                                     gate_chi2=self.gate_chi2)
         return path[(lo <= theta) & (theta < hi)]
 
 
 def branch_tracks(window: Window, thetas: np.ndarray, *, gate_radius: float = 300.0,
                   v_min: float = 50.0, v_max: float = 400.0, n_scans: int = 4,
-                  min_plots: int = 3) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+                  min_plots: int = 3, gate_chi2: float | None = None,
+                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The M-of-N branching of the (modified) logic over a window, for a grid of angle
     limits ``thetas`` (radians) at once.
 
@@ -132,7 +200,7 @@ def branch_tracks(window: Window, thetas: np.ndarray, *, gate_radius: float = 30
     ths = np.sort(np.asarray(thetas, float))
     N, M = n_scans, min_plots
     max_miss = N - M
-    z, t = window.z, window.times
+    z, t, tp = window.z, window.times, window.t
 
     def on_grid(lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
         i = np.searchsorted(ths, lo, side="left")
@@ -151,7 +219,12 @@ def branch_tracks(window: Window, thetas: np.ndarray, *, gate_radius: float = 30
             tree = cKDTree(z[rows]) if len(rows) else None
             q_all, j_all, a_all = [], [], []
             one = np.flatnonzero(hits == 1)
-            if len(one) and tree is not None:
+            if len(one) and tree is not None and tp is not None:
+                q, j = _second_timed(tree, tp, z, rows, last[one], v_min, v_max)
+                q_all.append(one[q])
+                j_all.append(rows[j])
+                a_all.append(np.full(len(q), -np.inf))  # no angle test
+            elif len(one) and tree is not None:
                 dt = t[c] - t[window.slot[last[one]]]
                 q, j = _ball(tree, z[last[one]], v_max * dt)
                 d = np.hypot(*(z[rows[j]] - z[last[one[q]]]).T)
@@ -162,10 +235,13 @@ def branch_tracks(window: Window, thetas: np.ndarray, *, gate_radius: float = 30
             more = np.flatnonzero(hits >= 2)
             if len(more) and tree is not None:
                 a, b = prev[more], last[more]
-                step = (t[c] - t[window.slot[b]]) / (t[window.slot[b]] - t[window.slot[a]])
                 leg = z[b] - z[a]
-                pred = z[b] + leg * step[:, None]
-                q, j = _ball(tree, pred, gate_radius)
+                if tp is not None:
+                    q, j = _later_timed(tree, window, rows, a, b, gate_radius, gate_chi2)
+                else:
+                    step = (t[c] - t[window.slot[b]]) / (t[window.slot[b]] - t[window.slot[a]])
+                    pred = z[b] + leg * step[:, None]
+                    q, j = _ball(tree, pred, gate_radius)
                 ang = (leg_angle(z[rows[j]] - z[b[q]], leg[q]) if len(q)
                        else np.zeros(0))
                 q_all.append(more[q])

@@ -43,6 +43,9 @@ class Window:
     index : (n,) index of the plot in its scan; origin : (n,) or None.
     start : (N + 1,) plots of slot ``s`` are ``start[s]:start[s+1]``.
     R_inv : (n, 2, 2) inverse covariances.
+    t : (n,) each plot's own time (s) when the scans carry one (timed plots: the slots
+        are a radar's rotations, ``times`` their nominal times); ``None``: every plot has
+        its slot's time (P2's scans).
     """
 
     scans: np.ndarray
@@ -54,6 +57,7 @@ class Window:
     origin: np.ndarray | None
     start: np.ndarray
     R_inv: np.ndarray
+    t: np.ndarray | None = None
 
     @property
     def n_scans(self) -> int:
@@ -66,9 +70,14 @@ class Window:
         """Flat indices of the plots of slot ``s``."""
         return np.arange(self.start[s], self.start[s + 1])
 
+    def plot_times(self) -> np.ndarray:
+        """(n,) each plot's time: ``t``, or its slot's time."""
+        return self.times[self.slot] if self.t is None else self.t
+
     @classmethod
     def from_scans(cls, scans: Sequence[Scan], default_R: np.ndarray = DEFAULT_R) -> Window:
-        """Stack ``scans`` (in time order) into a window."""
+        """Stack ``scans`` (in time order) into a window; the plots' own times ``t`` when
+        every scan has them (:attr:`Scan.t`)."""
         if len(scans) == 0:
             raise ValueError("a window needs at least one scan")
         times = np.array([s.time for s in scans], float)
@@ -93,6 +102,8 @@ class Window:
             origin=origin,
             start=np.concatenate(([0], np.cumsum(n))).astype(np.int64),
             R_inv=inv2(np.asarray(R, float)),
+            t=(np.concatenate([s.t for s in scans]).astype(float)  # type: ignore[misc]
+               if all(s.t is not None for s in scans) else None),
         )
 
 
@@ -138,7 +149,8 @@ def least_squares_state(
     """Straight-line GLS state ``x`` and covariance ``P`` at the last scan of ``window``
     for tracks given by flat plot indices ``flat`` (n, N) (module docstring).
 
-    With ``W_s = R_s⁻¹`` (0 on a miss) and ``τ_s = t_s − t_N`` the normal equations split
+    With ``W_s = R_s⁻¹`` (0 on a miss) and ``τ_s = t_s − t_N`` (``t_s`` the plot's own
+    time when the window has them, :attr:`Window.t`) the normal equations split
     into 2×2 blocks: ``A_m = Σ τ_s^m W_s`` (m = 0, 1, 2) and ``b_m = Σ τ_s^m W_s z_s``;
     ``info = [[A0, A1], [A1, A2]]`` over (position, velocity), inverted blockwise through
     the Schur complement ``A2 − A1 A0⁻¹ A1`` and permuted to ``[x, vx, y, vy]``."""
@@ -150,9 +162,14 @@ def least_squares_state(
     idx = np.maximum(flat, 0)
     W = window.R_inv[idx] * have[..., None, None]  # (n, N, 2, 2)
     Wz = np.einsum("nsab,nsb->nsa", W, window.z[idx])
-    tau = window.times - window.times[-1]
-    A0, A1, A2 = (np.tensordot(W, tau**m, axes=([1], [0])) for m in range(3))  # (n, 2, 2)
-    b0, b1 = (np.tensordot(Wz, tau**m, axes=([1], [0])) for m in range(2))  # (n, 2)
+    if window.t is None:
+        tau = window.times - window.times[-1]
+        A0, A1, A2 = (np.tensordot(W, tau**m, axes=([1], [0])) for m in range(3))  # (n,2,2)
+        b0, b1 = (np.tensordot(Wz, tau**m, axes=([1], [0])) for m in range(2))  # (n, 2)
+    else:  # each plot at its own time
+        tau_p = np.where(have, window.t[idx] - window.times[-1], 0.0)  # (n, N)
+        A0, A1, A2 = (np.einsum("nsab,ns->nab", W, tau_p**m) for m in range(3))
+        b0, b1 = (np.einsum("nsa,ns->na", Wz, tau_p**m) for m in range(2))
     # block inverse of [[A0, A1], [A1, A2]] (A1 symmetric) by the Schur complement
     A0i = inv2(A0)
     G = A0i @ A1

@@ -2,7 +2,8 @@
 
 * ``every-plot`` (default, P1 Fig. 1): every plot starts a tree (:mod:`.every_plot`);
 * ``logic`` / ``modified-logic`` / ``hough`` / ``modified-hough``: a P2 initiator over the
-  last scans (:mod:`.initiator`), scored by :mod:`.sequence`.
+  last scans (:mod:`.initiator`), on timed plots over each radar's last rotations
+  (:mod:`.timed_initiator`), scored by :mod:`.sequence`.
 
 :func:`default_birth` is the tracker's when none is passed; :func:`mhtrack.build.make_birth`
 builds the one an :class:`~mhtrack.mht.config.MHTConfig` names.
@@ -15,6 +16,7 @@ from collections.abc import Callable
 from mhtrack.mht.births.base import Birth, BirthCandidates
 from mhtrack.mht.births.every_plot import EveryPlotBirth
 from mhtrack.mht.births.initiator import InitiatorBirth
+from mhtrack.mht.births.timed_initiator import TimedInitiatorBirth
 from mhtrack.mht.config import MHTConfig
 from mhtrack.mht.sprt import sprt_thresholds
 from mhtrack.models.motion import MotionModel
@@ -39,4 +41,5 @@ def default_birth(cfg: MHTConfig, motion: MotionModel,
                           plot_pd=plot_pd)
 
 
-__all__ = ["Birth", "BirthCandidates", "EveryPlotBirth", "InitiatorBirth", "default_birth"]
+__all__ = ["Birth", "BirthCandidates", "EveryPlotBirth", "InitiatorBirth",
+           "TimedInitiatorBirth", "default_birth"]

@@ -241,7 +241,7 @@ class InitiatorBirth(Birth):
                ) -> tuple[BirthCandidates, np.ndarray]:
         if len(cand) == 0:
             return cand, np.zeros(0, np.int64)
-        keep = ~followed_by(cand.window, leaf_window)
+        keep = ~self._followed(cand.window, leaf_window)
         _, first = np.unique(cand.window, axis=0, return_index=True)
         uniq = np.zeros(len(cand), bool)
         uniq[first] = True
@@ -251,6 +251,10 @@ class InitiatorBirth(Birth):
         cand = cand.take(order)
         _, group = np.unique(last[order], return_inverse=True)
         return cand, group.reshape(-1).astype(np.int64)
+
+    def _followed(self, cand: np.ndarray, leaves: np.ndarray) -> np.ndarray:
+        """Candidates an existing leaf already follows (:func:`followed_by`)."""
+        return followed_by(cand, leaves)
 
     # ------------------------------------------------------------------ persistence
     def arrays(self) -> dict[str, np.ndarray]:

@@ -43,7 +43,8 @@ def sequence_score(
     """Score ``L`` and running peak of plot sequences, as an every-plot tree would score
     the branch (module docstring), with ``motion``'s filter and plot likelihood.
 
-    ``times`` (N,) scan times; per sequence and scan ``z`` (n, N, 2), ``R`` (n, N, 2, 2),
+    ``times`` (N,) scan times, or (n, N) per sequence (timed plots: each plot's own time,
+    a miss at its slot's nominal time); per sequence and scan ``z`` (n, N, 2), ``R`` (n, N, 2, 2),
     ``has`` (n, N) plot present, ``kappa`` (n, N) clutter intensity at the plot. Every
     sequence needs at least one plot.
     """
@@ -55,7 +56,9 @@ def sequence_score(
     started = np.zeros(n, bool)
     for s in range(N):
         if s and started.any():
-            st.put(started, motion.predict(st.take(started), float(times[s] - times[s - 1])))
+            dt = (float(times[s] - times[s - 1]) if times.ndim == 1
+                  else times[started, s] - times[started, s - 1])
+            st.put(started, motion.predict(st.take(started), dt))
         h = has[:, s]
         new = h & ~started
         if new.any():

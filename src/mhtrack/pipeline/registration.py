@@ -30,6 +30,8 @@ MAX_PAIR_DT = 5.0
 #: σ of the track velocity (m/s) and of an unmodelled acceleration (m/s²) bridging the
 #: two plots' times (ours): ``C += (dt² σ_v² + (σ_a dt²/2)²) I``.
 SIGMA_V, SIGMA_A = 5.0, 2.0
+#: Interval of :attr:`Registration.history` snapshots (s of plot time).
+SNAPSHOT_S = 10.0
 
 
 @dataclass
@@ -76,6 +78,9 @@ class Registration:
         self._last: dict[int, dict[int, _Plot]] = {}
         self._raw: dict[int, tuple[float, float]] = {}
         self.pairs = 0
+        #: ``(t, {id: RadarBias})`` every :data:`SNAPSHOT_S` seconds of plot time (the
+        #: estimate's history: convergence, ``docs/registration.md``).
+        self.history: list[tuple[float, dict[int, RadarBias]]] = []
 
     def _place(self, sid: int, r: np.ndarray, b: np.ndarray
                ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -136,6 +141,10 @@ class Registration:
                     pairs.append((new, other, v))
             last[sid] = new
         used = self._update(pairs)
+        if len(times):
+            now = float(times.max())
+            if not self.history or now >= self.history[-1][0] + SNAPSHOT_S:
+                self.history.append((now, self.biases()))
         if len(self._last) > 4096:  # forget tracks with no recent plot
             now = float(times.max()) if len(times) else 0.0
             self._last = {tid: d for tid, d in self._last.items()

@@ -27,10 +27,10 @@ for these speeds and periods) can have ``q >= 1``; the crossing is then the last
 and reported with range and bearing plus Gaussian noise ``σr``, ``σθ`` (range folded to
 ``|r|``, bearing wrapped to ``[0, 360)``), after the radar's registration bias, if it has
 one (``r_m = g r + Δr``, ``θ_m = θ + Δθ``: ``RotatingRadar.range_gain``, ``range_bias``,
-``azimuth_bias_deg``; clutter is drawn in the measured space). **Clutter** per rotation (the beam's turn from
-north to north): :func:`~mhtrack.models.clutter.sample_range_azimuth`, each plot timed
-when the beam points at its bearing. Every plot is converted to the local frame with its
-covariance by :func:`~mhtrack.models.geodesy.polar_to_local`.
+``azimuth_bias_deg``; clutter is drawn in the measured space). **Clutter** per rotation
+(the beam's turn from north to north): :func:`~mhtrack.models.clutter.sample_range_azimuth`,
+each plot timed when the beam points at its bearing. Every plot is converted to the local
+frame with its covariance by :func:`~mhtrack.models.geodesy.polar_to_local`.
 
 **Random streams** (integer spawn keys, as in :mod:`mhtrack.scenario.simulate`):
 ``(2, sensor id, target id)`` for a target's detections and noise by one radar,

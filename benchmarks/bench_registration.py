@@ -31,7 +31,7 @@ from mhtrack.sinks.files import TracksFileSink
 
 AT_S = 600.0
 #: Scale of each component below which "within 20 %" is taken of the scale (a true bias
-#: of 0 has no 20 %): 100 m, gain 0.001, 0.05°.
+#: of 0 has no 20 %): 100 m, gain 0.001, 0.05°; the relative errors are printed beside.
 SCALE = (100.0, 0.001, 0.05)
 
 
@@ -75,6 +75,14 @@ def _within(est: tuple[float, float, float], true: tuple[float, float, float]) -
     return all(abs(e) <= 0.2 * max(abs(t), s) for e, t, s in zip(errs, tv, SCALE, strict=True))
 
 
+def _relative(est: tuple[float, float, float], true: tuple[float, float, float]) -> str:
+    """Each component's error in % of its true value ("-" for a true 0)."""
+    tv = (true[0], true[1] - 1.0, true[2])
+    ev = (est[0], est[1] - 1.0, est[2])
+    return "/".join(f"{100 * (e - t) / abs(t):+.0f} %" if t else "-"
+                    for e, t in zip(ev, tv, strict=True))
+
+
 def main(draws: list[int]) -> None:
     for k in draws:
         ref, biases = draw(k)
@@ -115,6 +123,7 @@ def main(draws: list[int]) -> None:
                               f"{e[0]:+7.1f} ± {b.sigma[0]:4.1f} m (true {true[0]:+.1f}), gain "
                               f"{e[1]:.5f} ± {b.sigma[1]:.5f} (true {true[1]:.5f}), azimuth "
                               f"{e[2]:+.4f} ± {b.sigma[2]:.4f}° (true {true[2]:+.3f})"
+                              f"  relative errors {_relative(e, true)}"
                               f"  within 20 %: {'yes' if _within(e, true) else 'NO'}")
 
 

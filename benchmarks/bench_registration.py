@@ -66,6 +66,7 @@ def _estimated(d: Path, ref: int, out: Path) -> list:  # type: ignore[type-arg]
     pipe = Pipeline.open(d / "plots.csv", opts, sensors_file=str(d / "sensors.toml"))
     pipe.run([TracksFileSink(out, frame=pipe.frame, output=pipe.output)], keep_stats=False)
     assert pipe.registration is not None
+    print("   ", pipe.registration.describe()[1:])
     return pipe.registration.history
 
 

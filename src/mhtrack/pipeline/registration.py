@@ -8,7 +8,8 @@ by :func:`~mhtrack.models.geodesy.polar_to_local`). After the step, every confir
 track updated by a plot of one sensor is paired with the last plot another sensor gave
 that track within :attr:`Registration.max_dt` seconds; the pair's difference, the times
 bridged by the track's velocity, updates the estimator
-(:class:`~mhtrack.models.registration.BiasEstimator`).
+(:class:`~mhtrack.models.registration.BiasEstimator`). A radar's estimate corrects its
+plots only once it has settled (:data:`APPLY_SIGMA`).
 """
 
 from __future__ import annotations
@@ -32,6 +33,11 @@ MAX_PAIR_DT = 5.0
 SIGMA_V, SIGMA_A = 5.0, 2.0
 #: Interval of :attr:`Registration.history` snapshots (s of plot time).
 SNAPSHOT_S = 10.0
+#: A radar's estimate corrects its plots once every σ is below these (range offset m,
+#: gain, azimuth °; ours): the first few pairs, under the wide prior, can swing the
+#: estimate by 0.4° (opensky-radars seed 3, first 20 s), and plots moved by such a swing
+#: break tracks. Until then its plots go to the tracker as measured.
+APPLY_SIGMA = (20.0, 2e-4, 0.02)
 
 
 @dataclass
@@ -77,16 +83,34 @@ class Registration:
         self._site = {i: sensors.site_latlon(i) for i in estimated}
         self._last: dict[int, dict[int, _Plot]] = {}
         self._raw: dict[int, tuple[float, float]] = {}
+        #: Radar id → plot time from which its estimate corrects its plots (None: from
+        #: the start, a prior already within :data:`APPLY_SIGMA`).
+        self.settled: dict[int, float | None] = {}
         self.pairs = 0
         #: ``(t, {id: RadarBias})`` every :data:`SNAPSHOT_S` seconds of plot time (the
         #: estimate's history: convergence, ``docs/registration.md``).
         self.history: list[tuple[float, dict[int, RadarBias]]] = []
 
-    def _place(self, sid: int, r: np.ndarray, b: np.ndarray
+    def applied(self, sid: int) -> RadarBias:
+        """The bias that corrects radar ``sid``'s plots for the tracker: the estimate once
+        its σ are all below :data:`APPLY_SIGMA` (and from then on), else none."""
+        self._settle(sid, None)
+        return self.estimator.bias(sid) if sid in self.settled else RadarBias()
+
+    def _settle(self, sid: int, t: float | None) -> None:
+        """Mark radar ``sid`` settled (at time ``t``) once its σ are below the bounds."""
+        if sid not in self.settled and all(
+                s < a for s, a in zip(self.estimator.bias(sid).sigma, APPLY_SIGMA,
+                                      strict=True)):
+            self.settled[sid] = t
+
+    def _place(self, sid: int, r: np.ndarray, b: np.ndarray, bias: RadarBias | None = None
                ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Measured ``(r, b)`` of radar ``sid`` corrected: ``z`` (n, 2), ``R`` (n, 2, 2)
-        and the correction Jacobian ``H`` (n, 2, 3)."""
-        s, bias = self.sensors.sensor(sid), self.estimator.bias(sid)
+        """Measured ``(r, b)`` of radar ``sid`` corrected by ``bias`` (default: the
+        current estimate): ``z`` (n, 2), ``R`` (n, 2, 2) and the correction Jacobian
+        ``H`` (n, 2, 3)."""
+        s = self.sensors.sensor(sid)
+        bias = self.estimator.bias(sid) if bias is None else bias
         rc, bc = bias.correct(r, b)
         z, R = polar_to_local(self.frame, *self._site[sid], rc, bc, s.sigma_range,
                               s.sigma_bearing_deg)
@@ -107,7 +131,7 @@ class Registration:
             idx = np.flatnonzero(scan.sensor == sid)
             r, b = local_to_polar(self.frame, *self._site[sid], z[idx, 0], z[idx, 1])
             r, b = np.atleast_1d(r), np.atleast_1d(b)
-            zc, Rc, _ = self._place(sid, r, b)
+            zc, Rc, _ = self._place(sid, r, b, self.applied(sid))
             z[idx] = zc
             if R is None:
                 R = np.zeros((len(scan), 2, 2))
@@ -143,6 +167,8 @@ class Registration:
         used = self._update(pairs)
         if len(times):
             now = float(times.max())
+            for sid in self.estimator.ids:
+                self._settle(sid, now)
             if not self.history or now >= self.history[-1][0] + SNAPSHOT_S:
                 self.history.append((now, self.biases()))
         if len(self._last) > 4096:  # forget tracks with no recent plot
@@ -171,6 +197,12 @@ class Registration:
         self.pairs += used
         return used
 
+    def _since(self, sid: int) -> str:
+        if sid not in self.settled:
+            return "never applied: σ above the bounds"
+        t = self.settled[sid]
+        return "applied from the start" if t is None else f"applied from t = {t:.0f} s"
+
     def biases(self) -> dict[int, RadarBias]:
         """The estimated radars' current biases."""
         return self.estimator.biases()
@@ -185,5 +217,5 @@ class Registration:
             lines.append(f"  radar {sid}: range offset {b.range_offset:+.1f} ± {s[0]:.1f} m, "
                          f"gain {b.range_gain:.5f} ± {s[1]:.5f}, azimuth "
                          f"{b.azimuth_deg:+.4f} ± {s[2]:.4f}° "
-                         f"({self.estimator.used[sid]} pairs)")
+                         f"({self.estimator.used[sid]} pairs; {self._since(sid)})")
         return lines

@@ -86,6 +86,8 @@ class Registration:
         #: Radar id → plot time from which its estimate corrects its plots (None: from
         #: the start, a prior already within :data:`APPLY_SIGMA`).
         self.settled: dict[int, float | None] = {}
+        for sid in estimated:
+            self._settle(sid, None)
         self.pairs = 0
         #: ``(t, {id: RadarBias})`` every :data:`SNAPSHOT_S` seconds of plot time (the
         #: estimate's history: convergence, ``docs/registration.md``).

@@ -23,8 +23,13 @@ from mhtrack.cli.terminal import progress_enabled, progress_option
               help="Output directory (created).")
 @click.option("--format", "fmt", type=click.Choice(["csv", "parquet"]), default="csv",
               show_default=True, help="File format of plots and truth.")
+@click.option("--bias", "biases", multiple=True, metavar="ID:range=M,gain=G,azimuth=DEG",
+              help="Give rotating radar ID a registration bias (range offset m, range "
+                   "gain, azimuth offset degrees; repeat per radar). Written to "
+                   "DIR/scenario.toml, not to the sensors file.")
 def simulate(scenario: str, seed: int, clutter: str | None, clutter_rate: float | None,
-             pd: float | None, scans: int | None, out: Path, fmt: str) -> None:
+             pd: float | None, scans: int | None, out: Path, fmt: str,
+             biases: tuple[str, ...] = ()) -> None:
     """Simulate SCENARIO (a preset or a TOML file) and write DIR/plots, DIR/truth and the
     full parameters in DIR/scenario.toml.
 
@@ -38,6 +43,13 @@ def simulate(scenario: str, seed: int, clutter: str | None, clutter_rate: float 
     scenario_path = Path(scenario) if Path(scenario).is_file() else None
     check_output_dir(out, inputs=(scenario_path,), what="simulation files")
     sc = load_scenario_arg(scenario, clutter, clutter_rate, pd, scans)
+    if biases:
+        from mhtrack.scenario.biases import parse_bias, with_biases
+
+        try:
+            sc = with_biases(sc, [parse_bias(b) for b in biases])
+        except ValueError as e:
+            raise click.BadParameter(str(e), param_hint="--bias") from None
     sim = run_simulation(sc, seed=seed)
     out.mkdir(parents=True, exist_ok=True)
     if sc.rotating:

@@ -140,6 +140,17 @@ def track_options(tracker: str, tracker_pd: float | None, meas_sigma: float | No
               default=DEFAULT_CLUTTER_FRAME, show_default=True, help="Timed plots: estimate "
               "each radar's clutter in the local east-north plane or in the radar's own "
               "range and bearing (docs/clutter.md).")
+@click.option("--estimate-bias", is_flag=True, help="Estimate each radar's registration "
+              "bias (range offset, range gain, azimuth offset) online from aircraft that "
+              "several sensors see, and correct its plots (docs/registration.md).")
+@click.option("--bias-reference", type=int, default=None, metavar="ID",
+              help="With --estimate-bias: the radar whose bias is held at zero [ADS-B if "
+              "any, else the lowest radar id].")
+@click.option("--bias-init", type=click.Path(exists=True, dir_okay=False, path_type=Path),
+              default=None, help="With --estimate-bias: start from the biases of an earlier "
+              "run (a --bias-out file).")
+@click.option("--bias-out", type=click.Path(dir_okay=False, path_type=Path), default=None,
+              help="With --estimate-bias: write the final biases (JSON) for --bias-init.")
 @birth_options
 @output_option
 @progress_option
@@ -151,16 +162,28 @@ def track(plots: Path, tracker: str, tracker_pd: float | None, meas_sigma: float
           scenario_file: Path | None, sensors_file: Path | None,
           reorder_window_s: float | None, clutter_frame: str, birth: str,
           birth_theta: float | None, fusion: str | None, output: str | None,
-          progress: bool | None) -> None:
+          progress: bool | None, estimate_bias: bool = False,
+          bias_reference: int | None = None, bias_init: Path | None = None,
+          bias_out: Path | None = None) -> None:
     """Run a tracker on a PLOTS file and write its tracks."""
     from mhtrack.io.paths import check_output_file
     from mhtrack.pipeline.run import Pipeline
     from mhtrack.sinks.files import TracksFileSink
 
     check_output_file(out, inputs=(plots, scenario_file, sensors_file), what="tracks file")
+    if not estimate_bias and (bias_reference, bias_init, bias_out) != (None, None, None):
+        raise click.UsageError("--bias-reference, --bias-init and --bias-out go with "
+                               "--estimate-bias")
+    prior = None
+    if bias_init is not None:
+        from mhtrack.io.biasfile import read_biases
+
+        prior = read_biases(bias_init)
     options = track_options(tracker, tracker_pd, meas_sigma, accel_sigma, imm_accel_sigma,
                             clutter_density, birth_density, nscan, birth, birth_theta,
-                            fusion, output, clutter_frame=clutter_frame)
+                            fusion, output, clutter_frame=clutter_frame,
+                            estimate_bias=estimate_bias, bias_reference=bias_reference,
+                            bias_prior=prior)
     pipe = Pipeline.open(plots, options, scenario_file=scenario_file,
                          sensors_file=sensors_file, reorder_window_s=reorder_window_s)
     result = pipe.run([TracksFileSink(out, frame=pipe.frame, output=pipe.output)],
@@ -169,6 +192,13 @@ def track(plots: Path, tracker: str, tracker_pd: float | None, meas_sigma: float
     for note in (pipe.birth_note, pipe.reach_note):
         if note is not None:
             click.echo(note)
+    if pipe.registration is not None:
+        click.echo("\n".join(pipe.registration.describe()))
+        if bias_out is not None:
+            from mhtrack.io.biasfile import write_biases
+
+            write_biases(bias_out, pipe.registration.biases(), pipe.registration.references)
+            click.echo(f"biases -> {bias_out}")
 
 
 @click.command()

@@ -174,6 +174,10 @@ class RotatingRadar:
     ``max_range`` (m, ``None``: unlimited), and draws its own clutter per rotation:
     ``clutter_rate`` plots uniform in range–azimuth over its coverage plus
     ``clutter_patches`` (:func:`~mhtrack.models.clutter.sample_range_azimuth`).
+
+    Registration bias (simulation only, none by default): a target's plot reports
+    ``r_m = range_gain · r + range_bias`` and ``θ_m = θ + azimuth_bias_deg`` before its
+    noise (the range offset, gain and azimuth offset of :mod:`mhtrack.models.registration`).
     """
 
     id: int
@@ -187,12 +191,15 @@ class RotatingRadar:
     max_range: float | None = None
     clutter_rate: float = 0.0
     clutter_patches: tuple[ClutterPatch, ...] = ()
+    range_bias: float = 0.0
+    range_gain: float = 1.0
+    azimuth_bias_deg: float = 0.0
     kind: str = field(default="polar", init=False)
 
     def __post_init__(self) -> None:
         w = f"sensor {self.id}"
         for key in ("period", "sigma_range", "sigma_bearing_deg", "phase", "clutter_rate",
-                    "lat", "lon", "max_range"):
+                    "lat", "lon", "max_range", "range_bias", "range_gain", "azimuth_bias_deg"):
             v = getattr(self, key)
             if v is None:
                 continue
@@ -228,6 +235,8 @@ class RotatingRadar:
             object.__setattr__(self, "position", pos)
         if self.max_range is not None and not self.max_range > 0:
             raise ValueError(f"{w}: max_range must be > 0 m, got {self.max_range:g}")
+        if not 0.5 <= self.range_gain <= 2.0:
+            raise ValueError(f"{w}: range_gain must be within [0.5, 2], got {self.range_gain:g}")
         if self.clutter_rate < 0:
             raise ValueError(f"{w}: clutter_rate must be >= 0, got {self.clutter_rate:g}")
         if self.clutter_rate > 0 and self.max_range is None:

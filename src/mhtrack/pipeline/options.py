@@ -69,6 +69,12 @@ class TrackOptions:
     sensor_pd: float | None = None
     #: Keywords of the tracker's clutter estimator (:func:`~mhtrack.build.make_tracker`).
     clutter_params: dict[str, Any] | None = None
+    #: Estimate and remove the radars' registration biases online
+    #: (:mod:`mhtrack.pipeline.registration`); the reference radar (None: ADS-B if any,
+    #: else the lowest polar id) and the biases to start from (``{id: RadarBias}``).
+    estimate_bias: bool = False
+    bias_reference: int | None = None
+    bias_prior: dict[int, Any] | None = None
 
     def config_changes(self) -> dict[str, Any]:
         """The configuration fields set (``sensor_pd`` as the tracker's ``P_D``)."""

@@ -30,6 +30,7 @@ from mhtrack.sinks.base import FrameOutput, Sink, check_output
 if TYPE_CHECKING:
     from mhtrack.initiation.fusion import AdaptiveKMeansFusion
     from mhtrack.mht import MHTConfig, MHTTracker, StepStats
+    from mhtrack.pipeline.registration import Registration
     from mhtrack.sources.base import Source, Survey
 
 
@@ -70,17 +71,24 @@ def fused(scans: Iterable[Scan], fusion: str,
 
 def step_frames(tracker: MHTTracker, frames: Iterable[Scan], *, fusion: str = "none",
                 name: str = "mht", progress: bool = False,
-                total: int | None = None) -> Iterator[FrameOutput]:
+                total: int | None = None,
+                registration: Registration | None = None) -> Iterator[FrameOutput]:
     """Each frame fused (``fusion``), stepped through ``tracker``, and its output — the
     online rows, the backfill and the step's statistics with the fusion's caps merged
-    in. ``progress``: a tqdm bar of ``total`` frames."""
+    in. ``progress``: a tqdm bar of ``total`` frames. ``registration``: each frame's
+    plots corrected for the radars' biases before fusion, and the estimate updated
+    from the step's confirmed tracks (:mod:`mhtrack.pipeline.registration`)."""
     fusion_caps: dict[int, dict[str, int]] = {}
     depth = getattr(getattr(tracker, "config", None), "history_scans", None)
     recent: deque[int] = deque(maxlen=max(int(depth or 0), 1))
+    if registration is not None:
+        frames = (registration.correct(f) for f in frames)
     bar = tqdm(fused(frames, fusion, fusion_caps), total=total, desc=name, unit="scan",
                disable=not progress, leave=False)
     for scan in bar:
         online = tracker.step(scan)
+        if registration is not None:
+            registration.learn(scan, online)
         stats = tracker.last_stats
         assert stats is not None  # set by every step
         stats.caps.update(fusion_caps.pop(stats.scan, {}))
@@ -200,6 +208,20 @@ class Pipeline:
         self.choices = choose(source, self.options, survey, config)
         self.config, self.tracker = self.choices.config, self.choices.tracker
         self.fusion, self.frame = self.choices.fusion, self.choices.frame
+        self.registration = self._registration()
+
+    def _registration(self) -> Registration | None:
+        """The bias estimation asked for (``TrackOptions.estimate_bias``), or None."""
+        o = self.options
+        if not o.estimate_bias:
+            return None
+        from mhtrack.pipeline.registration import Registration
+
+        if self.source.sensors is None or self.source.sensors.reference is None:
+            raise ValueError("--estimate-bias needs the radars' sites (a sensors file or "
+                             "a recording's CAT034 sites)")
+        return Registration(self.source.sensors, reference=o.bias_reference,
+                            prior=o.bias_prior)
 
     @classmethod
     def open(cls, path: str | Path, options: TrackOptions | None = None, *,
@@ -242,7 +264,8 @@ class Pipeline:
         survey = self.survey if progress else None
         yield from step_frames(self.tracker, self.source, fusion=self.fusion,
                                name=self.options.tracker, progress=progress,
-                               total=None if survey is None else survey.n_frames)
+                               total=None if survey is None else survey.n_frames,
+                               registration=self.registration)
 
     def run(self, sinks: Sequence[Sink] = (), *, progress: bool = False,
             keep_stats: bool = True) -> RunResult:

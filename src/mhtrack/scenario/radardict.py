@@ -8,6 +8,7 @@ A ``[[sensors]]`` table of ``kind = "polar"`` with a ``period`` is a
     sigma_range = 30.0      sigma_bearing_deg = 0.08
     period = 4.0            phase = 0.0       # beam bearing at t = 0 (optional, 0)
     max_range = 300000.0    clutter_rate = 20.0   # per rotation (optional, 0)
+    range_bias = 200.0      range_gain = 1.0  azimuth_bias_deg = -0.12   # optional, none
     [[sensors.clutter_patches]]             # optional, any number
     range = 110000.0  bearing = 200.0  sigma_range = 15000.0  sigma_bearing_deg = 8.0
     rate = 8.0
@@ -25,9 +26,12 @@ from mhtrack.models.sensors import MAX_SIGMA, MAX_SIGMA_BEARING_DEG, RotatingRad
 from mhtrack.records import MAX_COORDINATE
 from mhtrack.scenario import _check as ck
 
+BIAS_KEYS = ("range_bias", "range_gain", "azimuth_bias_deg")
 _KEYS = {"kind", "id", "pd", "period", "sigma_range", "sigma_bearing_deg"}
 _OPTIONAL = {"phase", "lat", "lon", "position", "max_range", "clutter_rate",
-             "clutter_patches"}
+             "clutter_patches", *BIAS_KEYS}
+#: The registration-bias keys of a simulated radar and their "no bias" values.
+BIAS_DEFAULTS = {"range_bias": 0.0, "range_gain": 1.0, "azimuth_bias_deg": 0.0}
 _PATCH_KEYS = {"range", "bearing", "sigma_range", "sigma_bearing_deg", "rate"}
 
 
@@ -43,6 +47,7 @@ def rotating_to_dict(s: RotatingRadar, pd: float) -> dict[str, Any]:
     if s.max_range is not None:
         d["max_range"] = s.max_range
     d["clutter_rate"] = s.clutter_rate
+    d.update({k: getattr(s, k) for k, v in BIAS_DEFAULTS.items() if getattr(s, k) != v})
     if s.clutter_patches:
         d["clutter_patches"] = [{k: getattr(p, k) for k in ("range", "bearing", "sigma_range",
                                                            "sigma_bearing_deg", "rate")}
@@ -64,6 +69,7 @@ def rotating_from(d: Mapping[str, Any], path: str) -> tuple[RotatingRadar, float
                                        unit="degrees"),
         "clutter_rate": ck.number(d.get("clutter_rate", 0.0), f"{path}.clutter_rate", lo=0.0),
     }
+    kw.update({k: ck.number(d[k], f"{path}.{k}") for k in BIAS_KEYS if k in d})
     if "max_range" in d:
         kw["max_range"] = ck.number(d["max_range"], f"{path}.max_range", lo=0.0,
                                     lo_open=True, hi=MAX_COORDINATE, unit="m")

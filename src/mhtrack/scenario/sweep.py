@@ -25,10 +25,12 @@ for these speeds and periods) can have ``q >= 1``; the crossing is then the last
 
 **Detections.** Each crossing within ``max_range`` is detected with the radar's ``P_D``
 and reported with range and bearing plus Gaussian noise ``σr``, ``σθ`` (range folded to
-``|r|``, bearing wrapped to ``[0, 360)``). **Clutter** per rotation (the beam's turn from
-north to north): :func:`~mhtrack.models.clutter.sample_range_azimuth`, each plot timed
-when the beam points at its bearing. Every plot is converted to the local frame with its
-covariance by :func:`~mhtrack.models.geodesy.polar_to_local`.
+``|r|``, bearing wrapped to ``[0, 360)``), after the radar's registration bias, if it has
+one (``r_m = g r + Δr``, ``θ_m = θ + Δθ``: ``RotatingRadar.range_gain``, ``range_bias``,
+``azimuth_bias_deg``; clutter is drawn in the measured space). **Clutter** per rotation
+(the beam's turn from north to north): :func:`~mhtrack.models.clutter.sample_range_azimuth`,
+each plot timed when the beam points at its bearing. Every plot is converted to the local
+frame with its covariance by :func:`~mhtrack.models.geodesy.polar_to_local`.
 
 **Random streams** (integer spawn keys, as in :mod:`mhtrack.scenario.simulate`):
 ``(2, sensor id, target id)`` for a target's detections and noise by one radar,
@@ -58,6 +60,11 @@ _CLUTTER_STREAM = 3
 
 def _rng(seed: int, *key: int) -> np.random.Generator:
     return np.random.default_rng(np.random.SeedSequence(seed, spawn_key=key))
+
+
+def _biased(radar: RotatingRadar) -> bool:
+    """The radar has a registration bias (``RotatingRadar.range_bias`` …)."""
+    return (radar.range_bias, radar.range_gain, radar.azimuth_bias_deg) != (0.0, 1.0, 0.0)
 
 
 def _wrap180(a: np.ndarray) -> np.ndarray:
@@ -129,6 +136,8 @@ def radar_plots(
         if radar.max_range is not None:
             keep &= r <= radar.max_range
         cols["time"].append(t[keep])
+        if _biased(radar):  # registration bias (none: the former floats exactly)
+            r, b = radar.range_gain * r + radar.range_bias, b + radar.azimuth_bias_deg
         cols["range"].append(np.abs(r + nr)[keep])
         cols["bearing"].append(((b + nb) % 360.0)[keep])
         cols["origin"].append(np.full(int(keep.sum()), seg.target_id, np.int64))

@@ -19,10 +19,10 @@ pytest.importorskip("asterix.generated", reason="libasterix not installed")
 
 from mhtrack.io.sensors import read_sensors
 from mhtrack.pipeline import Pipeline, TrackOptions
-from mhtrack.pipeline.live import Live, LiveOptions, Status
+from mhtrack.pipeline.health import Health
+from mhtrack.pipeline.live import Live, LiveOptions
 from mhtrack.sinks import TrackCollector
 from mhtrack.sources.replay import recording_datagrams
-from mhtrack.sources.udp import ReaderStats
 
 OPTIONS = TrackOptions(output="online", new_target_density=1e-10)
 
@@ -56,15 +56,24 @@ def test_refusals(rec: Path) -> None:
 
 
 def test_status_line_by_hand() -> None:
-    reader = ReaderStats(datagrams=10, queue_dropped=1)
-    src = SimpleNamespace(plots_in=40, late_dropped=2)
-    st = Status(reader, lambda: src)
-    assert st.line(100.0) == ("live: 10 datagrams, 40 plots, 0 frames, 2 late drops, "
-                              "1 queue drops, 0 tracks")
-    reader.datagrams, src.plots_in = 30, 140
-    st._count(SimpleNamespace(online=[1, 2, 3]))
-    assert st.line(104.0) == ("live: 5.0 datagrams/s, 25.0 plots/s, 30 datagrams, 140 "
-                              "plots, 1 frames, 2 late drops, 1 queue drops, 3 tracks")
+    counts = {"datagrams": 10, "queue_drops": 1, "plots": 40, "duplicates": 3,
+              "late_drops": 2}
+    clock = iter([100.0, 104.0, 104.2, 104.5])  # line, frame out, frame out, line
+    st = Health(lambda: counts, lambda: 3, lambda out: np.array([0]), {1: 4.0, 2: 12.0},
+                lambda: next(clock))
+    assert st.line() == ("live: 10 datagrams, 40 plots, 3 duplicates, 2 late drops, "
+                         "1 queue drops, 0 frames, 0 tracks, 0 radars silent")
+    counts.update(datagrams=30, plots=140)
+    st.arrivals.add(0, 103.9)  # plot 0 came at 103.9 s: latencies 0.1 s and 0.3 s
+    frame = SimpleNamespace(time=50.0, sensor=np.array([2]), rows=np.array([0]))
+    st.write(SimpleNamespace(frame=frame))
+    st.write(SimpleNamespace(frame=SimpleNamespace(time=63.0, sensor=np.array([2]),
+                                                    rows=np.array([0]))))
+    # radar 1 never sent a frame in 13 s > 3 x 4 s: silent; radar 2 sent one at 63 s
+    # 20 datagrams and 100 plots in 4.5 s; p50 of (0.1, 0.3) 0.2 s, p99 0.1 + 0.99 x 0.2
+    assert st.line() == ("live: 4.4 datagrams/s, 22.2 plots/s, 30 datagrams, 140 plots, "
+                         "3 duplicates, 2 late drops, 1 queue drops, 2 frames, 3 tracks, "
+                         "1 radars silent (1), latency p50 200 ms p99 298 ms")
 
 
 def test_stdin_run_equals_the_pipeline_on_the_file(rec: Path) -> None:

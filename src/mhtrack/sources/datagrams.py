@@ -69,7 +69,9 @@ class DatagramSource(Source):
 
     def __init__(self, datagrams: Iterable[Datagram], *, sensors: SensorSet | None = None,
                  name: str = "datagrams", reorder_window_s: float | None = None,
-                 fast: bool = True, sectors: bool = False, chunk: int = CHUNK) -> None:
+                 fast: bool = True, sectors: bool = False, chunk: int = CHUNK,
+                 axis: TimeAxis | None = None, first_frame: int = 0,
+                 not_before: float | None = None) -> None:
         super().__init__()
         if chunk < 1:
             raise ValueError(f"chunk must be >= 1 plot, got {chunk!r}")
@@ -86,6 +88,17 @@ class DatagramSource(Source):
             raise ValueError(f"reorder_window_s must be >= 0, got {reorder_window_s!r}")
         self.fast = fast
         self.sectors = sectors
+        #: Where each pass's time axis starts (``day0, latest``: a resumed live run
+        #: continues its checkpoint's axis) and the number of its first frame;
+        #: :attr:`axis` is the running pass's axis.
+        self.axis_start = (None, None) if axis is None else (axis.day0, axis.latest)
+        self.axis = TimeAxis()
+        self.axis.day0, self.axis.latest = self.axis_start
+        self.first_frame = int(first_frame)
+        #: Plots before this time are late drops (a resumed run: its checkpoint's time).
+        self.not_before = not_before
+        #: Plots decoded so far: the next plot's decoding-order number (its ``file_row``).
+        self.decoded = 0
         self.problems = Problems()
         self._input = datagrams
         self._stream: TimedStream | None = None
@@ -108,7 +121,9 @@ class DatagramSource(Source):
         false, as decoded (:data:`~mhtrack.io.asterix.decode.PLOT_COLUMNS` with the time
         on the axis, ``offset``); sweep marks (time on the axis) go to ``sweeps``."""
         self._decoder = decoder = Decoder(fast=self.fast)
-        axis = TimeAxis()
+        self.axis = axis = TimeAxis()
+        axis.day0, axis.latest = self.axis_start
+        self.decoded = 0
         rows: list[tuple[Any, ...]] = []
         times: list[float] = []
         at_rows: list[int] = []
@@ -132,9 +147,11 @@ class DatagramSource(Source):
                 if len(rows) >= self.chunk:
                     yield self._chunk(rows, times, at_rows, n, convert, in_sector)
                     n += len(rows)
+                    self.decoded = n
                     rows, times, at_rows, in_sector = [], [], [], []
         if rows:
             yield self._chunk(rows, times, at_rows, n, convert, in_sector)
+            self.decoded = n + len(rows)
 
     def _chunk(self, rows: list[tuple[Any, ...]], times: list[float], at: list[int],
                n0: int, convert: bool, in_sector: list[int]) -> dict[str, np.ndarray]:
@@ -240,13 +257,19 @@ class DatagramSource(Source):
         self._skipped = {}
         self._stream = stream = TimedStream(
             self.name, self.stats, self._frame_lengths(), self.window_s,
-            lambda first: f"byte {first['offset']} (plot {first['file_row']})")
+            lambda first: f"byte {first['offset']} (plot {first['file_row']})",
+            first_frame=self.first_frame, not_before=self.not_before)
         for cols in self._decoded(problems):
             yield from stream.push(cols)
         yield from stream.finish()
         self.stats.skipped = dict(problems.counts)
         problems.warn(self.name)
         self._warn_skipped()
+
+    @property
+    def next_frame(self) -> int:
+        """The number the next frame will get."""
+        return self.first_frame if self._stream is None else self._stream.framer.n_frames
 
     def _warn_skipped(self) -> None:
         """One warning line listing the radars skipped for want of a site."""

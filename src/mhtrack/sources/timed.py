@@ -26,12 +26,16 @@ class TimedStream:
     first by ``where(its column values)``."""
 
     def __init__(self, name: str, stats: SourceStats, frame_s: Mapping[int, float] | float,
-                 window_s: float, where: Callable[[dict[str, object]], str]) -> None:
+                 window_s: float, where: Callable[[dict[str, object]], str], *,
+                 first_frame: int = 0, not_before: float | None = None) -> None:
         self.name = name
         self.stats = stats
         self.where = where
         self.buffer = ReorderBuffer(window_s)
         self.framer = Framer(frame_s)
+        self.framer.n_frames = int(first_frame)  # frames numbered on from here
+        if not_before is not None:  # as if plots up to it had gone: earlier ones are late
+            self.buffer.latest = self.buffer.released = float(not_before)
         # file row of each running row: one int64 array grown by doubling (8 bytes a
         # plot, no object per frame), the first ``_n_out`` entries valid
         self._rows = np.zeros(1024, np.int64)

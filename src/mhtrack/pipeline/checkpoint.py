@@ -1,0 +1,95 @@
+"""Checkpoints of a live run (``docs/live.md``, *Checkpoints and restart*): the tracker's
+full state (:meth:`~mhtrack.mht.MHTTracker.save`, one ``.npz`` written atomically) with
+what the live run needs to continue — the next frame's number, the time axis (``day0``,
+``latest``: the day of later times of day), the latest time tracked and the next tick of
+the period output — under ``meta["extra"]``.
+
+:class:`CheckpointSink` writes one every ``every_s`` seconds **of data time** (the frames'
+times: the same input checkpoints at the same frames) and a final one when the run ends
+(input ended, or stopped by SIGTERM/Ctrl-C after the held frames were tracked).
+:func:`read_checkpoint` gives the tracker back (:func:`~mhtrack.build.load_tracker`:
+the same track ids continue) and the bookkeeping.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import asdict, dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from mhtrack.errors import InputError
+from mhtrack.sinks.base import FrameOutput, Sink
+
+if TYPE_CHECKING:
+    from mhtrack.mht import MHTTracker
+
+#: Version of the ``extra`` bookkeeping.
+LIVE_FORMAT = 1
+
+
+@dataclass(frozen=True)
+class LiveState:
+    """What a live run continues from besides the tracker."""
+
+    #: The number of the next frame.
+    next_frame: int
+    #: The time axis: capture day of its day 0 (``None``: no capture times) and the
+    #: latest time on it (``None``: nothing received).
+    axis_day0: float | None
+    axis_latest: float | None
+    #: The latest frame time tracked (later plots only; earlier ones are late drops).
+    last_time: float | None
+    #: The next tick of the period output (``None``: none yet or no period output).
+    next_tick: int | None
+    format: int = LIVE_FORMAT
+
+
+class CheckpointSink(Sink):
+    """The tracker (``tracker()``, the one being stepped) and ``state()`` saved to
+    ``path`` every ``every_s`` s of data time (``None``: only at the end) and when the
+    run ends. :attr:`written` counts the checkpoints."""
+
+    def __init__(self, path: str | Path, tracker: Callable[[], MHTTracker],
+                 state: Callable[[], LiveState], every_s: float | None = None) -> None:
+        if every_s is not None and not every_s > 0:
+            raise ValueError(f"checkpoint period must be > 0 s, got {every_s!r}")
+        self.path, self.tracker, self.state = Path(path), tracker, state
+        self.every_s = math.inf if every_s is None else float(every_s)
+        self.written = 0
+        self._last: float | None = None
+
+    def save(self) -> None:
+        """Write a checkpoint now."""
+        self.tracker().save(self.path, extra=asdict(self.state()))
+        self.written += 1
+
+    def write(self, out: FrameOutput) -> None:
+        t = float(out.frame.time)
+        if self._last is None:
+            self._last = t
+        elif t - self._last >= self.every_s:
+            self.save()
+            self._last = t
+
+    def close(self) -> None:
+        self.save()
+
+
+def read_checkpoint(path: str | Path) -> tuple[MHTTracker, LiveState]:
+    """The tracker and the live bookkeeping of a checkpoint written by
+    :class:`CheckpointSink`; an :class:`InputError` naming the file otherwise."""
+    from mhtrack.build import load_tracker
+    from mhtrack.mht.state import saved_meta
+
+    meta: dict[str, Any] = saved_meta(path)
+    extra = meta.get("extra")
+    if not isinstance(extra, dict) or extra.get("format") != LIVE_FORMAT:
+        raise InputError(f"{path}: member 'meta': no live checkpoint (field 'extra' of "
+                         f"format {LIVE_FORMAT}): not written by mhtrack live", file=str(path))
+    try:
+        state = LiveState(**extra)
+    except TypeError as e:
+        raise InputError(f"{path}: member 'meta': field 'extra': {e}", file=str(path)) from None
+    return load_tracker(path), state

@@ -1,8 +1,10 @@
 """Checkpoints of a live run (``docs/live.md``, *Checkpoints and restart*): the tracker's
 full state (:meth:`~mhtrack.mht.MHTTracker.save`, one ``.npz`` written atomically) with
 what the live run needs to continue — the next frame's number, the time axis (``day0``,
-``latest``: the day of later times of day), the latest time tracked and the next tick of
-the period output — under ``meta["extra"]``.
+``latest``: the day of later times of day), the latest time tracked, the next tick of
+the period output and the plots received but not yet tracked (in the re-order window
+and in open frames) — under ``meta["extra"]``. A run resumed from it therefore makes the
+same frames as a run never stopped, given the same datagrams after the checkpoint.
 
 :class:`CheckpointSink` writes one every ``every_s`` seconds **of data time** (the frames'
 times: the same input checkpoints at the same frames) and a final one when the run ends
@@ -18,6 +20,8 @@ from collections.abc import Callable
 from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
+
+import numpy as np
 
 from mhtrack.errors import InputError
 from mhtrack.sinks.base import FrameOutput, Sink
@@ -43,7 +47,49 @@ class LiveState:
     last_time: float | None
     #: The next tick of the period output (``None``: none yet or no period output).
     next_tick: int | None
+    #: The plots received but not yet in a frame tracked (:func:`encode_pending`).
+    pending: dict[str, Any] | None = None
     format: int = LIVE_FORMAT
+
+
+#: Integer columns of the plots held (the others are floats).
+_INT_COLUMNS = ("sensor", "file_row", "offset", "seq", "sector")
+
+
+def encode_pending(pending: dict[str, Any] | None) -> dict[str, Any] | None:
+    """:meth:`~mhtrack.sources.datagrams.DatagramSource.pending` as JSON: each column a
+    list (floats to the bit: JSON keeps Python's shortest round-trip form), the times
+    ``None`` when infinite; ``None`` when no plot is held."""
+    if pending is None or (pending["framed"] is None and pending["held"] is None):
+        return None
+    out: dict[str, Any] = {k: None if pending[k] is None or not math.isfinite(pending[k])
+                           else float(pending[k]) for k in ("latest", "released")}
+    for part in ("framed", "held"):
+        cols = pending[part]
+        out[part] = None if cols is None else {k: np.asarray(v).tolist()
+                                               for k, v in cols.items()}
+    return out
+
+
+def decode_pending(saved: dict[str, Any] | None) -> dict[str, Any] | None:
+    """The plots held, back as columns for ``DatagramSource(pending=...)``; their
+    ``file_row`` is ``-1`` (numbers of the earlier run, not of this one's input)."""
+    if saved is None:
+        return None
+    out: dict[str, Any] = {k: -math.inf if saved[k] is None else float(saved[k])
+                           for k in ("latest", "released")}
+    for part in ("framed", "held"):
+        cols = saved[part]
+        if cols is None:
+            out[part] = None
+            continue
+        arrays = {k: np.asarray(v, np.int64 if k in _INT_COLUMNS else float)
+                  for k, v in cols.items()}
+        if "R" in arrays:
+            arrays["R"] = arrays["R"].reshape(-1, 2, 2)
+        arrays["file_row"] = np.full(len(arrays["time"]), -1, np.int64)
+        out[part] = arrays
+    return out
 
 
 class CheckpointSink(Sink):

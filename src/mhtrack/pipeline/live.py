@@ -27,7 +27,13 @@ from typing import TYPE_CHECKING, Any, BinaryIO, TextIO
 
 import numpy as np
 
-from mhtrack.pipeline.checkpoint import CheckpointSink, LiveState, read_checkpoint
+from mhtrack.pipeline.checkpoint import (
+    CheckpointSink,
+    LiveState,
+    decode_pending,
+    encode_pending,
+    read_checkpoint,
+)
 from mhtrack.pipeline.health import Health
 from mhtrack.pipeline.monitor import MetricsServer, prometheus_text, write_status
 from mhtrack.pipeline.options import TrackOptions
@@ -179,7 +185,10 @@ class Live:
             self._arrived(self.reader), sensors=sensors, name=name,
             reorder_window_s=live.reorder_window_s, chunk=1,  # each data block on at once
             axis=axis, first_frame=0 if st is None else st.next_frame,
-            not_before=None if st is None else st.last_time)
+            not_before=None if st is None else st.last_time,
+            pending=None if st is None else decode_pending(st.pending),
+            # stopped with a checkpoint: the plots held go into it, tracked on resume
+            hold=lambda: self.stop.is_set() and live.checkpoint is not None)
         try:
             self.pipeline = Pipeline(self.source, options)
         except BaseException:
@@ -265,7 +274,8 @@ class Live:
         axis = self.source.axis
         return LiveState(self.source.next_frame, axis.day0, axis.latest,
                          self.pipeline.tracker.last_time,
-                         None if self.periodic is None else self.periodic.next_tick)
+                         None if self.periodic is None else self.periodic.next_tick,
+                         encode_pending(self.source.pending()))
 
     # -- running ----------------------------------------------------------------------
     @property

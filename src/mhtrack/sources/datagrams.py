@@ -33,7 +33,7 @@ gives it, skipped radars included). Frame lengths come from the sensors' periods
 from __future__ import annotations
 
 import logging
-from collections.abc import Iterable, Iterator, Sequence
+from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from typing import Any
 
 import numpy as np
@@ -71,7 +71,9 @@ class DatagramSource(Source):
                  name: str = "datagrams", reorder_window_s: float | None = None,
                  fast: bool = True, sectors: bool = False, chunk: int = CHUNK,
                  axis: TimeAxis | None = None, first_frame: int = 0,
-                 not_before: float | None = None) -> None:
+                 not_before: float | None = None,
+                 pending: Mapping[str, Any] | None = None,
+                 hold: Callable[[], bool] | None = None) -> None:
         super().__init__()
         if chunk < 1:
             raise ValueError(f"chunk must be >= 1 plot, got {chunk!r}")
@@ -97,6 +99,11 @@ class DatagramSource(Source):
         self.first_frame = int(first_frame)
         #: Plots before this time are late drops (a resumed run: its checkpoint's time).
         self.not_before = not_before
+        #: Plots held by an earlier stream (``TimedStream.pending``), taken back first;
+        #: ``hold()`` true at the end of the input: keep the plots held (:attr:`held`)
+        #: instead of making frames of them (a live run stopped to be resumed).
+        self.restore, self.hold = pending, hold
+        self.held: dict[str, Any] | None = None
         #: Plots decoded so far: the next plot's decoding-order number (its ``file_row``).
         self.decoded = 0
         self.problems = Problems()
@@ -259,12 +266,24 @@ class DatagramSource(Source):
             self.name, self.stats, self._frame_lengths(), self.window_s,
             lambda first: f"byte {first['offset']} (plot {first['file_row']})",
             first_frame=self.first_frame, not_before=self.not_before)
+        if self.restore is not None:
+            yield from stream.restore(self.restore)
         for cols in self._decoded(problems):
             yield from stream.push(cols)
-        yield from stream.finish()
+        if self.hold is not None and self.hold():
+            self.held = stream.pending()
+        else:
+            yield from stream.finish()
         self.stats.skipped = dict(problems.counts)
         problems.warn(self.name)
         self._warn_skipped()
+
+    def pending(self) -> dict[str, Any] | None:
+        """The plots not yet in a frame given out (:meth:`TimedStream.pending`; after a
+        held end, those held); ``None`` before reading."""
+        if self.held is not None:
+            return self.held
+        return None if self._stream is None else self._stream.pending()
 
     @property
     def next_frame(self) -> int:

@@ -61,6 +61,32 @@ class TimedStream:
             logging.getLogger("mhtrack").warning("%s", late.line(self.name,
                                                                  self.where(late.first)))
 
+    def pending(self) -> dict[str, object]:
+        """The plots held — in the framer (``framed``) and in the re-order buffer
+        (``held``), columns or ``None`` — and the buffer's ``latest`` and ``released``
+        times: with :meth:`restore`, a later stream goes on as this one would have."""
+        b = self.buffer
+        return {"framed": self.framer.pending(), "held": b.held(), "latest": b.latest,
+                "released": b.released}
+
+    def restore(self, pending: Mapping[str, object]) -> Iterator[Scan]:
+        """Take the plots of another stream's :meth:`pending` back (before any push):
+        the framed ones straight into the framer, the held ones into the buffer; the
+        frames already complete (a checkpoint taken between two frames of one push)."""
+        b = self.buffer
+        b.latest, b.released = float(pending["latest"]), float(pending["released"])  # type: ignore[arg-type]
+        framed, held = pending.get("framed"), pending.get("held")
+        for c in (framed, held):
+            self.stats.plots_in += 0 if c is None else len(c["time"])  # type: ignore[index]
+        if framed is not None:
+            yield from map(self._scan, self.framer.push(framed))  # type: ignore[arg-type]
+        if held is not None:  # all within the window of ``latest``: none should leave
+            reordered = b.reordered
+            released = b.push(held)  # type: ignore[arg-type]
+            b.reordered = reordered
+            if released and len(released["time"]):
+                yield from map(self._scan, self.framer.push(released))
+
     def _count(self) -> None:
         b, s = self.buffer, self.stats
         s.reordered, s.late_dropped, s.max_late_s = b.reordered, b.late.n, b.late.max_late_s

@@ -2,7 +2,8 @@
 full state (:meth:`~mhtrack.mht.MHTTracker.save`, one ``.npz`` written atomically) with
 what the live run needs to continue — the next frame's number, the time axis (``day0``,
 ``latest``: the day of later times of day), the latest time tracked, the next tick of
-the period output and the plots received but not yet tracked (in the re-order window
+the period output, the next plot's row number (the tracker's plot windows
+name plots by row: numbers must not repeat) and the plots received but not yet tracked (in the re-order window
 and in open frames) — under ``meta["extra"]``. A run resumed from it therefore makes the
 same frames as a run never stopped, given the same datagrams after the checkpoint.
 
@@ -49,6 +50,8 @@ class LiveState:
     next_tick: int | None
     #: The plots received but not yet in a frame tracked (:func:`encode_pending`).
     pending: dict[str, Any] | None = None
+    #: The running row number of the next plot (the tracker knows plots by row).
+    next_row: int = 0
     format: int = LIVE_FORMAT
 
 

@@ -185,6 +185,7 @@ class Live:
             self._arrived(self.reader), sensors=sensors, name=name,
             reorder_window_s=live.reorder_window_s, chunk=1,  # each data block on at once
             axis=axis, first_frame=0 if st is None else st.next_frame,
+            first_row=0 if st is None else st.next_row,
             not_before=None if st is None else st.last_time,
             pending=None if st is None else decode_pending(st.pending),
             # stopped with a checkpoint: the plots held go into it, tracked on resume
@@ -275,7 +276,7 @@ class Live:
         return LiveState(self.source.next_frame, axis.day0, axis.latest,
                          self.pipeline.tracker.last_time,
                          None if self.periodic is None else self.periodic.next_tick,
-                         encode_pending(self.source.pending()))
+                         encode_pending(self.source.pending()), self.source.next_row)
 
     # -- running ----------------------------------------------------------------------
     @property

@@ -70,7 +70,7 @@ class DatagramSource(Source):
     def __init__(self, datagrams: Iterable[Datagram], *, sensors: SensorSet | None = None,
                  name: str = "datagrams", reorder_window_s: float | None = None,
                  fast: bool = True, sectors: bool = False, chunk: int = CHUNK,
-                 axis: TimeAxis | None = None, first_frame: int = 0,
+                 axis: TimeAxis | None = None, first_frame: int = 0, first_row: int = 0,
                  not_before: float | None = None,
                  pending: Mapping[str, Any] | None = None,
                  hold: Callable[[], bool] | None = None) -> None:
@@ -96,7 +96,7 @@ class DatagramSource(Source):
         self.axis_start = (None, None) if axis is None else (axis.day0, axis.latest)
         self.axis = TimeAxis()
         self.axis.day0, self.axis.latest = self.axis_start
-        self.first_frame = int(first_frame)
+        self.first_frame, self.first_row = int(first_frame), int(first_row)
         #: Plots before this time are late drops (a resumed run: its checkpoint's time).
         self.not_before = not_before
         #: Plots held by an earlier stream (``TimedStream.pending``), taken back first;
@@ -265,7 +265,8 @@ class DatagramSource(Source):
         self._stream = stream = TimedStream(
             self.name, self.stats, self._frame_lengths(), self.window_s,
             lambda first: f"byte {first['offset']} (plot {first['file_row']})",
-            first_frame=self.first_frame, not_before=self.not_before)
+            first_frame=self.first_frame, first_row=self.first_row,
+            not_before=self.not_before)
         if self.restore is not None:
             yield from stream.restore(self.restore)
         for cols in self._decoded(problems):
@@ -289,6 +290,11 @@ class DatagramSource(Source):
     def next_frame(self) -> int:
         """The number the next frame will get."""
         return self.first_frame if self._stream is None else self._stream.framer.n_frames
+
+    @property
+    def next_row(self) -> int:
+        """The running row number (``Scan.rows``) the next plot will get."""
+        return self.first_row if self._stream is None else self._stream.next_row
 
     def _warn_skipped(self) -> None:
         """One warning line listing the radars skipped for want of a site."""

@@ -27,7 +27,8 @@ class TimedStream:
 
     def __init__(self, name: str, stats: SourceStats, frame_s: Mapping[int, float] | float,
                  window_s: float, where: Callable[[dict[str, object]], str], *,
-                 first_frame: int = 0, not_before: float | None = None) -> None:
+                 first_frame: int = 0, first_row: int = 0,
+                 not_before: float | None = None) -> None:
         self.name = name
         self.stats = stats
         self.where = where
@@ -40,6 +41,9 @@ class TimedStream:
         # plot, no object per frame), the first ``_n_out`` entries valid
         self._rows = np.zeros(1024, np.int64)
         self._n_out = 0
+        #: The first running row number (a resumed run numbers on: the tracker's plot
+        #: windows hold the earlier run's rows, and a plot is known by its row).
+        self.first_row = int(first_row)
 
     def push(self, cols: Mapping[str, np.ndarray]) -> Iterator[Scan]:
         """Frames completed by one more batch of plots."""
@@ -94,7 +98,7 @@ class TimedStream:
     def _scan(self, fr: Frame) -> Scan:
         c = fr.cols
         n = len(c["time"])
-        rows = np.arange(self._n_out, self._n_out + n, dtype=np.int64)
+        rows = np.arange(self._n_out, self._n_out + n, dtype=np.int64) + self.first_row
         if self._n_out + n > self._rows.size:
             grown = np.zeros(max(2 * self._rows.size, self._n_out + n), np.int64)
             grown[:self._n_out] = self._rows[:self._n_out]
@@ -107,9 +111,15 @@ class TimedStream:
                     sensor=np.asarray(c["sensor"], np.int64), rows=rows, R=c.get("R"),
                     origin=c.get("origin"), t=np.asarray(c["time"], float))
 
+    @property
+    def next_row(self) -> int:
+        """The running row number of the next plot."""
+        return self.first_row + self._n_out
+
     def file_rows(self, rows: np.ndarray) -> np.ndarray:
-        """The ``file_row`` of each running row number (``-1`` stays ``-1``)."""
-        rows = np.asarray(rows, np.int64)
+        """The ``file_row`` of each running row number (``-1`` stays ``-1``, and so
+        does a row before :attr:`first_row`)."""
+        rows = np.asarray(rows, np.int64) - self.first_row
         out = np.full(rows.shape, -1, np.int64)
         ok = rows >= 0
         out[ok] = self._rows[:self._n_out][rows[ok]]

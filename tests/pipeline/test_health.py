@@ -65,7 +65,7 @@ def test_percentiles_against_numpy(seed: int) -> None:
     for i in range(n):
         arr.add(i, float(t_in[i]))
     # frame j has plots j-2 .. j: its last datagram is j's
-    h = _health(list(t_in + latency) + [1e9, 1e9], arr)
+    h = _health([*(t_in + latency).tolist(), 1e9, 1e9], arr)
     for j in range(n):
         h.write(SimpleNamespace(frame=SimpleNamespace(
             time=float(j), sensor=np.array([1]), rows=np.arange(max(0, j - 2), j + 1))))

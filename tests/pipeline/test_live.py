@@ -11,6 +11,7 @@ import os
 import threading
 from pathlib import Path
 from types import SimpleNamespace
+from typing import BinaryIO
 
 import numpy as np
 import pytest
@@ -43,16 +44,65 @@ def rec(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return out
 
 
+def _pipe(data: bytes) -> tuple[BinaryIO, threading.Thread]:
+    r, w = os.pipe()
+    return os.fdopen(r, "rb", buffering=0), threading.Thread(
+        target=lambda: (os.write(w, data), os.close(w)))
+
+
 def test_refusals(rec: Path) -> None:
     sensors = read_sensors(rec / "sensors.toml")
-    with pytest.raises(ValueError, match="--birth-density"):
-        Live(sensors, TrackOptions(), LiveOptions(listen=("udp://127.0.0.1:0",)))
     no_period = dataclasses.replace(sensors, sensors=tuple(
         dataclasses.replace(s, period=None) if s.id == 2 else s for s in sensors.sensors))
-    with pytest.raises(ValueError, match=r"no period for radar\(s\) 2"):
-        Live(no_period, OPTIONS, LiveOptions(listen=("udp://127.0.0.1:0",)))
+    rf, writer = _pipe(b"")  # no CAT034 mark to take a period from
+    writer.start()
+    with rf, pytest.raises(ValueError, match=r"no rotation period for radar\(s\) 2"):
+        Live(no_period, OPTIONS, LiveOptions(stdin="raw"), stdin=rf)
+    writer.join()
     with pytest.raises(ValueError, match="one of them"):
         Live(sensors, OPTIONS, LiveOptions())
+
+
+def test_periods_and_density_from_the_first_rotations(rec: Path, tmp_path: Path) -> None:
+    """Without periods in the sensors file nor a density, live takes them from its
+    first rotations: the periods are the file's (the export sends I034/041), the density
+    is the one track chooses for a recording of exactly the datagrams held, and the rows
+    are those of the pipeline given both — nothing held is lost."""
+    sensors = read_sensors(rec / "sensors.toml")
+    bare = dataclasses.replace(sensors, sensors=tuple(
+        dataclasses.replace(s, period=None) for s in sensors.sensors))
+    data = (rec / "radar.ast").read_bytes()
+    rf, writer = _pipe(data)
+    out = io.StringIO()
+    lines: list[str] = []
+    with rf:
+        writer.start()
+        live = Live(bare, TrackOptions(output="online"),
+                    LiveOptions(stdin="raw", day_from="stream", json=True), stdin=rf,
+                    stdout=out, emit=lines.append)
+        live.run()
+        writer.join()
+    warm = live.warmup
+    assert warm is not None and len(warm.datagrams) < len(recording_datagrams(
+        rec / "radar.ast"))  # the first rotations only
+    slowest = max(s.period for s in sensors.sensors)
+    assert 2 * slowest <= warm.span_s < 2 * slowest + 1.0
+    assert {s.id: s.period for s in live.source.sensors.sensors} == pytest.approx(
+        {s.id: s.period for s in sensors.sensors}, rel=1e-3)
+    first = tmp_path / "first.ast"
+    first.write_bytes(b"".join(d for d, _ in warm.datagrams))
+    surveyed = Pipeline.open(str(first), TrackOptions(output="online"),
+                             sensors_file=str(rec / "sensors.toml"))
+    density = live.pipeline.config.new_target_density
+    assert density == surveyed.config.new_target_density
+    assert any("new-target density" in x for x in lines)
+    ref = TrackCollector("online")
+    Pipeline.open(str(rec / "radar.ast"), dataclasses.replace(
+        OPTIONS, new_target_density=density), sensors_file=str(rec / "sensors.toml")
+    ).run([ref])
+    rows = [json.loads(x) for x in out.getvalue().splitlines()]
+    assert [r["track_id"] for r in rows] == ref.tracks().track_id.tolist()
+    assert np.allclose([r["x"] for r in rows], ref.tracks().x, atol=5e-4, rtol=0)
 
 
 def test_status_line_by_hand() -> None:

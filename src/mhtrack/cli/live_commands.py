@@ -62,7 +62,8 @@ def replay(recording: Path, to: str, speed: float | None, loop: bool) -> None:
               "or each datagram after its length (4 octets, big-endian).")
 @click.option("--sensors", "sensors_file", required=True, type=click.Path(
               exists=True, dir_okay=False, path_type=Path),
-              help="Sensors file: every radar's site, errors and rotation period.")
+              help="Sensors file: every radar's site and errors (its rotation period, if not "
+              "taken from its CAT034 marks in the first rotations).")
 @click.option("--day-from", type=click.Choice(["receive", "stream"]), default=None,
               help="The day of each time of day: from the receive clock (live feeds), or "
               "from the stream alone (a replayed recording) [receive].")
@@ -108,7 +109,8 @@ def live(listen: tuple[str, ...], stdin: str | None, sensors_file: Path,
          part_frames: int | None, as_json: bool, period_out: float | None,
          status_every: float | None, status_json: Path | None, prometheus: Path | None,
          metrics_http: str | None, checkpoint: Path | None,
-         checkpoint_every: float | None, resume: bool, reorder_window_s: float | None, tracker: str, tracker_pd: float | None,
+         checkpoint_every: float | None, resume: bool, reorder_window_s: float | None,
+         tracker: str, tracker_pd: float | None,
          meas_sigma: float | None, accel_sigma: float | None,
          imm_accel_sigma: float | None, clutter_density: float | None,
          birth_density: float | None, nscan: int | None, clutter_frame: str, birth: str,

@@ -2,10 +2,11 @@
 full state (:meth:`~mhtrack.mht.MHTTracker.save`, one ``.npz`` written atomically) with
 what the live run needs to continue — the next frame's number, the time axis (``day0``,
 ``latest``: the day of later times of day), the latest time tracked, the next tick of
-the period output, the next plot's row number (the tracker's plot windows
-name plots by row: numbers must not repeat) and the plots received but not yet tracked (in the re-order window
-and in open frames) — under ``meta["extra"]``. A run resumed from it therefore makes the
-same frames as a run never stopped, given the same datagrams after the checkpoint.
+the period output, the next plot's row number (the tracker's plot windows name plots
+by row: numbers must not repeat) and the plots received but not yet tracked (in the
+re-order window and in open frames) — under ``meta["extra"]``. A run resumed from it
+therefore makes the same frames as a run never stopped, given the same datagrams after
+the checkpoint.
 
 :class:`CheckpointSink` writes one every ``every_s`` seconds **of data time** (the frames'
 times: the same input checkpoints at the same frames) and a final one when the run ends

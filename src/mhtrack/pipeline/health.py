@@ -86,7 +86,8 @@ class Health(Sink):
 
     ``counts()`` → the running totals ``datagrams, queue_drops, plots, duplicates,
     late_drops`` (callables of the reader and source); ``tracks()`` → confirmed tracks
-    after a frame (called in :meth:`write`, the stepping thread); ``plot_numbers(out)`` → the frame's plots' decoding-order numbers; ``periods``
+    after a frame (called in :meth:`write`, the stepping thread); ``plot_numbers(out)``
+    → the frame's plots' decoding-order numbers; ``periods``
     — each radar's rotation period (s); ``clock`` → now (s, the receive times' clock)."""
 
     def __init__(self, counts: Callable[[], Mapping[str, int]], tracks: Callable[[], int],

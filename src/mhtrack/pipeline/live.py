@@ -7,16 +7,17 @@ JSON file, Prometheus text) and checkpoints of the tracker to restart from
 
 ``UdpReader``/``StdinReader`` (:mod:`mhtrack.sources.udp`) → ``DatagramSource`` (decode,
 time axis, re-order window, frames) → the tracker → the sinks. A live source has no
-survey: the frame lengths come from the sensors file's periods (every radar needs one —
-live cannot wait for CAT034 marks before its first frame), and the new-target density
-must be given (``TrackOptions.new_target_density``: there are no plots yet to take an
-area from). The day of each ASTERIX time of day comes from the datagrams' receive time
+survey of the whole input: the frame lengths come from the sensors file's periods and
+the new-target density from ``TrackOptions.new_target_density``; what is not given is
+taken from the first rotations (:mod:`~mhtrack.pipeline.warmup`). The day of each
+ASTERIX time of day comes from the datagrams' receive time
 (``day_from="receive"``, real feeds: the receive clock must be right to within 12 h) or
 from the stream alone (``"stream"``: a recording replayed at another speed or hour).
 """
 
 from __future__ import annotations
 
+import itertools
 import sys
 import threading
 import time
@@ -38,9 +39,11 @@ from mhtrack.pipeline.health import Health
 from mhtrack.pipeline.monitor import MetricsServer, prometheus_text, write_status
 from mhtrack.pipeline.options import TrackOptions
 from mhtrack.pipeline.run import Pipeline, RunResult
+from mhtrack.pipeline.warmup import Warmup, warm_up
 from mhtrack.sinks.base import FrameOutput, Sink
 
 if TYPE_CHECKING:
+    from mhtrack.mht import MHTConfig
     from mhtrack.models.radars import SensorSet
     from mhtrack.records import TrackTable
     from mhtrack.sources.udp import ReaderStats
@@ -143,14 +146,6 @@ class Live:
         from mhtrack.sources.datagrams import DatagramSource
         from mhtrack.sources.udp import StdinReader, UdpReader
 
-        if options.new_target_density is None:
-            raise ValueError("live: give the new-target density (--birth-density): a live "
-                             "feed has no plots yet to take the surveillance area from")
-        no_period = [s.id for s in sensors.sensors if s.period is None]
-        if no_period:
-            raise ValueError(f"live: the sensors file gives no period for radar(s) "
-                             f"{', '.join(map(str, no_period))}: live frames need each "
-                             "radar's rotation period (it cannot survey CAT034 first)")
         if live.day_from not in DAY_FROM:
             raise ValueError(f"unknown day_from {live.day_from!r} (expected "
                              f"{', '.join(DAY_FROM)})")
@@ -165,6 +160,8 @@ class Live:
             resumed = read_checkpoint(live.checkpoint)
         #: The checkpoint resumed from (``None``: a fresh start).
         self.resumed: LiveState | None = None if resumed is None else resumed[1]
+        #: The density comes from the first rotations (not given, not resumed).
+        self.live_density_needed = options.new_target_density is None and resumed is None
         if live.stdin is not None:
             self.reader: UdpReader | StdinReader = StdinReader(
                 stdin if stdin is not None else sys.stdin.buffer, framing=live.stdin,
@@ -173,6 +170,13 @@ class Live:
         else:
             self.reader = UdpReader(list(live.listen), stop=self.stop)
             name = ",".join(self.reader.names)
+        incoming: Iterator[tuple[bytes, float]] = iter(self.reader)
+        config = None
+        #: The first rotations surveyed (:mod:`~mhtrack.pipeline.warmup`), if needed.
+        self.warmup: Warmup | None = None
+        if self.live_density_needed or any(
+                s.period is None for s in sensors.sensors if s.kind == "polar"):
+            sensors, config, incoming = self._warm_up(sensors, incoming, name)
         axis = None
         st = self.resumed
         if st is not None:
@@ -182,7 +186,7 @@ class Live:
                              {s.id: float(s.period) for s in sensors.sensors  # type: ignore[arg-type]
                               if s.kind == "polar"}, clock)
         self.source = DatagramSource(
-            self._arrived(self.reader), sensors=sensors, name=name,
+            self._arrived(incoming), sensors=sensors, name=name,
             reorder_window_s=live.reorder_window_s, chunk=1,  # each data block on at once
             axis=axis, first_frame=0 if st is None else st.next_frame,
             first_row=0 if st is None else st.next_row,
@@ -191,7 +195,7 @@ class Live:
             # stopped with a checkpoint: the plots held go into it, tracked on resume
             hold=lambda: self.stop.is_set() and live.checkpoint is not None)
         try:
-            self.pipeline = Pipeline(self.source, options)
+            self.pipeline = Pipeline(self.source, options, config=config)
         except BaseException:
             if isinstance(self.reader, UdpReader):
                 self.reader.close()
@@ -200,6 +204,38 @@ class Live:
             self.pipeline.tracker = resumed[0]
             self.pipeline.config = resumed[0].config
         self._make_sinks(sensors, stdout)
+
+    def _warm_up(self, sensors: SensorSet, incoming: Iterator[tuple[bytes, float]],
+                 name: str) -> tuple[SensorSet, MHTConfig | None, Iterator[Any]]:
+        """The first rotations surveyed (:mod:`~mhtrack.pipeline.warmup`): the sensors
+        with their periods, the configuration of the plots' area (``None``: the density
+        was given) and the datagrams, those held first."""
+        from mhtrack.build import default_config
+        from mhtrack.io.asterix.api import sensors_with_periods
+        from mhtrack.pipeline.options import survey_area
+
+        self.warmup = warm = warm_up(incoming, sensors, name=name,
+                       use_receive_time=self.live.day_from == "receive",
+                       reorder_window_s=self.live.reorder_window_s, stop=self.stop)
+        sensors = sensors_with_periods(sensors, warm.periods)
+        missing = [s.id for s in sensors.sensors if s.kind == "polar" and s.period is None]
+        if missing and not self.stop.is_set():
+            raise ValueError(
+                f"live: no rotation period for radar(s) {', '.join(map(str, missing))} in "
+                f"the sensors file nor from their CAT034 marks in the first "
+                f"{warm.span_s:.0f} s: give period in the sensors file")
+        config = None
+        if self.live_density_needed:
+            area = survey_area(name, warm.survey)
+            config = default_config(area=area.area) if area is not None else None
+            if self.emit is not None and area is not None:
+                self.emit(f"live: new-target density {config.new_target_density:.3g} "
+                          f"per m² per scan from the first {warm.span_s:.0f} s of plots "
+                          f"({area.width / 1e3:.3g} km × {area.height / 1e3:.3g} km box)")
+        if self.emit is not None and warm.periods:
+            self.emit("live: periods " + ", ".join(
+                f"radar {k} {v:.3g} s" for k, v in sorted(warm.periods.items())))
+        return sensors, config, itertools.chain(warm.datagrams, incoming)
 
     def _make_sinks(self, sensors: SensorSet, stdout: TextIO | None) -> None:
         from mhtrack.sinks.files import Cat062Sink

@@ -156,3 +156,16 @@ def test_json_status_file_and_http(tmp_path: Path) -> None:
             urllib.request.urlopen(f"http://{host}:{port}/other", timeout=10)
     finally:
         server.close()
+
+
+def test_frames_made_by_the_end_are_not_timed() -> None:
+    h = _health([10.5, 30.0, 31.0])
+    h.arrivals.add(0, 9.9)
+    frame = SimpleNamespace(frame=SimpleNamespace(time=1.0, sensor=np.array([1]),
+                                                  rows=np.array([0])))
+    h.write(frame)
+    h.input_ended = True  # the stop flushes a frame 20 s later: not a latency of the data
+    h.write(frame)
+    lat = h.snapshot()["latency_s"]
+    assert (lat["count"], lat["after_end"], h.frames) == (1, 1, 2)
+    assert lat["p99"] == pytest.approx(0.6)

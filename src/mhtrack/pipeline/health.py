@@ -7,7 +7,9 @@ rotation) is ``t_out − t_in``: ``t_in`` the receive time of the frame's **last
 datagram** — the one carrying the frame's plot decoded last — and ``t_out`` the time its
 output had gone to every sink (the CAT062 datagrams sent, the JSON lines written). It
 includes the wait for the re-order window and for the next plot that closes the frame
-(``docs/sources.md``): what a consumer sees. Receive times come from the reader thread
+(``docs/sources.md``): what a consumer sees. Frames made by the end of the input (a stop:
+the window and the open frames flushed) are timed by the stop, not by the data: they
+are counted apart (``after_end``) and left out. Receive times come from the reader thread
 (``time.time()`` when ``recv`` returned); :class:`Arrivals` maps each plot's
 decoding-order number to its datagram's receive time over a bounded horizon.
 
@@ -99,6 +101,11 @@ class Health(Sink):
         self.clock = clock
         self.arrivals = Arrivals() if arrivals is None else arrivals
         self.frames = self.n_tracks = 0
+        #: Set once the input has ended: later frames are those the end made (the
+        #: re-order window and open frames flushed), timed by the stop, not by the
+        #: data — counted in :attr:`after_end`, left out of the latencies.
+        self.input_ended = False
+        self.after_end = 0
         self._lock = threading.Lock()  # write (stepping) against snapshot (status thread)
         self.untimed = 0  # frames whose last datagram was forgotten
         self.latency_sum = 0.0
@@ -125,6 +132,9 @@ class Health(Sink):
         for s in np.unique(out.frame.sensor).tolist():
             self._last_frame[int(s)] = t
         plots = self.plot_numbers(out)
+        if self.input_ended:
+            self.after_end += 1
+            return
         if plots.size == 0:
             return
         t_in = self.arrivals.time_of(int(plots.max()))
@@ -162,7 +172,8 @@ class Health(Sink):
                     "frames": self.frames, "tracks": self.n_tracks,
                     "radars_silent": self.silent(),
                     "latency_s": {"p50": p50, "p99": p99, "sum": self.latency_sum,
-                                  "count": self.latency_count, "untimed": self.untimed}}
+                                  "count": self.latency_count, "untimed": self.untimed,
+                                  "after_end": self.after_end}}
 
     def line(self, snap: Mapping[str, Any] | None = None) -> str:
         """The status line: rates since the last line (none at the first), totals, and

@@ -285,6 +285,7 @@ class Live:
         for data, when in reader:
             self.health.arrivals.add(self.source.decoded, when)
             yield data if stream else (data, when)
+        self.health.input_ended = True
 
     def _counts(self) -> dict[str, int]:
         s, r = self.source.stats, self.reader.stats

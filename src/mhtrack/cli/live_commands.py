@@ -135,10 +135,6 @@ def live(listen: tuple[str, ...], stdin: str | None, sensors_file: Path,
     with stop_on_signals(threading.Event()) as stop:
         run = Live(read_sensors(sensors_file), options, settings, stop=stop,
                    emit=lambda line: click.echo(line, err=True))
-        if run.resumed is not None:
-            click.echo(f"resumed from {checkpoint} (frame {run.resumed.next_frame}, time "
-                       f"{run.resumed.last_time} s)", err=True)
-        click.echo(f"listening on {', '.join(run.listening)}", err=True)
         result = run.run()
     click.echo(result.describe(), err=True)
 

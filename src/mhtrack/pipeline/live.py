@@ -170,6 +170,11 @@ class Live:
         else:
             self.reader = UdpReader(list(live.listen), stop=self.stop)
             name = ",".join(self.reader.names)
+        if emit is not None:  # before any warm-up: a sender may wait for this line
+            if self.resumed is not None:
+                emit(f"resumed from {live.checkpoint} (frame {self.resumed.next_frame}, "
+                     f"time {self.resumed.last_time} s)")
+            emit(f"listening on {', '.join(self.listening)}")
         incoming: Iterator[tuple[bytes, float]] = iter(self.reader)
         config = None
         #: The first rotations surveyed (:mod:`~mhtrack.pipeline.warmup`), if needed.
@@ -184,7 +189,7 @@ class Live:
             axis.day0, axis.latest = st.axis_day0, st.axis_latest
         self.health = Health(self._counts, self._tracks, self._plot_numbers,
                              {s.id: float(s.period) for s in sensors.sensors  # type: ignore[arg-type]
-                              if s.kind == "polar"}, clock)
+                              if s.kind == "polar" and s.period is not None}, clock)
         self.source = DatagramSource(
             self._arrived(incoming), sensors=sensors, name=name,
             reorder_window_s=live.reorder_window_s, chunk=1,  # each data block on at once

@@ -11,6 +11,7 @@ import os
 import threading
 from pathlib import Path
 from types import SimpleNamespace
+from typing import BinaryIO
 
 import numpy as np
 import pytest
@@ -19,10 +20,10 @@ pytest.importorskip("asterix.generated", reason="libasterix not installed")
 
 from mhtrack.io.sensors import read_sensors
 from mhtrack.pipeline import Pipeline, TrackOptions
-from mhtrack.pipeline.live import Live, LiveOptions, Status
+from mhtrack.pipeline.health import Health
+from mhtrack.pipeline.live import Live, LiveOptions
 from mhtrack.sinks import TrackCollector
 from mhtrack.sources.replay import recording_datagrams
-from mhtrack.sources.udp import ReaderStats
 
 OPTIONS = TrackOptions(output="online", new_target_density=1e-10)
 
@@ -43,28 +44,86 @@ def rec(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return out
 
 
+def _pipe(data: bytes) -> tuple[BinaryIO, threading.Thread]:
+    r, w = os.pipe()
+    return os.fdopen(r, "rb", buffering=0), threading.Thread(
+        target=lambda: (os.write(w, data), os.close(w)))
+
+
 def test_refusals(rec: Path) -> None:
     sensors = read_sensors(rec / "sensors.toml")
-    with pytest.raises(ValueError, match="--birth-density"):
-        Live(sensors, TrackOptions(), LiveOptions(listen=("udp://127.0.0.1:0",)))
     no_period = dataclasses.replace(sensors, sensors=tuple(
         dataclasses.replace(s, period=None) if s.id == 2 else s for s in sensors.sensors))
-    with pytest.raises(ValueError, match=r"no period for radar\(s\) 2"):
-        Live(no_period, OPTIONS, LiveOptions(listen=("udp://127.0.0.1:0",)))
+    rf, writer = _pipe(b"")  # no CAT034 mark to take a period from
+    writer.start()
+    with rf, pytest.raises(ValueError, match=r"no rotation period for radar\(s\) 2"):
+        Live(no_period, OPTIONS, LiveOptions(stdin="raw"), stdin=rf)
+    writer.join()
     with pytest.raises(ValueError, match="one of them"):
         Live(sensors, OPTIONS, LiveOptions())
 
 
+def test_periods_and_density_from_the_first_rotations(rec: Path, tmp_path: Path) -> None:
+    """Without periods in the sensors file nor a density, live takes them from its
+    first rotations: the periods are the file's (the export sends I034/041), the density
+    is the one track chooses for a recording of exactly the datagrams held, and the rows
+    are those of the pipeline given both — nothing held is lost."""
+    sensors = read_sensors(rec / "sensors.toml")
+    bare = dataclasses.replace(sensors, sensors=tuple(
+        dataclasses.replace(s, period=None) for s in sensors.sensors))
+    data = (rec / "radar.ast").read_bytes()
+    rf, writer = _pipe(data)
+    out = io.StringIO()
+    lines: list[str] = []
+    with rf:
+        writer.start()
+        live = Live(bare, TrackOptions(output="online"),
+                    LiveOptions(stdin="raw", day_from="stream", json=True), stdin=rf,
+                    stdout=out, emit=lines.append)
+        live.run()
+        writer.join()
+    warm = live.warmup
+    assert warm is not None and len(warm.datagrams) < len(recording_datagrams(
+        rec / "radar.ast"))  # the first rotations only
+    slowest = max(s.period for s in sensors.sensors)
+    assert 2 * slowest <= warm.span_s < 2 * slowest + 1.0
+    assert {s.id: s.period for s in live.source.sensors.sensors} == pytest.approx(
+        {s.id: s.period for s in sensors.sensors}, rel=1e-3)
+    first = tmp_path / "first.ast"
+    first.write_bytes(b"".join(d for d, _ in warm.datagrams))
+    surveyed = Pipeline.open(str(first), TrackOptions(output="online"),
+                             sensors_file=str(rec / "sensors.toml"))
+    density = live.pipeline.config.new_target_density
+    assert density == surveyed.config.new_target_density
+    assert any("new-target density" in x for x in lines)
+    ref = TrackCollector("online")
+    Pipeline.open(str(rec / "radar.ast"), dataclasses.replace(
+        OPTIONS, new_target_density=density), sensors_file=str(rec / "sensors.toml")
+    ).run([ref])
+    rows = [json.loads(x) for x in out.getvalue().splitlines()]
+    assert [r["track_id"] for r in rows] == ref.tracks().track_id.tolist()
+    assert np.allclose([r["x"] for r in rows], ref.tracks().x, atol=5e-4, rtol=0)
+
+
 def test_status_line_by_hand() -> None:
-    reader = ReaderStats(datagrams=10, queue_dropped=1)
-    src = SimpleNamespace(plots_in=40, late_dropped=2)
-    st = Status(reader, lambda: src)
-    assert st.line(100.0) == ("live: 10 datagrams, 40 plots, 0 frames, 2 late drops, "
-                              "1 queue drops, 0 tracks")
-    reader.datagrams, src.plots_in = 30, 140
-    st._count(SimpleNamespace(online=[1, 2, 3]))
-    assert st.line(104.0) == ("live: 5.0 datagrams/s, 25.0 plots/s, 30 datagrams, 140 "
-                              "plots, 1 frames, 2 late drops, 1 queue drops, 3 tracks")
+    counts = {"datagrams": 10, "queue_drops": 1, "plots": 40, "duplicates": 3,
+              "late_drops": 2}
+    clock = iter([100.0, 104.0, 104.2, 104.5])  # line, frame out, frame out, line
+    st = Health(lambda: counts, lambda: 3, lambda out: np.array([0]), {1: 4.0, 2: 12.0},
+                lambda: next(clock))
+    assert st.line() == ("live: 10 datagrams, 40 plots, 3 duplicates, 2 late drops, "
+                         "1 queue drops, 0 frames, 0 tracks, 0 radars silent")
+    counts.update(datagrams=30, plots=140)
+    st.arrivals.add(0, 103.9)  # plot 0 came at 103.9 s: latencies 0.1 s and 0.3 s
+    frame = SimpleNamespace(time=50.0, sensor=np.array([2]), rows=np.array([0]))
+    st.write(SimpleNamespace(frame=frame))
+    st.write(SimpleNamespace(frame=SimpleNamespace(time=63.0, sensor=np.array([2]),
+                                                    rows=np.array([0]))))
+    # radar 1 never sent a frame in 13 s > 3 x 4 s: silent; radar 2 sent one at 63 s
+    # 20 datagrams and 100 plots in 4.5 s; p50 of (0.1, 0.3) 0.2 s, p99 0.1 + 0.99 x 0.2
+    assert st.line() == ("live: 4.4 datagrams/s, 22.2 plots/s, 30 datagrams, 140 plots, "
+                         "3 duplicates, 2 late drops, 1 queue drops, 2 frames, 3 tracks, "
+                         "1 radars silent (1), latency p50 200 ms p99 298 ms")
 
 
 def test_stdin_run_equals_the_pipeline_on_the_file(rec: Path) -> None:

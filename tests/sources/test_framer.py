@@ -130,3 +130,32 @@ def test_sector_cuts_as_the_rule_says(stream, data) -> None:
             {"time": t[a:b], "sensor": s[a:b], "sector": sec[a:b], "pos": np.arange(a, b)})]
     got += [f.cols["pos"].tolist() for f in fr.flush()]
     assert got == _brute_sectors(t, s, sec, lengths)
+
+
+@settings(max_examples=150, deadline=None)
+@given(streams(), st.integers(0, 80))
+def test_pending_plots_continue_in_a_fresh_framer(stream, stop) -> None:
+    """Stopped after any batch, the plots a framer holds (:meth:`Framer.pending`) pushed
+    into a fresh framer (numbered on) with the batches after the stop give the frames of
+    the framer never stopped: what a resumed live run relies on."""
+    t, s, lengths, cuts = stream
+    bounds = [0, *sorted(set(c for c in cuts if 0 < c < t.size)), t.size]
+    pieces = list(itertools.pairwise(bounds))
+    stop = min(stop, len(pieces))
+
+    def batch(a: int, b: int) -> dict[str, np.ndarray]:
+        return {"time": t[a:b], "sensor": s[a:b], "pos": np.arange(a, b)}
+
+    first, got = Framer(lengths), []
+    for a, b in pieces[:stop]:
+        got += [f.cols["pos"].tolist() for f in first.push(batch(a, b))]
+    second = Framer(lengths)
+    second.n_frames = first.n_frames
+    held = first.pending()
+    if held is not None:
+        got += [f.cols["pos"].tolist() for f in second.push(held)]
+    for a, b in pieces[stop:]:
+        got += [f.cols["pos"].tolist() for f in second.push(batch(a, b))]
+    got += [f.cols["pos"].tolist() for f in second.flush()]
+    want = [g[3] for g in _frames(t, s, lengths, cuts)]
+    assert got == want

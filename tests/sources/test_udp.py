@@ -104,6 +104,14 @@ def test_stdin_framings(framing: str) -> None:
     assert got == blocks
 
 
+def test_stdin_from_a_regular_file(tmp_path) -> None:
+    """``live --stdin raw < rec.ast``: epoll refuses a regular file; it is read as is."""
+    blocks = _blocks() * 20
+    (tmp_path / "rec.ast").write_bytes(b"".join(blocks))
+    with (tmp_path / "rec.ast").open("rb", buffering=0) as f:
+        assert [d for d, _ in StdinReader(f, framing="raw")] == blocks
+
+
 def test_stdin_ending_inside_a_datagram_names_the_byte() -> None:
     r, w = os.pipe()
     os.write(w, _blocks()[0] + bytes([48, 0, 9, 1]))

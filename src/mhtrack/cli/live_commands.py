@@ -62,7 +62,8 @@ def replay(recording: Path, to: str, speed: float | None, loop: bool) -> None:
               "or each datagram after its length (4 octets, big-endian).")
 @click.option("--sensors", "sensors_file", required=True, type=click.Path(
               exists=True, dir_okay=False, path_type=Path),
-              help="Sensors file: every radar's site, errors and rotation period.")
+              help="Sensors file: every radar's site and errors (its rotation period, if not "
+              "taken from its CAT034 marks in the first rotations).")
 @click.option("--day-from", type=click.Choice(["receive", "stream"]), default=None,
               help="The day of each time of day: from the receive clock (live feeds), or "
               "from the stream alone (a replayed recording) [receive].")
@@ -74,8 +75,26 @@ def replay(recording: Path, to: str, speed: float | None, loop: bool) -> None:
               help="With --out: a new file STEM.partNNNN.SUFFIX every N frames.")
 @click.option("--json", "as_json", is_flag=True, help="Print each frame's tracks as JSON "
               "lines on stdout.")
+@click.option("--period-out", type=click.FloatRange(min=0, min_open=True), default=None,
+              help="Send every track on this period (s of data time), extrapolated to "
+              "each tick, instead of each sector's tracks on update.")
 @click.option("--status-every", type=click.FloatRange(min=0, min_open=True), default=None,
               help="Print a status line on stderr every N seconds.")
+@click.option("--status-json", type=click.Path(dir_okay=False, path_type=Path),
+              default=None, help="Write the status as JSON to this file (atomically) with "
+              "every status (every 10 s without --status-every) and at the end.")
+@click.option("--prometheus", type=click.Path(dir_okay=False, path_type=Path), default=None,
+              help="Write the status as Prometheus text (format 0.0.4) to this file.")
+@click.option("--metrics-http", default=None, metavar="HOST:PORT",
+              help="Serve the Prometheus text at http://HOST:PORT/metrics (:PORT: on "
+              "127.0.0.1).")
+@click.option("--checkpoint", type=click.Path(dir_okay=False, path_type=Path), default=None,
+              help="Save the tracker's state to this file (atomically) when the run ends "
+              "and every --checkpoint-every minutes of data time.")
+@click.option("--checkpoint-every", type=click.FloatRange(min=0, min_open=True),
+              default=None, help="Minutes of data time between checkpoints.")
+@click.option("--resume", is_flag=True, help="Start from --checkpoint when it exists: the "
+              "same track ids go on.")
 @click.option("--reorder-window", "reorder_window_s", type=click.FloatRange(min=0),
               default=None, help="Plots may be out of time order by at most this many "
               "seconds [2].")
@@ -87,8 +106,11 @@ def replay(recording: Path, to: str, speed: float | None, loop: bool) -> None:
 @needs_libasterix
 def live(listen: tuple[str, ...], stdin: str | None, sensors_file: Path,
          day_from: str | None, out_udp: tuple[str, ...], out: Path | None,
-         part_frames: int | None, as_json: bool, status_every: float | None,
-         reorder_window_s: float | None, tracker: str, tracker_pd: float | None,
+         part_frames: int | None, as_json: bool, period_out: float | None,
+         status_every: float | None, status_json: Path | None, prometheus: Path | None,
+         metrics_http: str | None, checkpoint: Path | None,
+         checkpoint_every: float | None, resume: bool, reorder_window_s: float | None,
+         tracker: str, tracker_pd: float | None,
          meas_sigma: float | None, accel_sigma: float | None,
          imm_accel_sigma: float | None, clutter_density: float | None,
          birth_density: float | None, nscan: int | None, clutter_frame: str, birth: str,
@@ -103,12 +125,16 @@ def live(listen: tuple[str, ...], stdin: str | None, sensors_file: Path,
                             fusion, "online", clutter_frame=clutter_frame)
     settings = LiveOptions(listen=listen, stdin=stdin, out_udp=out_udp, out_file=out,
                            part_frames=part_frames, json=as_json,
-                           status_every_s=status_every, reorder_window_s=reorder_window_s,
+                           period_out_s=period_out, status_every_s=status_every,
+                           status_json=status_json, prometheus=prometheus,
+                           metrics_http=metrics_http, checkpoint=checkpoint,
+                           checkpoint_every_s=(None if checkpoint_every is None
+                                               else 60.0 * checkpoint_every),
+                           resume=resume, reorder_window_s=reorder_window_s,
                            **({} if day_from is None else {"day_from": day_from}))
     with stop_on_signals(threading.Event()) as stop:
         run = Live(read_sensors(sensors_file), options, settings, stop=stop,
                    emit=lambda line: click.echo(line, err=True))
-        click.echo(f"listening on {', '.join(run.listening)}", err=True)
         result = run.run()
     click.echo(result.describe(), err=True)
 

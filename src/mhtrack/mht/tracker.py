@@ -134,6 +134,11 @@ class MHTTracker:
         """The current hypothesis store (read-only view for inspection and tests)."""
         return self._leaves
 
+    @property
+    def last_time(self) -> float | None:
+        """The time of the last scan stepped (``None`` before the first)."""
+        return self._last_time
+
     def step(self, scan: Scan) -> TrackTable:
         """Process one scan (or frame) through the module docstring's cycle; return the
         confirmed tracks of the best global hypothesis. Statistics go to :attr:`last_stats`,
@@ -266,15 +271,18 @@ class MHTTracker:
         return out.sorted() if history else out
 
     # ------------------------------------------------------------------ persistence
-    def save(self, path: str | PathLike[str]) -> None:
-        """Write the full state to one ``.npz`` (no pickle; :mod:`mhtrack.mht.state`)."""
+    def save(self, path: str | PathLike[str], extra: dict[str, Any] | None = None) -> None:
+        """Write the full state to one ``.npz`` (no pickle; :mod:`mhtrack.mht.state`);
+        ``extra``: the caller's JSON-able bookkeeping, saved with it (``meta["extra"]``,
+        e.g. a live run's frame number and time axis)."""
         parts = {"leaves": self._leaves.arrays(), "birth": self.birth.arrays(),
                  "history": self._history.arrays(), "coverage": self.coverage.arrays()}
         save_state(path, parts, self.clutter, self.config, {
             "last_time": self._last_time, "last_index": self._last_index,
             "next_tree": self.trees.next, "next_track": self.tracks.next,
             "next_node": self.nodes.next,
-            **({} if self.recipe is None else {"recipe": self.recipe})})
+            **({} if self.recipe is None else {"recipe": self.recipe}),
+            **({} if extra is None else {"extra": extra})})
 
     @classmethod
     def load(

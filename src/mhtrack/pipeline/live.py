@@ -1,36 +1,59 @@
 """``mhtrack live``: a :class:`~mhtrack.pipeline.Pipeline` over datagrams from the
-network or stdin, its tracks out as CAT062 over UDP, rolling CAT062 files and JSON lines,
-with a status line every few seconds (``docs/live.md``).
+network or stdin, its tracks out as CAT062 over UDP, rolling CAT062 files and JSON lines
+— on update or on a fixed period of data time (:mod:`mhtrack.sinks.periodic`) —, its
+health and latency every few seconds (:mod:`~mhtrack.pipeline.health`: a status line, a
+JSON file, Prometheus text) and checkpoints of the tracker to restart from
+(:mod:`~mhtrack.pipeline.checkpoint`) (``docs/live.md``).
 
 ``UdpReader``/``StdinReader`` (:mod:`mhtrack.sources.udp`) → ``DatagramSource`` (decode,
 time axis, re-order window, frames) → the tracker → the sinks. A live source has no
-survey: the frame lengths come from the sensors file's periods (every radar needs one —
-live cannot wait for CAT034 marks before its first frame), and the new-target density
-must be given (``TrackOptions.new_target_density``: there are no plots yet to take an
-area from). The day of each ASTERIX time of day comes from the datagrams' receive time
+survey of the whole input: the frame lengths come from the sensors file's periods and
+the new-target density from ``TrackOptions.new_target_density``; what is not given is
+taken from the first rotations (:mod:`~mhtrack.pipeline.warmup`). The day of each
+ASTERIX time of day comes from the datagrams' receive time
 (``day_from="receive"``, real feeds: the receive clock must be right to within 12 h) or
 from the stream alone (``"stream"``: a recording replayed at another speed or hour).
 """
 
 from __future__ import annotations
 
+import itertools
 import sys
 import threading
 import time
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, BinaryIO, TextIO
 
+import numpy as np
+
+from mhtrack.pipeline.checkpoint import (
+    CheckpointSink,
+    LiveState,
+    decode_pending,
+    encode_pending,
+    read_checkpoint,
+)
+from mhtrack.pipeline.health import Health
+from mhtrack.pipeline.monitor import MetricsServer, prometheus_text, write_status
 from mhtrack.pipeline.options import TrackOptions
 from mhtrack.pipeline.run import Pipeline, RunResult
-from mhtrack.sinks.base import CallbackSink, FrameOutput, Sink
+from mhtrack.pipeline.warmup import Warmup, warm_up
+from mhtrack.sinks.base import FrameOutput, Sink
 
 if TYPE_CHECKING:
+    from mhtrack.mht import MHTConfig
     from mhtrack.models.radars import SensorSet
+    from mhtrack.records import TrackTable
     from mhtrack.sources.udp import ReaderStats
 
 DAY_FROM = ("receive", "stream")
+#: Status period (s) when a status file or endpoint is asked for without one.
+DEFAULT_STATUS_EVERY_S = 10.0
+#: Period output: a track is extrapolated at most this many of the longest radar
+#: rotation periods past its own time (``LiveOptions.max_extrapolation_s``).
+EXTRAPOLATION_PERIODS = 2.0
 
 
 @dataclass(frozen=True)
@@ -50,43 +73,33 @@ class LiveOptions:
     part_frames: int | None = None
     #: JSON lines of the online rows on stdout.
     json: bool = False
+    #: Send every output on this period of data time (s) instead of on update.
+    period_out_s: float | None = None
+    #: Period output: longest extrapolation of a track (s; ``None``: 2 rotations).
+    max_extrapolation_s: float | None = None
     #: Seconds between status lines (``None``: none).
     status_every_s: float | None = None
+    #: The status as a JSON file and as Prometheus text (file; HTTP ``HOST:PORT``).
+    status_json: Path | None = None
+    prometheus: Path | None = None
+    metrics_http: str | None = None
+    #: Tracker checkpoints: the file, every this many seconds of data time (``None``:
+    #: only at the end); ``resume``: start from it when it exists.
+    checkpoint: Path | None = None
+    checkpoint_every_s: float | None = None
+    resume: bool = False
     #: CAT062 data source (I062/010).
     sac: int | None = None
     sic: int | None = None
     reorder_window_s: float | None = None
 
 
-class Status(CallbackSink):
-    """Counts what the run did; :meth:`line` is the status line since the last call:
-    ``datagrams/s, plots/s, frames, late drops, queue drops, tracks`` (tracks: reported
-    at the last frame)."""
-
-    def __init__(self, reader: ReaderStats, source_stats: Callable[[], Any]) -> None:
-        super().__init__(self._count)
-        self.reader, self.source_stats = reader, source_stats
-        self.frames = self.tracks = 0
-        self._last: tuple[float, int, int] | None = None
-
-    def _count(self, out: FrameOutput) -> None:
-        self.frames += 1
-        self.tracks = len(out.online)
-
-    def line(self, now: float) -> str:
-        """The status line at time ``now`` (s); rates over the time since the last line
-        (since the first call: totals only)."""
-        s = self.source_stats()
-        d, p = self.reader.datagrams, s.plots_in
-        rates = ""
-        if self._last is not None and now > self._last[0]:
-            dt = now - self._last[0]
-            rates = (f"{(d - self._last[1]) / dt:.1f} datagrams/s, "
-                     f"{(p - self._last[2]) / dt:.1f} plots/s, ")
-        self._last = (now, d, p)
-        return (f"live: {rates}{d} datagrams, {p} plots, {self.frames} frames, "
-                f"{s.late_dropped} late drops, {self.reader.queue_dropped} queue drops, "
-                f"{self.tracks} tracks")
+def _host_port(text: str) -> tuple[str, int]:
+    """``HOST:PORT`` (or ``:PORT``: 127.0.0.1) of the metrics endpoint."""
+    host, sep, port = text.rpartition(":")
+    if not sep or not port.isdigit():
+        raise ValueError(f"{text}: expected HOST:PORT for the metrics endpoint")
+    return host.strip("[]") or "127.0.0.1", int(port)
 
 
 @dataclass(frozen=True)
@@ -99,44 +112,56 @@ class LiveResult:
     sent_datagrams: int
     sent_rows: int
     files: tuple[Path, ...]
+    #: The final health snapshot (:meth:`Health.snapshot`).
+    health: dict[str, Any]
+    #: Ticks of the period output sent, checkpoints written.
+    ticks: int = 0
+    checkpoints: int = 0
 
     def describe(self) -> str:
-        """One line: datagrams received, the run, CAT062 sent, files."""
+        """One line: datagrams received, the run, CAT062 sent, files, latency."""
         files = f", {len(self.files)} CAT062 files" if self.files else ""
+        lat = self.health["latency_s"]
+        extra = (f"; {self.ticks} ticks" if self.ticks else "") + \
+            (f"; {self.checkpoints} checkpoints" if self.checkpoints else "")
+        latency = ("" if not lat["count"] else
+                   f"; latency p50 {1e3 * lat['p50']:.0f} ms, p99 {1e3 * lat['p99']:.0f} ms "
+                   f"({lat['count']} frames)")
         return (f"received {self.reader.datagrams} datagrams "
                 f"({self.reader.queue_dropped} dropped in the queue); {self.run.describe()}; "
-                f"sent {self.sent_datagrams} CAT062 datagrams ({self.sent_rows} rows){files}")
+                f"sent {self.sent_datagrams} CAT062 datagrams ({self.sent_rows} rows){files}"
+                f"{extra}{latency}")
 
 
 class Live:
     """The assembled live run (module docstring); :meth:`run` until ``stop`` is set or
     the input ends. ``stdin``/``stdout``: the streams of ``LiveOptions.stdin`` and
-    ``json``; ``emit``: where status lines go."""
+    ``json``; ``emit``: where status lines go; ``clock``: the receive times' clock."""
 
     def __init__(self, sensors: SensorSet, options: TrackOptions, live: LiveOptions, *,
                  stop: threading.Event | None = None, stdin: BinaryIO | None = None,
-                 stdout: TextIO | None = None,
-                 emit: Callable[[str], None] | None = None) -> None:
-        from mhtrack.sinks.files import Cat062Sink
-        from mhtrack.sinks.stream import Cat062UdpSink, JsonLinesSink
+                 stdout: TextIO | None = None, emit: Callable[[str], None] | None = None,
+                 clock: Callable[[], float] = time.time) -> None:
+        from mhtrack.io.asterix.timeaxis import TimeAxis
         from mhtrack.sources.datagrams import DatagramSource
         from mhtrack.sources.udp import StdinReader, UdpReader
 
-        if options.new_target_density is None:
-            raise ValueError("live: give the new-target density (--birth-density): a live "
-                             "feed has no plots yet to take the surveillance area from")
-        no_period = [s.id for s in sensors.sensors if s.period is None]
-        if no_period:
-            raise ValueError(f"live: the sensors file gives no period for radar(s) "
-                             f"{', '.join(map(str, no_period))}: live frames need each "
-                             "radar's rotation period (it cannot survey CAT034 first)")
         if live.day_from not in DAY_FROM:
             raise ValueError(f"unknown day_from {live.day_from!r} (expected "
                              f"{', '.join(DAY_FROM)})")
         if (live.stdin is None) == (not live.listen):
             raise ValueError("live: listen on UDP endpoints or read stdin (one of them)")
+        if live.resume and live.checkpoint is None:
+            raise ValueError("live: --resume needs --checkpoint FILE")
         self.live, self.emit = live, emit
         self.stop = threading.Event() if stop is None else stop
+        resumed = None
+        if live.resume and live.checkpoint is not None and live.checkpoint.exists():
+            resumed = read_checkpoint(live.checkpoint)
+        #: The checkpoint resumed from (``None``: a fresh start).
+        self.resumed: LiveState | None = None if resumed is None else resumed[1]
+        #: The density comes from the first rotations (not given, not resumed).
+        self.live_density_needed = options.new_target_density is None and resumed is None
         if live.stdin is not None:
             self.reader: UdpReader | StdinReader = StdinReader(
                 stdin if stdin is not None else sys.stdin.buffer, framing=live.stdin,
@@ -145,19 +170,84 @@ class Live:
         else:
             self.reader = UdpReader(list(live.listen), stop=self.stop)
             name = ",".join(self.reader.names)
-        datagrams: Iterable[Any] = self.reader
-        if live.day_from == "stream":
-            datagrams = (d for d, _ in self.reader)
-        self.source = DatagramSource(datagrams, sensors=sensors, name=name,
-                                     reorder_window_s=live.reorder_window_s,
-                                     chunk=1)  # each data block on as it arrives
+        if emit is not None:  # before any warm-up: a sender may wait for this line
+            if self.resumed is not None:
+                emit(f"resumed from {live.checkpoint} (frame {self.resumed.next_frame}, "
+                     f"time {self.resumed.last_time} s)")
+            emit(f"listening on {', '.join(self.listening)}")
+        incoming: Iterator[tuple[bytes, float]] = iter(self.reader)
+        config = None
+        #: The first rotations surveyed (:mod:`~mhtrack.pipeline.warmup`), if needed.
+        self.warmup: Warmup | None = None
+        if self.live_density_needed or any(
+                s.period is None for s in sensors.sensors if s.kind == "polar"):
+            sensors, config, incoming = self._warm_up(sensors, incoming, name)
+        axis = None
+        st = self.resumed
+        if st is not None:
+            axis = TimeAxis()
+            axis.day0, axis.latest = st.axis_day0, st.axis_latest
+        self.health = Health(self._counts, self._tracks, self._plot_numbers,
+                             {s.id: float(s.period) for s in sensors.sensors  # type: ignore[arg-type]
+                              if s.kind == "polar" and s.period is not None}, clock)
+        self.source = DatagramSource(
+            self._arrived(incoming), sensors=sensors, name=name,
+            reorder_window_s=live.reorder_window_s, chunk=1,  # each data block on at once
+            axis=axis, first_frame=0 if st is None else st.next_frame,
+            first_row=0 if st is None else st.next_row,
+            not_before=None if st is None else st.last_time,
+            pending=None if st is None else decode_pending(st.pending),
+            # stopped with a checkpoint: the plots held go into it, tracked on resume
+            hold=lambda: self.stop.is_set() and live.checkpoint is not None)
         try:
-            self.pipeline = Pipeline(self.source, options)
+            self.pipeline = Pipeline(self.source, options, config=config)
         except BaseException:
             if isinstance(self.reader, UdpReader):
                 self.reader.close()
             raise
-        frame = self.pipeline.frame
+        if resumed is not None:  # the same track ids, hypotheses and clutter go on
+            self.pipeline.tracker = resumed[0]
+            self.pipeline.config = resumed[0].config
+        self._make_sinks(sensors, stdout)
+
+    def _warm_up(self, sensors: SensorSet, incoming: Iterator[tuple[bytes, float]],
+                 name: str) -> tuple[SensorSet, MHTConfig | None, Iterator[Any]]:
+        """The first rotations surveyed (:mod:`~mhtrack.pipeline.warmup`): the sensors
+        with their periods, the configuration of the plots' area (``None``: the density
+        was given) and the datagrams, those held first."""
+        from mhtrack.build import default_config
+        from mhtrack.io.asterix.api import sensors_with_periods
+        from mhtrack.pipeline.options import survey_area
+
+        self.warmup = warm = warm_up(incoming, sensors, name=name,
+                       use_receive_time=self.live.day_from == "receive",
+                       reorder_window_s=self.live.reorder_window_s, stop=self.stop)
+        sensors = sensors_with_periods(sensors, warm.periods)
+        missing = [s.id for s in sensors.sensors if s.kind == "polar" and s.period is None]
+        if missing and not self.stop.is_set():
+            raise ValueError(
+                f"live: no rotation period for radar(s) {', '.join(map(str, missing))} in "
+                f"the sensors file nor from their CAT034 marks in the first "
+                f"{warm.span_s:.0f} s: give period in the sensors file")
+        config = None
+        if self.live_density_needed:
+            area = survey_area(name, warm.survey)
+            config = default_config(area=area.area) if area is not None else None
+            if self.emit is not None and area is not None:
+                self.emit(f"live: new-target density {config.new_target_density:.3g} "
+                          f"per m² per scan from the first {warm.span_s:.0f} s of plots "
+                          f"({area.width / 1e3:.3g} km × {area.height / 1e3:.3g} km box)")
+        if self.emit is not None and warm.periods:
+            self.emit("live: periods " + ", ".join(
+                f"radar {k} {v:.3g} s" for k, v in sorted(warm.periods.items())))
+        return sensors, config, itertools.chain(warm.datagrams, incoming)
+
+    def _make_sinks(self, sensors: SensorSet, stdout: TextIO | None) -> None:
+        from mhtrack.sinks.files import Cat062Sink
+        from mhtrack.sinks.periodic import PeriodicSink
+        from mhtrack.sinks.stream import Cat062UdpSink, JsonLinesSink
+
+        live, frame = self.live, self.pipeline.frame
         if frame is None and (live.out_udp or live.out_file is not None):
             raise ValueError("live: CAT062 output needs the sensors' geodetic reference")
         self.udp = [Cat062UdpSink(to, frame, sac=live.sac, sic=live.sic)  # type: ignore[arg-type]
@@ -165,41 +255,123 @@ class Live:
         self.files = None if live.out_file is None else Cat062Sink(
             live.out_file, frame, output="online", sac=live.sac,  # type: ignore[arg-type]
             sic=live.sic, part_frames=live.part_frames, empty_ok=True)
-        self.status = Status(self.reader.stats, lambda: self.source.stats)
-        self.sinks: list[Sink] = [*self.udp, self.status]
+        outputs: list[Sink] = [*self.udp]
         if self.files is not None:
-            self.sinks.append(self.files)
+            outputs.append(self.files)
         if live.json:
-            self.sinks.append(JsonLinesSink(stdout if stdout is not None else sys.stdout,
-                                            frame))
+            outputs.append(JsonLinesSink(stdout if stdout is not None else sys.stdout, frame,
+                                         label="frame" if live.period_out_s is None
+                                         else "tick"))
+        self.periodic: PeriodicSink | None = None
+        if live.period_out_s is not None:
+            longest = max((float(s.period) for s in sensors.sensors  # type: ignore[arg-type]
+                           if s.period is not None), default=live.period_out_s)
+            self.periodic = PeriodicSink(
+                outputs, live.period_out_s, self._picture,
+                max_extrapolation_s=(EXTRAPOLATION_PERIODS * longest
+                                     if live.max_extrapolation_s is None
+                                     else live.max_extrapolation_s),
+                next_tick=None if self.resumed is None else self.resumed.next_tick)
+            if self.resumed is not None and self.pipeline.tracker.last_time is not None:
+                self.periodic.resume(self._picture(None), self.pipeline.tracker.last_time)
+            outputs = [self.periodic]
+        self.checkpoints = None if live.checkpoint is None else CheckpointSink(
+            live.checkpoint, lambda: self.pipeline.tracker, self._state,
+            live.checkpoint_every_s)
+        # the health sink comes after the outputs (its time is the frame's out time)
+        self.sinks: list[Sink] = [*outputs, self.health]
+        if self.checkpoints is not None:
+            self.sinks.append(self.checkpoints)
 
+    # -- what the health, period output and checkpoints read --------------------------
+    def _arrived(self, reader: Iterable[tuple[bytes, float]]) -> Iterator[Any]:
+        """The reader's datagrams, each receive time noted for the latency first."""
+        stream = self.live.day_from == "stream"
+        for data, when in reader:
+            self.health.arrivals.add(self.source.decoded, when)
+            yield data if stream else (data, when)
+        self.health.input_ended = True
+
+    def _counts(self) -> dict[str, int]:
+        s, r = self.source.stats, self.reader.stats
+        return {"datagrams": r.datagrams, "queue_drops": r.queue_dropped,
+                "plots": s.plots_in, "duplicates": self.source.problems.counts.get(
+                    "duplicate", 0), "late_drops": s.late_dropped}
+
+    def _tracks(self) -> int:
+        return int(np.count_nonzero(self.pipeline.tracker.leaves.reported()))
+
+    def _plot_numbers(self, out: FrameOutput) -> np.ndarray:
+        return self.source.file_rows(out.frame.rows)
+
+    def _picture(self, out: FrameOutput | None) -> TrackTable:
+        """Every confirmed track of the tracker now, at its own time."""
+        from mhtrack.mht.report import report
+        from mhtrack.sinks.periodic import empty_frame
+
+        trk = self.pipeline.tracker
+        scan = empty_frame(-1, trk.last_time or 0.0) if out is None else out.frame
+        return report(scan, trk.leaves)
+
+    def _state(self) -> LiveState:
+        axis = self.source.axis
+        return LiveState(self.source.next_frame, axis.day0, axis.latest,
+                         self.pipeline.tracker.last_time,
+                         None if self.periodic is None else self.periodic.next_tick,
+                         encode_pending(self.source.pending()), self.source.next_row)
+
+    # -- running ----------------------------------------------------------------------
     @property
     def listening(self) -> list[str]:
         """The endpoints bound (``udp://HOST:PORT``), or ``["stdin"]``."""
         return list(getattr(self.reader, "names", ["stdin"]))
 
-    def _report(self, done: threading.Event) -> None:
-        every = self.live.status_every_s
-        assert every is not None and self.emit is not None
-        self.status.line(time.monotonic())
+    def _publish(self, server: MetricsServer | None, line: bool) -> None:
+        snap = self.health.snapshot()
+        if line and self.emit is not None:
+            self.emit(self.health.line(snap))
+        write_status(snap, self.live.status_json, self.live.prometheus)
+        if server is not None:
+            server.update(prometheus_text(snap))
+
+    def _report(self, done: threading.Event, server: MetricsServer | None) -> None:
+        live = self.live
+        every = live.status_every_s or DEFAULT_STATUS_EVERY_S
+        self.health.line(self.health.snapshot())  # the rates start here
         while not done.wait(every):
-            self.emit(self.status.line(time.monotonic()))
+            self._publish(server, live.status_every_s is not None)
 
     def run(self) -> LiveResult:
-        """Track until the input ends or :attr:`stop` is set; every sink is closed."""
+        """Track until the input ends or :attr:`stop` is set; every sink is closed (a
+        final checkpoint and status written)."""
+        live = self.live
+        server = None
+        if live.metrics_http is not None:
+            server = MetricsServer(*_host_port(live.metrics_http))
+            #: The metrics endpoint's bound ``host, port``.
+            self.metrics_address = server.address
+            if self.emit is not None:
+                self.emit(f"metrics on http://{server.address[0]}:{server.address[1]}"
+                          "/metrics")
         done = threading.Event()
         reporter = None
-        if self.live.status_every_s and self.emit is not None:
-            reporter = threading.Thread(target=self._report, args=(done,), daemon=True,
-                                        name="mhtrack-status")
+        if (live.status_every_s and self.emit is not None) or live.status_json or \
+                live.prometheus or server is not None:
+            reporter = threading.Thread(target=self._report, args=(done, server),
+                                        daemon=True, name="mhtrack-status")
             reporter.start()
         try:
-            result = self.pipeline.run(self.sinks)
+            result = self.pipeline.run(self.sinks, keep_stats=False)
         finally:
             done.set()
             self.stop.set()
             if reporter is not None:
                 reporter.join()
+        self._publish(server, False)  # the final figures
+        if server is not None:
+            server.close()
         files = tuple(self.files.paths) if self.files is not None else ()
         return LiveResult(result, self.reader.stats, sum(s.datagrams for s in self.udp),
-                          sum(s.rows for s in self.udp), files)
+                          sum(s.rows for s in self.udp), files, self.health.snapshot(),
+                          0 if self.periodic is None else self.periodic.ticks,
+                          0 if self.checkpoints is None else self.checkpoints.written)

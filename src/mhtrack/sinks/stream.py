@@ -75,10 +75,13 @@ class JsonLinesSink(Sink):
     """One JSON object per online row, a line each, flushed after every frame:
     ``frame, time, track_id, x, y, vx, vy`` (the local frame, m and m/s, to 1 mm; time
     to 1 µs), ``lat, lon``
-    (with a ``frame``), ``coasting`` (no plot this frame) and ``tentative``."""
+    (with a ``frame``), ``coasting`` (no plot this frame) and ``tentative``. ``label``
+    names the first field: ``frame`` on update, ``tick`` for the ticks of
+    :class:`~mhtrack.sinks.periodic.PeriodicSink` (the tick's number)."""
 
-    def __init__(self, stream: TextIO, frame: LocalFrame | None = None) -> None:
-        self.stream, self.frame = stream, frame
+    def __init__(self, stream: TextIO, frame: LocalFrame | None = None, *,
+                 label: str = "frame") -> None:
+        self.stream, self.frame, self.label = stream, frame, label
 
     def write(self, out: FrameOutput) -> None:
         t = out.online
@@ -89,7 +92,7 @@ class JsonLinesSink(Sink):
             lat, lon = self.frame.to_geodetic(t.x, t.y)
         tent = np.zeros(len(t), bool) if t.tentative is None else t.tentative.astype(bool)
         for i in range(len(t)):
-            row = {"frame": int(out.frame.index), "time": _num(float(t.time[i]), 6),
+            row = {self.label: int(out.frame.index), "time": _num(float(t.time[i]), 6),
                    "track_id": int(t.track_id[i]), "x": _num(float(t.x[i])),
                    "y": _num(float(t.y[i])), "vx": _num(float(t.vx[i])),
                    "vy": _num(float(t.vy[i]))}

@@ -33,7 +33,7 @@ gives it, skipped radars included). Frame lengths come from the sensors' periods
 from __future__ import annotations
 
 import logging
-from collections.abc import Iterable, Iterator, Sequence
+from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from typing import Any
 
 import numpy as np
@@ -69,7 +69,11 @@ class DatagramSource(Source):
 
     def __init__(self, datagrams: Iterable[Datagram], *, sensors: SensorSet | None = None,
                  name: str = "datagrams", reorder_window_s: float | None = None,
-                 fast: bool = True, sectors: bool = False, chunk: int = CHUNK) -> None:
+                 fast: bool = True, sectors: bool = False, chunk: int = CHUNK,
+                 axis: TimeAxis | None = None, first_frame: int = 0, first_row: int = 0,
+                 not_before: float | None = None,
+                 pending: Mapping[str, Any] | None = None,
+                 hold: Callable[[], bool] | None = None) -> None:
         super().__init__()
         if chunk < 1:
             raise ValueError(f"chunk must be >= 1 plot, got {chunk!r}")
@@ -86,6 +90,22 @@ class DatagramSource(Source):
             raise ValueError(f"reorder_window_s must be >= 0, got {reorder_window_s!r}")
         self.fast = fast
         self.sectors = sectors
+        #: Where each pass's time axis starts (``day0, latest``: a resumed live run
+        #: continues its checkpoint's axis) and the number of its first frame;
+        #: :attr:`axis` is the running pass's axis.
+        self.axis_start = (None, None) if axis is None else (axis.day0, axis.latest)
+        self.axis = TimeAxis()
+        self.axis.day0, self.axis.latest = self.axis_start
+        self.first_frame, self.first_row = int(first_frame), int(first_row)
+        #: Plots before this time are late drops (a resumed run: its checkpoint's time).
+        self.not_before = not_before
+        #: Plots held by an earlier stream (``TimedStream.pending``), taken back first;
+        #: ``hold()`` true at the end of the input: keep the plots held (:attr:`held`)
+        #: instead of making frames of them (a live run stopped to be resumed).
+        self.restore, self.hold = pending, hold
+        self.held: dict[str, Any] | None = None
+        #: Plots decoded so far: the next plot's decoding-order number (its ``file_row``).
+        self.decoded = 0
         self.problems = Problems()
         self._input = datagrams
         self._stream: TimedStream | None = None
@@ -108,7 +128,9 @@ class DatagramSource(Source):
         false, as decoded (:data:`~mhtrack.io.asterix.decode.PLOT_COLUMNS` with the time
         on the axis, ``offset``); sweep marks (time on the axis) go to ``sweeps``."""
         self._decoder = decoder = Decoder(fast=self.fast)
-        axis = TimeAxis()
+        self.axis = axis = TimeAxis()
+        axis.day0, axis.latest = self.axis_start
+        self.decoded = 0
         rows: list[tuple[Any, ...]] = []
         times: list[float] = []
         at_rows: list[int] = []
@@ -132,9 +154,11 @@ class DatagramSource(Source):
                 if len(rows) >= self.chunk:
                     yield self._chunk(rows, times, at_rows, n, convert, in_sector)
                     n += len(rows)
+                    self.decoded = n
                     rows, times, at_rows, in_sector = [], [], [], []
         if rows:
             yield self._chunk(rows, times, at_rows, n, convert, in_sector)
+            self.decoded = n + len(rows)
 
     def _chunk(self, rows: list[tuple[Any, ...]], times: list[float], at: list[int],
                n0: int, convert: bool, in_sector: list[int]) -> dict[str, np.ndarray]:
@@ -240,13 +264,37 @@ class DatagramSource(Source):
         self._skipped = {}
         self._stream = stream = TimedStream(
             self.name, self.stats, self._frame_lengths(), self.window_s,
-            lambda first: f"byte {first['offset']} (plot {first['file_row']})")
+            lambda first: f"byte {first['offset']} (plot {first['file_row']})",
+            first_frame=self.first_frame, first_row=self.first_row,
+            not_before=self.not_before)
+        if self.restore is not None:
+            yield from stream.restore(self.restore)
         for cols in self._decoded(problems):
             yield from stream.push(cols)
-        yield from stream.finish()
+        if self.hold is not None and self.hold():
+            self.held = stream.pending()
+        else:
+            yield from stream.finish()
         self.stats.skipped = dict(problems.counts)
         problems.warn(self.name)
         self._warn_skipped()
+
+    def pending(self) -> dict[str, Any] | None:
+        """The plots not yet in a frame given out (:meth:`TimedStream.pending`; after a
+        held end, those held); ``None`` before reading."""
+        if self.held is not None:
+            return self.held
+        return None if self._stream is None else self._stream.pending()
+
+    @property
+    def next_frame(self) -> int:
+        """The number the next frame will get."""
+        return self.first_frame if self._stream is None else self._stream.framer.n_frames
+
+    @property
+    def next_row(self) -> int:
+        """The running row number (``Scan.rows``) the next plot will get."""
+        return self.first_row if self._stream is None else self._stream.next_row
 
     def _warn_skipped(self) -> None:
         """One warning line listing the radars skipped for want of a site."""

@@ -122,6 +122,20 @@ class Framer:
             self._close(s)
         yield from self._ready(final=True)
 
+    def pending(self) -> dict[str, np.ndarray] | None:
+        """The columns of every plot held (open frames and closed frames not yet given
+        out), in time order (ties: in the order pushed); ``None`` when none. Pushed into a
+        fresh framer (same lengths) they give the same frames as here."""
+        parts = [p for fr in (*self._open.values(), *(c[2] for c in self._closed))
+                 for p in fr.parts]
+        if not parts:
+            return None
+        parts.sort(key=lambda p: p[0])  # batch order, then rows in order
+        cols = {k: np.concatenate([self._batches[b][k][rows] for b, rows in parts])
+                for k in self._batches[parts[0][0]]}
+        order = np.argsort(cols["time"], kind="stable")
+        return {k: v[order] for k, v in cols.items()}
+
     def _close(self, sensor: int) -> None:
         fr = self._open.pop(sensor)
         self._closed.append((fr.end, sensor, fr))

@@ -107,6 +107,15 @@ class ReorderBuffer:
             self.released = max(self.released, self._time_of(out[-1]))
         return self._move(None, self.n_in, out)
 
+    def held(self) -> dict[str, np.ndarray] | None:
+        """The columns of the plots held, in the order they would leave (time, then
+        arrival); ``None`` when none."""
+        if not self._heap or self._held is None:
+            return None
+        seq = np.array([s for _, s in sorted(self._heap)], np.int64)
+        pos = np.searchsorted(self._held_seq, seq)
+        return {k: v[pos] for k, v in self._held.items()}
+
     def _time_of(self, seq: int) -> float:
         assert self._held is not None
         return float(self._held["time"][np.searchsorted(self._held_seq, seq)])

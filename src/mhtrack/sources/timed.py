@@ -26,16 +26,24 @@ class TimedStream:
     first by ``where(its column values)``."""
 
     def __init__(self, name: str, stats: SourceStats, frame_s: Mapping[int, float] | float,
-                 window_s: float, where: Callable[[dict[str, object]], str]) -> None:
+                 window_s: float, where: Callable[[dict[str, object]], str], *,
+                 first_frame: int = 0, first_row: int = 0,
+                 not_before: float | None = None) -> None:
         self.name = name
         self.stats = stats
         self.where = where
         self.buffer = ReorderBuffer(window_s)
         self.framer = Framer(frame_s)
+        self.framer.n_frames = int(first_frame)  # frames numbered on from here
+        if not_before is not None:  # as if plots up to it had gone: earlier ones are late
+            self.buffer.latest = self.buffer.released = float(not_before)
         # file row of each running row: one int64 array grown by doubling (8 bytes a
         # plot, no object per frame), the first ``_n_out`` entries valid
         self._rows = np.zeros(1024, np.int64)
         self._n_out = 0
+        #: The first running row number (a resumed run numbers on: the tracker's plot
+        #: windows hold the earlier run's rows, and a plot is known by its row).
+        self.first_row = int(first_row)
 
     def push(self, cols: Mapping[str, np.ndarray]) -> Iterator[Scan]:
         """Frames completed by one more batch of plots."""
@@ -57,6 +65,32 @@ class TimedStream:
             logging.getLogger("mhtrack").warning("%s", late.line(self.name,
                                                                  self.where(late.first)))
 
+    def pending(self) -> dict[str, object]:
+        """The plots held — in the framer (``framed``) and in the re-order buffer
+        (``held``), columns or ``None`` — and the buffer's ``latest`` and ``released``
+        times: with :meth:`restore`, a later stream goes on as this one would have."""
+        b = self.buffer
+        return {"framed": self.framer.pending(), "held": b.held(), "latest": b.latest,
+                "released": b.released}
+
+    def restore(self, pending: Mapping[str, object]) -> Iterator[Scan]:
+        """Take the plots of another stream's :meth:`pending` back (before any push):
+        the framed ones straight into the framer, the held ones into the buffer; the
+        frames already complete (a checkpoint taken between two frames of one push)."""
+        b = self.buffer
+        b.latest, b.released = float(pending["latest"]), float(pending["released"])  # type: ignore[arg-type]
+        framed, held = pending.get("framed"), pending.get("held")
+        for c in (framed, held):
+            self.stats.plots_in += 0 if c is None else len(c["time"])  # type: ignore[index]
+        if framed is not None:
+            yield from map(self._scan, self.framer.push(framed))  # type: ignore[arg-type]
+        if held is not None:  # all within the window of ``latest``: none should leave
+            reordered = b.reordered
+            released = b.push(held)  # type: ignore[arg-type]
+            b.reordered = reordered
+            if released and len(released["time"]):
+                yield from map(self._scan, self.framer.push(released))
+
     def _count(self) -> None:
         b, s = self.buffer, self.stats
         s.reordered, s.late_dropped, s.max_late_s = b.reordered, b.late.n, b.late.max_late_s
@@ -64,7 +98,7 @@ class TimedStream:
     def _scan(self, fr: Frame) -> Scan:
         c = fr.cols
         n = len(c["time"])
-        rows = np.arange(self._n_out, self._n_out + n, dtype=np.int64)
+        rows = np.arange(self._n_out, self._n_out + n, dtype=np.int64) + self.first_row
         if self._n_out + n > self._rows.size:
             grown = np.zeros(max(2 * self._rows.size, self._n_out + n), np.int64)
             grown[:self._n_out] = self._rows[:self._n_out]
@@ -77,9 +111,15 @@ class TimedStream:
                     sensor=np.asarray(c["sensor"], np.int64), rows=rows, R=c.get("R"),
                     origin=c.get("origin"), t=np.asarray(c["time"], float))
 
+    @property
+    def next_row(self) -> int:
+        """The running row number of the next plot."""
+        return self.first_row + self._n_out
+
     def file_rows(self, rows: np.ndarray) -> np.ndarray:
-        """The ``file_row`` of each running row number (``-1`` stays ``-1``)."""
-        rows = np.asarray(rows, np.int64)
+        """The ``file_row`` of each running row number (``-1`` stays ``-1``, and so
+        does a row before :attr:`first_row`)."""
+        rows = np.asarray(rows, np.int64) - self.first_row
         out = np.full(rows.shape, -1, np.int64)
         ok = rows >= 0
         out[ok] = self._rows[:self._n_out][rows[ok]]

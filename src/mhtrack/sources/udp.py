@@ -253,9 +253,13 @@ class StdinReader(_Threaded):
         fd = self.stream.fileno()
         buf, offset = bytearray(), 0
         with selectors.DefaultSelector() as sel:
-            sel.register(fd, selectors.EVENT_READ)
+            try:
+                sel.register(fd, selectors.EVENT_READ)
+                ready: Any = lambda: sel.select(POLL_S)  # noqa: E731
+            except PermissionError:  # a regular file (`live --stdin raw < rec.ast`):
+                ready = lambda: True  # noqa: E731 - always readable; epoll refuses files
             while not self.stop.is_set():
-                if not sel.select(POLL_S):
+                if not ready():
                     continue
                 chunk = os.read(fd, 1 << 16)
                 if not chunk:

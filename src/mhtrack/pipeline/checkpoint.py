@@ -1,0 +1,145 @@
+"""Checkpoints of a live run (``docs/live.md``, *Checkpoints and restart*): the tracker's
+full state (:meth:`~mhtrack.mht.MHTTracker.save`, one ``.npz`` written atomically) with
+what the live run needs to continue — the next frame's number, the time axis (``day0``,
+``latest``: the day of later times of day), the latest time tracked, the next tick of
+the period output, the next plot's row number (the tracker's plot windows name plots
+by row: numbers must not repeat) and the plots received but not yet tracked (in the
+re-order window and in open frames) — under ``meta["extra"]``. A run resumed from it
+therefore makes the same frames as a run never stopped, given the same datagrams after
+the checkpoint.
+
+:class:`CheckpointSink` writes one every ``every_s`` seconds **of data time** (the frames'
+times: the same input checkpoints at the same frames) and a final one when the run ends
+(input ended, or stopped by SIGTERM/Ctrl-C after the held frames were tracked).
+:func:`read_checkpoint` gives the tracker back (:func:`~mhtrack.build.load_tracker`:
+the same track ids continue) and the bookkeeping.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import asdict, dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from mhtrack.errors import InputError
+from mhtrack.sinks.base import FrameOutput, Sink
+
+if TYPE_CHECKING:
+    from mhtrack.mht import MHTTracker
+
+#: Version of the ``extra`` bookkeeping.
+LIVE_FORMAT = 1
+
+
+@dataclass(frozen=True)
+class LiveState:
+    """What a live run continues from besides the tracker."""
+
+    #: The number of the next frame.
+    next_frame: int
+    #: The time axis: capture day of its day 0 (``None``: no capture times) and the
+    #: latest time on it (``None``: nothing received).
+    axis_day0: float | None
+    axis_latest: float | None
+    #: The latest frame time tracked (later plots only; earlier ones are late drops).
+    last_time: float | None
+    #: The next tick of the period output (``None``: none yet or no period output).
+    next_tick: int | None
+    #: The plots received but not yet in a frame tracked (:func:`encode_pending`).
+    pending: dict[str, Any] | None = None
+    #: The running row number of the next plot (the tracker knows plots by row).
+    next_row: int = 0
+    format: int = LIVE_FORMAT
+
+
+#: Integer columns of the plots held (the others are floats).
+_INT_COLUMNS = ("sensor", "file_row", "offset", "seq", "sector")
+
+
+def encode_pending(pending: dict[str, Any] | None) -> dict[str, Any] | None:
+    """:meth:`~mhtrack.sources.datagrams.DatagramSource.pending` as JSON: each column a
+    list (floats to the bit: JSON keeps Python's shortest round-trip form), the times
+    ``None`` when infinite; ``None`` when no plot is held."""
+    if pending is None or (pending["framed"] is None and pending["held"] is None):
+        return None
+    out: dict[str, Any] = {k: None if pending[k] is None or not math.isfinite(pending[k])
+                           else float(pending[k]) for k in ("latest", "released")}
+    for part in ("framed", "held"):
+        cols = pending[part]
+        out[part] = None if cols is None else {k: np.asarray(v).tolist()
+                                               for k, v in cols.items()}
+    return out
+
+
+def decode_pending(saved: dict[str, Any] | None) -> dict[str, Any] | None:
+    """The plots held, back as columns for ``DatagramSource(pending=...)``; their
+    ``file_row`` is ``-1`` (numbers of the earlier run, not of this one's input)."""
+    if saved is None:
+        return None
+    out: dict[str, Any] = {k: -math.inf if saved[k] is None else float(saved[k])
+                           for k in ("latest", "released")}
+    for part in ("framed", "held"):
+        cols = saved[part]
+        if cols is None:
+            out[part] = None
+            continue
+        arrays = {k: np.asarray(v, np.int64 if k in _INT_COLUMNS else float)
+                  for k, v in cols.items()}
+        if "R" in arrays:
+            arrays["R"] = arrays["R"].reshape(-1, 2, 2)
+        arrays["file_row"] = np.full(len(arrays["time"]), -1, np.int64)
+        out[part] = arrays
+    return out
+
+
+class CheckpointSink(Sink):
+    """The tracker (``tracker()``, the one being stepped) and ``state()`` saved to
+    ``path`` every ``every_s`` s of data time (``None``: only at the end) and when the
+    run ends. :attr:`written` counts the checkpoints."""
+
+    def __init__(self, path: str | Path, tracker: Callable[[], MHTTracker],
+                 state: Callable[[], LiveState], every_s: float | None = None) -> None:
+        if every_s is not None and not every_s > 0:
+            raise ValueError(f"checkpoint period must be > 0 s, got {every_s!r}")
+        self.path, self.tracker, self.state = Path(path), tracker, state
+        self.every_s = math.inf if every_s is None else float(every_s)
+        self.written = 0
+        self._last: float | None = None
+
+    def save(self) -> None:
+        """Write a checkpoint now."""
+        self.tracker().save(self.path, extra=asdict(self.state()))
+        self.written += 1
+
+    def write(self, out: FrameOutput) -> None:
+        t = float(out.frame.time)
+        if self._last is None:
+            self._last = t
+        elif t - self._last >= self.every_s:
+            self.save()
+            self._last = t
+
+    def close(self) -> None:
+        self.save()
+
+
+def read_checkpoint(path: str | Path) -> tuple[MHTTracker, LiveState]:
+    """The tracker and the live bookkeeping of a checkpoint written by
+    :class:`CheckpointSink`; an :class:`InputError` naming the file otherwise."""
+    from mhtrack.build import load_tracker
+    from mhtrack.mht.state import saved_meta
+
+    meta: dict[str, Any] = saved_meta(path)
+    extra = meta.get("extra")
+    if not isinstance(extra, dict) or extra.get("format") != LIVE_FORMAT:
+        raise InputError(f"{path}: member 'meta': no live checkpoint (field 'extra' of "
+                         f"format {LIVE_FORMAT}): not written by mhtrack live", file=str(path))
+    try:
+        state = LiveState(**extra)
+    except TypeError as e:
+        raise InputError(f"{path}: member 'meta': field 'extra': {e}", file=str(path)) from None
+    return load_tracker(path), state

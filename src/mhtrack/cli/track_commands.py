@@ -10,7 +10,7 @@ import click
 
 from mhtrack.cli.asterix_commands import needs_libasterix
 from mhtrack.cli.common import echo_json, load_scenario_arg, scenario_options
-from mhtrack.cli.terminal import progress_enabled, progress_option
+from mhtrack.cli.terminal import say, show_progress
 from mhtrack.names import (
     BIRTHS,
     CLUTTER_FRAMES,
@@ -141,7 +141,6 @@ def track_options(tracker: str, tracker_pd: float | None, meas_sigma: float | No
               "range and bearing (docs/clutter.md).")
 @birth_options
 @output_option
-@progress_option
 @needs_libasterix
 def track(plots: Path, tracker: str, tracker_pd: float | None, meas_sigma: float | None,
           accel_sigma: float | None, imm_accel_sigma: float | None,
@@ -149,8 +148,7 @@ def track(plots: Path, tracker: str, tracker_pd: float | None, meas_sigma: float
           birth_density: float | None, nscan: int | None, out: Path,
           scenario_file: Path | None, sensors_file: Path | None,
           reorder_window_s: float | None, clutter_frame: str, birth: str,
-          birth_theta: float | None, fusion: str | None, output: str | None,
-          progress: bool | None) -> None:
+          birth_theta: float | None, fusion: str | None, output: str | None) -> None:
     """Run a tracker on a PLOTS file and write its tracks."""
     from mhtrack.io.paths import check_output_file
     from mhtrack.pipeline.run import Pipeline
@@ -163,11 +161,11 @@ def track(plots: Path, tracker: str, tracker_pd: float | None, meas_sigma: float
     pipe = Pipeline.open(plots, options, scenario_file=scenario_file,
                          sensors_file=sensors_file, reorder_window_s=reorder_window_s)
     result = pipe.run([TracksFileSink(out, frame=pipe.frame, output=pipe.output)],
-                      progress=progress_enabled(progress), keep_stats=False)
-    click.echo(f"{result.describe()} -> {out}")
+                      progress=show_progress(), keep_stats=False)
+    say(f"{result.describe()} -> {out}")
     for note in (pipe.birth_note, pipe.reach_note):
         if note is not None:
-            click.echo(note)
+            say(note)
 
 
 @click.command()
@@ -187,15 +185,14 @@ def track(plots: Path, tracker: str, tracker_pd: float | None, meas_sigma: float
               "parameters; needs mhtrack[report]).")
 @birth_options
 @output_option
-@progress_option
 def run(scenario: str, seed: int, clutter: str | None, clutter_rate: float | None,
         pd: float | None, scans: int | None, tracker: str, tracker_pd: float | None,
         meas_sigma: float | None, accel_sigma: float | None, imm_accel_sigma: float | None,
         clutter_density: float | None,
         birth_density: float | None, nscan: int | None, out: Path | None,
         cutoff: float | None, order: float | None, as_json: bool, html_report: bool,
-        birth: str, birth_theta: float | None, fusion: str | None, output: str | None,
-        progress: bool | None) -> None:
+        birth: str, birth_theta: float | None, fusion: str | None, output: str | None
+        ) -> None:
     """Simulate SCENARIO, track, evaluate and plot, in one go.
 
     Writes plots, truth, tracks, scenario.toml, metrics.json, scene.png (truth, plots,
@@ -216,7 +213,7 @@ def run(scenario: str, seed: int, clutter: str | None, clutter_rate: float | Non
                             fusion, output, sensor_pd=pd)
     warn_known_kappa(sc, options)
     result = run_scenario(sc, seed, options=options, cutoff=cutoff, order=order,
-                          progress=progress_enabled(progress))
+                          progress=show_progress())
     out = out if out is not None else run_dir(sc, tracker, birth, seed)
     summary = write_run(out, result, seed)
     page = None
@@ -227,12 +224,12 @@ def run(scenario: str, seed: int, clutter: str | None, clutter_rate: float | Non
     if as_json:
         echo_json(summary)
         if page is not None:
-            click.echo(f"wrote {page}", err=True)
+            say(f"wrote {page}", err=True)
         return
     for line in run_text(result, out):
-        click.echo(line)
+        say(line)
     if page is not None:
-        click.echo(f"wrote {page}")
+        say(f"wrote {page}")
 
 
 COMMANDS = [track, run]

@@ -11,6 +11,7 @@ order), so it stays a row of the source.
 from __future__ import annotations
 
 import dataclasses
+import logging
 from collections import deque
 from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import dataclass
@@ -19,11 +20,12 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
-from tqdm.auto import tqdm
 
 from mhtrack.build import TRACKER_FUSERS, tracker_fuser
 from mhtrack.names import TRACKER_FUSIONS
+from mhtrack.pipeline.frame_log import log_frame
 from mhtrack.pipeline.options import TrackOptions, birth_density_note, choose
+from mhtrack.progress import Count
 from mhtrack.records import Scan
 from mhtrack.sinks.base import FrameOutput, Sink, check_output
 
@@ -31,6 +33,9 @@ if TYPE_CHECKING:
     from mhtrack.initiation.fusion import AdaptiveKMeansFusion
     from mhtrack.mht import MHTConfig, MHTTracker, StepStats
     from mhtrack.sources.base import Source, Survey
+
+#: The per-frame DEBUG lines (``mhtrack -vv``).
+_log = logging.getLogger("mhtrack.pipeline")
 
 
 def fuse_scan(scan: Scan, fuser: AdaptiveKMeansFusion | None = None) -> Scan:
@@ -73,21 +78,23 @@ def step_frames(tracker: MHTTracker, frames: Iterable[Scan], *, fusion: str = "n
                 total: int | None = None) -> Iterator[FrameOutput]:
     """Each frame fused (``fusion``), stepped through ``tracker``, and its output — the
     online rows, the backfill and the step's statistics with the fusion's caps merged
-    in. ``progress``: a tqdm bar of ``total`` frames."""
+    in. ``progress``: a bar of ``total`` frames (:class:`~mhtrack.progress.Count`); at
+    DEBUG, one line per frame (:func:`~mhtrack.pipeline.frame_log.log_frame`)."""
     fusion_caps: dict[int, dict[str, int]] = {}
     depth = getattr(getattr(tracker, "config", None), "history_scans", None)
     recent: deque[int] = deque(maxlen=max(int(depth or 0), 1))
-    bar = tqdm(fused(frames, fusion, fusion_caps), total=total, desc=name, unit="scan",
-               disable=not progress, leave=False)
-    for scan in bar:
-        online = tracker.step(scan)
-        stats = tracker.last_stats
-        assert stats is not None  # set by every step
-        stats.caps.update(fusion_caps.pop(stats.scan, {}))
-        # the next backfill reaches back to the oldest of the last ``depth`` frames
-        recent.append(int(scan.index))
-        yield FrameOutput(scan, online, tracker.last_backfill, stats,
-                          None if depth is None else recent[0])
+    with Count(total, name, "frame", progress) as bar:
+        for scan in bar.over(fused(frames, fusion, fusion_caps)):
+            online = tracker.step(scan)
+            stats = tracker.last_stats
+            assert stats is not None  # set by every step
+            stats.caps.update(fusion_caps.pop(stats.scan, {}))
+            if _log.isEnabledFor(logging.DEBUG):
+                log_frame(_log, scan, tracker, stats)
+            # the next backfill reaches back to the oldest of the last ``depth`` frames
+            recent.append(int(scan.index))
+            yield FrameOutput(scan, online, tracker.last_backfill, stats,
+                              None if depth is None else recent[0])
 
 
 def mean_step_time(stats: Sequence[StepStats]) -> float:

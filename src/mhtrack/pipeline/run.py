@@ -75,16 +75,18 @@ def fused(scans: Iterable[Scan], fusion: str,
 
 def step_frames(tracker: MHTTracker, frames: Iterable[Scan], *, fusion: str = "none",
                 name: str = "mht", progress: bool = False,
-                total: int | None = None) -> Iterator[FrameOutput]:
+                total: int | None = None, unit: str = "frame") -> Iterator[FrameOutput]:
     """Each frame fused (``fusion``), stepped through ``tracker``, and its output — the
     online rows, the backfill and the step's statistics with the fusion's caps merged
-    in. ``progress``: a bar of ``total`` frames (:class:`~mhtrack.progress.Count`); at
-    DEBUG, one line per frame (:func:`~mhtrack.pipeline.frame_log.log_frame`)."""
+    in. ``progress``: a bar (:class:`~mhtrack.progress.Count`) of ``total`` frames, or
+    of ``total`` plots with ``unit="plot"`` (timed plots and recordings, whose number of
+    frames is known only at the end); at DEBUG, one line per frame
+    (:func:`~mhtrack.pipeline.frame_log.log_frame`)."""
     fusion_caps: dict[int, dict[str, int]] = {}
     depth = getattr(getattr(tracker, "config", None), "history_scans", None)
     recent: deque[int] = deque(maxlen=max(int(depth or 0), 1))
-    with Count(total, name, "frame", progress) as bar:
-        for scan in bar.over(fused(frames, fusion, fusion_caps)):
+    with Count(total, name, unit, progress) as bar:
+        for scan in fused(frames, fusion, fusion_caps):
             online = tracker.step(scan)
             stats = tracker.last_stats
             assert stats is not None  # set by every step
@@ -93,6 +95,7 @@ def step_frames(tracker: MHTTracker, frames: Iterable[Scan], *, fusion: str = "n
                 log_frame(_log, scan, tracker, stats)
             # the next backfill reaches back to the oldest of the last ``depth`` frames
             recent.append(int(scan.index))
+            bar.update(len(scan) if unit == "plot" else 1)
             yield FrameOutput(scan, online, tracker.last_backfill, stats,
                               None if depth is None else recent[0])
 
@@ -247,9 +250,12 @@ class Pipeline:
     def outputs(self, *, progress: bool = False) -> Iterator[FrameOutput]:
         """The tracker's output frame by frame (the iterator form of a sink)."""
         survey = self.survey if progress else None
+        frames = None if survey is None else survey.n_frames
+        plots = None if survey is None or frames is not None else survey.n_plots
         yield from step_frames(self.tracker, self.source, fusion=self.fusion,
                                name=self.options.tracker, progress=progress,
-                               total=None if survey is None else survey.n_frames)
+                               total=frames if plots is None else plots,
+                               unit="frame" if plots is None else "plot")
 
     def run(self, sinks: Sequence[Sink] = (), *, progress: bool = False,
             keep_stats: bool = True) -> RunResult:

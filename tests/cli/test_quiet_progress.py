@@ -115,3 +115,12 @@ def test_quiet_silences_warnings_on_stderr_not_in_the_log_file(tmp_path):
     r = _run(*args, "--quiet", "--log-file", log)
     assert r.stdout == "" and r.stderr == ""
     assert "WARNING" in log.read_text(encoding="utf-8")
+
+
+def test_track_of_a_recording_shows_its_survey_in_bytes_then_its_plots(radars, tmp_path):
+    r = _run("track", radars / "rec.pcap", "--sensors", radars / "sensors.toml", "-o",
+             tmp_path / "t.csv", "--progress")
+    survey, plots = r.stderr.find("survey:"), r.stderr.find("plot/s")
+    assert 0 <= survey < plots and "B/s" in r.stderr[:plots], r.stderr
+    assert not bar_drawn(_run("track", radars / "rec.pcap", "--sensors",
+                              radars / "sensors.toml", "-o", tmp_path / "u.csv").stderr)

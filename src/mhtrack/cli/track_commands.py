@@ -158,10 +158,12 @@ def track(plots: Path, tracker: str, tracker_pd: float | None, meas_sigma: float
     options = track_options(tracker, tracker_pd, meas_sigma, accel_sigma, imm_accel_sigma,
                             clutter_density, birth_density, nscan, birth, birth_theta,
                             fusion, output, clutter_frame=clutter_frame)
+    bars = show_progress()
     pipe = Pipeline.open(plots, options, scenario_file=scenario_file,
-                         sensors_file=sensors_file, reorder_window_s=reorder_window_s)
+                         sensors_file=sensors_file, reorder_window_s=reorder_window_s,
+                         progress=bars)
     result = pipe.run([TracksFileSink(out, frame=pipe.frame, output=pipe.output)],
-                      progress=show_progress(), keep_stats=False)
+                      progress=bars, keep_stats=False)
     say(f"{result.describe()} -> {out}")
     for note in (pipe.birth_note, pipe.reach_note):
         if note is not None:

@@ -17,7 +17,7 @@ pytestmark = pytest.mark.skipif(not sys.platform.startswith("linux"),
 
 POLLS = 600  # × 0.1 s
 STUDY = ["montecarlo", "crossing", "--trackers", "mht-agmm", "--scans", "25", "--runs",
-         "12", "--seed", "3", "--workers", "2", "--quiet"]
+         "12", "--seed", "3", "--workers", "2", "--no-progress"]
 
 
 def mhtrack(*args):

@@ -27,7 +27,7 @@ def _commands(group=cli, prefix=()):
                          if isinstance(v, tuple) else "")
 def test_every_command_has_the_vocabulary(path, cmd):
     opts = {o for p in cmd.params for o in p.opts}
-    assert {"-v", "--verbose", "--log-file"} <= opts, path
+    assert {"-v", "--verbose", "--log-file", "-q", "--quiet", "--progress"} <= opts, path
     if "--out" in opts:
         assert "-o" in opts, path
 

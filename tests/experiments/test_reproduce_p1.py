@@ -200,10 +200,12 @@ def test_paper_settings_side_by_side(tmp_path):
 
 def test_cli_help():
     assert [reproduce] == COMMANDS
-    r = CliRunner().invoke(reproduce, ["p1", "--help"])
+    from mhtrack.cli.main import cli  # every command's options (-v, -q, --progress)
+
+    r = CliRunner().invoke(cli, ["reproduce", "p1", "--help"])
     assert r.exit_code == 0
-    for opt in ("--runs", "--out", "--seed", "--workers", "--dask-scheduler", "--no-progress",
-                "--tracker-settings"):
+    for opt in ("--runs", "--out", "--seed", "--workers", "--dask-scheduler", "--progress",
+                "--quiet", "--tracker-settings"):
         assert opt in r.output
 
 

@@ -219,10 +219,12 @@ def test_jobs_are_plain_and_chunked():
 
 
 def test_cli_help():
-    r = CliRunner().invoke(reproduce, ["p2", "--help"])
+    from mhtrack.cli.main import cli  # every command's options (-v, -q, --progress)
+
+    r = CliRunner().invoke(cli, ["reproduce", "p2", "--help"])
     assert r.exit_code == 0, r.output
     for opt in ("--runs", "--out", "--seed", "--workers", "--dask-scheduler",
-                "--no-progress"):
+                "--progress", "--quiet"):
         assert opt in r.output
     r = CliRunner().invoke(reproduce, ["p2", "--out", "x", "--workers", "2",
                                        "--dask-scheduler", "tcp://h:1"])

@@ -10,6 +10,7 @@ from typing import Any
 
 import click
 
+from mhtrack.cli.terminal import say, show_progress
 from mhtrack.names import EXPORT_CATEGORIES
 
 _EXISTING = click.Path(exists=True, dir_okay=False, path_type=Path)
@@ -48,7 +49,8 @@ def convert(recording: Path, output: Path, sensors_file: Path | None) -> None:
 
     check_output_file(output, inputs=(recording, sensors_file), what="plots file")
     sensors = read_sensors(sensors_file) if sensors_file is not None else None
-    click.echo(f"{run_convert(recording, output, sensors).describe()} -> {output}")
+    done = run_convert(recording, output, sensors, progress=show_progress())
+    say(f"{done.describe()} -> {output}")
 
 
 @click.command()
@@ -80,8 +82,9 @@ def export(plots: Path, sensors_file: Path | None, out: Path, category: str,
     check_output_file(out, inputs=(plots, sensors_file), suffixes=(".pcap", ".ast"),
                       what="recording")
     sensors = read_sensors(sensors_file) if sensors_file is not None else None
-    done = export_file(plots, sensors, out, category=category, sac=sac, sic=sic)
-    click.echo(f"{done.describe()} -> {out}")
+    done = export_file(plots, sensors, out, category=category, sac=sac, sic=sic,
+                       progress=show_progress())
+    say(f"{done.describe()} -> {out}")
 
 
 COMMANDS = [convert, export]

@@ -7,6 +7,7 @@ from pathlib import Path
 import click
 
 from mhtrack.cli.common import echo_json, load_scenario_arg, scenario_options
+from mhtrack.cli.terminal import say
 from mhtrack.names import CLUTTER_ESTIMATORS
 
 
@@ -80,11 +81,11 @@ def clutter(scenario: str, seed: int, clutter: str | None, clutter_rate: float |
     if as_json:
         echo_json(summary)
         return
-    click.echo(f"{sc.name}, seed {seed}, {estimator}: iae_mean {acc.iae_mean:.3f}, "
-               f"count_error_mean {acc.count_error_mean:.3f} "
-               f"(true mean count {summary['rate_mean']:.2f}/scan), "
-               f"{summary['ms_per_update']:.2f} ms/update")
-    click.echo(f"wrote {out}/ (clutter.json, clutter.png)")
+    say(f"{sc.name}, seed {seed}, {estimator}: iae_mean {acc.iae_mean:.3f}, "
+        f"count_error_mean {acc.count_error_mean:.3f} "
+        f"(true mean count {summary['rate_mean']:.2f}/scan), "
+        f"{summary['ms_per_update']:.2f} ms/update")
+    say(f"wrote {out}/ (clutter.json, clutter.png)")
 
 
 COMMANDS = [clutter]

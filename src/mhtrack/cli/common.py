@@ -9,7 +9,7 @@ from typing import Any
 import click
 
 from mhtrack import bounds as B
-from mhtrack.cli.terminal import progress_enabled, progress_option
+from mhtrack.cli.terminal import show_progress
 
 
 class InputProblem(click.ClickException):
@@ -209,7 +209,7 @@ def table_path(directory: Path, stem: str) -> Path | None:
 
 
 def executor_options(f: Callable[..., Any]) -> Callable[..., Any]:
-    """``--workers`` / ``--dask-scheduler`` / ``--progress`` of the Monte-Carlo commands."""
+    """``--workers`` / ``--dask-scheduler`` of the Monte-Carlo commands."""
     for opt in reversed(
         [
             click.option("--workers", type=click.IntRange(min=1), default=None,
@@ -218,17 +218,16 @@ def executor_options(f: Callable[..., Any]) -> Callable[..., Any]:
             click.option("--dask-scheduler", default=None, metavar="ADDRESS",
                          help="Run the jobs on this Dask scheduler (e.g. tcp://host:8786) "
                          "instead."),
-            progress_option,
         ]
     ):
         f = opt(f)
     return f
 
 
-def executor_kwargs(workers: int | None, dask_scheduler: str | None,
-                    progress: bool | None) -> dict[str, Any]:
+def executor_kwargs(workers: int | None, dask_scheduler: str | None) -> dict[str, Any]:
     """The ``executor``, ``workers``, ``scheduler`` and ``progress`` keywords of the
-    experiment runners, from :func:`executor_options`' values."""
+    experiment runners, from :func:`executor_options`' values (and
+    :func:`~mhtrack.cli.terminal.show_progress`)."""
     if workers is not None and dask_scheduler is not None:
         raise click.UsageError("give --workers or --dask-scheduler, not both")
     if dask_scheduler is not None:
@@ -242,7 +241,7 @@ def executor_kwargs(workers: int | None, dask_scheduler: str | None,
         "executor": "dask" if dask_scheduler else "local",
         "workers": workers,
         "scheduler": dask_scheduler,
-        "progress": progress_enabled(progress),
+        "progress": show_progress(),
     }
 
 

@@ -14,7 +14,7 @@ from mhtrack.cli.common import (
     scenario_options,
     table_path,
 )
-from mhtrack.cli.terminal import progress_enabled, progress_option
+from mhtrack.cli.terminal import say, show_progress
 
 
 @click.command()
@@ -60,7 +60,7 @@ def simulate(scenario: str, seed: int, clutter: str | None, clutter_rate: float 
     write_scenario_toml({"seed": seed, **sc.to_dict()}, out / "scenario.toml")
     n_scans = sim.plots.n_scans
     n_clutter = int((sim.plots.origin < 0).sum()) if sim.plots.origin is not None else 0
-    click.echo(
+    say(
         f"{sc.name}: {n_scans} scans, {len(sim.plots)} plots ({n_clutter} clutter), "
         f"{len(set(sim.truth.target_id.tolist()))} targets -> {out}"
     )
@@ -80,7 +80,7 @@ def _write_rotating(sim: Any, out: Path, fmt: str) -> None:
     write_scenario_toml({"seed": sim.seed, **sc.to_dict()}, out / "scenario.toml")
     n_clutter = int((plots.origin < 0).sum())
     t0, t1 = sc.first * sc.T, sc.last * sc.T
-    click.echo(
+    say(
         f"{sc.name}: {len(sc.sensors)} rotating radars over {t1 - t0:g} s, {len(plots)} "
         f"plots ({n_clutter} clutter), {len(set(truth.target_id.tolist()))} targets -> {out}"
     )
@@ -121,12 +121,10 @@ def _write_rotating(sim: Any, out: Path, fmt: str) -> None:
 @click.option("--out", "-o", "out", type=click.Path(dir_okay=False, path_type=Path),
               default=None, help="Write the table (.txt) or the JSON (.json) to FILE "
               "instead of stdout.")
-@progress_option
 def evaluate(tracks: Path, truth: Path | None, reference: Path | None,
              reference_period: float | None, plots: Path | None, cutoff: float,
              order: float, match_distance: float | None, sensors_file: Path | None,
-             at: str | None, max_age_s: float | None, as_json: bool, out: Path | None,
-             progress: bool | None) -> None:
+             at: str | None, max_age_s: float | None, as_json: bool, out: Path | None) -> None:
     """Score TRACKS against TRUTH (or a reference system's CAT062 tracks, --reference
     REC): OSPA, GOSPA, cardinality, CLEAR-MOT, coverage."""
     import logging
@@ -152,7 +150,7 @@ def evaluate(tracks: Path, truth: Path | None, reference: Path | None,
     age = DEFAULT_MAX_AGE_S if max_age_s is None else max_age_s
     if reference is not None:
         ev = _against_reference(tracks, reference, reference_period, sensors_file,
-                                cutoff, order, match_distance, age, progress)
+                                cutoff, order, match_distance, age)
         _print(ev, as_json, out)
         return
     assert truth is not None
@@ -160,7 +158,7 @@ def evaluate(tracks: Path, truth: Path | None, reference: Path | None,
         sensors_file = truth.parent / "sensors.toml"
     sensor_set = read_sensors(sensors_file) if sensors_file is not None else None
     frame = sensor_set.frame() if sensor_set is not None else None
-    run = Stages(3 + 8, "evaluate", progress_enabled(progress))  # 3 files, 8 metrics
+    run = Stages(3 + 8, "evaluate", show_progress())  # 3 files, 8 metrics
     try:
         pl = run("read plots", read_plots, plots, sensors=sensor_set) if plots else None
         tr = run("read tracks", read_tracks, tracks, frame=frame, plots=pl)
@@ -184,8 +182,7 @@ def evaluate(tracks: Path, truth: Path | None, reference: Path | None,
 
 def _against_reference(tracks: Path, rec: Path, period: float | None,
                        sensors_file: Path | None, cutoff: float, order: float,
-                       match_distance: float | None, max_age_s: float,
-                       progress: bool | None) -> Any:
+                       match_distance: float | None, max_age_s: float) -> Any:
     """``evaluate TRACKS --reference REC``: the reference's CAT062 tracks as the truth
     (:func:`mhtrack.io.reference.read_reference`, its skipped records warned, one line
     per kind), our tracks placed in the same frame from their ``lat, lon``, both sampled
@@ -209,7 +206,7 @@ def _against_reference(tracks: Path, rec: Path, period: float | None,
     if frame is None and not geodetic:
         raise click.UsageError(f"{tracks} has no lat, lon: give the sensors file of its "
                                "local frame (--sensors FILE) to place the reference in it")
-    run = Stages(2 + 8, "evaluate", progress_enabled(progress))  # 2 files, 8 metrics
+    run = Stages(2 + 8, "evaluate", show_progress())  # 2 files, 8 metrics
     try:
         ref = run("read reference", read_reference, rec, frame)
         ref.problems.warn(str(rec))
@@ -227,9 +224,9 @@ def _against_reference(tracks: Path, rec: Path, period: float | None,
     finally:
         run.close()
     moved = f", moved by {ref.days:+d} day(s)" if ref.days else ""
-    click.echo(f"{rec}: {len(ref)} CAT062 updates of {len(np.unique(truth.target_id))} "
-               f"reference tracks, sampled every {used:g} s at {len(np.unique(truth.scan))}"
-               f" times{moved}", err=True)
+    say(f"{rec}: {len(ref)} CAT062 updates of {len(np.unique(truth.target_id))} "
+        f"reference tracks, sampled every {used:g} s at {len(np.unique(truth.scan))}"
+        f" times{moved}", err=True)
     return ev
 
 
@@ -240,7 +237,7 @@ def _print(ev: Any, as_json: bool, out: Path | None) -> None:
 
     if out is not None:
         text = (dumps(ev.to_dict()) if as_json else ev.to_table()) + "\n"
-        click.echo(f"wrote {atomic_write(out, text)}")
+        say(f"wrote {atomic_write(out, text)}")
     elif as_json:
         echo_json(ev.to_dict())
     else:
@@ -302,7 +299,7 @@ def plot(directory: Path, output: Path | None, output_alias: Path | None,
         sites=sensor_sites(sensor_set) if sensor_set is not None else None,
     )
     path = save_figure(fig, output or directory / "scene.png")
-    click.echo(f"wrote {path}")
+    say(f"wrote {path}")
 
 
 COMMANDS = [simulate, evaluate, plot]

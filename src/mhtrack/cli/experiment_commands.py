@@ -18,7 +18,7 @@ from mhtrack.cli.common import (
     load_scenario_arg,
     scenario_options,
 )
-from mhtrack.cli.terminal import resume_on_interrupt
+from mhtrack.cli.terminal import resume_on_interrupt, say
 from mhtrack.cli.track_commands import config_changes, output_option, tracker_options
 
 
@@ -97,8 +97,7 @@ def montecarlo(scenario: str, clutter: str | None, clutter_rate: float | None,
                accel_sigma: float | None, imm_accel_sigma: float | None,
                clutter_density: float | None,
                birth_density: float | None, nscan: int | None, cutoff: float, order: float,
-               output: str, run_kwarg: dict[str, Any], as_json: bool,
-               progress: bool | None) -> None:
+               output: str, run_kwarg: dict[str, Any], as_json: bool) -> None:
     """Monte-Carlo study: RUNS simulations of SCENARIO, each tracked by every tracker.
 
     Every finished run is written at once to OUT/runs/<tracker>/run-<i>.parquet; rerunning
@@ -113,7 +112,7 @@ def montecarlo(scenario: str, clutter: str | None, clutter_rate: float | None,
     )
     from mhtrack.reports.montecarlo import summary_markdown, write_montecarlo_report
 
-    run_on = executor_kwargs(workers, dask_scheduler, progress)
+    run_on = executor_kwargs(workers, dask_scheduler)
     sc = load_scenario_arg(scenario, clutter, clutter_rate, pd, scans)
     tracker_pd = tracker_pd if tracker_pd is not None else pd
     config = config_changes(tracker_pd, meas_sigma, accel_sigma, birth_density, nscan,
@@ -132,14 +131,14 @@ def montecarlo(scenario: str, clutter: str | None, clutter_rate: float | None,
     if as_json:
         echo_json(result.summary())
     else:
-        click.echo(summary_markdown(result), nl=False)
-        click.echo(f"{result.computed} runs computed, {result.skipped} already done; "
-                   f"wrote {out}/ (runs/, montecarlo.json, summary.md, ospa_cardinality.png)")
+        say(summary_markdown(result), nl=False)
+        say(f"{result.computed} runs computed, {result.skipped} already done; "
+            f"wrote {out}/ (runs/, montecarlo.json, summary.md, ospa_cardinality.png)")
     capped = {t: n for t, n in result.runs_with_caps().items() if n}
     if capped:
         listed = ", ".join(f"{t}: {n} of {len(result.records[t])} runs" for t, n in capped.items())
-        click.echo(f"mhtrack montecarlo: hard caps of the MHT acted ({listed}); per-run "
-                   f"counts in the 'caps' column of {out}/runs/", err=True)
+        say(f"mhtrack montecarlo: hard caps of the MHT acted ({listed}); per-run "
+            f"counts in the 'caps' column of {out}/runs/", err=True)
     exit_if_runs_failed("montecarlo", result)
 
 

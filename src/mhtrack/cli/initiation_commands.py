@@ -13,7 +13,7 @@ from typing import Any
 import click
 
 from mhtrack.cli.common import echo_json, load_scenario_arg, out_option, scenario_options
-from mhtrack.cli.terminal import progress_enabled, progress_option
+from mhtrack.cli.terminal import show_progress
 from mhtrack.names import CLUSTER_METHODS, INITIATION_FUSIONS, INITIATORS
 
 
@@ -25,7 +25,6 @@ def _common(f: Any) -> Any:
                      default="mean", show_default=True,
                      help="Fused plot: cluster mean (P2) or information-weighted."),
         click.option("--json", "as_json", is_flag=True, help="Print one JSON object."),
-        progress_option,
         out_option("figure", "--figure", type=click.Path(dir_okay=False, path_type=Path),
                    help="Also draw the first run to FILE (PNG/PDF/SVG)."),
     ]
@@ -47,7 +46,7 @@ def _rate(sc: Any) -> float:
 @_common
 def cluster(scenario: str, seed: int, clutter: str | None, clutter_rate: float | None,
             pd: float | None, scans: int | None, method: str, runs: int, weighting: str,
-            as_json: bool, progress: bool | None, figure: Path | None) -> None:
+            as_json: bool, figure: Path | None) -> None:
     """Fuse the plots of every scan of SCENARIO by clustering and score the clusters:
     k_correct_rate (share of scans with as many clusters as targets seen), mean distance
     of the fused plots to the truth, cluster purity, time per scan."""
@@ -60,7 +59,7 @@ def cluster(scenario: str, seed: int, clutter: str | None, clutter_rate: float |
 
     sc = load_scenario_arg(scenario, clutter, clutter_rate, pd, scans)
     out = run_clustering(sc, method, runs=runs, seed=seed, weighting=weighting,
-                         progress=progress_enabled(progress))
+                         progress=show_progress())
     m = clustering_metrics(
         [len(c.fused) for c in out],
         [len(c.truth) for c in out],
@@ -108,8 +107,7 @@ def cluster(scenario: str, seed: int, clutter: str | None, clutter_rate: float |
 def initiate(scenario: str, seed: int, clutter: str | None, clutter_rate: float | None,
              pd: float | None, scans: int | None, method: str, fusion: str,
              theta_deg: float, gate_radius: float, v_min: float, v_max: float, runs: int,
-             weighting: str, as_json: bool, progress: bool | None,
-             figure: Path | None) -> None:
+             weighting: str, as_json: bool, figure: Path | None) -> None:
     """Start tracks on every 4-scan window of SCENARIO and score them (P2's metrics):
     p_true, p_false, false tracks per run, time per window."""
     from mhtrack.build import make_initiator
@@ -131,7 +129,7 @@ def initiate(scenario: str, seed: int, clutter: str | None, clutter_rate: float 
         params["region"] = sc.region.as_tuple()
     ini = make_initiator(method, theta_deg=theta_deg, **params)
     res = run_initiation(sc, ini, fusion=fusion, runs=runs, seed=seed, weighting=weighting,
-                         progress=progress_enabled(progress))
+                         progress=show_progress())
     M = 3  # a track is true with ≥ 3 plots of one target; initiable: seen in ≥ 3 scans
     m = initiation_metrics(
         [track_targets(w.track_origins, M) for w in res.windows],

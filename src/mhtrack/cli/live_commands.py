@@ -10,6 +10,7 @@ from pathlib import Path
 import click
 
 from mhtrack.cli.asterix_commands import needs_libasterix
+from mhtrack.cli.terminal import say
 from mhtrack.cli.track_commands import birth_options, track_options, tracker_options
 from mhtrack.names import CLUTTER_FRAMES, DEFAULT_CLUTTER_FRAME
 
@@ -50,8 +51,8 @@ def replay(recording: Path, to: str, speed: float | None, loop: bool) -> None:
     with stop_on_signals(threading.Event()) as stop:
         stats = play(recording, to, loops=None if loop else 1, stop=stop,
                      **({} if speed is None else {"speed": speed}))
-    click.echo(f"sent {stats.datagrams} datagrams ({stats.bytes} bytes, {stats.passes} "
-               f"passes) to {to}")
+    say(f"sent {stats.datagrams} datagrams ({stats.bytes} bytes, {stats.passes} "
+        f"passes) to {to}")
 
 
 @click.command()
@@ -136,7 +137,7 @@ def live(listen: tuple[str, ...], stdin: str | None, sensors_file: Path,
         run = Live(read_sensors(sensors_file), options, settings, stop=stop,
                    emit=lambda line: click.echo(line, err=True))
         result = run.run()
-    click.echo(result.describe(), err=True)
+    say(result.describe(), err=True)
 
 
 COMMANDS = [live, replay]

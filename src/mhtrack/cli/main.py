@@ -41,20 +41,18 @@ class Group(click.Group):
             raise InputProblem(msg) from None
 
 
-@click.group(cls=Group, context_settings={"help_option_names": ["-h", "--help"]})
+@click.group(cls=Group, context_settings={"help_option_names": ["-h", "--help"]},
+             params=logs.shared_options(group=True))
 @click.version_option(__version__, prog_name="mhtrack")
-@click.option("-v", "--verbose", count=True,
-              help="More log output: -v mhtrack's summaries, -vv its per-frame progress "
-              "(other libraries stay at warnings). Also accepted after the command.")
-@click.option("--log-file", type=click.Path(dir_okay=False, path_type=Path), default=None,
-              help="Append mhtrack's log (INFO at least, time-stamped) to FILE. Also "
-              "accepted after the command.")
-def cli(verbose: int, log_file: Path | None) -> None:
+def cli(verbose: int, log_file: Path | None, quiet: bool, progress: bool,
+        no_progress: bool) -> None:
     """Multiple-target tracking in unknown, varying clutter (MHT, MHT-GMM, MHT-AGMM) and
-    multi-radar track initiation."""
+    multi-radar track initiation.
+
+    -v, --log-file, -q/--quiet and --progress are also accepted after the command."""
     from mhtrack.io.atomic import install_signal_cleanup
 
-    logs.configure(verbose, log_file)
+    logs.configure(verbose, log_file, quiet)
     install_signal_cleanup()  # SIGTERM/SIGINT remove the temporaries of writes in flight
     for stream in (sys.stdout, sys.stderr):  # file names that are not UTF-8 print as \xNN
         with contextlib.suppress(AttributeError, ValueError, io.UnsupportedOperation):
@@ -71,15 +69,16 @@ def _short_out(command: click.Command) -> None:
 
 
 def _every_command(command: click.Command) -> None:
-    """The options every command has: ``-v``, ``--log-file`` (:mod:`mhtrack.cli.logs`)
-    and ``-o`` for ``--out``; for a group's subcommands too."""
+    """The options every command has: ``-v``, ``--log-file``, ``-q/--quiet``,
+    ``--progress`` (:func:`mhtrack.cli.logs.shared_options`) and ``-o`` for ``--out``;
+    for a group's subcommands too."""
     subs = getattr(command, "commands", None)
     if subs is not None:
         for sub in subs.values():
             _every_command(sub)
         return
     names = {o for p in command.params for o in (*p.opts, *p.secondary_opts)}
-    command.params += [p for p in logs.logging_params() if not names & set(p.opts)]
+    command.params += [p for p in logs.shared_options() if not names & set(p.opts)]
     _short_out(command)
 
 

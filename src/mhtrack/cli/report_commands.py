@@ -6,7 +6,7 @@ from pathlib import Path
 
 import click
 
-from mhtrack.cli.terminal import progress_enabled, progress_option
+from mhtrack.cli.terminal import say, show_progress
 
 
 def write_report_or_fail(directory: Path, output: Path | None = None, *,
@@ -32,9 +32,8 @@ def write_report_or_fail(directory: Path, output: Path | None = None, *,
               help="Plotly's JavaScript (4.8 MB) inlined in the page (one self-contained "
               "file), or written once beside it as plotly-VERSION.min.js and shared by "
               "every report in that folder [inline].")
-@progress_option
-def report(directory: Path, out: Path | None, output_alias: Path | None, plotlyjs: str | None,
-           progress: bool | None) -> None:
+def report(directory: Path, out: Path | None, output_alias: Path | None,
+           plotlyjs: str | None) -> None:
     """Write one HTML page of DIR (opens from disk, no network).
 
     DIR is a run (``run``'s output, or plots, truth, tracks and sensors files, with
@@ -51,8 +50,8 @@ def report(directory: Path, out: Path | None, output_alias: Path | None, plotlyj
     if out is not None:
         check_output_file(out, inputs=(), suffixes=(".html",), what="report", option="--out")
     path = write_report_or_fail(directory, out, plotlyjs=plotlyjs,
-                                progress=progress_enabled(progress))
-    click.echo(f"wrote {path}")
+                                progress=show_progress())
+    say(f"wrote {path}")
 
 
 COMMANDS = [report]

@@ -8,7 +8,7 @@ from typing import Any
 import click
 
 from mhtrack.cli.common import InputProblem, executor_kwargs, executor_options, exit_if_runs_failed
-from mhtrack.cli.terminal import resume_on_interrupt
+from mhtrack.cli.terminal import resume_on_interrupt, say
 
 
 @click.group()
@@ -31,7 +31,7 @@ def reproduce() -> None:
               "output, our estimator additions).")
 @executor_options
 def p1(runs: int, out: Path, seed: int, tracker_settings: str, workers: int | None,
-       dask_scheduler: str | None, progress: bool | None) -> None:
+       dask_scheduler: str | None) -> None:
     """P1 §3: Monte-Carlo study of `crossing` with mht, mht-gmm and mht-agmm.
 
     Writes OUT/montecarlo/ (the runs; rerunning resumes), OUT/table3.md (our Table 3,
@@ -46,7 +46,7 @@ def p1(runs: int, out: Path, seed: int, tracker_settings: str, workers: int | No
     from mhtrack.experiments.p1 import reproduce_p1
     from mhtrack.reports.p1 import write_p1_report
 
-    run_on = executor_kwargs(workers, dask_scheduler, progress)
+    run_on = executor_kwargs(workers, dask_scheduler)
     try:
         with resume_on_interrupt("reproduce p1", out):
             repro = reproduce_p1(out, runs, seed, settings=tracker_settings, **run_on)
@@ -54,8 +54,8 @@ def p1(runs: int, out: Path, seed: int, tracker_settings: str, workers: int | No
         raise InputProblem(str(e)) from None
     report = write_p1_report(repro)
     res = repro.result
-    click.echo(report.table_md)
-    click.echo(f"{res.computed} runs computed, {res.skipped} already done.")
+    say(report.table_md)
+    say(f"{res.computed} runs computed, {res.skipped} already done.")
     _wrote(report.paths)
     exit_if_runs_failed("reproduce p1", res)
 
@@ -77,7 +77,7 @@ def p1(runs: int, out: Path, seed: int, tracker_settings: str, workers: int | No
               help="Read λ as clutter plots per radar per scan, or per scan over all radars.")
 @executor_options
 def p2(runs: int, out: Path, seed: int, settings: str, clutter_per: str,
-       workers: int | None, dask_scheduler: str | None, progress: bool | None) -> None:
+       workers: int | None, dask_scheduler: str | None) -> None:
     """P2 (Gong, Dai & Ma 2013) on `multiradar`: Figs. 2, 3, 4, 12–15 and Tables 1–2.
 
     Fig. 3: p_true of the modified 3/4 logic against θ ∈ {0°, 10°, …, 180°} for
@@ -90,7 +90,7 @@ def p2(runs: int, out: Path, seed: int, settings: str, clutter_per: str,
     from mhtrack.experiments.p2 import reproduce_p2
     from mhtrack.reports.p2 import write_p2_report
 
-    run_on = executor_kwargs(workers, dask_scheduler, progress)
+    run_on = executor_kwargs(workers, dask_scheduler)
     try:
         with resume_on_interrupt("reproduce p2", out):
             repro = reproduce_p2(out, runs, seed, settings=settings, clutter_per=clutter_per,
@@ -98,9 +98,9 @@ def p2(runs: int, out: Path, seed: int, settings: str, clutter_per: str,
     except ValueError as e:
         raise InputProblem(str(e)) from None
     paths = write_p2_report(repro)
-    click.echo((repro.out_dir / "tables.md").read_text(encoding="utf-8"))
-    click.echo(f"{repro.computed} jobs computed, {repro.skipped} already done "
-               f"({repro.wall_seconds:.1f} s).")
+    say((repro.out_dir / "tables.md").read_text(encoding="utf-8"))
+    say(f"{repro.computed} jobs computed, {repro.skipped} already done "
+        f"({repro.wall_seconds:.1f} s).")
     _wrote(paths)
     _exit_if_jobs_failed("p2", repro.errors, f"{repro.out_dir}/jobs/<name>.error.txt")
 
@@ -119,7 +119,7 @@ def p2(runs: int, out: Path, seed: int, settings: str, clutter_per: str,
               "report (kept in OUT/ablation.json).")
 @executor_options
 def clutter_shift(runs: int, out: Path, seed: int, ablation_runs: int, workers: int | None,
-                  dask_scheduler: str | None, progress: bool | None) -> None:
+                  dask_scheduler: str | None) -> None:
     """Known κ, uniform κ̂, GMM and AGMM on `crossing-changing`, a clutter that changes.
 
     Every method tracks the same RUNS simulations; the report compares them run by run
@@ -130,7 +130,7 @@ def clutter_shift(runs: int, out: Path, seed: int, ablation_runs: int, workers: 
     from mhtrack.experiments import clutter_shift as cs
     from mhtrack.reports.clutter_shift import write_clutter_shift_report
 
-    run_on = executor_kwargs(workers, dask_scheduler, progress)
+    run_on = executor_kwargs(workers, dask_scheduler)
     try:
         scenario = cs.default_scenario()
         with resume_on_interrupt("reproduce clutter-shift", out):
@@ -145,17 +145,17 @@ def clutter_shift(runs: int, out: Path, seed: int, ablation_runs: int, workers: 
     rep = write_clutter_shift_report(study, scenario, ablation)
     for c in study.paired:
         if c.a == "agmm" and c.b == "gmm":
-            click.echo(f"* {c.sentence}")
-    click.echo(f"{study.computed} jobs computed, {study.skipped} already done.")
+            say(f"* {c.sentence}")
+    say(f"{study.computed} jobs computed, {study.skipped} already done.")
     _wrote(rep.paths)
     _exit_if_jobs_failed("clutter-shift", study.errors, f"{out}/jobs/")
 
 
 def _wrote(paths: Any) -> None:
     """List the files and folders a study wrote (folders with a trailing ``/``)."""
-    click.echo("wrote:")
+    say("wrote:")
     for p in paths:
-        click.echo(f"  {p}{'/' if p.is_dir() else ''}")
+        say(f"  {p}{'/' if p.is_dir() else ''}")
 
 
 def _exit_if_jobs_failed(study: str, errors: Any, where: str) -> None:

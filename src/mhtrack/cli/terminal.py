@@ -1,9 +1,13 @@
-"""What the commands show on the terminal: the progress bar, and what to do after Ctrl-C.
+"""What the commands show on the terminal: the progress bar, the info lines, and what to
+do after Ctrl-C.
 
-* :func:`progress_option` — ``--progress/--quiet`` (``--no-progress`` an alias of
-  ``--quiet``) on every long command; :func:`progress_enabled` turns it into the one
-  boolean the library takes: the bar is drawn iff stderr is a terminal, unless an option
-  says otherwise — so logs and pipes get no bar.
+* :func:`show_progress` — the one boolean the library takes (``progress=``) from the
+  options every command has (``-q/--quiet``, ``--progress``: :mod:`mhtrack.cli.logs`):
+  the bar is drawn iff stderr is a terminal, unless an option says otherwise — so logs,
+  pipes and tests get no bar;
+* :func:`say` — an info line (what a command did: its summary, a note, ``wrote FILE``),
+  silenced by ``--quiet``; the results a command was asked for (``evaluate``'s table,
+  ``--json``) and errors are printed with :func:`click.echo` whatever ``--quiet`` says.
 * :func:`resume_on_interrupt` — Ctrl-C during a study: finished jobs are already stored
   (the job store writes each one as it ends, atomically), the workers are stopped, and
   the command says how to resume, with the exact command, then exits with status 130.
@@ -15,7 +19,7 @@ import contextlib
 import os
 import shlex
 import sys
-from collections.abc import Callable, Iterator
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
@@ -23,14 +27,6 @@ import click
 
 #: Exit status after Ctrl-C (128 + SIGINT), as shells report it.
 INTERRUPTED_EXIT = 130
-
-
-def progress_option(f: Callable[..., Any]) -> Callable[..., Any]:
-    """``--progress/--quiet``: the progress bar on stderr [shown iff stderr is a terminal]."""
-    return click.option(
-        "--progress/--quiet", " /--no-progress", "progress", default=None,
-        help="Progress bar on stderr, or none (--quiet, --no-progress) [shown when stderr "
-        "is a terminal].")(f)
 
 
 def progress_enabled(progress: bool | None, stream: Any = None) -> bool:
@@ -44,6 +40,24 @@ def progress_enabled(progress: bool | None, stream: Any = None) -> bool:
         return bool(isatty()) if isatty is not None else False
     except (OSError, ValueError):  # a closed or detached stream
         return False
+
+
+def show_progress() -> bool:
+    """Whether this invocation draws progress bars: never with ``--quiet``; always with
+    ``--progress``; else iff stderr is a terminal (:func:`progress_enabled`)."""
+    from mhtrack.cli.logs import shown
+
+    s = shown()
+    return False if s.quiet else progress_enabled(s.progress)
+
+
+def say(text: str, *, err: bool = False, nl: bool = True) -> None:
+    """Print the info line ``text`` (stdout, or stderr with ``err``; ``nl`` as for
+    :func:`click.echo`) unless ``--quiet``."""
+    from mhtrack.cli.logs import shown
+
+    if not shown().quiet:
+        click.echo(text, err=err, nl=nl)
 
 
 def rerun_command(argv: list[str] | None = None) -> str:

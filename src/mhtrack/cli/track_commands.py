@@ -10,7 +10,7 @@ import click
 
 from mhtrack.cli.asterix_commands import needs_libasterix
 from mhtrack.cli.common import echo_json, load_scenario_arg, scenario_options
-from mhtrack.cli.terminal import progress_enabled, progress_option
+from mhtrack.cli.terminal import say, show_progress
 from mhtrack.names import (
     BIRTHS,
     CLUTTER_FRAMES,
@@ -153,7 +153,6 @@ def track_options(tracker: str, tracker_pd: float | None, meas_sigma: float | No
               help="With --estimate-bias: write the final biases (JSON) for --bias-init.")
 @birth_options
 @output_option
-@progress_option
 @needs_libasterix
 def track(plots: Path, tracker: str, tracker_pd: float | None, meas_sigma: float | None,
           accel_sigma: float | None, imm_accel_sigma: float | None,
@@ -162,9 +161,8 @@ def track(plots: Path, tracker: str, tracker_pd: float | None, meas_sigma: float
           scenario_file: Path | None, sensors_file: Path | None,
           reorder_window_s: float | None, clutter_frame: str, birth: str,
           birth_theta: float | None, fusion: str | None, output: str | None,
-          progress: bool | None, estimate_bias: bool = False,
-          bias_reference: int | None = None, bias_init: Path | None = None,
-          bias_out: Path | None = None) -> None:
+          estimate_bias: bool = False, bias_reference: int | None = None,
+          bias_init: Path | None = None, bias_out: Path | None = None) -> None:
     """Run a tracker on a PLOTS file and write its tracks."""
     from mhtrack.io.paths import check_output_file
     from mhtrack.pipeline.run import Pipeline
@@ -184,21 +182,23 @@ def track(plots: Path, tracker: str, tracker_pd: float | None, meas_sigma: float
                             fusion, output, clutter_frame=clutter_frame,
                             estimate_bias=estimate_bias, bias_reference=bias_reference,
                             bias_prior=prior)
+    bars = show_progress()
     pipe = Pipeline.open(plots, options, scenario_file=scenario_file,
-                         sensors_file=sensors_file, reorder_window_s=reorder_window_s)
+                         sensors_file=sensors_file, reorder_window_s=reorder_window_s,
+                         progress=bars)
     result = pipe.run([TracksFileSink(out, frame=pipe.frame, output=pipe.output)],
-                      progress=progress_enabled(progress), keep_stats=False)
-    click.echo(f"{result.describe()} -> {out}")
+                      progress=bars, keep_stats=False)
+    say(f"{result.describe()} -> {out}")
     for note in (pipe.birth_note, pipe.reach_note):
         if note is not None:
-            click.echo(note)
+            say(note)
     if pipe.registration is not None:
-        click.echo("\n".join(pipe.registration.describe()))
+        say("\n".join(pipe.registration.describe()))
         if bias_out is not None:
             from mhtrack.io.biasfile import write_biases
 
             write_biases(bias_out, pipe.registration.biases(), pipe.registration.references)
-            click.echo(f"biases -> {bias_out}")
+            say(f"biases -> {bias_out}")
 
 
 @click.command()
@@ -218,15 +218,14 @@ def track(plots: Path, tracker: str, tracker_pd: float | None, meas_sigma: float
               "parameters; needs mhtrack[report]).")
 @birth_options
 @output_option
-@progress_option
 def run(scenario: str, seed: int, clutter: str | None, clutter_rate: float | None,
         pd: float | None, scans: int | None, tracker: str, tracker_pd: float | None,
         meas_sigma: float | None, accel_sigma: float | None, imm_accel_sigma: float | None,
         clutter_density: float | None,
         birth_density: float | None, nscan: int | None, out: Path | None,
         cutoff: float | None, order: float | None, as_json: bool, html_report: bool,
-        birth: str, birth_theta: float | None, fusion: str | None, output: str | None,
-        progress: bool | None) -> None:
+        birth: str, birth_theta: float | None, fusion: str | None, output: str | None
+        ) -> None:
     """Simulate SCENARIO, track, evaluate and plot, in one go.
 
     Writes plots, truth, tracks, scenario.toml, metrics.json, scene.png (truth, plots,
@@ -247,7 +246,7 @@ def run(scenario: str, seed: int, clutter: str | None, clutter_rate: float | Non
                             fusion, output, sensor_pd=pd)
     warn_known_kappa(sc, options)
     result = run_scenario(sc, seed, options=options, cutoff=cutoff, order=order,
-                          progress=progress_enabled(progress))
+                          progress=show_progress())
     out = out if out is not None else run_dir(sc, tracker, birth, seed)
     summary = write_run(out, result, seed)
     page = None
@@ -258,12 +257,12 @@ def run(scenario: str, seed: int, clutter: str | None, clutter_rate: float | Non
     if as_json:
         echo_json(summary)
         if page is not None:
-            click.echo(f"wrote {page}", err=True)
+            say(f"wrote {page}", err=True)
         return
     for line in run_text(result, out):
-        click.echo(line)
+        say(line)
     if page is not None:
-        click.echo(f"wrote {page}")
+        say(f"wrote {page}")
 
 
 COMMANDS = [track, run]

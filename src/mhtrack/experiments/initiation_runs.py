@@ -19,7 +19,6 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from tqdm.auto import tqdm
 
 from mhtrack.build import INITIATION_FUSER_CLASSES, make_initiator
 from mhtrack.experiments.jobs import run_seeds
@@ -27,6 +26,7 @@ from mhtrack.initiation.fused import FusedScan
 from mhtrack.initiation.fusion import AdaptiveKMeansFusion, KMeansFusion
 from mhtrack.initiation.window import Window, sliding_windows
 from mhtrack.names import CLUSTER_METHODS, INITIATION_FUSIONS, INITIATORS
+from mhtrack.progress import count
 from mhtrack.records import Scan, TruthTable
 from mhtrack.scenario import Scenario, simulate
 
@@ -151,8 +151,8 @@ def run_clustering(scenario: Scenario, method: str = "adaptive", *, runs: int = 
                    **params: Any) -> list[ClusteredScan]:
     """Simulate ``runs`` runs of ``scenario`` and fuse every scan with ``method``."""
     out = []
-    for rs in tqdm(run_seeds(seed, runs, "words"), desc=f"cluster {method}", unit="run",
-                   disable=not progress, leave=False):
+    seeds = run_seeds(seed, runs, "words")
+    for rs in count(len(seeds), f"cluster {method}", "run", progress).over(seeds):
         sim = simulate(scenario, rs)
         tr = sim.truth
         for scan in sim.plots.scans():
@@ -201,8 +201,8 @@ def run_initiation(scenario: Scenario, initiator: Any, *, fusion: str = "adaptiv
     windows: list[WindowOutcome] = []
     fusion_secs: list[float] = []
     N = initiator.n_scans
-    for r, rs in enumerate(tqdm(run_seeds(seed, runs, "words"), desc="initiate", unit="run",
-                                disable=not progress, leave=False)):
+    seeds = run_seeds(seed, runs, "words")
+    for r, rs in enumerate(count(len(seeds), "initiate", "run", progress).over(seeds)):
         run = simulate_and_fuse(scenario, rs, fusion, weighting=weighting)
         fusion_secs += run.fusion_seconds
         for raw_win, win in run.windows(N):

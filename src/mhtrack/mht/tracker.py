@@ -125,6 +125,9 @@ class MHTTracker:
         self._history = TentativeHistory(cfg.history_scans)
         self._cap_warnings = CapWarnings()
         self.last_stats: StepStats | None = None
+        #: The clutter intensity κ̂ (per m² per scan, floored) the last :meth:`step` scored
+        #: each of its plots with (kept for the pipeline's DEBUG line, not recomputed).
+        self.last_kappa: np.ndarray = np.empty(0)
         #: Rows, at earlier scans, of the tracks confirmed by the last :meth:`step`: their
         #: tentative past (``tentative`` true; :mod:`mhtrack.mht.history`).
         self.last_backfill: TrackTable = TrackTable.empty()
@@ -151,6 +154,7 @@ class MHTTracker:
                                        motion=self.motion)
         in_gates = plots_in_confirmed_gates(leaves, gated, f.n_plots)
         kappa = clutter_intensity(self.clutter, f, in_gates, self.config.min_clutter_density)
+        self.last_kappa = kappa
         update_dl = update_increment(gated.loglik, kappa, self.coverage.plot_pd(scan),
                                      self.config.new_target_density, gated.plot)
         children = propose_children(leaves, gated, self._miss(looks), update_dl)

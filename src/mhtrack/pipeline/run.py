@@ -11,6 +11,7 @@ order), so it stays a row of the source.
 from __future__ import annotations
 
 import dataclasses
+import logging
 from collections import deque
 from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import dataclass
@@ -19,11 +20,12 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
-from tqdm.auto import tqdm
 
 from mhtrack.build import TRACKER_FUSERS, tracker_fuser
 from mhtrack.names import TRACKER_FUSIONS
+from mhtrack.pipeline.frame_log import log_frame
 from mhtrack.pipeline.options import TrackOptions, birth_density_note, choose
+from mhtrack.progress import Count
 from mhtrack.records import Scan
 from mhtrack.sinks.base import FrameOutput, Sink, check_output
 
@@ -32,6 +34,9 @@ if TYPE_CHECKING:
     from mhtrack.mht import MHTConfig, MHTTracker, StepStats
     from mhtrack.pipeline.registration import Registration
     from mhtrack.sources.base import Source, Survey
+
+#: The per-frame DEBUG lines (``mhtrack -vv``).
+_log = logging.getLogger("mhtrack.pipeline")
 
 
 def fuse_scan(scan: Scan, fuser: AdaptiveKMeansFusion | None = None) -> Scan:
@@ -71,11 +76,14 @@ def fused(scans: Iterable[Scan], fusion: str,
 
 def step_frames(tracker: MHTTracker, frames: Iterable[Scan], *, fusion: str = "none",
                 name: str = "mht", progress: bool = False,
-                total: int | None = None,
+                total: int | None = None, unit: str = "frame",
                 registration: Registration | None = None) -> Iterator[FrameOutput]:
     """Each frame fused (``fusion``), stepped through ``tracker``, and its output — the
     online rows, the backfill and the step's statistics with the fusion's caps merged
-    in. ``progress``: a tqdm bar of ``total`` frames. ``registration``: each frame's
+    in. ``progress``: a bar (:class:`~mhtrack.progress.Count`) of ``total`` frames, or
+    of ``total`` plots with ``unit="plot"`` (timed plots and recordings, whose number of
+    frames is known only at the end); at DEBUG, one line per frame
+    (:func:`~mhtrack.pipeline.frame_log.log_frame`). ``registration``: each frame's
     plots corrected for the radars' biases before fusion, and the estimate updated
     from the step's confirmed tracks (:mod:`mhtrack.pipeline.registration`)."""
     fusion_caps: dict[int, dict[str, int]] = {}
@@ -83,19 +91,21 @@ def step_frames(tracker: MHTTracker, frames: Iterable[Scan], *, fusion: str = "n
     recent: deque[int] = deque(maxlen=max(int(depth or 0), 1))
     if registration is not None:
         frames = (registration.correct(f) for f in frames)
-    bar = tqdm(fused(frames, fusion, fusion_caps), total=total, desc=name, unit="scan",
-               disable=not progress, leave=False)
-    for scan in bar:
-        online = tracker.step(scan)
-        if registration is not None:
-            registration.learn(scan, online)
-        stats = tracker.last_stats
-        assert stats is not None  # set by every step
-        stats.caps.update(fusion_caps.pop(stats.scan, {}))
-        # the next backfill reaches back to the oldest of the last ``depth`` frames
-        recent.append(int(scan.index))
-        yield FrameOutput(scan, online, tracker.last_backfill, stats,
-                          None if depth is None else recent[0])
+    with Count(total, name, unit, progress) as bar:
+        for scan in fused(frames, fusion, fusion_caps):
+            online = tracker.step(scan)
+            if registration is not None:
+                registration.learn(scan, online)
+            stats = tracker.last_stats
+            assert stats is not None  # set by every step
+            stats.caps.update(fusion_caps.pop(stats.scan, {}))
+            if _log.isEnabledFor(logging.DEBUG):
+                log_frame(_log, scan, tracker, stats)
+            # the next backfill reaches back to the oldest of the last ``depth`` frames
+            recent.append(int(scan.index))
+            bar.update(len(scan) if unit == "plot" else 1)
+            yield FrameOutput(scan, online, tracker.last_backfill, stats,
+                              None if depth is None else recent[0])
 
 
 def mean_step_time(stats: Sequence[StepStats]) -> float:
@@ -226,12 +236,15 @@ class Pipeline:
     @classmethod
     def open(cls, path: str | Path, options: TrackOptions | None = None, *,
              scenario_file: str | None = None, sensors_file: str | None = None,
-             reorder_window_s: float | None = None) -> Pipeline:
-        """A pipeline on a plots file or a recording (:func:`~mhtrack.pipeline.open_input`)."""
+             reorder_window_s: float | None = None, progress: bool = False) -> Pipeline:
+        """A pipeline on a plots file or a recording (:func:`~mhtrack.pipeline.open_input`);
+        ``progress``: a bar over the source's survey (:attr:`Source.progress`)."""
         from mhtrack.pipeline.inputs import open_input
 
-        return cls(open_input(path, scenario_file=scenario_file, sensors_file=sensors_file,
-                              reorder_window_s=reorder_window_s), options)
+        source = open_input(path, scenario_file=scenario_file, sensors_file=sensors_file,
+                            reorder_window_s=reorder_window_s)
+        source.progress = progress
+        return cls(source, options)
 
     @cached_property
     def survey(self) -> Survey | None:
@@ -262,9 +275,12 @@ class Pipeline:
     def outputs(self, *, progress: bool = False) -> Iterator[FrameOutput]:
         """The tracker's output frame by frame (the iterator form of a sink)."""
         survey = self.survey if progress else None
+        frames = None if survey is None else survey.n_frames
+        plots = None if survey is None or frames is not None else survey.n_plots
         yield from step_frames(self.tracker, self.source, fusion=self.fusion,
                                name=self.options.tracker, progress=progress,
-                               total=None if survey is None else survey.n_frames,
+                               total=frames if plots is None else plots,
+                               unit="frame" if plots is None else "plot",
                                registration=self.registration)
 
     def run(self, sinks: Sequence[Sink] = (), *, progress: bool = False,

@@ -92,6 +92,9 @@ class Source(ABC):
     iso_times: bool = False
     sensors: SensorSet | None = None
     scenario: Scenario | None = None
+    #: Draw a progress bar over :meth:`survey`'s pass where the source can count it (a
+    #: recording: its bytes; :class:`~mhtrack.progress.Count`).
+    progress: bool = False
 
     def __init__(self) -> None:
         self.stats = SourceStats()

@@ -28,6 +28,7 @@ from mhtrack.io.asterix.problems import Problems
 from mhtrack.io.asterix.sites import radar_name
 from mhtrack.io.paths import check_input_file
 from mhtrack.models.radars import SensorSet
+from mhtrack.progress import Count
 from mhtrack.records import Scan
 from mhtrack.sources.base import Survey
 from mhtrack.sources.datagrams import DatagramSource
@@ -48,6 +49,7 @@ class AsterixSource(DatagramSource):
         with self._mapped() as data:
             self.container = recognise(data, self.name, self.categories)
         self._survey: Survey | None = None
+        self._bar: Count | None = None  # over the survey's pass (``progress``)
 
     @contextmanager
     def _mapped(self) -> Iterator[Any]:
@@ -63,12 +65,17 @@ class AsterixSource(DatagramSource):
         with self._mapped() as data:
             for offset, when, payload in units(data, self.container, self.name,
                                                self.categories, problems):
+                if self._bar is not None:
+                    self._bar.to(offset)
                 yield offset, payload, when
 
     def survey(self) -> Survey:
         """The recording's radars, plots' ``x, y`` and periods (one pass, kept)."""
         if self._survey is None:
-            periods, survey = self.periods_and_survey()
+            with Count(self.path.stat().st_size, "survey", "B", self.progress,
+                       scale=True) as self._bar:
+                periods, survey = self.periods_and_survey()
+            self._bar = None
             if survey.n_plots == 0:
                 radars = ", ".join(map(radar_name, sorted(self._seen)))
                 why = "" if not radars else (

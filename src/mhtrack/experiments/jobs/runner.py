@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import sys
 from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
@@ -11,6 +10,7 @@ from mhtrack.experiments.jobs.executor import JobFunction, check_executor, execu
 from mhtrack.experiments.jobs.job import Job
 from mhtrack.experiments.jobs.plan import JobPlan
 from mhtrack.experiments.jobs.store import JobStore
+from mhtrack.progress import Count
 
 
 @dataclass
@@ -28,23 +28,21 @@ def run_jobs(jobs: Sequence[Job] | JobPlan, fn: JobFunction, store: JobStore, *,
              progress: bool = False, desc: str = "jobs", unit: str = "job") -> JobsRun:
     """Run every job of ``jobs`` not done in ``store`` (:meth:`JobStore.is_done`) with
     :func:`~mhtrack.experiments.jobs.executor.execute`, storing each record — or its
-    traceback — as the job ends. ``progress``: a tqdm bar on stderr. A job that raises does
-    not stop the others; an interruption loses no finished job.
+    traceback — as the job ends. ``progress``: a bar of the jobs done
+    (:class:`~mhtrack.progress.Count`). A job that raises does not stop the others; an
+    interruption loses no finished job.
 
     ``jobs`` is a list (its keys are checked to be unique) or a lazy
     :class:`~mhtrack.experiments.jobs.plan.JobPlan` (unique by construction): jobs are
     made, checked against the store and handed to the executor one at a time, so the
     memory used does not grow with the number of jobs."""
-    from tqdm.auto import tqdm
-
     check_executor(executor, workers, scheduler)
     if not isinstance(jobs, JobPlan):
         keys = [j.key for j in jobs]
         if len(set(keys)) != len(keys):
             raise ValueError("run_jobs: two jobs share a key")
     out = JobsRun(computed=0, skipped=0)
-    bar = tqdm(total=len(jobs), unit=unit, desc=desc, disable=not progress, file=sys.stderr,
-               dynamic_ncols=True)
+    bar = Count(len(jobs), desc, unit, progress)
 
     def pending() -> Iterator[Job]:
         for job in jobs:
@@ -59,7 +57,7 @@ def run_jobs(jobs: Sequence[Job] | JobPlan, fn: JobFunction, store: JobStore, *,
         if error is not None:
             store.save_error(job, error)
             out.errors[job.key] = error
-            bar.set_postfix_str(f"{len(out.errors)} failed")
+            bar.note(f"{len(out.errors)} failed")
         else:
             assert record is not None
             store.save(job, record)

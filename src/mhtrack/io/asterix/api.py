@@ -27,6 +27,7 @@ from mhtrack.io.asterix.notplots import PLOT_TYPES
 from mhtrack.io.asterix.writer import write_blocks
 from mhtrack.models.radars import SensorSet
 from mhtrack.names import EXPORT_CATEGORIES
+from mhtrack.progress import Count
 
 #: Largest sensor id an ASTERIX data source holds (SAC·256 + SIC).
 MAX_SENSOR_ID = 0xFFFF
@@ -163,12 +164,12 @@ class Converted:
 
 
 def convert(source: str | Path, out: str | Path, sensors: SensorSet | None = None, *,
-            recording: Recording | None = None) -> Converted:
+            recording: Recording | None = None, progress: bool = False) -> Converted:
     """Decode ``source`` (warning one line per kind of part skipped) and write its plots
     and ADS-B reports to ``out`` (CSV or Parquet; :func:`plot_columns`); ``recording``:
-    ``source`` already decoded."""
+    ``source`` already decoded; ``progress``: a bar of the bytes decoded."""
     if recording is None:
-        recording = read_recording(source)
+        recording = read_recording(source, progress=progress)
         recording.problems.warn(str(source))
     rec = recording
     if len(rec) == 0:
@@ -209,11 +210,12 @@ class Exported:
 
 def export_file(path: str | Path, sensors: SensorSet | None, out: str | Path, *,
                 category: str | None = None, sac: int | None = None,
-                sic: int | None = None) -> Exported:
+                sic: int | None = None, progress: bool = False) -> Exported:
     """``mhtrack export`` (:data:`~mhtrack.names.EXPORT_CATEGORIES`, the first the
     default): timed plots as CAT048 target reports with CAT034 sweeps (:func:`export`;
     needs ``sensors``), or with ``category "062"`` a tracks file as CAT062 system tracks
-    from data source ``sac``/``sic`` (:func:`~mhtrack.io.asterix.cat062.export_tracks`)."""
+    from data source ``sac``/``sic`` (:func:`~mhtrack.io.asterix.cat062.export_tracks`).
+    ``progress``: a bar of the rows encoded."""
     from mhtrack.io.asterix.cat062 import export_tracks
 
     category = EXPORT_CATEGORIES[0] if category is None else category
@@ -221,10 +223,11 @@ def export_file(path: str | Path, sensors: SensorSet | None, out: str | Path, *,
         raise ValueError(f"unknown category {category!r} (expected "
                          f"{', '.join(EXPORT_CATEGORIES)})")
     if category == "062":
-        return Exported(*export_tracks(path, sensors, out, sac=sac, sic=sic), category)
+        return Exported(*export_tracks(path, sensors, out, sac=sac, sic=sic,
+                                       progress=progress), category)
     if sensors is None:
         raise ValueError("export of plots (CAT048) needs --sensors FILE")
-    return Exported(*export(path, sensors, out), category)
+    return Exported(*export(path, sensors, out, progress=progress), category)
 
 
 _EXPORT = {"time": TIME, "sensor": INT, "range": FLOAT, "slant_range": FLOAT,
@@ -232,10 +235,12 @@ _EXPORT = {"time": TIME, "sensor": INT, "range": FLOAT, "slant_range": FLOAT,
            "mode_3a": TIME, "address": TIME, "callsign": TIME}  # TIME: read as text
 
 
-def export(plots: str | Path, sensors: SensorSet, out: str | Path) -> tuple[int, int]:
+def export(plots: str | Path, sensors: SensorSet, out: str | Path, *,
+           progress: bool = False) -> tuple[int, int]:
     """Encode a timed plots file (``time, sensor, bearing`` and ``slant_range`` or
     ``range``) as CAT048 with CAT034 sweep marks of the radars with a ``period``;
-    ``out`` ``.pcap`` or raw. Returns ``(plots, data blocks)`` written."""
+    ``out`` ``.pcap`` or raw. Returns ``(plots, data blocks)`` written. ``progress``: a
+    bar of the plots encoded (:func:`~mhtrack.io.asterix.encode.encode_blocks`)."""
     _lib.modules()
     f = read_frame(plots, _EXPORT, ("time", "sensor", "bearing"), "timed plots")
     if f.n == 0:
@@ -283,5 +288,6 @@ def export(plots: str | Path, sensors: SensorSet, out: str | Path) -> tuple[int,
         raise InputError(f"{plots}: {e}", file=str(plots)) from None
     periods = {s.id: float(s.period) for s in sensors.sensors if s.period is not None}
     messages += sweep_messages(time, sensor, bearing, periods)
-    n = write_blocks(out, encode_blocks(messages))
+    with Count(f.n, "export", "row", progress) as bar:
+        n = write_blocks(out, encode_blocks(messages, bar))
     return f.n, n

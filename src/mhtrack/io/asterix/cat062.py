@@ -25,6 +25,7 @@ from mhtrack.io.asterix.problems import Problems
 from mhtrack.io.asterix.timeaxis import DAY_S, unwrap_days
 from mhtrack.io.asterix.writer import write_blocks
 from mhtrack.models.radars import SensorSet
+from mhtrack.progress import Count
 from mhtrack.records import TrackTable
 
 if TYPE_CHECKING:
@@ -63,11 +64,12 @@ Check = Callable[[np.ndarray, str, Callable[[int], str]], None]
 
 
 def export_tracks(tracks: str | Path, sensors: SensorSet | None, out: str | Path, *,
-                  sac: int | None = None, sic: int | None = None) -> tuple[int, int]:
+                  sac: int | None = None, sic: int | None = None,
+                  progress: bool = False) -> tuple[int, int]:
     """Encode a tracks file as CAT062 system tracks from data source ``sac``/``sic``
     (default :data:`DEFAULT_SAC`/:data:`DEFAULT_SIC`); positions from ``lat, lon`` (else
     ``x, y`` through the sensors file's frame), velocities east/north. Returns
-    ``(track rows, data blocks)``."""
+    ``(track rows, data blocks)``. ``progress``: a bar of the rows encoded."""
     _lib.modules()
     f = read_frame(tracks, _TRACKS, ("time", "track_id"), "tracks")
     if f.n == 0:
@@ -93,7 +95,8 @@ def export_tracks(tracks: str | Path, sensors: SensorSet | None, out: str | Path
         if f.has("tentative") else np.zeros(f.n, int)
     messages = track_messages(time, tn, lat, lon, ve, vn, coasting, tentative, f.check,
                               sac=sac, sic=sic)
-    n = write_blocks(out, encode_blocks(messages))
+    with Count(f.n, "export", "row", progress) as bar:
+        n = write_blocks(out, encode_blocks(messages, bar))
     return f.n, n
 
 

@@ -35,6 +35,7 @@ from mhtrack.io.asterix.framings import recognise, units
 from mhtrack.io.asterix.notplots import flags048, plot_type048_of, reason
 from mhtrack.io.asterix.problems import Problems
 from mhtrack.io.asterix.timeaxis import TimeAxis
+from mhtrack.progress import Count
 
 #: One nautical mile (m), the unit of I048/040 RHO.
 NM_M = 1852.0
@@ -76,7 +77,8 @@ class Recording:
         return sweep_periods(self.sweeps)
 
 
-def read_recording(path: str | Path, *, fast: bool = True) -> Recording:
+def read_recording(path: str | Path, *, fast: bool = True, progress: bool = False
+                   ) -> Recording:
     """Decode the plots (CAT048, CAT001), ADS-B reports (CAT021: rows of ``plots`` in file
     order, with ``lat, lon, sigma`` columns, NaN on the radars' rows, present only when
     the recording has any), sweep marks (CAT034, CAT002) and sites (I034/120) of a
@@ -86,7 +88,8 @@ def read_recording(path: str | Path, *, fast: bool = True) -> Recording:
     :class:`~mhtrack.errors.InputError`. ``fast=False`` decodes every record with
     libasterix alone (the reference path of :mod:`~mhtrack.io.asterix.fast`). Times are
     on one monotonic axis (:mod:`~mhtrack.io.asterix.timeaxis`, capture times where the
-    framing has them)."""
+    framing has them). ``progress``: a bar of the bytes decoded
+    (:class:`~mhtrack.progress.Count`)."""
     name = str(path)
     data = Path(path).read_bytes()
     decoder = Decoder(fast=fast)
@@ -97,12 +100,16 @@ def read_recording(path: str | Path, *, fast: bool = True) -> Recording:
     is_plot: list[bool] = []
     times: list[float] = []
     axis = TimeAxis()
+    bar = Count(len(data), "decode", "B", progress, scale=True)
     for offset, when, payload in units(data, kind, name, decoder.categories, problems):
+        bar.to(offset)
         for _, what, found in decoder.blocks(payload, offset, problems, when):
             into = marks if what == MARKS else rows  # ADS-B reports beside the plots
             into.extend(found)
             is_plot.extend([what != MARKS] * len(found))
             times.extend(axis.times_list([r[0] for r in found], when))
+    bar.to(len(data))
+    bar.close()
     plots, sweeps = _columns(rows, marks, np.array(is_plot, bool),
                              np.array(times, float))
     return Recording(name, kind, plots, sweeps, problems, dict(decoder.sites))

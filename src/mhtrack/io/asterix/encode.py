@@ -19,6 +19,7 @@ import numpy as np
 import mhtrack.io.asterix._lib as _lib
 from mhtrack.io.asterix.decode import NM_M
 from mhtrack.io.asterix.timeaxis import DAY_S
+from mhtrack.progress import Count
 
 #: Records per data block at most (CAT048 reports of up to ~30 octets each).
 MAX_RECORDS = 40
@@ -163,9 +164,11 @@ def sweep_messages(time: np.ndarray, sensor: np.ndarray, bearing: np.ndarray,
     return out
 
 
-def encode_blocks(messages: list[Message]) -> Iterator[tuple[float, int, bytes]]:
+def encode_blocks(messages: list[Message], bar: Count | None = None
+                  ) -> Iterator[tuple[float, int, bytes]]:
     """``(time, sensor, data block bytes)`` of the messages in time order (stable: at
-    equal times a sweep mark before the plots), runs of one radar and category per block."""
+    equal times a sweep mark before the plots), runs of one radar and category per block.
+    ``bar`` counts the rows (plots, track updates; not the CAT034 marks) encoded."""
     spec = {48: _lib.cat048(), 34: _lib.cat034(), 62: _lib.cat062()}
     order = sorted(range(len(messages)),
                    key=lambda i: (messages[i].time, messages[i].category != 34, i))
@@ -174,6 +177,8 @@ def encode_blocks(messages: list[Message]) -> Iterator[tuple[float, int, bytes]]
     def flush() -> tuple[float, int, bytes]:
         s = spec[run[0].category]
         records = [s.cv_record.create(m.items) for m in run]
+        if bar is not None and run[0].category != 34:
+            bar.update(len(run))
         return run[0].time, run[0].sensor, s.create(records).unparse().to_bytes()
 
     for i in order:

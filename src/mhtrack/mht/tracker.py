@@ -43,13 +43,21 @@ from __future__ import annotations
 
 import time
 from collections.abc import Iterable
+from dataclasses import replace
 from os import PathLike
 from typing import Any
 
 import numpy as np
 
+from mhtrack.attributes import PlotAttributes
 from mhtrack.clutter.base import ClutterEstimator
 from mhtrack.clutter.known import KnownClutter
+from mhtrack.mht.attribute_scores import (
+    AttributeModel,
+    grow_attributes,
+    pair_increments,
+    seed_attributes,
+)
 from mhtrack.mht.births import Birth, default_birth
 from mhtrack.mht.caps import CapWarnings
 from mhtrack.mht.config import MHTConfig
@@ -91,6 +99,9 @@ class MHTTracker:
     coverage : the sensors' coverage (:mod:`mhtrack.mht.coverage`); default
         :class:`~mhtrack.mht.coverage.Everywhere` with ``config.p_detection`` (every leaf
         looked at every scan: P1's scans).
+    attributes : the likelihood ratios of plots' codes, addresses and flight levels
+        (:mod:`mhtrack.mht.attribute_scores`); default :class:`AttributeModel`'s. Plots
+        without attributes are scored by position alone, as in P1.
 
     Examples
     --------
@@ -102,8 +113,9 @@ class MHTTracker:
     def __init__(
         self, config: MHTConfig | None = None, clutter: ClutterEstimator | None = None, *,
         motion: MotionModel | None = None, birth: Birth | None = None,
-        coverage: Coverage | None = None,
+        coverage: Coverage | None = None, attributes: AttributeModel | None = None,
     ) -> None:
+        self.attributes = AttributeModel() if attributes is None else attributes
         self.config = cfg = MHTConfig() if config is None else config
         self.clutter: ClutterEstimator = KnownClutter() if clutter is None else clutter
         self.motion: MotionModel = cfg.motion if motion is None else motion
@@ -148,6 +160,11 @@ class MHTTracker:
         kappa = clutter_intensity(self.clutter, f, in_gates, self.config.min_clutter_density)
         update_dl = update_increment(gated.loglik, kappa, self.coverage.plot_pd(scan),
                                      self.config.new_target_density, gated.plot)
+        attrs = scan.attrs if scan.attrs is not None and scan.attrs.any() else None
+        if attrs is not None:
+            update_dl = update_dl + pair_increments(
+                self.attributes, leaves.level, leaves.ident, attrs, scan.plot_times(),
+                gated.track, gated.plot)
         children = propose_children(leaves, gated, self._miss(looks), update_dl)
         cand = self.birth.propose(f, kappa, in_gates)
         children = prune_children(f, leaves, children, self.sprt,
@@ -155,6 +172,8 @@ class MHTTracker:
         grown = grow_children(f, leaves, pred, children, motion=self.motion,
                               pair_pred=pair_pred, posterior=gated.posterior)
         births = self.birth.seed(f, cand, grown.window, self.trees)
+        if attrs is not None:
+            grown, births = self._attributes(f, attrs, grown, births, children.plot)
         leaves, parts, first_node = self._number(grown, births, idle)
         hyp = self._hypothesis(f, leaves)
         leaves = prune_after_solve(f, leaves, hyp.leaves, by_id=self.coverage.per_tree_looks,
@@ -191,6 +210,27 @@ class MHTTracker:
         if looks.uniform is not None:
             return miss_increment(looks.uniform, self._miss_pg)
         return miss_increments(looks.miss_pd, self._miss_pg)
+
+    def _attributes(self, frame: FrameContext, attrs: PlotAttributes, grown: Leaves,
+                    births: Leaves, plot: np.ndarray) -> tuple[Leaves, Leaves]:
+        """The grown leaves' and new trees' vertical states, codes and addresses
+        (:mod:`mhtrack.mht.attribute_scores`): children from their plots (``plot``, ``-1``
+        a miss), new trees from the plot of the frame they start with."""
+        t = frame.scan.plot_times()
+        level, ident = grow_attributes(self.attributes, grown.level, grown.ident, attrs,
+                                       t, plot)
+        grown = replace(grown, level=level, ident=ident)
+        if len(births):
+            rows = frame.rows
+            order = np.argsort(rows, kind="stable")
+            last = births.window[:, -1]
+            pos = np.minimum(np.searchsorted(rows, last, sorter=order), rows.size - 1)
+            j = order[pos] if rows.size else np.zeros(0, np.int64)
+            j = np.where((last >= 0) & (rows[j] == last), j, -1) if rows.size else \
+                np.full(len(births), -1, np.int64)
+            level, ident = seed_attributes(self.attributes, attrs, t, j)
+            births = replace(births, level=level, ident=ident)
+        return grown, births
 
     def _number(self, grown: Leaves, births: Leaves, idle: Leaves
                 ) -> tuple[Leaves, tuple[Leaves, Leaves] | None, int]:

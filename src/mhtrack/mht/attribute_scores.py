@@ -83,6 +83,9 @@ class AttributeModel:
     sigma_rate0: float = 0.5
     #: A validated level more than this many σ from the prediction restarts the state.
     reset_sigmas: float = 5.0
+    #: A new track on the address of a track that ended at most this long ago (s) takes
+    #: its id (:mod:`mhtrack.mht.resume`; the OpenSky data's longest gap is 660 s).
+    resume_s: float = 900.0
 
     def __post_init__(self) -> None:
         for name in ("address_error", "address_share", "code_error", "code_error_garbled",
@@ -91,7 +94,7 @@ class AttributeModel:
             if not 0.0 < v < 1.0:
                 raise ValueError(f"AttributeModel.{name}: must be in (0, 1), got {v!r}")
         for name in ("level_span", "sigma_level", "q_level", "sigma_rate0",
-                     "reset_sigmas"):
+                     "reset_sigmas", "resume_s"):
             v = getattr(self, name)
             if not (math.isfinite(v) and v > 0):
                 raise ValueError(f"AttributeModel.{name}: must be > 0, got {v!r}")

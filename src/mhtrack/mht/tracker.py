@@ -73,6 +73,7 @@ from mhtrack.mht.numbering import Counter, number_and_merge
 from mhtrack.mht.predict import predict_leaves
 from mhtrack.mht.pruning import prune_after_solve, prune_children, removed_after_solve
 from mhtrack.mht.report import StepStats, confirmed_windows, report
+from mhtrack.mht.resume import AddressBook
 from mhtrack.mht.scoring import miss_increment, miss_increments, update_increment
 from mhtrack.mht.sprt import SPRT
 from mhtrack.mht.state import load_state, located, save_state
@@ -136,6 +137,7 @@ class MHTTracker:
         self.trees, self.tracks, self.nodes = Counter(), Counter(), Counter()
         self._history = TentativeHistory(cfg.history_scans)
         self._cap_warnings = CapWarnings()
+        self._book = AddressBook(self.attributes.resume_s)
         self.last_stats: StepStats | None = None
         #: Rows, at earlier scans, of the tracks confirmed by the last :meth:`step`: their
         #: tentative past (``tentative`` true; :mod:`mhtrack.mht.history`).
@@ -261,8 +263,20 @@ class MHTTracker:
         assert frame.previous is not None
         first_new = self.tracks.next
         leaves = hand_over(leaves, frame.previous, by_id=self.coverage.per_tree_looks)
-        leaves = confirm(leaves, self.sprt.confirms(leaves), self.tracks)
-        self.last_backfill = self._history.backfill(leaves, newly_confirmed(leaves, first_new))
+        confirms = self.sprt.confirms(leaves)
+        leaves, resumed, last = self._book.resume(leaves, confirms)
+        leaves = confirm(leaves, confirms, self.tracks)
+        new = newly_confirmed(leaves, first_new)
+        if resumed.size:
+            new = (leaves.chosen & ((leaves.track >= first_new)
+                                    | contains(resumed, leaves.track))).nonzero()[0]
+        back = self._history.backfill(leaves, new)
+        if resumed.size and len(back):  # a resumed id's past: only after its last report
+            k = np.searchsorted(resumed, back.track_id, sorter=np.argsort(resumed))
+            k = np.argsort(resumed)[np.minimum(k, resumed.size - 1)]
+            old = (resumed[k] == back.track_id) & (back.time <= last[k])
+            back = back.take(~old)
+        self.last_backfill = back
         return leaves
 
     def _report(self, frame: FrameContext, leaves: Leaves,
@@ -273,6 +287,7 @@ class MHTTracker:
         ``None``: all)."""
         rep = leaves.reported()
         self._history.record(frame.index, frame.time, leaves, stepped, rep)
+        self._book.record(leaves, rep, frame.time)
         self._forget(leaves, frame.rows, rep)
         self._leaves, self._last_time, self._last_index = leaves, frame.time, frame.index
         return report(frame.scan, leaves, stepped, rep)
@@ -309,7 +324,8 @@ class MHTTracker:
     def save(self, path: str | PathLike[str]) -> None:
         """Write the full state to one ``.npz`` (no pickle; :mod:`mhtrack.mht.state`)."""
         parts = {"leaves": self._leaves.arrays(), "birth": self.birth.arrays(),
-                 "history": self._history.arrays(), "coverage": self.coverage.arrays()}
+                 "history": self._history.arrays(), "coverage": self.coverage.arrays(),
+                 "addresses": self._book.arrays()}
         save_state(path, parts, self.clutter, self.config, {
             "last_time": self._last_time, "last_index": self._last_index,
             "next_tree": self.trees.next, "next_track": self.tracks.next,
@@ -338,7 +354,7 @@ class MHTTracker:
         trk.trees, trk.tracks = Counter(meta["next_tree"]), Counter(meta["next_track"])
         trk.nodes = Counter(meta["next_node"])
         for part, owner in (("history", trk._history), ("birth", trk.birth),
-                            ("coverage", trk.coverage)):
+                            ("coverage", trk.coverage), ("addresses", trk._book)):
             with located(path, f"{part}__*"):
                 owner.set_arrays(saved.part(part))
         return trk

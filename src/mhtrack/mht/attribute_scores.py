@@ -33,10 +33,15 @@ climb rate with continuous white-noise acceleration of spectral density ``q`` (B
 Li & Kirubarajan 2001, §6.2.2): ``F = [[1, Δt], [0, 1]]``, ``Q = q [[Δt³/3, Δt²/2],
 [Δt²/2, Δt]]``; measurement ``h`` with variance ``σ_C²`` (Mode C's 100 ft steps:
 ``100/√12`` ft ≈ 0.3 FL, rounded up for altimetry). ``S = P⁻_hh + σ_C²``. A validated
-level starts the filter (``ḣ = 0``, ``σ_ḣ`` :attr:`AttributeModel.sigma_rate0`) when the
-branch has none or when it is more than :attr:`AttributeModel.reset_sigmas` σ from the
-prediction (the branch then follows the new level); otherwise it updates it. A leaf's
-code and address are those of its last plot that had them (validated codes only).
+level within :attr:`AttributeModel.reset_sigmas` σ of the prediction updates the filter;
+one farther is an outlier and leaves it as it is, until
+:attr:`AttributeModel.reset_after` such levels in a row restart it there (a level bust,
+or a branch that now follows another aircraft: each of those plots has paid ``ln ε_C``
+first). The first validated level starts the filter (``ḣ = 0``, ``σ_ḣ``
+:attr:`AttributeModel.sigma_rate0`). A leaf's
+address is the first one its plots gave (an airframe's address does not change: a
+branch that takes another aircraft's plots pays ``ln λ`` of a mismatch at each of them);
+its code the last validated one (codes change on the controller's instruction).
 """
 
 from __future__ import annotations
@@ -83,6 +88,8 @@ class AttributeModel:
     sigma_rate0: float = 0.5
     #: A validated level more than this many σ from the prediction restarts the state.
     reset_sigmas: float = 5.0
+    #: Outliers in a row that restart the vertical state at the last one.
+    reset_after: int = 3
     #: A new track on the address of a track that ended at most this long ago (s) takes
     #: its id (:mod:`mhtrack.mht.resume`; the OpenSky data's longest gap is 660 s).
     resume_s: float = 900.0
@@ -98,6 +105,9 @@ class AttributeModel:
             v = getattr(self, name)
             if not (math.isfinite(v) and v > 0):
                 raise ValueError(f"AttributeModel.{name}: must be > 0, got {v!r}")
+        if self.reset_after < 1:
+            raise ValueError(f"AttributeModel.reset_after: must be >= 1, got "
+                             f"{self.reset_after!r}")
 
     def discrete(self, error: float, share: float) -> tuple[float, float]:
         """``(ln λ if equal, ln λ if not)`` of a code or address: ``ln((1 − ε)/q)``,
@@ -109,7 +119,7 @@ def predict_level(level: np.ndarray, t: np.ndarray, q: float
                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """``(h⁻, P⁻_hh, P⁻_hḣ, P⁻_ḣḣ)`` of vertical states ``level`` (k, 6) predicted to
     times ``t`` (k,) (module docstring; ``|Δt|`` in ``Q``)."""
-    h, r, phh, phr, prr, t0 = level.T
+    h, r, phh, phr, prr, t0 = level[:, :6].T
     dt = t - t0
     a = np.abs(dt)
     return (h + r * dt,
@@ -160,13 +170,13 @@ def grow_attributes(model: AttributeModel, level: np.ndarray, ident: np.ndarray,
                     attrs: PlotAttributes, plot_t: np.ndarray, plot: np.ndarray
                     ) -> tuple[np.ndarray, np.ndarray]:
     """The children's ``(level, ident)`` from their parents' (rows of ``level``,
-    ``ident``) and their plots ``plot`` (``-1``: a miss keeps the parent's): the last
-    address, validated code and vertical state (module docstring)."""
+    ``ident``) and their plots ``plot`` (``-1``: a miss keeps the parent's): the first
+    address, the last validated code and the vertical state (module docstring)."""
     level, ident = level.copy(), ident.copy()
     upd = plot >= 0
     j = np.where(upd, plot, 0)
     a = attrs.address[j]
-    ident[:, 1] = np.where(upd & (a >= 0), a, ident[:, 1])
+    ident[:, 1] = np.where(upd & (a >= 0) & (ident[:, 1] < 0), a, ident[:, 1])
     c = attrs.mode_3a[j]
     ok = upd & (c >= 0) & (attrs.mode_3a_v[j] == 0) & (attrs.mode_3a_g[j] == 0)
     ident[:, 0] = np.where(ok, c, ident[:, 0])
@@ -184,14 +194,20 @@ def grow_attributes(model: AttributeModel, level: np.ndarray, ident: np.ndarray,
     S = phh + model.sigma_level ** 2
     nu = hk - hp
     update = known & (nu * nu <= model.reset_sigmas ** 2 * S)
+    outliers = np.where(known & ~update, np.nan_to_num(level[k, 6]) + 1, 0.0)
+    start = ~known | (outliers >= model.reset_after)
     kh, kr = phh / S, phr / S
-    new = np.empty((k.size, 6))
-    new[:, 0] = np.where(update, hp + kh * nu, hk)
-    new[:, 1] = np.where(update, level[k, 1] + kr * nu, 0.0)
-    new[:, 2] = np.where(update, phh - kh * phh, model.sigma_level ** 2)
-    new[:, 3] = np.where(update, phr - kh * phr, 0.0)
-    new[:, 4] = np.where(update, prr - kr * phr, model.sigma_rate0 ** 2)
-    new[:, 5] = t
+    new = level[k].copy()  # an outlier below the count: the state as it was
+    new[update, 0] = (hp + kh * nu)[update]
+    new[update, 1] = (level[k, 1] + kr * nu)[update]
+    new[update, 2] = (phh - kh * phh)[update]
+    new[update, 3] = (phr - kh * phr)[update]
+    new[update, 4] = (prr - kr * phr)[update]
+    new[update, 5] = t[update]
+    new[start, :6] = np.column_stack((hk, np.zeros(k.size), np.full(k.size, model.sigma_level ** 2),
+                                      np.zeros(k.size), np.full(k.size, model.sigma_rate0 ** 2),
+                                      t))[start]
+    new[:, 6] = np.where(start, 0.0, outliers)
     level[k] = new
     return level, ident
 
@@ -200,5 +216,5 @@ def seed_attributes(model: AttributeModel, attrs: PlotAttributes, plot_t: np.nda
                     plot: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """``(level, ident)`` of new trees started by plots ``plot`` (``-1``: none known)."""
     n = plot.size
-    return grow_attributes(model, np.full((n, 6), np.nan), np.full((n, 2), -1, np.int64),
+    return grow_attributes(model, np.full((n, 7), np.nan), np.full((n, 2), -1, np.int64),
                            attrs, plot_t, plot)

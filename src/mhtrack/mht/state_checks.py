@@ -37,7 +37,7 @@ LEAF_COLUMNS: dict[str, tuple[str, tuple[Any, ...]]] = {
     "tree": ("iu", ()), "track": ("iu", ()), "birth": ("iu", ()), "n_updates": ("iu", ()),
     "window": ("iu", ("w",)), "chosen": ("b", ()), "mu": ("f", ("r",)),
     "xm": ("f", ("r", 4)), "Pm": ("f", ("r", 4, 4)), "node": ("iu", ()),
-    "parent": ("iu", ()), "time": ("f", ()), "level": ("fn", (6,)), "ident": ("iu", (2,)),
+    "parent": ("iu", ()), "time": ("f", ()), "level": ("fn", (7,)), "ident": ("iu", (2,)),
 }
 #: Columns of one logged scan of the tentative history (``history__<i>__<name>``).
 HISTORY_COLUMNS: dict[str, tuple[str, tuple[Any, ...]]] = {

@@ -49,9 +49,10 @@ class Leaves:
     time : (L,) time (s) of the leaf's state ``x, P``: its last plot's own time, or the
         time of the frame that last predicted it (a miss). With synchronous scans every
         leaf's time is the last scan's.
-    level : (L, 6) the vertical state of :mod:`mhtrack.mht.attribute_scores`: flight
-        level ``h`` (FL), climb rate ``ḣ`` (FL/s), covariance ``P_hh, P_hḣ, P_ḣḣ`` and the
-        time (s) they are at; NaN ``h`` when no plot of the branch gave a flight level.
+    level : (L, 7) the vertical state of :mod:`mhtrack.mht.attribute_scores`: flight
+        level ``h`` (FL), climb rate ``ḣ`` (FL/s), covariance ``P_hh, P_hḣ, P_ḣḣ``, the
+        time (s) they are at and the count of validated levels in a row far from it; NaN
+        ``h`` when no plot of the branch gave a flight level.
     ident : (L, 2) the branch's last Mode 3/A code and Mode S address (``-1``: none).
     ``level`` and ``ident`` default to "nothing known" for every leaf.
     """
@@ -140,7 +141,7 @@ class Leaves:
 
 def no_level(n: int) -> np.ndarray:
     """``n`` rows of :attr:`Leaves.level` with nothing known (all NaN)."""
-    return np.full((n, 6), np.nan)
+    return np.full((n, 7), np.nan)
 
 
 #: The store's columns, in order.

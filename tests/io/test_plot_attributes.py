@@ -58,7 +58,7 @@ def test_round_trip(tmp_path: Path, suffix: str, timed: bool) -> None:
     rng = np.random.default_rng(4)
     n = 50
     t = np.sort(rng.uniform(0, 100, n))
-    table = PlotTable(scan=np.arange(n) // 5 if not timed else np.arange(n) // 5,
+    table = PlotTable(scan=np.arange(n) // 5,
                       time=t if timed else (np.arange(n) // 5).astype(float),
                       sensor=np.zeros(n, np.int64), x=rng.normal(size=n),
                       y=rng.normal(size=n), timed=timed, attrs=_attrs(n, rng))

@@ -179,3 +179,31 @@ def test_plots_without_attributes_score_as_before():
     for f in ("track_id", "x", "y", "vx", "vy", "plot", "score"):
         np.testing.assert_array_equal(getattr(a, f), getattr(b, f))
     np.testing.assert_array_equal(la.score, lb.score)
+
+
+def test_save_restore_with_attributes_continues_bit_for_bit(tmp_path):
+    """Vertical states, codes, addresses and the address book are saved with the state."""
+    rng = np.random.default_rng(5)
+    scans = []
+    for k in range(40):
+        z = np.array([[100.0 * k, 0.0], [0.0, 90.0 * k]]) + rng.normal(scale=50, size=(2, 2))
+        attrs = PlotAttributes.from_columns({
+            "flight_level": np.array([300.0 + 0.2 * k, 250.0]),
+            "mode_3a": np.array([0o1234, 0o4321]), "address": np.array([0xA1, 0xB2])}, 2)
+        keep = rng.random(2) < 0.9
+        scans.append(Scan(k, float(k), z[keep], np.zeros(int(keep.sum()), np.int64),
+                          np.arange(2 * k, 2 * k + int(keep.sum())), attrs=attrs.take(keep)))
+    whole = MHTTracker()
+    want = [whole.step(s) for s in scans]
+    first = MHTTracker()
+    for s in scans[:20]:
+        first.step(s)
+    first.save(tmp_path / "state.npz")
+    again = MHTTracker.load(tmp_path / "state.npz")
+    got = [again.step(s) for s in scans[20:]]
+    for a, b in zip(want[20:], got, strict=True):
+        for f in ("track_id", "x", "y", "plot", "score"):
+            np.testing.assert_array_equal(getattr(a, f), getattr(b, f))
+    np.testing.assert_array_equal(whole.leaves.level, again.leaves.level)
+    np.testing.assert_array_equal(whole.leaves.ident, again.leaves.ident)
+    assert np.isfinite(whole.leaves.level[:, 0]).any()

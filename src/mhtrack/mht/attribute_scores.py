@@ -218,3 +218,11 @@ def seed_attributes(model: AttributeModel, attrs: PlotAttributes, plot_t: np.nda
     n = plot.size
     return grow_attributes(model, np.full((n, 7), np.nan), np.full((n, 2), -1, np.int64),
                            attrs, plot_t, plot)
+
+
+def positions(rows: np.ndarray, wanted: np.ndarray) -> np.ndarray:
+    """The index in ``rows`` (a frame's plot row ids, not empty) of each of ``wanted``
+    (a new tree's last plot), ``-1`` where it is not there."""
+    order = np.argsort(rows, kind="stable")
+    j = order[np.minimum(np.searchsorted(rows, wanted, sorter=order), rows.size - 1)]
+    return np.where((wanted >= 0) & (rows[j] == wanted), j, -1)

@@ -56,6 +56,7 @@ from mhtrack.mht.attribute_scores import (
     AttributeModel,
     grow_attributes,
     pair_increments,
+    positions,
     seed_attributes,
 )
 from mhtrack.mht.births import Birth, default_birth
@@ -222,14 +223,8 @@ class MHTTracker:
         level, ident = grow_attributes(self.attributes, grown.level, grown.ident, attrs,
                                        t, plot)
         grown = replace(grown, level=level, ident=ident)
-        if len(births):
-            rows = frame.rows
-            order = np.argsort(rows, kind="stable")
-            last = births.window[:, -1]
-            pos = np.minimum(np.searchsorted(rows, last, sorter=order), rows.size - 1)
-            j = order[pos] if rows.size else np.zeros(0, np.int64)
-            j = np.where((last >= 0) & (rows[j] == last), j, -1) if rows.size else \
-                np.full(len(births), -1, np.int64)
+        if len(births) and frame.rows.size:
+            j = positions(frame.rows, births.window[:, -1])
             level, ident = seed_attributes(self.attributes, attrs, t, j)
             births = replace(births, level=level, ident=ident)
         return grown, births

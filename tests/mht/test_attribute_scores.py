@@ -207,3 +207,35 @@ def test_save_restore_with_attributes_continues_bit_for_bit(tmp_path):
     np.testing.assert_array_equal(whole.leaves.level, again.leaves.level)
     np.testing.assert_array_equal(whole.leaves.ident, again.leaves.ident)
     assert np.isfinite(whole.leaves.level[:, 0]).any()
+
+
+def test_a_mode_s_address_is_evidence_against_clutter_by_hand():
+    from mhtrack.mht.attribute_scores import reply_terms
+
+    attrs = PlotAttributes.from_columns({"address": np.array([0xA1, -1, 0xA2])}, 3)
+    kappa, lam = np.array([1e-9, 1e-9, 1e-13]), 1.8e-11
+    got = reply_terms(M, attrs, kappa, lam)
+    # p_S = 0.9, f_S = 1e-3: 0.9 (κ + λ) / (κ f_S + λ p_S)
+    assert got[0] == pytest.approx(math.log(0.9 * (1e-9 + lam) / (1e-12 + lam * 0.9)))
+    assert got[0] > 3.9  # dense clutter: a reply is strong evidence of a target
+    assert got[1] == 0.0  # no address: a position only
+    assert abs(got[2]) < 0.01  # κ ≪ λ_v: clutter is no explanation anyway
+
+
+def test_a_mode_s_track_confirms_no_later():
+    """With addresses the same two aircraft's tracks are confirmed no later (online)."""
+    def first_rows(attrs_on):
+        rng = np.random.default_rng(2)
+        trk, first = MHTTracker(), {}
+        for k in range(12):
+            z = np.array([[100.0 * k, 0.0], [0.0, 2000.0 + 90 * k]]) + rng.normal(
+                scale=50, size=(2, 2))
+            a = PlotAttributes.from_columns({"address": np.array([0xA1, 0xB2])}, 2) \
+                if attrs_on else None
+            out = trk.step(Scan(k, float(k), z, np.zeros(2, np.int64),
+                                np.arange(2 * k, 2 * k + 2), attrs=a))
+            for p in out.plot[out.plot >= 0].tolist():
+                first.setdefault(p % 2, k)
+        return first
+    off, on = first_rows(False), first_rows(True)
+    assert set(on) == {0, 1} and all(on[i] <= off.get(i, 99) for i in on)

@@ -22,6 +22,14 @@ of a plot without attributes is exactly P1's):
 * **Mode 3/A code** ``c`` against the track's last validated code ``C``: the same form
   with ``ε_A`` (a code change or error) and ``q_A``; a code flagged garbled or not
   validated (I048/070 G, V) uses the larger ``ε_A,g``.
+* **A Mode S address at all** (a reply, on an update and on a new tree's first plot
+  alike): P1's reference explains a plot as clutter (density ``κ̂``) or a new target
+  (``λ_v``), and clutter rarely carries an address, so ``λ = p_S (κ̂ + λ_v) /
+  (κ̂ f_S + λ_v p_S)`` with ``p_S`` a target's plot carrying its address, ``f_S`` a false
+  plot carrying one (:func:`reply_terms`). In clutter (``κ̂ ≫ λ_v``) it approaches
+  ``p_S / f_S``; where ``κ̂ ≪ λ_v`` it is 1. A plot *without* an address is scored as a
+  position only (no ratio ``(1 − p_S)/(1 − f_S)``): aircraft without Mode S, and
+  primary-only plots, must stay trackable (our approximation).
 * **Flight level** ``h`` against the track's vertical state (below): a Gaussian with an
   outlier floor, ``λ = (1 − ε_C) N(h; ĥ, S) W + ε_C``, where ``W`` (FL) is the span of
   the levels an unrelated plot may have (density ``1/W``) and ``ε_C`` the probability of
@@ -90,13 +98,18 @@ class AttributeModel:
     reset_sigmas: float = 5.0
     #: Outliers in a row that restart the vertical state at the last one.
     reset_after: int = 3
+    #: p_S: a target's plot carries its Mode S address (a Mode S aircraft's reply).
+    address_reply: float = 0.9
+    #: f_S: a false plot carries a Mode S address (fruit that passes the parity check).
+    address_fruit: float = 1e-3
     #: A new track on the address of a track that ended at most this long ago (s) takes
     #: its id (:mod:`mhtrack.mht.resume`; the OpenSky data's longest gap is 660 s).
     resume_s: float = 900.0
 
     def __post_init__(self) -> None:
         for name in ("address_error", "address_share", "code_error", "code_error_garbled",
-                     "code_share", "level_error", "level_error_garbled"):
+                     "code_share", "level_error", "level_error_garbled", "address_reply",
+                     "address_fruit"):
             v = getattr(self, name)
             if not 0.0 < v < 1.0:
                 raise ValueError(f"AttributeModel.{name}: must be in (0, 1), got {v!r}")
@@ -226,3 +239,13 @@ def positions(rows: np.ndarray, wanted: np.ndarray) -> np.ndarray:
     order = np.argsort(rows, kind="stable")
     j = order[np.minimum(np.searchsorted(rows, wanted, sorter=order), rows.size - 1)]
     return np.where((wanted >= 0) & (rows[j] == wanted), j, -1)
+
+
+def reply_terms(model: AttributeModel, attrs: PlotAttributes, kappa: np.ndarray,
+                new_target_density: float) -> np.ndarray:
+    """Per plot, ``ln[p_S (κ̂ + λ_v) / (κ̂ f_S + λ_v p_S)]`` for a plot with a Mode S
+    address, 0 for the others (module docstring)."""
+    p, f = model.address_reply, model.address_fruit
+    lam = new_target_density
+    k = np.broadcast_to(np.asarray(kappa, float), attrs.address.shape)
+    return np.where(attrs.address >= 0, np.log(p * (k + lam)) - np.log(k * f + lam * p), 0.0)

@@ -57,6 +57,7 @@ from mhtrack.mht.attribute_scores import (
     grow_attributes,
     pair_increments,
     positions,
+    reply_terms,
     seed_attributes,
 )
 from mhtrack.mht.births import Birth, default_birth
@@ -165,11 +166,17 @@ class MHTTracker:
                                      self.config.new_target_density, gated.plot)
         attrs = scan.attrs if scan.attrs is not None and scan.attrs.any() else None
         if attrs is not None:
-            update_dl = update_dl + pair_increments(
+            reply = reply_terms(self.attributes, attrs, kappa,
+                                self.config.new_target_density)
+            update_dl = update_dl + reply[gated.plot] + pair_increments(
                 self.attributes, leaves.level, leaves.ident, attrs, scan.plot_times(),
                 gated.track, gated.plot)
         children = propose_children(leaves, gated, self._miss(looks), update_dl)
         cand = self.birth.propose(f, kappa, in_gates)
+        if attrs is not None and len(cand) and f.rows.size:
+            gain = np.where((j := positions(f.rows, cand.window[:, -1])) >= 0,
+                            reply[j], 0.0)
+            cand = replace(cand, score=cand.score + gain, peak=cand.peak + gain)
         children = prune_children(f, leaves, children, self.sprt,
                                   n_births=len(cand) + len(idle))
         grown = grow_children(f, leaves, pred, children, motion=self.motion,

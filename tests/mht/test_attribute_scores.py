@@ -239,3 +239,24 @@ def test_a_mode_s_track_confirms_no_later():
         return first
     off, on = first_rows(False), first_rows(True)
     assert set(on) == {0, 1} and all(on[i] <= off.get(i, 99) for i in on)
+
+
+def test_one_mode_s_plot_may_confirm_on_the_sprt_threshold():
+    import dataclasses
+
+    from mhtrack.mht.config import MHTConfig
+    from mhtrack.mht.sprt import SPRT
+    from mhtrack.mht.tree import Leaves
+
+    sprt = SPRT.from_config(MHTConfig())
+    n = 4
+    lv = Leaves(np.zeros((n, 4)), np.tile(np.eye(4), (n, 1, 1)),
+                np.array([sprt.confirm_threshold + 0.1] * 3 + [sprt.confirm_threshold - 0.1]),
+                np.zeros(n), np.arange(n), np.full(n, -1), np.zeros(n, np.int64),
+                np.array([1, 1, 2, 1]), np.full((n, 4), -1), np.ones(n, bool),
+                np.zeros((n, 0)), np.zeros((n, 0, 4)), np.zeros((n, 0, 4, 4)),
+                np.arange(n), np.full(n, -1), np.zeros(n))
+    lv = dataclasses.replace(lv, ident=np.array([[-1, 0xA1], [-1, -1], [-1, -1], [-1, 0xA2]]))
+    # one plot with an address and a score on the threshold: confirmed; one plot without
+    # an address: not (confirm_min_plots = 2); two plots: as before; below: never
+    assert sprt.confirms(lv).tolist() == [True, False, True, False]

@@ -40,7 +40,21 @@ class AddressBook:
         self.track, self.address, self.time = track[keep], address[first][keep], \
             when[first][keep]
 
-    def resume(self, leaves: Leaves, confirms: np.ndarray) -> tuple[Leaves, np.ndarray]:
+    @staticmethod
+    def one_per_address(leaves: Leaves, confirms: np.ndarray) -> np.ndarray:
+        """``confirms`` without the tentative trees whose address a confirmed track of
+        the best hypothesis carries: one confirmed track per Mode S address (the
+        tentative tree may still take the id over when that track ends)."""
+        on_air = leaves.chosen & (leaves.track >= 0) & (leaves.ident[:, 1] >= 0)
+        if not on_air.any():
+            return confirms
+        taken = np.unique(leaves.ident[on_air, 1])
+        clash = (leaves.track < 0) & (leaves.ident[:, 1] >= 0) & \
+            np.isin(leaves.ident[:, 1], taken)
+        return confirms & ~clash
+
+    def resume(self, leaves: Leaves, confirms: np.ndarray
+               ) -> tuple[Leaves, np.ndarray, np.ndarray]:
         """The tentative trees whose chosen leaf ``confirms`` (mask) and whose address an
         ended track (no leaf carries its id) had take that id — the most recently seen
         first, each id once, trees in order — before the others are numbered; returns

@@ -39,6 +39,10 @@ LEAF_COLUMNS: dict[str, tuple[str, tuple[Any, ...]]] = {
     "xm": ("f", ("r", 4)), "Pm": ("f", ("r", 4, 4)), "node": ("iu", ()),
     "parent": ("iu", ()), "time": ("f", ()), "level": ("fn", (7,)), "ident": ("iu", (2,)),
 }
+#: Columns of the address book (``addresses__<name>``, :mod:`mhtrack.mht.resume`).
+ADDRESS_COLUMNS: dict[str, tuple[str, tuple[Any, ...]]] = {
+    "track": ("iu", ()), "address": ("iu", ()), "time": ("f", ()),
+}
 #: Columns of one logged scan of the tentative history (``history__<i>__<name>``).
 HISTORY_COLUMNS: dict[str, tuple[str, tuple[Any, ...]]] = {
     "node": ("iu", ()), "parent": ("iu", ()), "x": ("f", (4,)), "P": ("f", (4, 4)),
@@ -249,6 +253,12 @@ def check_arrays(path: PathArg, arrays: Mapping[str, np.ndarray], meta: Mapping[
             raise c.fail(f"leaves__{name}", "must be >= 0")
     if leaves["window"].size and leaves["window"].min() < -1:
         raise c.fail("leaves__window", "plot rows must be >= -1")
+    if any(k.startswith("addresses__") for k in arrays):  # mht/resume.AddressBook
+        book = c.part("addresses__", ADDRESS_COLUMNS, {})
+        v = book["track"]
+        if v.size and (v.min() < 0 or v.max() >= meta["next_track"]):
+            raise c.fail("addresses__track", f"ids must be in [0, {meta['next_track']}) "
+                         f"(the saved next_track), got {v.min()} to {v.max()}")
     if "history__count" not in arrays:
         return
     count = c.column("history__count", "iu", (1,))

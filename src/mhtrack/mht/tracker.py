@@ -265,7 +265,7 @@ class MHTTracker:
         assert frame.previous is not None
         first_new = self.tracks.next
         leaves = hand_over(leaves, frame.previous, by_id=self.coverage.per_tree_looks)
-        confirms = self.sprt.confirms(leaves)
+        confirms = self._book.one_per_address(leaves, self.sprt.confirms(leaves))
         leaves, resumed, last = self._book.resume(leaves, confirms)
         leaves = confirm(leaves, confirms, self.tracks)
         new = newly_confirmed(leaves, first_new)

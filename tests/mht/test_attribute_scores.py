@@ -260,3 +260,22 @@ def test_one_mode_s_plot_may_confirm_on_the_sprt_threshold():
     # one plot with an address and a score on the threshold: confirmed; one plot without
     # an address: not (confirm_min_plots = 2); two plots: as before; below: never
     assert sprt.confirms(lv).tolist() == [True, False, True, False]
+
+
+def test_one_confirmed_track_per_address():
+    import dataclasses
+
+    from mhtrack.mht.resume import AddressBook
+    from mhtrack.mht.tree import Leaves
+
+    n = 4
+    lv = Leaves(np.zeros((n, 4)), np.tile(np.eye(4), (n, 1, 1)), np.ones(n), np.ones(n),
+                np.arange(n), np.array([7, -1, -1, -1]), np.zeros(n, np.int64),
+                np.full(n, 2), np.full((n, 4), -1), np.ones(n, bool), np.zeros((n, 0)),
+                np.zeros((n, 0, 4)), np.zeros((n, 0, 4, 4)), np.arange(n), np.full(n, -1),
+                np.zeros(n))
+    lv = dataclasses.replace(lv, ident=np.array([[-1, 0xA1], [-1, 0xA1], [-1, 0xB2],
+                                                 [-1, -1]]))
+    # track 7 carries 0xA1: the tentative tree on 0xA1 waits; the others confirm
+    got = AddressBook.one_per_address(lv, np.ones(n, bool))
+    assert got.tolist() == [True, False, True, True]

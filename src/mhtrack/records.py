@@ -26,6 +26,8 @@ from typing import Any
 
 import numpy as np
 
+from mhtrack.attributes import PlotAttributes
+
 CLUTTER = -1
 NO_PLOT = -1
 #: Largest ``|coordinate|`` (m) of the local frame that plots, sensors, regions and target
@@ -70,6 +72,8 @@ class Scan:
     t : (n,) each plot's own time (s) for asynchronous data (a frame of a rotating radar);
         ``None`` when every plot has the scan's ``time`` (synchronous scans). With ``t``,
         ``time`` is the frame's reference time, the latest plot time.
+    attrs : what each plot says besides its position (:class:`~mhtrack.attributes.
+        PlotAttributes`: code, flight level, address, ...); ``None`` when nothing.
     """
 
     index: int
@@ -80,6 +84,7 @@ class Scan:
     R: np.ndarray | None = None
     origin: np.ndarray | None = None
     t: np.ndarray | None = None
+    attrs: PlotAttributes | None = None
 
     def plot_times(self) -> np.ndarray:
         """(n,) the time of each plot: ``t``, or the scan's ``time`` for every plot."""
@@ -119,6 +124,8 @@ class PlotTable:
     (a timed file is re-sorted on reading); ``None`` when the rows are in file order.
     Tracks refer to the table's rows (``Scan.rows``); writers translate them to file rows.
     ``iso_times``: the file's times were ISO-8601 text or timestamps (kept as POSIX seconds).
+    ``attrs``: the plots' attributes (:class:`~mhtrack.attributes.PlotAttributes`), or
+    ``None`` when the plots are positions only.
     """
 
     scan: np.ndarray
@@ -136,11 +143,12 @@ class PlotTable:
     #: The file gave ISO-8601 (or timestamp) times, read as POSIX seconds: outputs made
     #: from these plots write their times as ISO-8601 too (docs/file-formats.md).
     iso_times: bool = field(default=False, repr=False)
+    attrs: PlotAttributes | None = field(default=None, repr=False)
 
     def __post_init__(self) -> None:
         n = len(self.scan)
         for name in ("time", "sensor", "x", "y", "range", "bearing", "origin", "R",
-                     "file_row"):
+                     "file_row", "attrs"):
             v = getattr(self, name)
             if v is not None and len(v) != n:
                 raise ValueError(f"PlotTable column {name!r} has {len(v)} rows, expected {n}")
@@ -190,6 +198,7 @@ class PlotTable:
                 R=None if self.R is None else self.R[s],
                 origin=None if self.origin is None else self.origin[s],
                 t=self.time[s] if self.timed else None,
+                attrs=None if self.attrs is None else self.attrs.take(s),
             )
 
     @classmethod
@@ -202,6 +211,10 @@ class PlotTable:
         z = np.concatenate([s.z for s in scans]).reshape(-1, 2)
         has_r = any(s.R is not None for s in scans)
         has_o = all(s.origin is not None for s in scans)
+        attrs = None
+        if any(s.attrs is not None for s in scans):
+            attrs = PlotAttributes.concat([s.attrs if s.attrs is not None else
+                                           PlotAttributes.absent(len(s)) for s in scans])
         return cls(
             scan=_i8(np.repeat([s.index for s in scans], n)),
             time=_f8(np.repeat([s.time for s in scans], n)),
@@ -215,6 +228,7 @@ class PlotTable:
             if has_r
             else None,
             scan_times=(_i8([s.index for s in scans]), _f8([s.time for s in scans])),
+            attrs=attrs,
         )
 
 

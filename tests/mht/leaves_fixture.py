@@ -15,7 +15,8 @@ def random_leaves(rng, n, tree=None, r=2, width=4):
     return Leaves(rng.normal(size=(n, 4)), rng.normal(size=(n, 4, 4)), f, f + 1, tree, i,
                   i + 1, i + 2, rng.integers(-1, 99, (n, width)), rng.random(n) < 0.5,
                   rng.random((n, r)), rng.normal(size=(n, r, 4)),
-                  rng.normal(size=(n, r, 4, 4)), i + 3, i + 4, f + 2)
+                  rng.normal(size=(n, r, 4, 4)), i + 3, i + 4, f + 2,
+                  rng.normal(size=(n, 7)), rng.integers(-1, 1 << 24, (n, 2)))
 
 
 def leaves_of_trees(rng, n, trees):

@@ -24,6 +24,8 @@ from mhtrack.io._frame import (
     write_frame,
 )
 from mhtrack.io._source import PathArg, Source
+from mhtrack.io.plot_attributes import KINDS as ATTRIBUTE_KINDS
+from mhtrack.io.plot_attributes import attribute_columns, read_attributes
 from mhtrack.io.timed_plots import DEFAULT_REORDER_WINDOW_S, read_timed_plots
 from mhtrack.models.linalg2 import det2
 from mhtrack.models.radars import SensorSet
@@ -40,6 +42,7 @@ COLUMNS = {
     "range": FLOAT,
     "bearing": FLOAT,
     "origin": INT,
+    **ATTRIBUTE_KINDS,
 }
 
 SensorRegistry = Mapping[int, CartesianSensor | PolarRadar]
@@ -140,7 +143,7 @@ def read_plots(
         )
     return PlotTable(
         scan=scan, time=time, sensor=sensor, x=x, y=y,
-        range=rng, bearing=bearing, origin=origin, R=R,
+        range=rng, bearing=bearing, origin=origin, R=R, attrs=read_attributes(f),
     )  # fmt: skip
 
 
@@ -325,7 +328,8 @@ def plots_to_table_rows(plot: np.ndarray, table: PlotTable) -> np.ndarray:
 
 def write_plots(table: PlotTable, path: PathArg) -> None:
     """Write ``table`` to a ``.csv`` or ``.parquet`` file (``R`` and ``scan_times`` are not
-    stored; NaN ``range``/``bearing`` are written as empty cells / nulls).
+    stored; NaN ``range``/``bearing`` are written as empty cells / nulls; the plots'
+    attributes, when any, as :mod:`~mhtrack.io.plot_attributes` columns after them).
 
     A timed table (``table.timed``) is written without ``scan`` — ``time, sensor`` [,
     ``range, bearing``], ``x, y`` (left out when every plot is polar: the reader converts
@@ -351,4 +355,6 @@ def write_plots(table: PlotTable, path: PathArg) -> None:
         cols["bearing"] = float_array(table.bearing, nan_as_null=True)
     if table.origin is not None:
         cols["origin"] = int_array(table.origin[order])
+    if table.attrs is not None:
+        cols.update(attribute_columns(table.attrs, order))
     write_frame(path, cols)

@@ -17,11 +17,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from mhtrack.attributes import PlotAttributes
 from mhtrack.frames import frame_lengths, make_frames
 from mhtrack.io._checks import num
 from mhtrack.io._frame import FLOAT, INT, TIME, Frame, read_frame
 from mhtrack.io._source import PathArg
 from mhtrack.io._times import is_iso, seconds
+from mhtrack.io.plot_attributes import KINDS as ATTRIBUTE_KINDS
+from mhtrack.io.plot_attributes import read_attributes
 from mhtrack.models.radars import RadarSensor, SensorSet
 from mhtrack.records import MAX_COORDINATE, PlotTable
 
@@ -34,7 +37,8 @@ MAX_RANGE_M = 2e7
 
 REQUIRED = ("time", "sensor")
 COLUMNS = {"time": TIME, "sensor": INT, "range": FLOAT, "bearing": FLOAT, "x": FLOAT,
-           "y": FLOAT, "lat": FLOAT, "lon": FLOAT, "sigma": FLOAT, "origin": INT}
+           "y": FLOAT, "lat": FLOAT, "lon": FLOAT, "sigma": FLOAT, "origin": INT,
+           **ATTRIBUTE_KINDS}
 #: Position column pairs, in the order a row's position is taken from them.
 PAIRS = (("range", "bearing"), ("x", "y"), ("lat", "lon"))
 _NEEDS_SENSORS = "read them with a sensors file (mhtrack track --sensors FILE)"
@@ -72,6 +76,7 @@ def read_timed_plots(
         scan=frame[order], time=c.time[order], sensor=c.sensor[order], x=take(c.x),
         y=take(c.y), range=take(c.range), bearing=take(c.bearing), origin=take(c.origin),
         R=take(c.R), timed=True, file_row=order.astype(np.int64), iso_times=is_iso(f),
+        attrs=None if c.attrs is None else c.attrs.take(order),
     )  # type: ignore[arg-type]
 
 
@@ -88,6 +93,7 @@ class TimedColumns:
     bearing: np.ndarray | None
     origin: np.ndarray | None
     R: np.ndarray | None
+    attrs: PlotAttributes | None = None
 
 
 def read_timed_columns(
@@ -120,7 +126,7 @@ def read_timed_columns(
         f.check(np.abs(v) > MAX_COORDINATE, name if f.has(name) else None,
                 lambda r, v=v, name=name: f"{name} = {num(v[r])} m is beyond "
                 f"±{MAX_COORDINATE:g} m of the frame's origin (a unit or parsing error?)")
-    return f, TimedColumns(time, sensor, x, y, rng, bearing, origin, R)
+    return f, TimedColumns(time, sensor, x, y, rng, bearing, origin, R, read_attributes(f))
 
 
 def polar_plots(sensors: SensorSet, sensor_id: int, rng: np.ndarray, bearing: np.ndarray

@@ -117,4 +117,6 @@ def grow_children(frame: FrameContext, leaves: Leaves, pred: States, children: C
         node=np.full(len(par), -1, np.int64),
         parent=leaves.node[par],
         time=child_time,
+        level=leaves.level.take(par, axis=0),
+        ident=leaves.ident.take(par, axis=0),
     )

@@ -83,10 +83,15 @@ class SPRT:
     def confirms(self, leaves: Leaves) -> np.ndarray:
         """Leaves whose tree the rule would confirm: ``L ≥ ln((1−β)/α)``, or plots in at
         least ``confirm_hits`` of the window's ``N + 1`` scans with
-        ``L > confirm_min_score``; in both cases at least ``confirm_min_plots`` plots."""
-        confirm = leaves.score >= self.confirm_threshold
+        ``L > confirm_min_score``; in both cases at least ``confirm_min_plots`` plots — or,
+        on the SPRT's threshold, one plot with a Mode S address (its score then holds the
+        address's evidence against clutter, :func:`~mhtrack.mht.attribute_scores.
+        reply_terms`; issue 29 item 3)."""
+        sprt = leaves.score >= self.confirm_threshold
+        confirm = sprt
         if self.confirm_hits > 0:
             hits = (leaves.window >= 0).sum(axis=1)
-            confirm |= (hits >= self.confirm_hits) & (leaves.score > self.confirm_min_score)
-        confirm &= leaves.n_updates >= self.confirm_min_plots
-        return confirm
+            confirm = confirm | ((hits >= self.confirm_hits)
+                                 & (leaves.score > self.confirm_min_score))
+        enough = leaves.n_updates >= self.confirm_min_plots
+        return confirm & enough | sprt & (leaves.ident[:, 1] >= 0)

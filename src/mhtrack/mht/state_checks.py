@@ -37,7 +37,11 @@ LEAF_COLUMNS: dict[str, tuple[str, tuple[Any, ...]]] = {
     "tree": ("iu", ()), "track": ("iu", ()), "birth": ("iu", ()), "n_updates": ("iu", ()),
     "window": ("iu", ("w",)), "chosen": ("b", ()), "mu": ("f", ("r",)),
     "xm": ("f", ("r", 4)), "Pm": ("f", ("r", 4, 4)), "node": ("iu", ()),
-    "parent": ("iu", ()), "time": ("f", ()),
+    "parent": ("iu", ()), "time": ("f", ()), "level": ("fn", (7,)), "ident": ("iu", (2,)),
+}
+#: Columns of the address book (``addresses__<name>``, :mod:`mhtrack.mht.resume`).
+ADDRESS_COLUMNS: dict[str, tuple[str, tuple[Any, ...]]] = {
+    "track": ("iu", ()), "address": ("iu", ()), "time": ("f", ()),
 }
 #: Columns of one logged scan of the tentative history (``history__<i>__<name>``).
 HISTORY_COLUMNS: dict[str, tuple[str, tuple[Any, ...]]] = {
@@ -58,7 +62,7 @@ class _Checker:
 
     def column(self, member: str, kinds: str, shape: tuple[int, ...]) -> np.ndarray:
         """The array ``member``: present, of a dtype kind in ``kinds`` and shape ``shape``
-        (``-1`` = any length), floats finite."""
+        (``-1`` = any length), floats finite (kinds ``"fn"``: NaN allowed, as "none")."""
         if member not in self.arrays:
             raise self.fail(member, "missing")
         a = self.arrays[member]
@@ -70,7 +74,7 @@ class _Checker:
             want_shape = "(" + ", ".join("n" if s == -1 else str(s) for s in shape) + ")"
             raise self.fail(member, f"has shape {a.shape}, expected {want_shape}")
         if a.dtype.kind == "f":
-            bad = ~np.isfinite(a)
+            bad = np.isinf(a) if "n" in kinds else ~np.isfinite(a)
             if bad.any():
                 i = np.argwhere(bad)[0]
                 raise self.fail(member, f"value {a[tuple(i)].item()!r} at index "
@@ -220,7 +224,8 @@ def check_arrays(path: PathArg, arrays: Mapping[str, np.ndarray], meta: Mapping[
                  n_scan: int) -> None:
     """The leaf and history arrays (module docstring)."""
     c = _Checker(path, arrays)
-    leaves = c.part("leaves__", LEAF_COLUMNS, {"w": n_scan + 1})
+    leaves = c.part("leaves__", LEAF_COLUMNS, {"w": n_scan + 1},
+                    optional=("level", "ident"))
     c.covariances("leaves__P", leaves["P"])
     if leaves["Pm"].size:
         c.covariances("leaves__Pm", leaves["Pm"])
@@ -248,6 +253,12 @@ def check_arrays(path: PathArg, arrays: Mapping[str, np.ndarray], meta: Mapping[
             raise c.fail(f"leaves__{name}", "must be >= 0")
     if leaves["window"].size and leaves["window"].min() < -1:
         raise c.fail("leaves__window", "plot rows must be >= -1")
+    if any(k.startswith("addresses__") for k in arrays):  # mht/resume.AddressBook
+        book = c.part("addresses__", ADDRESS_COLUMNS, {})
+        v = book["track"]
+        if v.size and (v.min() < 0 or v.max() >= meta["next_track"]):
+            raise c.fail("addresses__track", f"ids must be in [0, {meta['next_track']}) "
+                         f"(the saved next_track), got {v.min()} to {v.max()}")
     if "history__count" not in arrays:
         return
     count = c.column("history__count", "iu", (1,))

@@ -43,13 +43,23 @@ from __future__ import annotations
 
 import time
 from collections.abc import Iterable
+from dataclasses import replace
 from os import PathLike
 from typing import Any
 
 import numpy as np
 
+from mhtrack.attributes import PlotAttributes
 from mhtrack.clutter.base import ClutterEstimator
 from mhtrack.clutter.known import KnownClutter
+from mhtrack.mht.attribute_scores import (
+    AttributeModel,
+    grow_attributes,
+    pair_increments,
+    positions,
+    reply_terms,
+    seed_attributes,
+)
 from mhtrack.mht.births import Birth, default_birth
 from mhtrack.mht.caps import CapWarnings
 from mhtrack.mht.config import MHTConfig
@@ -65,6 +75,7 @@ from mhtrack.mht.numbering import Counter, number_and_merge
 from mhtrack.mht.predict import predict_leaves
 from mhtrack.mht.pruning import prune_after_solve, prune_children, removed_after_solve
 from mhtrack.mht.report import StepStats, confirmed_windows, report
+from mhtrack.mht.resume import AddressBook
 from mhtrack.mht.scoring import miss_increment, miss_increments, update_increment
 from mhtrack.mht.sprt import SPRT
 from mhtrack.mht.state import load_state, located, save_state
@@ -91,6 +102,9 @@ class MHTTracker:
     coverage : the sensors' coverage (:mod:`mhtrack.mht.coverage`); default
         :class:`~mhtrack.mht.coverage.Everywhere` with ``config.p_detection`` (every leaf
         looked at every scan: P1's scans).
+    attributes : the likelihood ratios of plots' codes, addresses and flight levels
+        (:mod:`mhtrack.mht.attribute_scores`); default :class:`AttributeModel`'s. Plots
+        without attributes are scored by position alone, as in P1.
 
     Examples
     --------
@@ -102,8 +116,9 @@ class MHTTracker:
     def __init__(
         self, config: MHTConfig | None = None, clutter: ClutterEstimator | None = None, *,
         motion: MotionModel | None = None, birth: Birth | None = None,
-        coverage: Coverage | None = None,
+        coverage: Coverage | None = None, attributes: AttributeModel | None = None,
     ) -> None:
+        self.attributes = AttributeModel() if attributes is None else attributes
         self.config = cfg = MHTConfig() if config is None else config
         self.clutter: ClutterEstimator = KnownClutter() if clutter is None else clutter
         self.motion: MotionModel = cfg.motion if motion is None else motion
@@ -124,6 +139,7 @@ class MHTTracker:
         self.trees, self.tracks, self.nodes = Counter(), Counter(), Counter()
         self._history = TentativeHistory(cfg.history_scans)
         self._cap_warnings = CapWarnings()
+        self._book = AddressBook(self.attributes.resume_s)
         self.last_stats: StepStats | None = None
         #: The clutter intensity κ̂ (per m² per scan, floored) the last :meth:`step` scored
         #: each of its plots with (kept for the pipeline's DEBUG line, not recomputed).
@@ -157,13 +173,26 @@ class MHTTracker:
         self.last_kappa = kappa
         update_dl = update_increment(gated.loglik, kappa, self.coverage.plot_pd(scan),
                                      self.config.new_target_density, gated.plot)
+        attrs = scan.attrs if scan.attrs is not None and scan.attrs.any() else None
+        if attrs is not None:
+            reply = reply_terms(self.attributes, attrs, kappa,
+                                self.config.new_target_density)
+            update_dl = update_dl + reply[gated.plot] + pair_increments(
+                self.attributes, leaves.level, leaves.ident, attrs, scan.plot_times(),
+                gated.track, gated.plot)
         children = propose_children(leaves, gated, self._miss(looks), update_dl)
         cand = self.birth.propose(f, kappa, in_gates)
+        if attrs is not None and len(cand) and f.rows.size:
+            gain = np.where((j := positions(f.rows, cand.window[:, -1])) >= 0,
+                            reply[j], 0.0)
+            cand = replace(cand, score=cand.score + gain, peak=cand.peak + gain)
         children = prune_children(f, leaves, children, self.sprt,
                                   n_births=len(cand) + len(idle))
         grown = grow_children(f, leaves, pred, children, motion=self.motion,
                               pair_pred=pair_pred, posterior=gated.posterior)
         births = self.birth.seed(f, cand, grown.window, self.trees)
+        if attrs is not None:
+            grown, births = self._attributes(f, attrs, grown, births, children.plot)
         leaves, parts, first_node = self._number(grown, births, idle)
         hyp = self._hypothesis(f, leaves)
         leaves = prune_after_solve(f, leaves, hyp.leaves, by_id=self.coverage.per_tree_looks,
@@ -201,6 +230,21 @@ class MHTTracker:
             return miss_increment(looks.uniform, self._miss_pg)
         return miss_increments(looks.miss_pd, self._miss_pg)
 
+    def _attributes(self, frame: FrameContext, attrs: PlotAttributes, grown: Leaves,
+                    births: Leaves, plot: np.ndarray) -> tuple[Leaves, Leaves]:
+        """The grown leaves' and new trees' vertical states, codes and addresses
+        (:mod:`mhtrack.mht.attribute_scores`): children from their plots (``plot``, ``-1``
+        a miss), new trees from the plot of the frame they start with."""
+        t = frame.scan.plot_times()
+        level, ident = grow_attributes(self.attributes, grown.level, grown.ident, attrs,
+                                       t, plot)
+        grown = replace(grown, level=level, ident=ident)
+        if len(births) and frame.rows.size:
+            j = positions(frame.rows, births.window[:, -1])
+            level, ident = seed_attributes(self.attributes, attrs, t, j)
+            births = replace(births, level=level, ident=ident)
+        return grown, births
+
     def _number(self, grown: Leaves, births: Leaves, idle: Leaves
                 ) -> tuple[Leaves, tuple[Leaves, Leaves] | None, int]:
         """Node ids for the new leaves (the history's links) and the idle trees merged
@@ -230,8 +274,20 @@ class MHTTracker:
         assert frame.previous is not None
         first_new = self.tracks.next
         leaves = hand_over(leaves, frame.previous, by_id=self.coverage.per_tree_looks)
-        leaves = confirm(leaves, self.sprt.confirms(leaves), self.tracks)
-        self.last_backfill = self._history.backfill(leaves, newly_confirmed(leaves, first_new))
+        confirms = self._book.one_per_address(leaves, self.sprt.confirms(leaves))
+        leaves, resumed, last = self._book.resume(leaves, confirms)
+        leaves = confirm(leaves, confirms, self.tracks)
+        new = newly_confirmed(leaves, first_new)
+        if resumed.size:
+            new = (leaves.chosen & ((leaves.track >= first_new)
+                                    | contains(resumed, leaves.track))).nonzero()[0]
+        back = self._history.backfill(leaves, new)
+        if resumed.size and len(back):  # a resumed id's past: only after its last report
+            k = np.searchsorted(resumed, back.track_id, sorter=np.argsort(resumed))
+            k = np.argsort(resumed)[np.minimum(k, resumed.size - 1)]
+            old = (resumed[k] == back.track_id) & (back.time <= last[k])
+            back = back.take(~old)
+        self.last_backfill = back
         return leaves
 
     def _report(self, frame: FrameContext, leaves: Leaves,
@@ -242,6 +298,7 @@ class MHTTracker:
         ``None``: all)."""
         rep = leaves.reported()
         self._history.record(frame.index, frame.time, leaves, stepped, rep)
+        self._book.record(leaves, rep, frame.time)
         self._forget(leaves, frame.rows, rep)
         self._leaves, self._last_time, self._last_index = leaves, frame.time, frame.index
         return report(frame.scan, leaves, stepped, rep)
@@ -280,7 +337,8 @@ class MHTTracker:
         ``extra``: the caller's JSON-able bookkeeping, saved with it (``meta["extra"]``,
         e.g. a live run's frame number and time axis)."""
         parts = {"leaves": self._leaves.arrays(), "birth": self.birth.arrays(),
-                 "history": self._history.arrays(), "coverage": self.coverage.arrays()}
+                 "history": self._history.arrays(), "coverage": self.coverage.arrays(),
+                 "addresses": self._book.arrays()}
         save_state(path, parts, self.clutter, self.config, {
             "last_time": self._last_time, "last_index": self._last_index,
             "next_tree": self.trees.next, "next_track": self.tracks.next,
@@ -310,7 +368,7 @@ class MHTTracker:
         trk.trees, trk.tracks = Counter(meta["next_tree"]), Counter(meta["next_track"])
         trk.nodes = Counter(meta["next_node"])
         for part, owner in (("history", trk._history), ("birth", trk.birth),
-                            ("coverage", trk.coverage)):
+                            ("coverage", trk.coverage), ("addresses", trk._book)):
             with located(path, f"{part}__*"):
                 owner.set_arrays(saved.part(part))
         return trk

@@ -49,6 +49,12 @@ class Leaves:
     time : (L,) time (s) of the leaf's state ``x, P``: its last plot's own time, or the
         time of the frame that last predicted it (a miss). With synchronous scans every
         leaf's time is the last scan's.
+    level : (L, 7) the vertical state of :mod:`mhtrack.mht.attribute_scores`: flight
+        level ``h`` (FL), climb rate ``ḣ`` (FL/s), covariance ``P_hh, P_hḣ, P_ḣḣ``, the
+        time (s) they are at and the count of validated levels in a row far from it; NaN
+        ``h`` when no plot of the branch gave a flight level.
+    ident : (L, 2) the branch's last Mode 3/A code and Mode S address (``-1``: none).
+    ``level`` and ``ident`` default to "nothing known" for every leaf.
     """
 
     x: np.ndarray
@@ -67,6 +73,15 @@ class Leaves:
     node: np.ndarray
     parent: np.ndarray
     time: np.ndarray
+    level: np.ndarray = None  # type: ignore[assignment]  # filled by __post_init__
+    ident: np.ndarray = None  # type: ignore[assignment]
+
+    def __post_init__(self) -> None:
+        n = self.score.shape[0]
+        if self.level is None:
+            object.__setattr__(self, "level", no_level(n))
+        if self.ident is None:
+            object.__setattr__(self, "ident", np.full((n, 2), -1, np.int64))
 
     def __len__(self) -> int:
         return int(self.score.shape[0])
@@ -99,7 +114,10 @@ class Leaves:
 
     @classmethod
     def from_arrays(cls, arrays: dict[str, np.ndarray]) -> Leaves:
-        return cls(**{f.name: np.asarray(arrays[f.name]) for f in fields(cls)})
+        """The store of :meth:`arrays` (``level``, ``ident`` may be missing: a state
+        saved before they existed)."""
+        return cls(**{f.name: np.asarray(arrays[f.name]) for f in fields(cls)
+                      if f.name in arrays or f.name not in ("level", "ident")})
 
     def states(self) -> States:
         """The leaves' filter states (``x, P`` and the per-model ``xm, Pm, mu``)."""
@@ -119,6 +137,11 @@ class Leaves:
     def n_trees(self) -> int:
         tree = self.tree  # the runs of equal tree ids (leaves are sorted by tree)
         return int(np.count_nonzero(changes(tree))) if tree.size else 0
+
+
+def no_level(n: int) -> np.ndarray:
+    """``n`` rows of :attr:`Leaves.level` with nothing known (all NaN)."""
+    return np.full((n, 7), np.nan)
 
 
 #: The store's columns, in order.

@@ -45,6 +45,7 @@ from mhtrack.io.asterix.decode import MARKS, PLOT_COLUMNS, Decoder, plot_columns
 from mhtrack.io.asterix.problems import Problems
 from mhtrack.io.asterix.sites import sensors_with_sites, skipped_line
 from mhtrack.io.asterix.timeaxis import TimeAxis
+from mhtrack.io.plot_attributes import decoded_attributes
 from mhtrack.io.timed_plots import DEFAULT_REORDER_WINDOW_S, polar_plots
 from mhtrack.models.radars import SensorSet
 from mhtrack.records import Scan
@@ -204,6 +205,8 @@ class DatagramSource(Source):
         p = {k: v[ok] for k, v in p.items()}
         adsb, sensor = adsb[ok], p["sensor"]
         out = {k: p[k] for k in ("time", "sensor", "file_row", "offset", "sector") if k in p}
+        if "mode_3a" in p:  # the plots' attributes (every batch has these columns)
+            out.update(decoded_attributes(p))
         if not sensor.size:
             return {**out, "x": np.zeros(0), "y": np.zeros(0), "R": np.zeros((0, 2, 2))}
         assert self.sensors is not None

@@ -84,7 +84,7 @@ class ReorderBuffer:
         for i, ti in enumerate(t.tolist()):
             if ti < released:
                 self.late.add(latest - ti, lambda i=i: {  # type: ignore[misc]
-                    k: np.asarray(v)[i].item() for k, v in cols.items()
+                    k: _scalar(np.asarray(v)[i]) for k, v in cols.items()
                     if np.ndim(v) == 1})
                 continue
             if ti < latest:
@@ -155,3 +155,8 @@ def kept(time: np.ndarray, window_s: float = DEFAULT_REORDER_WINDOW_S) -> np.nda
         if s is not None:
             out[s] = True
     return out
+
+
+def _scalar(v: object) -> object:
+    """A NumPy scalar as its Python value (an object column's element as it is)."""
+    return v.item() if isinstance(v, np.generic) else v

@@ -10,6 +10,7 @@ from collections.abc import Callable, Iterator, Mapping
 
 import numpy as np
 
+from mhtrack.attributes import of_columns
 from mhtrack.records import Scan
 from mhtrack.sources.base import SourceStats
 from mhtrack.sources.framer import Frame, Framer
@@ -18,7 +19,8 @@ from mhtrack.sources.reorder import ReorderBuffer
 
 class TimedStream:
     """Batches of plots (columns ``time, sensor, x, y, file_row`` and optionally ``R``,
-    ``origin``; arrival order) in, :class:`Scan` frames out.
+    ``origin`` and the attribute columns of :data:`mhtrack.attributes.COLUMNS`; arrival
+    order) in, :class:`Scan` frames out.
 
     ``Scan.rows`` number the plots 0, 1, … in the order they are yielded;
     :meth:`file_rows` maps them to the batches' ``file_row``. ``stats`` is updated as
@@ -109,7 +111,8 @@ class TimedStream:
         self.stats.frames += 1
         return Scan(index=fr.index, time=fr.time, z=np.column_stack((c["x"], c["y"])),
                     sensor=np.asarray(c["sensor"], np.int64), rows=rows, R=c.get("R"),
-                    origin=c.get("origin"), t=np.asarray(c["time"], float))
+                    origin=c.get("origin"), t=np.asarray(c["time"], float),
+                    attrs=of_columns(c))
 
     @property
     def next_row(self) -> int:

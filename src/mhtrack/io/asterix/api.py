@@ -123,6 +123,13 @@ def plot_columns(rec: Recording, sensors: SensorSet | None = None) -> dict[str, 
     cols: dict[str, pa.Array] = {}
     for name in (*PLOT_COLUMNS, *(c for c in ADSB_EXTRA if c in p)):
         v = p[name]
+        if name.endswith("_vg"):  # 2·V + G → the V and G columns, where any is set
+            base = name[:-3]
+            for bit, shift in (("v", 1), ("g", 0)):
+                flag = (v >> shift) & 1
+                if flag.any():
+                    cols[f"{base}_{bit}"] = int_array(flag)
+            continue
         if name in _TEXT:
             cols[name] = pa.array(v.tolist(), type=pa.string(), mask=v == "")
         elif name == "plot_type":  # the name of the type: primary, secondary, ...
@@ -232,7 +239,11 @@ def export_file(path: str | Path, sensors: SensorSet | None, out: str | Path, *,
 
 _EXPORT = {"time": TIME, "sensor": INT, "range": FLOAT, "slant_range": FLOAT,
            "bearing": FLOAT, "flight_level": FLOAT, "typ": INT, "track_number": INT,
-           "mode_3a": TIME, "address": TIME, "callsign": TIME}  # TIME: read as text
+           "mode_3a": TIME, "address": TIME, "callsign": TIME, "plot_type": TIME,
+           "mode_3a_v": INT, "mode_3a_g": INT, "flight_level_v": INT,
+           "flight_level_g": INT}  # TIME: read as text
+#: I048/020 TYP written for a ``plot_type`` name when the file has no ``typ`` column.
+_TYP_OF = {"primary": 1, "secondary": 2, "combined": 3, "mode_s": 5}
 
 
 def export(plots: str | Path, sensors: SensorSet, out: str | Path, *,
@@ -260,9 +271,14 @@ def export(plots: str | Path, sensors: SensorSet, out: str | Path, *,
     extra: dict[str, np.ndarray] = {}
     if f.has("flight_level"):
         extra["flight_level"] = f.floats("flight_level", nullable=True)
-    for name in ("typ", "track_number"):
+    for name in ("typ", "track_number", "mode_3a_v", "mode_3a_g", "flight_level_v",
+                 "flight_level_g"):
         if f.has(name):
-            extra[name] = f.ints(name, nullable=True)
+            extra[name] = f.ints(name, nullable=True, fill=-1 if name in (
+                "typ", "track_number") else 0)
+    if f.has("plot_type") and "typ" not in extra:
+        names = ["" if s is None else str(s) for s in f.table.column("plot_type").to_pylist()]
+        extra["typ"] = np.array([_TYP_OF.get(s, -1) for s in names], np.int64)
     for name in _TEXT:
         if f.has(name):
             extra[name] = np.array(f.table.column(name).to_pylist(), dtype=object)

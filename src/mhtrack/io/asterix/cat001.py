@@ -31,8 +31,8 @@ TRUNC_S = 512.0
 NM_M = 1852.0
 #: Columns of a CAT001 plot row, in order (PLOT_COLUMNS, then the plot type and flags).
 COLUMNS = ("time", "sensor", "sac", "sic", "slant_range", "bearing", "flight_level",
-           "mode_3a", "address", "callsign", "track_number", "typ", "plot_type", "sim",
-           "rab", "tst", "track")
+           "mode_3a", "address", "callsign", "track_number", "typ", "plot_type",
+           "mode_3a_vg", "flight_level_vg", "sim", "rab", "tst", "track")
 
 
 def specs() -> tuple[Any, Any]:
@@ -95,8 +95,9 @@ def plot_row001(rec: Any, at: int, problems: Problems) -> tuple[Any, ...] | None
         typ, sim, rab, tst = (_uint(i020, k) for k in ("SSRPSR", "SIM", "RAB", "TST"))
         track = _uint(i020, "TYP")
     ptype = typ if typ >= 0 else 0
+    vg = [0 if i is None else 2 * _uint(i, "V") + _uint(i, "G") for i in (i070, i090)]
     return (float(i141.variation.content.as_quantity("s")), sac * 256 + sic, sac, sic,
-            rho, theta, fl, m3a, "", "", -1, typ, ptype, sim, rab, tst, track)
+            rho, theta, fl, m3a, "", "", -1, typ, ptype, *vg, sim, rab, tst, track)
 
 
 def mark_row002(rec: Any) -> tuple[Any, ...] | None:

@@ -48,8 +48,8 @@ ADSB = next(k for k, v in PLOT_TYPES.items() if v == "adsb")
 #: Columns of an ADS-B row: PLOT_COLUMNS' identity and time columns, the position in
 #: WGS-84 (``slant_range``/``bearing`` NaN: no radar), its σ (m), the plot type and flags.
 COLUMNS = ("time", "sensor", "sac", "sic", "slant_range", "bearing", "flight_level",
-           "mode_3a", "address", "callsign", "track_number", "typ", "plot_type", "sim",
-           "rab", "tst", "lat", "lon", "sigma")
+           "mode_3a", "address", "callsign", "track_number", "typ", "plot_type",
+           "mode_3a_vg", "flight_level_vg", "sim", "rab", "tst", "lat", "lon", "sigma")
 
 
 def spec() -> Any:
@@ -115,7 +115,7 @@ def report_row(rec: Any, at: int, problems: Problems) -> tuple[Any, ...] | None:
         flags = [uint(x) if (x := sub_or_none(i040, k)) is not None else 0
                  for k in ("SIM", "RAB", "TST")]
     return (tod, sac * 256 + sic, sac, sic, np.nan, np.nan, fl, "", address, callsign, tn,
-            -1, ADSB, *flags, lat, lon, sigma_m(nacp, nucp, version))
+            -1, ADSB, 0, 0, *flags, lat, lon, sigma_m(nacp, nucp, version))
 
 
 def block021(raw: bytes, at: int, problems: Problems) -> list[tuple[Any, ...]] | None:

@@ -16,7 +16,8 @@ KINDS: dict[str, Any] = {
     "slant_range": float, "bearing": float, "flight_level": float, "mode_3a": object,
     "address": object, "callsign": object, "track_number": np.int64, "typ": np.int64,
     "plot_type": np.int64, "sim": np.int64, "rab": np.int64, "tst": np.int64,
-    "track": np.int64, "lat": float, "lon": float, "sigma": float}
+    "track": np.int64, "lat": float, "lon": float, "sigma": float,
+    "mode_3a_vg": np.int64, "flight_level_vg": np.int64}
 
 
 def columns(rows: Sequence[tuple[Any, ...]], names: Sequence[str]

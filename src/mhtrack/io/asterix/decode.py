@@ -44,7 +44,11 @@ FL_M = 30.48
 
 #: The plot columns, in output order (docs/file-formats.md).
 PLOT_COLUMNS = ("time", "sensor", "sac", "sic", "slant_range", "bearing", "flight_level",
-                "mode_3a", "address", "callsign", "track_number", "typ", "plot_type")
+                "mode_3a", "address", "callsign", "track_number", "typ", "plot_type",
+                "mode_3a_vg", "flight_level_vg")
+#: The validity bits of I048/070 and /090 in the ``*_vg`` columns: ``2·V + G`` (V "not
+#: validated", G "garbled"; 0 when the item is absent).
+VG = "2·V + G"
 #: The columns an ADS-B report (CAT021) adds to :data:`PLOT_COLUMNS`: WGS-84 position
 #: (deg) and its σ per axis (m, from NACp/NUCp, :mod:`~mhtrack.io.asterix.cat021`).
 ADSB_EXTRA = ("lat", "lon", "sigma")
@@ -194,20 +198,21 @@ def _plots_only(rows: list[tuple[Any, ...]], cat: int, at: int, problems: Proble
     """The rows that are plots of real targets (:func:`~mhtrack.io.asterix.notplots.
     reason`), the others counted (``not_plot``, the first one's reason in the detail).
     Rows hold from column 11 on: CAT048 ``typ`` and the I048/020 flags (the plot type
-    made here); CAT001 ``typ, plot_type, sim, rab, tst, track``; CAT021 ``typ, plot_type``,
-    the flags, ``lat, lon, sigma``. The result has :data:`PLOT_COLUMNS` (CAT021: then
-    ``lat, lon, sigma``)."""
+    made here), then ``mode_3a_vg, flight_level_vg``; CAT001 ``typ, plot_type,
+    mode_3a_vg, flight_level_vg, sim, rab, tst, track``; CAT021 ``typ, plot_type``, the
+    validity bits (0), the flags, ``lat, lon, sigma``. The result has
+    :data:`PLOT_COLUMNS` (CAT021: then ``lat, lon, sigma``)."""
     out, dropped, first = [], 0, ""
     for r in rows:
         if cat == 48:
             why = reason(r[11], r[12], r[13], r[14])
-            row = (*r[:12], plot_type048_of(r[11]))
+            row = (*r[:12], plot_type048_of(r[11]), r[15], r[16])
         elif cat == 1:
-            why = reason(r[11], r[13], r[14], r[15], r[16])
-            row = r[:13]
+            why = reason(r[11], r[15], r[16], r[17], r[18])
+            row = r[:15]
         else:
-            why = reason(-1, r[13], r[14], r[15])
-            row = (*r[:11], -1, r[12], *r[16:])
+            why = reason(-1, r[15], r[16], r[17])
+            row = (*r[:11], -1, *r[12:15], *r[18:])
         if why is None:
             out.append(row)
         else:
@@ -243,8 +248,8 @@ def _sub(item: Any, name: str) -> Any:
 def plot_row(rec: Any, at: int, problems: Problems) -> tuple[Any, ...] | None:
     """One report row from a CAT048 record — :data:`PLOT_COLUMNS` up to
     ``track_number``, then I048/020's ``typ, sim, rab, tst``
-    (:func:`~mhtrack.io.asterix.notplots.flags048`) — or ``None`` (counted) without
-    040/140/010."""
+    (:func:`~mhtrack.io.asterix.notplots.flags048`), then the validity bits of 070 and
+    090 (:data:`VG`) — or ``None`` (counted) without 040/140/010."""
     i040 = rec.get_item("040")
     if i040 is None:
         problems.add("no_position", at)
@@ -265,7 +270,15 @@ def plot_row(rec: Any, at: int, problems: Problems) -> tuple[Any, ...] | None:
     callsign = i240.variation.content.as_string().strip() if i240 is not None else ""
     tn = _sub(i161, "TRN").variation.content.as_uint() if i161 is not None else -1
     return (quantity(i140, "s"), sac * 256 + sic, sac, sic, rho, theta, fl, m3a, address,
-            callsign, tn, *flags048(rec))
+            callsign, tn, *flags048(rec), vg(i070), vg(i090))
+
+
+def vg(item: Any) -> int:
+    """``2·V + G`` of a libasterix I048/070, /090 or I001/070, /090 (0 when absent)."""
+    if item is None:
+        return 0
+    return 2 * _sub(item, "V").variation.content.as_uint() + \
+        _sub(item, "G").variation.content.as_uint()
 
 
 def site_row(rec: Any, at: int, sites: dict[int, tuple[float, float, float, int]]

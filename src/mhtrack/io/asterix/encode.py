@@ -69,8 +69,9 @@ def plot_messages(time: np.ndarray, sensor: np.ndarray, slant: np.ndarray,
                   bearing: np.ndarray, extra: dict[str, np.ndarray]) -> list[Message]:
     """CAT048 messages of plots (slant range m, bearing deg); ``extra`` may hold
     ``flight_level``, ``typ``, ``mode_3a``, ``address``, ``callsign``, ``track_number``
-    (NaN, -1 or "" where absent). Raises ``ValueError`` naming the first plot out of an
-    item's range."""
+    (NaN, -1 or "" where absent) and the V, G bits of 070 and 090 (``mode_3a_v``,
+    ``mode_3a_g``, ``flight_level_v``, ``flight_level_g``; 0 where absent). Raises
+    ``ValueError`` naming the first plot out of an item's range."""
     L = lsb()
     rho = np.round(np.asarray(slant, float) / NM_M / L["rho_nm"]).astype(np.int64)
     _check(rho, 0, 0xFFFF, "slant range", slant, "m (I048/040 holds below 256 NM)")
@@ -94,9 +95,12 @@ def plot_messages(time: np.ndarray, sensor: np.ndarray, slant: np.ndarray,
         }
         m3a = _text(extra, "mode_3a", i)
         if m3a:
-            items["070"] = (0, 0, 0, 0, ("MODE3A", m3a))
+            items["070"] = (_int(extra, "mode_3a_v", i, 0), _int(extra, "mode_3a_g", i, 0),
+                            0, 0, ("MODE3A", m3a))
         if fl_raw is not None and not np.isnan(fl[i]):  # type: ignore[index]
-            items["090"] = (0, 0, ("FL", int(fl_raw[i]) & 0x3FFF))
+            items["090"] = (_int(extra, "flight_level_v", i, 0),
+                            _int(extra, "flight_level_g", i, 0),
+                            ("FL", int(fl_raw[i]) & 0x3FFF))
         address = _text(extra, "address", i)
         if address:
             items["220"] = int(address, 16)

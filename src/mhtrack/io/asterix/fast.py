@@ -236,8 +236,10 @@ def cat048_row(self: FastRecords, raw: bytes, spans: dict[str, tuple[int, int]],
     tn = f["trn"].read(raw, spans["161"][0]) if "161" in spans else -1
     flags = self._decoded("020", raw[slice(*_range(spans["020"]))], flags048_item) \
         if "020" in spans else (-1, -1, -1, -1)
+    vg = [2 * f[f"{k}_v"].read(raw, spans[k][0]) + f[f"{k}_g"].read(raw, spans[k][0])
+          if k in spans else 0 for k in ("070", "090")]
     return (f["tod"].read(raw, spans["140"][0]), sac * 256 + sic, sac, sic, rho, theta,
-            fl, m3a, address, callsign, tn, *flags)
+            fl, m3a, address, callsign, tn, *flags, *vg)
 
 
 def cat034_row(self: FastRecords, raw: bytes, spans: dict[str, tuple[int, int]], at: int,
@@ -274,6 +276,8 @@ def reader048(slow_row: Callable[[Any, int, Problems], tuple[Any, ...] | None]
         "tod": field(rec, "140"), "rho": field(rec, "040", "RHO"),
         "theta": field(rec, "040", "THETA"), "fl": field(rec, "090", "FL"),
         "trn": field(rec, "161", "TRN"), "address": field(rec, "220"),
+        "070_v": field(rec, "070", "V"), "070_g": field(rec, "070", "G"),
+        "090_v": field(rec, "090", "V"), "090_g": field(rec, "090", "G"),
     }
     return out
 

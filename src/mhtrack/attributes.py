@@ -1,0 +1,146 @@
+"""What a plot says besides its position: plot type, Mode 3/A code, Mode C flight level,
+Mode S address, aircraft identification and amplitude (docs/file-formats.md, "Plot
+attributes").
+
+A civil radar's plot is primary (PSR: position only), secondary (SSR: a reply with a
+Mode 3/A code and a Mode C flight level), combined (both) or Mode S (a reply that also
+carries the aircraft's 24-bit ICAO address and often its identification). The columns
+follow ASTERIX CAT048 (EUROCONTROL, edition 1.32): I048/070 (Mode 3/A code with its bits
+V "code not validated", G "garbled"), I048/090 (flight level, 1/4 FL, with V and G),
+I048/220 (address), I048/240 (identification), I048/020 TYP (plot type, coded as
+:data:`PLOT_TYPES`), I048/130 SAM (amplitude, dBm).
+
+Every column may be absent on a row: ``-1`` for the integer codes, NaN for the numbers,
+``""`` for the text. A plot without any attribute is a position only, and the tracker
+scores it exactly as without this record (:mod:`mhtrack.mht.attribute_scores`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, fields
+
+import numpy as np
+
+#: Plot type codes (I048/020 TYP grouped as in :mod:`mhtrack.io.asterix.notplots`).
+PLOT_TYPES = {0: "none", 1: "primary", 2: "secondary", 3: "combined", 4: "mode_s",
+              5: "adsb"}
+PRIMARY, SECONDARY, COMBINED, MODE_S = 1, 2, 3, 4
+#: A missing code or address.
+ABSENT = -1
+#: The columns, in file order (``docs/file-formats.md``).
+COLUMNS = ("plot_type", "mode_3a", "mode_3a_v", "mode_3a_g", "flight_level",
+           "flight_level_v", "flight_level_g", "address", "callsign", "amplitude")
+_INT = ("plot_type", "mode_3a", "mode_3a_v", "mode_3a_g", "flight_level_v",
+        "flight_level_g", "address")
+_FLOAT = ("flight_level", "amplitude")
+
+
+def code_value(text: str) -> int:
+    """A Mode 3/A code written as four octal digits (``"7000"``) as its 12-bit value
+    (``0o7000``); ``""`` → :data:`ABSENT`. ``ValueError`` for anything else."""
+    if text == "":
+        return ABSENT
+    if len(text) != 4 or any(c not in "01234567" for c in text):
+        raise ValueError(f"Mode 3/A code {text!r} is not four octal digits")
+    return int(text, 8)
+
+
+def code_text(value: int) -> str:
+    """The four octal digits of a 12-bit Mode 3/A code (:data:`ABSENT` → ``""``)."""
+    return "" if value < 0 else f"{int(value):04o}"
+
+
+def address_value(text: str) -> int:
+    """A 24-bit ICAO address written in hexadecimal (``"3C4591"``) as an integer;
+    ``""`` → :data:`ABSENT`. ``ValueError`` for anything else."""
+    if text == "":
+        return ABSENT
+    v = int(text, 16)
+    if len(text) > 6 or v < 0:
+        raise ValueError(f"Mode S address {text!r} is not 24 bits of hexadecimal")
+    return v
+
+
+def address_text(value: int) -> str:
+    """Six upper-case hexadecimal digits (:data:`ABSENT` → ``""``)."""
+    return "" if value < 0 else f"{int(value):06X}"
+
+
+@dataclass(frozen=True)
+class PlotAttributes:
+    """One row per plot (module docstring): ``plot_type`` (:data:`PLOT_TYPES`, 0 unknown),
+    ``mode_3a`` (12-bit code, ``-1`` absent) with ``mode_3a_v`` / ``mode_3a_g`` (1: not
+    validated / garbled), ``flight_level`` (FL, NaN absent) with ``flight_level_v`` /
+    ``flight_level_g``, ``address`` (24 bits, ``-1`` absent), ``callsign`` (text) and
+    ``amplitude`` (dBm, NaN absent)."""
+
+    plot_type: np.ndarray
+    mode_3a: np.ndarray
+    mode_3a_v: np.ndarray
+    mode_3a_g: np.ndarray
+    flight_level: np.ndarray
+    flight_level_v: np.ndarray
+    flight_level_g: np.ndarray
+    address: np.ndarray
+    callsign: np.ndarray
+    amplitude: np.ndarray
+
+    def __post_init__(self) -> None:
+        n = len(self.plot_type)
+        for f in fields(self):
+            if len(getattr(self, f.name)) != n:
+                raise ValueError(f"PlotAttributes column {f.name!r} has "
+                                 f"{len(getattr(self, f.name))} rows, expected {n}")
+
+    def __len__(self) -> int:
+        return len(self.plot_type)
+
+    @classmethod
+    def from_columns(cls, cols: Mapping[str, np.ndarray], n: int | None = None
+                     ) -> PlotAttributes:
+        """The attributes among ``cols`` (any subset of :data:`COLUMNS`, already decoded:
+        codes and addresses as integers), the others absent on every row."""
+        if n is None:
+            n = len(next(iter(cols.values())))
+        out = {}
+        for name in COLUMNS:
+            v = cols.get(name)
+            if name in _INT:
+                fill = 0 if name.endswith(("_v", "_g")) or name == "plot_type" else ABSENT
+                out[name] = np.full(n, fill, np.int64) if v is None else \
+                    np.asarray(v, np.int64)
+            elif name in _FLOAT:
+                out[name] = np.full(n, np.nan) if v is None else np.asarray(v, float)
+            else:
+                out[name] = np.full(n, "", object) if v is None else np.asarray(v, object)
+        return cls(**out)
+
+    @classmethod
+    def absent(cls, n: int) -> PlotAttributes:
+        """``n`` plots without any attribute."""
+        return cls.from_columns({}, n)
+
+    def columns(self) -> dict[str, np.ndarray]:
+        """The columns by name (:data:`COLUMNS`)."""
+        return {name: getattr(self, name) for name in COLUMNS}
+
+    def take(self, idx: np.ndarray | slice) -> PlotAttributes:
+        """Rows ``idx`` (index array, mask or slice), in that order."""
+        return PlotAttributes(**{k: v[idx] for k, v in self.columns().items()})
+
+    @classmethod
+    def concat(cls, parts: list[PlotAttributes]) -> PlotAttributes:
+        return cls(**{k: np.concatenate([getattr(p, k) for p in parts]) for k in COLUMNS})
+
+    def any(self) -> bool:
+        """Some plot carries a code, a flight level or an address."""
+        return bool((self.mode_3a >= 0).any() or (self.address >= 0).any()
+                    or np.isfinite(self.flight_level).any())
+
+
+def of_columns(cols: Mapping[str, np.ndarray]) -> PlotAttributes | None:
+    """:meth:`PlotAttributes.from_columns` of the attribute columns among ``cols`` (a
+    source's batch), ``None`` when there are none."""
+    mine = {k: v for k, v in cols.items() if k in COLUMNS}
+    return PlotAttributes.from_columns(mine, len(cols["time"])) if mine else None

@@ -131,3 +131,32 @@ def test_resume_needs_a_checkpoint_file(rec: Path, tmp_path: Path) -> None:
                                               checkpoint=tmp_path / "none.npz"),
                 stdin=io.BytesIO(b""))
     assert live.resumed is None
+
+
+def test_held_plots_keep_their_columns_types_through_json() -> None:
+    """The plots a checkpoint holds come back with each column's type — text attribute
+    columns (callsign, an object array of str) included; a column of any other object
+    is refused (a checkpoint is read from disk, so it may be hostile)."""
+    import json
+
+    import numpy as np
+    import pytest
+
+    from mhtrack.pipeline.checkpoint import decode_pending, encode_pending
+
+    callsign = np.empty(2, object)
+    callsign[:] = ["AFR12", ""]
+    held = {"time": np.array([1.5, 0.1 + 0.2]), "sensor": np.array([3, 4]),
+            "callsign": callsign, "mode_3a_v": np.array([0, 1], np.int8),
+            "file_row": np.array([7, 8])}
+    saved = json.loads(json.dumps(encode_pending(
+        {"latest": 2.0, "released": -np.inf, "framed": None, "held": held})))
+    back = decode_pending(saved)["held"]
+    assert back["time"].tolist() == held["time"].tolist()  # to the bit
+    assert back["sensor"].dtype == held["sensor"].dtype
+    assert back["mode_3a_v"].dtype == np.int8
+    assert back["callsign"].dtype == object and back["callsign"].tolist() == ["AFR12", ""]
+    assert back["file_row"].tolist() == [-1, -1]  # numbers of the earlier run
+    saved["held"]["callsign"]["values"] = [{"a": 1}, ""]
+    with pytest.raises(ValueError, match="numbers or text only"):
+        decode_pending(saved)

@@ -56,10 +56,6 @@ class LiveState:
     format: int = LIVE_FORMAT
 
 
-#: Integer columns of the plots held (the others are floats).
-_INT_COLUMNS = ("sensor", "file_row", "offset", "seq", "sector")
-
-
 def encode_pending(pending: dict[str, Any] | None) -> dict[str, Any] | None:
     """:meth:`~mhtrack.sources.datagrams.DatagramSource.pending` as JSON: each column a
     list (floats to the bit: JSON keeps Python's shortest round-trip form), the times
@@ -70,9 +66,29 @@ def encode_pending(pending: dict[str, Any] | None) -> dict[str, Any] | None:
                            else float(pending[k]) for k in ("latest", "released")}
     for part in ("framed", "held"):
         cols = pending[part]
-        out[part] = None if cols is None else {k: np.asarray(v).tolist()
-                                               for k, v in cols.items()}
+        out[part] = None if cols is None else {k: _column(v) for k, v in cols.items()}
     return out
+
+
+def _array(saved: dict[str, Any]) -> np.ndarray:
+    """A held column read back with its dtype: numbers, booleans or text only (text
+    columns of plot attributes, such as the callsign, are object arrays of str)."""
+    dtype = np.dtype(saved["dtype"])
+    values = saved["values"]
+    if dtype.kind == "O" and all(isinstance(v, str) for v in values):
+        out = np.empty(len(values), object)
+        out[:] = values
+        return out
+    if dtype.kind not in "biufU":
+        raise ValueError(f"a held column of dtype {saved['dtype']!r} (numbers or text only)")
+    return np.asarray(values, dtype)
+
+
+def _column(values: Any) -> dict[str, Any]:
+    """One held column as JSON: its NumPy dtype (text columns of plot attributes are
+    kept as text, numbers to the bit) and its values."""
+    a = np.asarray(values)
+    return {"dtype": a.dtype.str, "values": a.tolist()}
 
 
 def decode_pending(saved: dict[str, Any] | None) -> dict[str, Any] | None:
@@ -87,8 +103,7 @@ def decode_pending(saved: dict[str, Any] | None) -> dict[str, Any] | None:
         if cols is None:
             out[part] = None
             continue
-        arrays = {k: np.asarray(v, np.int64 if k in _INT_COLUMNS else float)
-                  for k, v in cols.items()}
+        arrays = {k: _array(v) for k, v in cols.items()}
         if "R" in arrays:
             arrays["R"] = arrays["R"].reshape(-1, 2, 2)
         arrays["file_row"] = np.full(len(arrays["time"]), -1, np.int64)
@@ -140,6 +155,7 @@ def read_checkpoint(path: str | Path) -> tuple[MHTTracker, LiveState]:
                          f"format {LIVE_FORMAT}): not written by mhtrack live", file=str(path))
     try:
         state = LiveState(**extra)
-    except TypeError as e:
+        decode_pending(state.pending)  # the plots held must read back
+    except (TypeError, ValueError, KeyError, AttributeError) as e:
         raise InputError(f"{path}: member 'meta': field 'extra': {e}", file=str(path)) from None
     return load_tracker(path), state

@@ -126,3 +126,21 @@ def test_scans_keep_p1s_area_rule(tmp_path):
                                  str(tmp_path / "t.csv")])
     assert r.exit_code == 0, r.output
     assert "new targets per scan over the plots'" in r.stdout and "radar" not in r.stdout
+
+
+def test_pipeline_takes_the_rule_and_the_user_overrides_it(sim):
+    from mhtrack.pipeline import Pipeline, TrackOptions
+
+    plots, sensors = str(sim / "plots.csv"), str(sim / "sensors.toml")
+    pipe = Pipeline.open(plots, TrackOptions(tracker="mht"), sensors_file=sensors)
+    rule = pipe.choices.radars
+    assert [r.sensor for r in rule.radars] == [1, 2, 3]
+    assert pipe.config.new_target_density == rule.new_target_density
+    # --tracker mht: the known κ is the median plot density per look, and the note says so
+    assert pipe.tracker.clutter.estimator(2).kappa == rule.clutter_density
+    assert f"clutter κ = {rule.clutter_density:.4g} per m² per look" in pipe.birth_note
+    given = Pipeline.open(plots, TrackOptions(tracker="mht", new_target_density=1e-9,
+                                              clutter_density=3e-9), sensors_file=sensors)
+    assert given.config.new_target_density == 1e-9
+    assert given.tracker.clutter.estimator(2).kappa == 3e-9
+    assert given.birth_note is None

@@ -11,6 +11,7 @@ from click.testing import CliRunner
 
 from mhtrack.build import misses_to_delete, radar_rule
 from mhtrack.cli.main import cli
+from mhtrack.mht.reach import ReachEstimator
 from mhtrack.models.radars import RadarSensor, SensorSet
 
 ORIGIN = (46.8, 8.2)
@@ -21,30 +22,36 @@ def radar(sid, period=10.0, max_range=100e3, pd=0.9, position=(0.0, 0.0)):
                        sigma_bearing_deg=0.1, period=period, max_range=max_range)
 
 
-def ring(n_rot, per_rot, period, r, rng, t0=0.0):
-    """``per_rot`` plots a rotation at range ``r`` and random bearings, ``n_rot`` rotations."""
-    t = t0 + np.repeat(np.arange(n_rot), per_rot) * period + rng.uniform(0, period,
-                                                                         n_rot * per_rot)
+def ring(n_rot, per_rot, period, r, rng):
+    """``per_rot`` plots a rotation at range ``r`` and random bearings, evenly timed over
+    each of ``n_rot`` rotations (so they fall in exactly ``n_rot`` rotations)."""
+    t = (np.repeat(np.arange(n_rot), per_rot)
+         + np.tile((np.arange(per_rot) + 0.5) / per_rot, n_rot)) * period
     b = rng.uniform(0, 2 * np.pi, t.size)
-    return np.sort(t), r * np.sin(b), r * np.cos(b)
+    return t, r * np.sin(b), r * np.cos(b)
 
 
 def test_one_radar_with_max_range_against_hand_worked_values():
-    # 101 plots over 100 s of a 10 s radar reaching 100 km:
-    # K = 100/10 = 10 rotations, 10.1 plots a rotation, A = π·1e10 = 3.14159e10 m²,
-    # ρ = 10.1 / 3.14159e10 = 3.21496e-10 per m² per look,
-    # D = (π/2)·100 km / 300 m/s = 523.599 s, λ = ρ·10/523.599 = 6.14009e-12.
-    t = np.linspace(0.0, 100.0, 101)
-    x, y = np.full(101, 10e3), np.zeros(101)
-    rule = radar_rule(SensorSet(ORIGIN, (radar(1),)), np.ones(101, int), t, x, y, v_max=300.0)
+    # 100 plots, one a second from 0 to 99 s, of a 10 s radar reaching 100 km:
+    # K = 10 rotations, 10 plots a rotation, A = π·1e10 = 3.14159e10 m²,
+    # ρ = 10 / 3.14159e10 = 3.18310e-10 per m² per look,
+    # D = (π/2)·100 km / 300 m/s = 523.599 s, λ = ρ·10/523.599 = 6.07927e-12.
+    t = np.arange(100.0)
+    x, y = np.full(100, 10e3), np.zeros(100)
+    rule = radar_rule(SensorSet(ORIGIN, (radar(1),)), np.ones(100, int), t, x, y, v_max=300.0)
     (r,) = rule.radars
-    assert r.plots_per_rotation == pytest.approx(10.1)
+    assert r.plots_per_rotation == pytest.approx(10.0)
     assert r.reach == pytest.approx(100e3)
-    assert r.density == pytest.approx(3.21496e-10, rel=1e-5)
+    assert r.density == pytest.approx(3.18310e-10, rel=1e-5)
     assert r.crossing_s(300.0) == pytest.approx(523.599, rel=1e-6)
-    assert rule.new_target_density == pytest.approx(6.14009e-12, rel=1e-5)
-    assert rule.clutter_density == pytest.approx(3.21496e-10, rel=1e-5)
+    assert rule.new_target_density == pytest.approx(6.07927e-12, rel=1e-5)
+    assert rule.clutter_density == pytest.approx(3.18310e-10, rel=1e-5)
     assert not r.learned
+    # a 13 h gap in the middle (the recording paused) adds no rotation: same figures
+    gap = np.where(t >= 50, t + 13 * 3600.0, t)
+    again = radar_rule(SensorSet(ORIGIN, (radar(1),)), np.ones(100, int), gap, x, y,
+                       v_max=300.0)
+    assert again.new_target_density == rule.new_target_density
 
 
 def test_the_median_over_three_radars():
@@ -59,10 +66,9 @@ def test_the_median_over_three_radars():
     lam = [r.new_target_density(300.0) for r in rule.radars]
     assert lam[0] < lam[1] < lam[2]
     assert rule.new_target_density == lam[1]
-    # each: 200 plots over (span/T) rotations, span just under 10 T
-    for r, p in zip(rule.radars, parts, strict=True):
-        k = (p[0].max() - p[0].min()) / r.period
-        assert r.density == pytest.approx(200 / k / (math.pi * 1e10))
+    # each: 200 plots over 10 rotations, 20 a rotation over π·(100 km)²
+    for r in rule.radars:
+        assert r.density == pytest.approx(20 / (math.pi * 1e10))
 
 
 def test_reach_learned_from_a_ring_of_plots():
@@ -76,6 +82,22 @@ def test_reach_learned_from_a_ring_of_plots():
     assert r.learned
     assert r.reach == pytest.approx(60e3)
     assert r.area == pytest.approx(math.pi * 60e3**2)
+
+
+def test_learned_area_is_the_online_estimators_envelope_over_the_whole_input():
+    # the tracker's own ReachEstimator, given a memory as long as the input, learns the
+    # same per-sector reach: random ranges and bearings, some sectors left empty
+    rng = np.random.default_rng(2)
+    t = np.sort(rng.uniform(0, 300, 3000))
+    b = rng.uniform(0, 300, t.size)  # degrees: 300–360 stays empty
+    r = rng.uniform(1e3, 2e5, t.size)
+    x, y = r * np.sin(np.radians(b)), r * np.cos(np.radians(b))
+    s = SensorSet(ORIGIN, (radar(4, period=6.0, max_range=None),))
+    est = ReachEstimator({4: 6.0}, memory=400.0)
+    est.update(4, t, r, b)
+    want = math.pi * np.mean(est.envelope(4) ** 2)
+    (got,) = radar_rule(s, np.full(t.size, 4), t, x, y, v_max=300.0).radars
+    assert got.area == pytest.approx(want, rel=1e-9)
 
 
 def test_no_rotating_radar_no_rule():
@@ -105,10 +127,11 @@ def test_track_prints_the_rule_naming_the_radars(sim, tmp_path):
     r = CliRunner().invoke(cli, ["track", str(sim / "plots.csv"), "--sensors",
                                  str(sim / "sensors.toml"), "--out", str(tmp_path / "t.csv")])
     assert r.exit_code == 0, r.output
-    # radar 1 by hand from the plots file: plots a rotation over π·(300 km)²
+    # radar 1 by hand from the plots file: plots over the 4 s rotations holding them,
+    # over π·(300 km)²
     p = pd.read_csv(sim / "plots.csv")
     one = p[p.sensor == 1]
-    per_rot = len(one) / ((one.time.max() - one.time.min()) / 4.0)
+    per_rot = len(one) / ((one.time - one.time.min()) // 4.0).nunique()
     rho = per_rot / (math.pi * 300e3**2)
     for sid, period in ((1, 4), (2, 10), (3, 12)):
         assert f"radar {sid} ({period} s, reach 300 km max_range" in r.stdout

@@ -7,12 +7,13 @@ tracker scores misses, the clutter ``κ`` and the new-target density ``λv`` per
 ``r`` with a site, a rotation period ``T_r`` and plots in the input:
 
 * **reach** ``R_r``: its ``max_range`` from the sensors file, else learned from its
-  plots as the tracker learns it online (:class:`~mhtrack.mht.reach.ReachEstimator`: per
+  plots by the rule the tracker learns it with online (:mod:`mhtrack.mht.reach`: per
   azimuth sector the 2nd largest of the per-rotation farthest plots), here over the
   whole input; the area it covers ``A_r = π R_r²`` (learned: ``Σ_s π R_s² / S``) and its
   reach is quoted as ``√(A_r/π)``;
-* **plot density per look** ``ρ_r = n_r / (K_r A_r)``: its ``n_r`` plots over its
-  ``K_r = span_r / T_r`` rotations (at least 1), spread over its area;
+* **plot density per look** ``ρ_r = n_r / (K_r A_r)``: its ``n_r`` plots over the
+  ``K_r`` rotations that hold them (rotation ``⌊(t − t_first) / T_r⌋``; a gap in the
+  recording does not count), spread over its area;
 * **new targets per look** ``λ_r = ρ_r · T_r / D_r``: a target is new on one of the
   ``D_r / T_r`` looks it takes to cross the radar's reach, ``D_r = (π/2) R_r / v_max``
   (the mean chord of a disc of radius ``R`` is ``πR/2``; ``v_max`` the tracker's
@@ -39,7 +40,7 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
-from mhtrack.mht.reach import ReachEstimator
+from mhtrack.mht.reach import RANK, SECTORS
 from mhtrack.models.radars import SensorSet
 
 
@@ -139,13 +140,12 @@ def radar_rule(sensors: SensorSet | None, sensor: npt.ArrayLike | None,
         n = int(np.count_nonzero(mine))
         if s.period is None or not s.has_site or n < 2:
             continue
-        t = time[mine]
-        span = float(t.max() - t.min())
-        rotations = max(span / s.period, 1.0)
+        rot = np.floor((time[mine] - time[mine].min()) / s.period).astype(np.int64)
+        rotations = np.unique(rot).size  # rotations holding plots: gaps do not count
         if s.max_range is not None:
             area, learned = math.pi * s.max_range**2, False
         else:
-            area, learned = _learned_area(sensors, s.id, s.period, span, t, x[mine], y[mine]), True
+            area, learned = _learned_area(sensors, s.id, s.period, rot, x[mine], y[mine]), True
         if not area > 0:
             continue
         radars.append(RadarFigures(s.id, float(s.period), area, learned, n / rotations,
@@ -153,14 +153,19 @@ def radar_rule(sensors: SensorSet | None, sensor: npt.ArrayLike | None,
     return RadarRule(tuple(radars), float(v_max)) if radars else None
 
 
-def _learned_area(sensors: SensorSet, sid: int, period: float, span: float,
-                  t: np.ndarray, x: np.ndarray, y: np.ndarray) -> float:
-    """``Σ_s π R_s² / S`` of the reach the tracker would learn over the whole input."""
+def _learned_area(sensors: SensorSet, sid: int, period: float, rot: np.ndarray,
+                  x: np.ndarray, y: np.ndarray) -> float:
+    """``Σ_s π R_s² / S`` of the reach :class:`~mhtrack.mht.reach.ReachEstimator` learns,
+    over every rotation that holds plots (``rot``: each plot's rotation number): per
+    sector the :data:`~mhtrack.mht.reach.RANK`-th largest of the per-rotation farthest
+    plots (a rotation without plots in a sector counts 0), the largest while fewer
+    rotations are held."""
     sx, sy = sensors.site_xy(sid)
     dx, dy = x - sx, y - sy
-    est = ReachEstimator({sid: period}, memory=span + period)
-    order = np.argsort(t, kind="stable")
-    est.update(sid, t[order], np.hypot(dx, dy)[order],
-               np.degrees(np.arctan2(dx, dy))[order] % 360.0)
-    env = est.envelope(sid)
-    return 0.0 if env is None else float(math.pi * np.mean(env**2))
+    sector = (np.floor(np.mod(np.degrees(np.arctan2(dx, dy)), 360.0) / 360.0 * SECTORS)
+              .astype(np.int64) % SECTORS)
+    _, k = np.unique(rot, return_inverse=True)
+    maxima = np.zeros((int(k.max()) + 1, SECTORS))
+    np.maximum.at(maxima, (k, sector), np.hypot(dx, dy))
+    env = np.sort(maxima, axis=0)[-min(RANK, maxima.shape[0])]
+    return float(math.pi * np.mean(env**2))

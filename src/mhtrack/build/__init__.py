@@ -41,6 +41,12 @@ from mhtrack.build.parts import (
     takes_clutter_density,
     tracker_fuser,
 )
+from mhtrack.build.radar_defaults import (
+    RadarFigures,
+    RadarRule,
+    misses_to_delete,
+    radar_rule,
+)
 from mhtrack.build.recipe import sensors_from_recipe, sensors_recipe
 from mhtrack.initiation.factory import INITIATOR_CLASSES, make_initiator
 
@@ -59,6 +65,8 @@ __all__ = [
     "TRACKER_FUSION_CONSISTENCY",
     "TRACKER_FUSION_WEIGHTING",
     "PlotsArea",
+    "RadarFigures",
+    "RadarRule",
     "birth_density_for_area",
     "birth_suffix",
     "capped_pd",
@@ -71,7 +79,9 @@ __all__ = [
     "make_clutter_estimator",
     "make_initiator",
     "make_tracker",
+    "misses_to_delete",
     "plots_area",
+    "radar_rule",
     "sensors_from_recipe",
     "sensors_recipe",
     "takes_clutter_density",

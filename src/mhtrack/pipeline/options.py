@@ -14,6 +14,7 @@ from mhtrack.build import (
     P1_BIRTHS_PER_SCAN,
     TRACKER_FUSERS,
     PlotsArea,
+    RadarRule,
     capped_pd,
     config_with,
     default_config,
@@ -21,8 +22,10 @@ from mhtrack.build import (
     known_kappa_mismatch,
     make_tracker,
     plots_area,
+    radar_rule,
     takes_clutter_density,
 )
+from mhtrack.mht import MHTConfig
 from mhtrack.names import (
     DEFAULT_CLUTTER_FRAME,
     DEFAULT_OUTPUT,
@@ -31,7 +34,7 @@ from mhtrack.names import (
 )
 
 if TYPE_CHECKING:
-    from mhtrack.mht import MHTConfig, MHTTracker
+    from mhtrack.mht import MHTTracker
     from mhtrack.models.geodesy import LocalFrame
     from mhtrack.sources.base import Source, Survey
 
@@ -100,6 +103,8 @@ class Choices:
     area: PlotsArea | None
     #: Where the new-target density came from, for :func:`birth_density_note`.
     area_text: str
+    #: The defaults taken from rotating radars (timed plots without a scenario), or None.
+    radars: RadarRule | None = None
 
 
 def choose(source: Source, options: TrackOptions, survey: Survey | None,
@@ -107,17 +112,23 @@ def choose(source: Source, options: TrackOptions, survey: Survey | None,
     """Every default of a run on ``source``, chosen once:
 
     * configuration: ``config`` if given, else :func:`~mhtrack.build.default_config` of
-      the scenario's region, else of the plots' robust area (:func:`survey_area`), else
-      P1's; then the options' fields;
+      the scenario's region; else, for timed plots of rotating radars, ``λv`` (and the
+      known κ of ``mht``) from the radars (:func:`~mhtrack.build.radar_rule`); else of the
+      plots' robust area (:func:`survey_area`), else P1's; then the options' fields;
     * fusion: none for timed plots (one sensor per frame), else
       :func:`~mhtrack.build.default_fusion` of the scenario's or the plots' sensors;
     * the tracker (:func:`~mhtrack.build.make_tracker`) with the source's sensors
       (radar coverage, per-radar clutter in ``clutter_frame``);
     * the output frame: the sensors' local frame when they have a geodetic reference.
     """
-    scenario, area = source.scenario, None
+    scenario, area, radars = source.scenario, None, None
     if config is None and scenario is not None:
         config = default_config(scenario)
+    elif config is None and source.timed and survey is not None:
+        radars = radar_rule(source.sensors, survey.sensor, survey.time, survey.x, survey.y,
+                            v_max=MHTConfig().v_max)
+    if config is None and radars is not None:
+        config = MHTConfig(new_target_density=radars.new_target_density)
     elif config is None:
         area = survey_area(source.name, survey)
         config = default_config(area=area.area) if area is not None else default_config()
@@ -133,7 +144,10 @@ def choose(source: Source, options: TrackOptions, survey: Survey | None,
     if source.timed and TRACKER_FUSERS[fusion] is not None:
         raise ValueError("plots with their own times are tracked frame by frame, one "
                          f"sensor per frame: use fusion 'none', not {fusion!r}")
-    tracker = make_tracker(options.tracker, config, clutter_density=options.clutter_density,
+    kappa = options.clutter_density
+    if kappa is None and radars is not None and takes_clutter_density(options.tracker):
+        kappa = radars.clutter_density
+    tracker = make_tracker(options.tracker, config, clutter_density=kappa,
                            birth=options.birth, theta_deg=options.birth_theta_deg,
                            sensors=source.sensors, clutter_params=options.clutter_params,
                            clutter_frame=options.clutter_frame)
@@ -142,7 +156,7 @@ def choose(source: Source, options: TrackOptions, survey: Survey | None,
     text = ("the scenario's region" if scenario is not None
             else f"the plots' {area.width / 1e3:.3g} km × {area.height / 1e3:.3g} km "
             "bounding box" if area is not None else "P1's 8 km × 8 km region")
-    return Choices(config, fusion, tracker, frame, area, text)
+    return Choices(config, fusion, tracker, frame, area, text, radars)
 
 
 def _n_sensors(source: Source, survey: Survey | None) -> int:

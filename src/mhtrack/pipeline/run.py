@@ -21,7 +21,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from mhtrack.build import TRACKER_FUSERS, tracker_fuser
+from mhtrack.build import TRACKER_FUSERS, takes_clutter_density, tracker_fuser
 from mhtrack.names import TRACKER_FUSIONS
 from mhtrack.pipeline.frame_log import log_frame
 from mhtrack.pipeline.options import TrackOptions, birth_density_note, choose
@@ -253,8 +253,18 @@ class Pipeline:
 
     @property
     def birth_note(self) -> str | None:
-        """The line naming the new-target density chosen (None when the user set it)."""
-        if self.options.new_target_density is not None:
+        """The line naming the new-target density chosen — for rotating radars, with the
+        clutter density and the deletion, radar by radar
+        (:meth:`~mhtrack.build.RadarRule.note`) — (None when the user set both)."""
+        radars, given = self.choices.radars, self.options.new_target_density is not None
+        known = (takes_clutter_density(self.options.tracker)
+                 and self.options.clutter_density is None)
+        if radars is not None:
+            if given and not known:
+                return None
+            return radars.note(self.config.alpha, self.config.beta, birth=not given,
+                               known=known)
+        if given:
             return None
         return birth_density_note(self.config.new_target_density, self.choices.area_text)
 

@@ -68,6 +68,10 @@ class Survey:
     y: np.ndarray | None = None
     #: Number of frames (or scans) the source will yield, when known (progress bars).
     n_frames: int | None = None
+    #: Each plot's sensor id and time (s), aligned with ``x, y``, for the defaults of
+    #: rotating radars (:func:`mhtrack.build.radar_rule`); ``None`` if not given.
+    sensor: np.ndarray | None = None
+    time: np.ndarray | None = None
 
 
 class Source(ABC):

@@ -328,7 +328,7 @@ class DatagramSource(Source):
         listed = np.asarray([s.id for s in self.given.sensors if s.kind == "polar" and
                              s.has_site] if self.given is not None else [], np.int64)
         self._seen.update(listed.tolist())
-        xs, ys, ts, rows, kept, waiting = [], [], [], [], set(), []
+        xs, ys, ts, ss, rows, kept, waiting = [], [], [], [], [], set(), []
         for c in self._decoded(Problems(), sweeps, convert=False):
             now = np.isin(c["sensor"], listed)
             if "lat" in c:
@@ -340,6 +340,7 @@ class DatagramSource(Source):
                 xs.append(done["x"])
                 ys.append(done["y"])
                 ts.append(done["time"])
+                ss.append(done["sensor"])
                 rows.append(done["file_row"])
                 kept.update(np.unique(done["sensor"]).tolist())
             if not now.all():
@@ -359,18 +360,19 @@ class DatagramSource(Source):
             xs.append(done["x"])
             ys.append(done["y"])
             ts.append(done["time"])
+            ss.append(done["sensor"])
             rows.append(done["file_row"])
             kept.update(np.unique(done["sensor"]).tolist())
         cols = list(zip(*sweeps, strict=True)) if sweeps else [()] * 5
         marks = {k: np.array(c, dtype=d) for k, c, d in zip(
             ("time", "sensor", "kind", "azimuth", "period"), cols,
             (float, np.int64, np.int64, float, float), strict=True)}
-        x = np.concatenate(xs) if xs else np.zeros(0)
-        y = np.concatenate(ys) if ys else np.zeros(0)
+        x, y, t, sensor = (np.concatenate(a) if a else np.zeros(0, d) for a, d in (
+            (xs, float), (ys, float), (ts, float), (ss, np.int64)))
         # the plots the re-order buffer will let through, replayed in decoding order
         order = np.argsort(np.concatenate(rows), kind="stable") if rows else np.zeros(0, int)
         on_time = np.zeros(x.size, bool)
-        on_time[order] = kept_by_buffer(np.concatenate(ts)[order] if ts else np.zeros(0),
-                                        self.window_s)
+        on_time[order] = kept_by_buffer(t[order], self.window_s)
         return sweep_periods(marks), Survey(int(x.size), tuple(sorted(kept)), x[on_time],
-                                            y[on_time])
+                                            y[on_time], sensor=sensor[on_time],
+                                            time=t[on_time])

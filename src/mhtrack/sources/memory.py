@@ -47,4 +47,4 @@ class MemorySource(Source):
     def survey(self) -> Survey:
         t = self.table
         return Survey(n_plots=len(t), sensors=tuple(np.unique(t.sensor).tolist()),
-                      x=t.x, y=t.y, n_frames=t.n_scans)
+                      x=t.x, y=t.y, n_frames=t.n_scans, sensor=t.sensor, time=t.time)

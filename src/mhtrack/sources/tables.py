@@ -119,11 +119,12 @@ class TableSource(Source):
         """Every plot's ``x, y`` and the sensors; the number of scans of a scan table."""
         if self._table is not None:
             t = self._table
-            return Survey(len(t), tuple(np.unique(t.sensor).tolist()), t.x, t.y, t.n_scans)
+            return Survey(len(t), tuple(np.unique(t.sensor).tolist()), t.x, t.y, t.n_scans,
+                          t.sensor, t.time)
         c = self._cols
         on_time = kept(c.time, self.window_s)  # the plots the re-order buffer lets through
         return Survey(int(c.time.size), tuple(np.unique(c.sensor).tolist()), c.x[on_time],
-                      c.y[on_time])
+                      c.y[on_time], sensor=c.sensor[on_time], time=c.time[on_time])
 
 
 #: Rows pushed through the re-order buffer at a time.

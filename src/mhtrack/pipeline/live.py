@@ -43,9 +43,9 @@ from mhtrack.pipeline.warmup import Warmup, warm_up
 from mhtrack.sinks.base import FrameOutput, Sink
 
 if TYPE_CHECKING:
-    from mhtrack.mht import MHTConfig
     from mhtrack.models.radars import SensorSet
     from mhtrack.records import TrackTable
+    from mhtrack.sources.base import Survey
     from mhtrack.sources.udp import ReaderStats
 
 DAY_FROM = ("receive", "stream")
@@ -176,12 +176,12 @@ class Live:
                      f"time {self.resumed.last_time} s)")
             emit(f"listening on {', '.join(self.listening)}")
         incoming: Iterator[tuple[bytes, float]] = iter(self.reader)
-        config = None
+        survey = None
         #: The first rotations surveyed (:mod:`~mhtrack.pipeline.warmup`), if needed.
         self.warmup: Warmup | None = None
         if self.live_density_needed or any(
                 s.period is None for s in sensors.sensors if s.kind == "polar"):
-            sensors, config, incoming = self._warm_up(sensors, incoming, name)
+            sensors, survey, incoming = self._warm_up(sensors, incoming, name)
         axis = None
         st = self.resumed
         if st is not None:
@@ -200,7 +200,7 @@ class Live:
             # stopped with a checkpoint: the plots held go into it, tracked on resume
             hold=lambda: self.stop.is_set() and live.checkpoint is not None)
         try:
-            self.pipeline = Pipeline(self.source, options, config=config)
+            self.pipeline = Pipeline(self.source, options, survey=survey)
         except BaseException:
             if isinstance(self.reader, UdpReader):
                 self.reader.close()
@@ -208,16 +208,20 @@ class Live:
         if resumed is not None:  # the same track ids, hypotheses and clutter go on
             self.pipeline.tracker = resumed[0]
             self.pipeline.config = resumed[0].config
+        elif survey is not None and self.emit is not None:
+            note = self.pipeline.birth_note
+            if note is not None:
+                span = 0.0 if self.warmup is None else self.warmup.span_s
+                self.emit(f"live, from the first {span:.0f} s: {note}")
         self._make_sinks(sensors, stdout)
 
     def _warm_up(self, sensors: SensorSet, incoming: Iterator[tuple[bytes, float]],
-                 name: str) -> tuple[SensorSet, MHTConfig | None, Iterator[Any]]:
+                 name: str) -> tuple[SensorSet, Survey | None, Iterator[Any]]:
         """The first rotations surveyed (:mod:`~mhtrack.pipeline.warmup`): the sensors
-        with their periods, the configuration of the plots' area (``None``: the density
-        was given) and the datagrams, those held first."""
-        from mhtrack.build import default_config
+        with their periods, the survey the defaults come from as ``track``'s survey of a
+        recording (``None``: the density was given) and the datagrams, those held
+        first."""
         from mhtrack.io.asterix.api import sensors_with_periods
-        from mhtrack.pipeline.options import survey_area
 
         self.warmup = warm = warm_up(incoming, sensors, name=name,
                        use_receive_time=self.live.day_from == "receive",
@@ -229,18 +233,11 @@ class Live:
                 f"live: no rotation period for radar(s) {', '.join(map(str, missing))} in "
                 f"the sensors file nor from their CAT034 marks in the first "
                 f"{warm.span_s:.0f} s: give period in the sensors file")
-        config = None
-        if self.live_density_needed:
-            area = survey_area(name, warm.survey)
-            config = default_config(area=area.area) if area is not None else None
-            if self.emit is not None and area is not None:
-                self.emit(f"live: new-target density {config.new_target_density:.3g} "
-                          f"per m² per scan from the first {warm.span_s:.0f} s of plots "
-                          f"({area.width / 1e3:.3g} km × {area.height / 1e3:.3g} km box)")
         if self.emit is not None and warm.periods:
             self.emit("live: periods " + ", ".join(
                 f"radar {k} {v:.3g} s" for k, v in sorted(warm.periods.items())))
-        return sensors, config, itertools.chain(warm.datagrams, incoming)
+        survey = warm.survey if self.live_density_needed else None
+        return sensors, survey, itertools.chain(warm.datagrams, incoming)
 
     def _make_sinks(self, sensors: SensorSet, stdout: TextIO | None) -> None:
         from mhtrack.sinks.files import Cat062Sink

@@ -207,13 +207,16 @@ class Pipeline:
     Every default is chosen once, here (:func:`~mhtrack.pipeline.options.choose`):
     configuration (``config`` if given, else from the source's scenario or plots),
     fusion, the tracker with the source's sensors, the output frame. ``options``: what
-    the user set (:class:`TrackOptions`)."""
+    the user set (:class:`TrackOptions`); ``survey``: the source's survey when it was
+    taken elsewhere (else :meth:`Source.survey`)."""
 
     def __init__(self, source: Source, options: TrackOptions | None = None, *,
-                 config: MHTConfig | None = None) -> None:
+                 config: MHTConfig | None = None, survey: Survey | None = None) -> None:
         self.source = source
         self.options = TrackOptions() if options is None else options
         self.output = check_output(self.options.output)
+        if survey is not None:  # surveyed elsewhere (live: its first rotations)
+            self.__dict__["survey"] = survey
         survey = self.survey if source.scenario is None else None
         self.choices = choose(source, self.options, survey, config)
         self.config, self.tracker = self.choices.config, self.choices.tracker

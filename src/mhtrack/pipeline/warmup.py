@@ -6,10 +6,10 @@ datagrams of the first rotations, then
 * each radar's **period** comes from its CAT034/CAT002 sweep marks so far
   (:func:`~mhtrack.io.asterix.decode.sweep_periods`: the median I034/041, else the
   median interval between north markers — at least two of them);
-* the **new-target density** from the plots' robust box
-  (:func:`~mhtrack.pipeline.options.survey_area`, then
-  :func:`~mhtrack.build.default_config`: P1's 6.4 new targets per scan over it), the
-  same rule as ``track`` applies to a whole recording.
+* the **new-target density** (and the known κ of ``--tracker mht``) from the held
+  plots by the same rule as ``track`` applies to a whole recording
+  (:func:`~mhtrack.pipeline.options.choose`: for rotating radars,
+  :func:`~mhtrack.build.radar_rule` — their reach, periods and plots per rotation).
 
 The warm-up ends once the stream's time covers :data:`WARMUP_ROTATIONS` rotations of
 the slowest radar seen and every radar seen has a period, or after :data:`MAX_WARMUP_S`

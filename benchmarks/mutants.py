@@ -135,7 +135,7 @@ def _plots_by_packet(data: bytes, spans: list[tuple[int, int]]
         for at, what, found in decoder.blocks(payload, offset, problems, when):
             if what == "plots":
                 i = int(np.searchsorted(starts, at, side="right")) - 1
-                out[i].extend(tuple(float(r[j]) for j in idx) + (float(r[0]) % 86400,)
+                out[i].extend((*(float(r[j]) for j in idx), float(r[0]) % 86400)
                               for r in found)
     assert not problems.counts, problems.counts  # the base is undamaged
     return out

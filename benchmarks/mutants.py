@@ -318,6 +318,7 @@ def main(argv: list[str] | None = None) -> int:
         if fails:
             counts[fmt, kind][1] += 1
             failures.append(f"{fmt}-{kind}-{seed}: " + " | ".join(fails))
+            print("FAIL", failures[-1], flush=True)
         if i % 200 == 0:
             print(f"  {i} mutants, {len(failures)} failed", flush=True)
     print(f"{'format':8} {'damage':10} {'mutants':>8} {'failed':>7} {'raw-covered':>12}")
@@ -326,8 +327,6 @@ def main(argv: list[str] | None = None) -> int:
     total = sum(c[0] for c in counts.values())
     print(f"mutants: {total}, failed: {len(failures)}, raw blocks lost to a damaged "
           f"length (documented): {sum(c[2] for c in counts.values())}")
-    for f in failures[:20]:
-        print("FAIL", f)
     return 1 if failures else 0
 
 

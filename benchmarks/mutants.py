@@ -293,6 +293,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--timeout", type=float, default=120.0)
     ap.add_argument("--only", help="replay one mutant: FORMAT-KIND-SEED")
     ap.add_argument("--work", type=Path, default=None)
+    ap.add_argument("--shard", default="0/1", help="K/N: run the mutants K, K + N, ...")
     args = ap.parse_args(argv)
     work = args.work or Path(tempfile.mkdtemp(prefix="mutants-"))
     work.mkdir(parents=True, exist_ok=True)
@@ -307,6 +308,8 @@ def main(argv: list[str] | None = None) -> int:
         rng = random.Random(args.seed)
         jobs = [(rng.choice(FORMATS), rng.choice(KINDS), rng.randrange(2**31))
                 for _ in range(args.mutants)]
+        k, n = map(int, args.shard.split("/"))
+        jobs = jobs[k::n]
     counts: dict[tuple[str, str], list[int]] = collections.defaultdict(lambda: [0, 0, 0])
     failures: list[str] = []
     for i, (fmt, kind, seed) in enumerate(jobs, 1):

@@ -39,7 +39,6 @@ that block undecodable).
 
 from __future__ import annotations
 
-import functools
 import struct
 from collections.abc import Callable, Iterator
 
@@ -222,15 +221,12 @@ def _confirmed(data: bytes, q: int, at: Callable[[int], int]) -> bool:
 def _walk(data: bytes, start: int, at: Callable[[int], int], problems: Problems
           ) -> Iterator[tuple[int, int]]:
     """``(offset, length)`` of each valid record from ``start``. A record is taken when the
-    one after it is confirmed by :data:`CONFIRM` valid records in a row (or the file ends
-    there), or else when no confirmed record starts inside it (it is the last good record
-    before damage, not a false length swallowing good records). One valid record after
-    it is not enough: in a raw stream almost any octet reads as a category and a length
-    that fits, so a damaged length would swallow the good blocks up to a chance landing.
-    After damage, reading resumes at the next confirmed record, searched octet by octet
-    (damage may add or remove octets, so no alignment is assumed)."""
+    one after it is valid too (or the file ends there), or else when no record confirmed
+    by :data:`CONFIRM` valid records in a row (or by the end of the file) starts inside it
+    (it is the last good record before damage, not a false length swallowing good
+    records). After damage, reading resumes at the next confirmed record, searched octet
+    by octet (damage may add or remove octets, so no alignment is assumed)."""
     n = len(data)
-    at = functools.lru_cache(maxsize=4 * CONFIRM)(at)  # the next records are read again
 
     def confirmed(q: int) -> bool:
         return _confirmed(data, q, at)
@@ -238,7 +234,7 @@ def _walk(data: bytes, start: int, at: Callable[[int], int], problems: Problems
     p = start
     while p < n:
         step = at(p)
-        if step and (p + step == n or confirmed(p + step)
+        if step and (p + step == n or at(p + step)
                      or not any(confirmed(q) for q in range(p + 1, p + step))):
             yield p, step
             p += step

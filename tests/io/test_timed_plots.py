@@ -3,6 +3,7 @@ times against ``datetime``, frames against :func:`make_frames`, and write/read r
 
 from __future__ import annotations
 
+import logging
 from dataclasses import fields, replace
 from datetime import UTC, datetime, timedelta
 
@@ -163,9 +164,23 @@ def test_rows_out_of_order_within_the_window_give_the_sorted_table(tmp_path, sen
                    sensors=None)
     assert table_equal(replace(a, file_row=None), replace(b, file_row=None))
     assert b.file_row.tolist() == [1, 0, 4, 2, 3, 5]
-    with pytest.raises(ValueError, match=r"line 6, column 'time': time 1.0 is 1 s before "
-                       r"time 2.0 on line 5, beyond the reorder window of 0.5 s"):
-        read_plots(tmp_path / "b.csv", reorder_window_s=0.5)
+    # 0.5 s: "1.0" is 1 s before the latest but nothing after 0.5 had left the buffer
+    c = read_plots(tmp_path / "b.csv", reorder_window_s=0.5)
+    assert table_equal(replace(a, file_row=None), replace(c, file_row=None))
+
+
+def test_rows_beyond_the_window_dropped_with_the_sources_warning(tmp_path, caplog):
+    """0.2 s: "1.5" has left the buffer when "1.0" (line 6) arrives, so the row is
+    dropped, with the warning ``track`` gives (before: the whole file was refused)."""
+    rows = ["0.5,2,2,2", "0.0,2,1,1", "1.5,2,4,4", "2.0,2,5,5", "1.0,2,3,3", "2.5,2,6,6"]
+    path = write(tmp_path, "time,sensor,x,y\n" + "\n".join(rows) + "\n", "b.csv")
+    with caplog.at_level(logging.WARNING, logger="mhtrack"):
+        t = read_plots(path, reorder_window_s=0.2)
+    assert t.time.tolist() == [0.0, 0.5, 1.5, 2.0, 2.5]
+    assert t.file_row.tolist() == [1, 0, 2, 3, 5]
+    assert [r.getMessage() for r in caplog.records] == [
+        f"{path}: 1 plot dropped, late by 1 s (after later plots had gone to the tracker, "
+        "beyond the reorder window; first at line 6)"]
 
 
 def test_track_plot_references_translate_both_ways(tmp_path):

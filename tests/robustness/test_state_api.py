@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import io
 import json
+import math
 import sys
 import warnings
 import zipfile
@@ -254,3 +255,69 @@ def test_tracker_load_names_a_wrong_estimator_as_input_error(
 
     with pytest.raises(InputError, match=r"member 'meta': field 'clutter_name'"):
         MHTTracker.load(path, AGMMClutter())
+
+
+@pytest.mark.parametrize("origin", [[46.8, 8.2, 0.0], ["46.8", "8.2"], [True, False], [46.8]])
+def test_recipe_origin_not_two_numbers_is_an_input_error(
+        tmp_path: Path, states: dict[str, Any], origin: list[Any]) -> None:
+    """A radars' origin of three values raised a plain ``ValueError`` at the rebuild
+    ('too many values to unpack'); strings or booleans were taken as degrees."""
+    members, _ = states["async"]
+    meta = _meta(members)
+    meta["recipe"]["sensors"]["origin"] = origin
+    path = _write(tmp_path / "s.npz", _with_meta(members, meta))
+    with pytest.raises(InputError) as e:
+        build.load_tracker(path)
+    assert str(e.value).startswith(f"{path}, member 'meta': field 'recipe.sensors.origin'")
+    assert e.value.file == str(path) and e.value.key == "meta"
+
+
+def test_recipe_that_cannot_be_rebuilt_is_an_input_error(
+        tmp_path: Path, states: dict[str, Any], monkeypatch: pytest.MonkeyPatch) -> None:
+    """Whatever the checks let through and the rebuild refuses is an InputError naming
+    the file and the member (before: a plain ValueError)."""
+    members, _ = states["async"]
+    path = _write(tmp_path / "s.npz", members)
+
+    def refuse(*args: Any, **kwargs: Any) -> None:
+        raise ValueError("refused")
+
+    monkeypatch.setattr(build.parts, "make_tracker", refuse)
+    with pytest.raises(InputError, match=r"member 'meta': field 'recipe' cannot be rebuilt "
+                                         r"\(refused\)") as e:
+        build.load_tracker(path)
+    assert e.value.file == str(path) and e.value.key == "meta"
+
+
+def _config_fields() -> list[tuple[str, Any]]:
+    from dataclasses import fields
+
+    from mhtrack.mht.config import MHTConfig
+
+    return [(f.name, f.default) for f in fields(MHTConfig)
+            if isinstance(f.default, int | float) and not isinstance(f.default, bool)]
+
+
+@pytest.mark.parametrize(("name", "default"), _config_fields(),
+                         ids=[n for n, _ in _config_fields()])
+def test_config_by_hand_is_bounded(name: str, default: Any) -> None:
+    """``MHTConfig`` made by hand in Python: every number beyond :mod:`mhtrack.bounds`
+    (a float beyond ±1e15 or not finite, an integer beyond ±2^53) raises ``ValueError``
+    naming the field; before, ``sigma_w=1e308`` or ``max_leaves=10**30`` were taken and
+    overflowed later, inside ``step``."""
+    from mhtrack.mht.config import MHTConfig
+
+    huge = 10**30 if isinstance(default, int) else 1e308
+    for value in (huge, -huge) + (() if isinstance(default, int) else (math.inf, math.nan)):
+        with pytest.raises(ValueError, match=rf"^MHTConfig\.{name}"):
+            MHTConfig(**{name: value})
+    MHTConfig(**{name: default})  # the default itself is within every bound
+
+
+def test_config_bound_message() -> None:
+    from mhtrack.mht.config import MHTConfig
+
+    with pytest.raises(ValueError) as e:
+        MHTConfig(sigma_w=1e308)
+    assert str(e.value) == ("MHTConfig.sigma_w: 1e+308 is out of range (expected a finite "
+                            "number in [-1e15, 1e15])")

@@ -9,7 +9,7 @@ import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from mhtrack.sources.reorder import ReorderBuffer
+from mhtrack.io.reorder import ReorderBuffer
 
 
 def _run(times: list[float], window: float, cuts: list[int] | None = None

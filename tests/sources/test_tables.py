@@ -10,7 +10,6 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from mhtrack.errors import InputError
 from mhtrack.io.plots import read_plots
 from mhtrack.io.sensors import read_sensors
 from mhtrack.io.timed_plots import read_timed_plots
@@ -51,9 +50,11 @@ def test_without_sensors_file(opensky2: Path, tmp_path: Path) -> None:
 
 def test_rows_out_of_order(opensky2: Path, tmp_path: Path,
                            caplog: pytest.LogCaptureFixture) -> None:
-    """Row 100 moved 40 s later in the file: read_timed_plots refuses the file, the source
-    drops that row (one warning naming its line) and gives the frames of the file
-    without it; rows within the window are re-ordered."""
+    """Row 100 moved 40 s later in the file: the source drops that row (one warning
+    naming its line) and gives the frames of the file without it; read_timed_plots keeps
+    and drops the same rows by the same rule (before: it refused the whole file, so that
+    ``evaluate --plots`` refused a file ``track`` had taken); rows within the window are
+    re-ordered."""
     sensors = read_sensors(opensky2 / "sensors.toml")
     lines = (opensky2 / "plots.csv").read_text().splitlines(keepends=True)
     t = [float(x.split(",")[0]) for x in lines[1:]]
@@ -62,13 +63,17 @@ def test_rows_out_of_order(opensky2: Path, tmp_path: Path,
     late = lines[:moved + 1] + lines[moved + 2:to + 2] + [lines[moved + 1]] + lines[to + 2:]
     (tmp_path / "late.csv").write_text("".join(late))
     (tmp_path / "without.csv").write_text("".join(lines[:moved + 1] + lines[moved + 2:]))
-    with pytest.raises(InputError, match="reorder window"):
-        read_timed_plots(tmp_path / "late.csv", sensors)
+    with caplog.at_level(logging.WARNING, logger="mhtrack"):
+        read = read_timed_plots(tmp_path / "late.csv", sensors)
+    read_warnings = [r.getMessage() for r in caplog.records]
+    caplog.clear()
     src = open_source(tmp_path / "late.csv", sensors=sensors)
     with caplog.at_level(logging.WARNING, logger="mhtrack"):
         got = list(src)
     ref = list(read_timed_plots(tmp_path / "without.csv", sensors).scans())
     assert differences(ref, got) == []
+    assert differences(list(read.scans()), got) == []
+    assert to not in read.file_row.tolist() and read.file_row.size == len(t) - 1
     assert src.stats.late_dropped == 1
     lateness = t[to] - t[moved]  # the latest time before it arrived
     assert src.stats.max_late_s == pytest.approx(lateness) and 40.0 < lateness < 41.0
@@ -76,6 +81,7 @@ def test_rows_out_of_order(opensky2: Path, tmp_path: Path,
     assert warnings == [f"{tmp_path / 'late.csv'}: 1 plot dropped, late by "
                         f"{lateness:.3g} s (after later plots had gone to the tracker, "
                         f"beyond the reorder window; first at line {to + 2})"]
+    assert read_warnings == warnings  # one rule, one line
     # within the window: two neighbouring rows swapped come out sorted
     swap = lines[:1] + lines[1:50] + [lines[51], lines[50]] + lines[52:]
     (tmp_path / "swap.csv").write_text("".join(swap))
@@ -104,3 +110,26 @@ def test_scan_table_with_and_without_scenario(tmp_path: Path) -> None:
     assert differences(list(table.scans()), got) == []
     assert src.survey().n_frames == len(got) and src.scenario is sc
     assert src.file_rows(np.array([3, -1])).tolist() == [3, -1]
+
+
+def test_evaluate_takes_the_plots_file_track_took(opensky2: Path, tmp_path: Path) -> None:
+    """A timed plots file with one row 40 s late: ``track`` drops it with a warning, and
+    ``evaluate --plots`` reads the same file by the same rule (before: it refused it)."""
+    from click.testing import CliRunner
+
+    from mhtrack.cli.main import cli
+
+    lines = (opensky2 / "plots.csv").read_text().splitlines(keepends=True)
+    t = [float(x.split(",")[0]) for x in lines[1:]]
+    to = next(i for i in range(len(t)) if t[i] > t[100] + 40.0)
+    (tmp_path / "late.csv").write_text("".join(lines[:101] + lines[102:to + 2] + [lines[101]]
+                                               + lines[to + 2:]))
+    sensors = str(opensky2 / "sensors.toml")
+    r = CliRunner().invoke(cli, ["track", str(tmp_path / "late.csv"), "--sensors", sensors,
+                                 "--out", str(tmp_path / "tracks.csv")])
+    assert r.exit_code == 0, r.output
+    r = CliRunner().invoke(cli, ["evaluate", str(tmp_path / "tracks.csv"),
+                                 str(opensky2 / "truth.csv"), "--plots",
+                                 str(tmp_path / "late.csv"), "--sensors", sensors, "--json"])
+    assert r.exit_code == 0, r.output
+    assert '"ospa' in r.output

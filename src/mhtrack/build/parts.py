@@ -220,6 +220,7 @@ def load_tracker(path: str | os.PathLike[str]) -> MHTTracker:
     estimator, motion model, birth process and coverage are rebuilt, then
     :meth:`MHTTracker.load` restores their states. A tracker assembled by hand has no
     recipe: load it with :meth:`MHTTracker.load` and its parts."""
+    from mhtrack.io.npzfile import member_error
     from mhtrack.mht.state import saved_meta
 
     meta = saved_meta(path)
@@ -235,9 +236,8 @@ def load_tracker(path: str | os.PathLike[str]) -> MHTTracker:
                              clutter_density=recipe.get("clutter_density"), sensors=sensors,
                              clutter_frame=recipe.get("clutter_frame", names.DEFAULT_CLUTTER_FRAME),
                              clutter_params=recipe.get("clutter_params"))
-    except (KeyError, TypeError, ValueError) as e:
-        raise ValueError(f"{path}: member 'meta': field 'recipe' cannot be rebuilt "
-                         f"({e})") from None
+    except (KeyError, TypeError, ValueError, OverflowError) as e:
+        raise member_error(path, "meta", f"field 'recipe' cannot be rebuilt ({e})") from None
     trk = MHTTracker.load(path, fresh.clutter, motion=fresh.motion, birth=fresh.birth,
                           coverage=fresh.coverage)
     trk.recipe = recipe

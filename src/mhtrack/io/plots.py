@@ -26,7 +26,8 @@ from mhtrack.io._frame import (
 from mhtrack.io._source import PathArg, Source
 from mhtrack.io.plot_attributes import KINDS as ATTRIBUTE_KINDS
 from mhtrack.io.plot_attributes import attribute_columns, read_attributes
-from mhtrack.io.timed_plots import DEFAULT_REORDER_WINDOW_S, read_timed_plots
+from mhtrack.io.reorder import DEFAULT_REORDER_WINDOW_S
+from mhtrack.io.timed_plots import read_timed_plots
 from mhtrack.models.linalg2 import det2
 from mhtrack.models.radars import SensorSet
 from mhtrack.models.sensors import CartesianSensor, PolarRadar
@@ -315,15 +316,23 @@ def plots_to_file_rows(plot: np.ndarray, table: PlotTable) -> np.ndarray:
     return np.where(plot == NO_PLOT, NO_PLOT, rows[np.maximum(plot, 0)])
 
 
+#: :func:`plots_to_table_rows` of a file row the table does not hold (beyond the file, or
+#: a row dropped as too late by the re-order rule, :mod:`mhtrack.io.reorder`).
+NOT_A_ROW = -2
+
+
 def plots_to_table_rows(plot: np.ndarray, table: PlotTable) -> np.ndarray:
-    """The inverse of :func:`plots_to_file_rows`: file rows (``-1`` kept) as table rows."""
+    """The inverse of :func:`plots_to_file_rows`: file rows (``-1`` kept) as table rows;
+    :data:`NOT_A_ROW` for a file row that is no row of ``table``."""
     rows = file_rows(table)
     plot = np.asarray(plot, np.int64)
     if rows is None:
-        return plot
-    inverse = np.empty(len(rows), np.int64)
+        return np.where((plot >= len(table)) | (plot < NO_PLOT), NOT_A_ROW, plot)
+    size = max(len(rows), int(rows.max()) + 1 if len(rows) else 0)
+    inverse = np.full(size + 1, NOT_A_ROW, np.int64)  # the last: every row beyond
     inverse[rows] = np.arange(len(rows))
-    return np.where(plot == NO_PLOT, NO_PLOT, inverse[np.maximum(plot, 0)])
+    at = np.where((plot < 0) | (plot > size), size, plot)
+    return np.where(plot == NO_PLOT, NO_PLOT, inverse[at])
 
 
 def write_plots(table: PlotTable, path: PathArg) -> None:

@@ -5,14 +5,15 @@ and its position as ``range, bearing`` (polar radars), ``x, y`` (local frame) or
 
 Reading converts every plot into the local frame with :mod:`mhtrack.models.geodesy`
 through the :class:`~mhtrack.models.radars.SensorSet` of a sensors file (its frame and
-sites), checks that the rows are in time order to within a reorder window, cuts them into
+sites), keeps the rows that the sources' re-order buffer keeps (:mod:`mhtrack.io.reorder`:
+rows out of order within the window sorted, later ones dropped with one warning), cuts them into
 one-sensor frames with :func:`mhtrack.frames.make_frames` and returns a timed
 :class:`~mhtrack.records.PlotTable` whose ``file_row`` maps each row back to the file.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable
+import logging
 from dataclasses import dataclass
 
 import numpy as np
@@ -25,12 +26,10 @@ from mhtrack.io._source import PathArg
 from mhtrack.io._times import is_iso, seconds
 from mhtrack.io.plot_attributes import KINDS as ATTRIBUTE_KINDS
 from mhtrack.io.plot_attributes import read_attributes
+from mhtrack.io.reorder import DEFAULT_REORDER_WINDOW_S, kept_and_late
 from mhtrack.models.radars import RadarSensor, SensorSet
 from mhtrack.records import MAX_COORDINATE, PlotTable
 
-#: Rows may come out of time order by at most this much (s) by default (network jitter
-#: between radars): a row's time must be ≥ the largest time of the rows above it − window.
-DEFAULT_REORDER_WINDOW_S = 2.0
 #: Largest range accepted (m): 20 000 km, about half a meridian (20 003.9 km) — farther
 #: than any point of the Earth from the site along the ground.
 MAX_RANGE_M = 2e7
@@ -54,17 +53,25 @@ def read_timed_plots(
     own σ applies) and ``range``/``bearing`` are only carried along. With ``sensors``:
     a polar sensor's rows need ``range, bearing`` (``z, R`` by
     :func:`~mhtrack.models.geodesy.polar_to_local`), a Cartesian sensor's rows ``x, y`` or
-    ``lat, lon`` (``LocalFrame.to_local``) with ``R = σ² I``. Rows out of time order by
-    more than ``reorder_window_s`` are refused (:mod:`mhtrack.sources` re-orders and drops
-    instead).
+    ``lat, lon`` (``LocalFrame.to_local``) with ``R = σ² I``. Rows out of time order are
+    kept or dropped by the one rule of the sources (:mod:`mhtrack.io.reorder`, window
+    ``reorder_window_s``): a dropped row is left out with one warning line naming the
+    first one's line, as ``track`` says it.
 
     Returns a ``PlotTable(timed=True)`` sorted by frame, then time; ``file_row[i]`` is the
     0-based file row of table row ``i``.
     """
     if not reorder_window_s >= 0:
         raise ValueError(f"reorder_window_s must be >= 0, got {reorder_window_s!r}")
-    f, c = read_timed_columns(path, sensors, order=lambda f, time: _check_order(
-        f, time, reorder_window_s))
+    f, c = read_timed_columns(path, sensors)
+    on_time, late = kept_and_late(c.time, reorder_window_s)
+    rows = np.flatnonzero(on_time)
+    if late.n:
+        logging.getLogger("mhtrack").warning("%s", late.line(
+            str(path), f.src.where(int(late.first["row"]))))  # type: ignore[call-overload]
+        c = TimedColumns(*(None if v is None else v[on_time] for v in (
+            c.time, c.sensor, c.x, c.y, c.range, c.bearing, c.origin, c.R)),
+            attrs=None if c.attrs is None else c.attrs.take(rows))
     periods = {s: sensors.sensor(s).period if sensors is not None else None
                for s in np.unique(c.sensor).tolist()}
     frame, order = make_frames(c.time, c.sensor, frame_lengths(periods))
@@ -75,7 +82,7 @@ def read_timed_plots(
     return PlotTable(
         scan=frame[order], time=c.time[order], sensor=c.sensor[order], x=take(c.x),
         y=take(c.y), range=take(c.range), bearing=take(c.bearing), origin=take(c.origin),
-        R=take(c.R), timed=True, file_row=order.astype(np.int64), iso_times=is_iso(f),
+        R=take(c.R), timed=True, file_row=rows[order].astype(np.int64), iso_times=is_iso(f),
         attrs=None if c.attrs is None else c.attrs.take(order),
     )  # type: ignore[arg-type]
 
@@ -96,20 +103,16 @@ class TimedColumns:
     attrs: PlotAttributes | None = None
 
 
-def read_timed_columns(
-    path: PathArg, sensors: SensorSet | None = None, *,
-    order: Callable[[Frame, np.ndarray], None] | None = None,
-) -> tuple[Frame, TimedColumns]:
+def read_timed_columns(path: PathArg, sensors: SensorSet | None = None
+                       ) -> tuple[Frame, TimedColumns]:
     """Read, check and convert a timed plots file (as :func:`read_timed_plots`, without
-    cutting frames): the file (for located errors) and its rows in file order. ``order``
-    checks the times before anything else is read (``read_timed_plots``: the window)."""
+    re-ordering or cutting frames): the file (for located errors) and its rows in file
+    order."""
     f = read_frame(path, COLUMNS, REQUIRED, "timed plots")
     if f.n == 0:
         f.fail("no rows (a plots file needs at least one plot)")
     _check_pairs(f)
     time = seconds(f)
-    if order is not None:
-        order(f, time)
     sensor = f.ints("sensor")
     origin = None
     if f.has("origin"):
@@ -153,23 +156,6 @@ def _check_pairs(f: Frame) -> None:
     if not any(f.has(a) for a, _ in PAIRS):
         f.fail("no plot positions: a plots file without 'scan' needs columns 'range' and "
                "'bearing', 'x' and 'y', or 'lat' and 'lon'")
-
-
-def _check_order(f: Frame, time: np.ndarray, window: float) -> None:
-    """Each row's time ≥ (largest time of the rows above it) − ``window``."""
-    if time.size < 2:
-        return
-    before = np.maximum.accumulate(time)[:-1]
-    late = np.concatenate(([False], time[1:] < before - window))
-
-    def text(r: int) -> str:
-        m = before[r - 1]
-        at = int(np.flatnonzero(time[:r] == m)[0])
-        return (f"time {f.text('time', r)} is {m - time[r]:.6g} s before time "
-                f"{f.text('time', at)} on {f.src.where(at)}, beyond the reorder window of "
-                f"{window:g} s; sort the rows by time (or widen reorder_window_s)")
-
-    f.check(late, "time", text)
 
 
 def _floats_or_none(f: Frame, name: str) -> np.ndarray | None:

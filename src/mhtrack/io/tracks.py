@@ -28,7 +28,7 @@ from mhtrack.io._frame import (
 )
 from mhtrack.io._source import PathArg, file_format
 from mhtrack.io._times import seconds, time_column
-from mhtrack.io.plots import plots_to_file_rows, plots_to_table_rows
+from mhtrack.io.plots import NOT_A_ROW, plots_to_file_rows, plots_to_table_rows
 from mhtrack.io.truth import read_truth
 from mhtrack.records import NO_PLOT, PlotTable, TrackTable, TruthTable
 
@@ -131,9 +131,10 @@ def read_tracks(
         check_scan_order(f, scan, time)
     check_unique(f, scan, tid, "track_id")
     if plots is not None:
-        f.check(plot >= len(plots), "plot", lambda r: f"plot {num(plot[r])} is not a row of "
+        rows = plots_to_table_rows(plot, plots)
+        f.check(rows == NOT_A_ROW, "plot", lambda r: f"plot {num(plot[r])} is not a row of "
                 f"the plots file ({len(plots)} plots)")
-        plot = plots_to_table_rows(plot, plots)
+        plot = rows
     return TrackTable(scan=scan, time=time, track_id=tid, plot=plot, score=score,
                       tentative=tentative, **cols)
 

@@ -11,6 +11,7 @@ import math
 from dataclasses import asdict, dataclass, fields
 from typing import Any
 
+from mhtrack.bounds import float_problem, int_problem
 from mhtrack.models.imm import CVModelSet
 from mhtrack.models.motion import ConstantVelocity, MotionModel
 from mhtrack.names import BIRTHS
@@ -30,6 +31,11 @@ REMOVED_FIELDS = ("milp_time_limit",)
 @dataclass(frozen=True)
 class MHTConfig:
     """Configuration of :class:`~mhtrack.mht.tracker.MHTTracker`.
+
+    Built by hand or read from a state, every number is checked when the object is made:
+    first against :mod:`mhtrack.bounds` (finite within ±1e15, integers within ±2^53),
+    then against its own range below; a ``ValueError`` names the field
+    (``MHTConfig.sigma_w: 1e+308 is out of range (...)``, ``docs/errors.md``).
 
     Parameters
     ----------
@@ -176,6 +182,12 @@ class MHTConfig:
             if not ok:
                 raise ValueError(f"MHTConfig.{name} must be {what}, got {getattr(self, name)!r}")
 
+        for f in fields(self):  # mhtrack.bounds first: no later square or exp overflows
+            v = getattr(self, f.name)
+            if isinstance(v, int | float) and not isinstance(v, bool):
+                problem = int_problem(v) if _is_int(v) else float_problem(v)
+                if problem is not None:
+                    raise ValueError(f"MHTConfig.{f.name}: {problem}")
         for name in ("p_detection", "gate_probability", "alpha", "beta"):
             v = getattr(self, name)
             check(name, isinstance(v, int | float) and 0.0 < v < 1.0, "in (0, 1)")

@@ -187,6 +187,11 @@ def _recipe(path: PathArg, recipe: object) -> None:
     if sensors is not None:
         from mhtrack.models.radars import RadarSensor, SensorSet
 
+        origin = sensors.get("origin") if isinstance(sensors, dict) else None
+        if origin is not None and not (isinstance(origin, list) and len(origin) == 2 and all(
+                isinstance(v, int | float) and not isinstance(v, bool) for v in origin)):
+            raise fail("sensors.origin", "expected null or [lat, lon], two numbers, got "
+                       f"{clip(repr(origin))}")
         try:
             origin = sensors["origin"]
             SensorSet(None if origin is None else (float(origin[0]), float(origin[1])),

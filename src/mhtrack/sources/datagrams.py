@@ -46,11 +46,12 @@ from mhtrack.io.asterix.problems import Problems
 from mhtrack.io.asterix.sites import sensors_with_sites, skipped_line
 from mhtrack.io.asterix.timeaxis import TimeAxis
 from mhtrack.io.plot_attributes import decoded_attributes
-from mhtrack.io.timed_plots import DEFAULT_REORDER_WINDOW_S, polar_plots
+from mhtrack.io.reorder import DEFAULT_REORDER_WINDOW_S
+from mhtrack.io.reorder import kept as kept_by_buffer
+from mhtrack.io.timed_plots import polar_plots
 from mhtrack.models.radars import SensorSet
 from mhtrack.records import Scan
 from mhtrack.sources.base import Source, SourceStats, Survey
-from mhtrack.sources.reorder import kept as kept_by_buffer
 from mhtrack.sources.timed import TimedStream
 
 #: Plots decoded before they are converted and pushed on (memory: a few hundred kB).

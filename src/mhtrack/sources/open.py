@@ -24,7 +24,7 @@ def open_source(path: PathArg, *, sensors: SensorSet | None = None,
     without one: :mod:`mhtrack.io.asterix.sites`);
     ``scenario``: the sensors and scan times of a scan table; ``reorder_window_s``: the
     re-order window of timed plots (default
-    :data:`~mhtrack.io.timed_plots.DEFAULT_REORDER_WINDOW_S`). Nothing else is guessed:
+    :data:`~mhtrack.io.reorder.DEFAULT_REORDER_WINDOW_S`). Nothing else is guessed:
     a sensors file beside the plots is the caller's choice."""
     from mhtrack.io.asterix.api import is_recording
 

@@ -26,10 +26,10 @@ from mhtrack.frames import DEFAULT_FRAME_S, frame_lengths
 from mhtrack.io._source import PathArg
 from mhtrack.io._times import is_iso
 from mhtrack.io.plots import check_scan_times, is_timed, read_plots
-from mhtrack.io.timed_plots import DEFAULT_REORDER_WINDOW_S, read_timed_columns
+from mhtrack.io.reorder import DEFAULT_REORDER_WINDOW_S, kept
+from mhtrack.io.timed_plots import read_timed_columns
 from mhtrack.records import PlotTable, Scan
 from mhtrack.sources.base import Source, SourceStats, Survey
-from mhtrack.sources.reorder import kept
 from mhtrack.sources.timed import TimedStream
 
 if TYPE_CHECKING:

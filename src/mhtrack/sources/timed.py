@@ -1,5 +1,5 @@
 """Timed plots in arrival order → frames in processing order: the re-order buffer
-(:mod:`~mhtrack.sources.reorder`), then the framer (:mod:`~mhtrack.sources.framer`),
+(:mod:`~mhtrack.io.reorder`), then the framer (:mod:`~mhtrack.sources.framer`),
 then :class:`~mhtrack.records.Scan` frames with running row numbers. Shared by every
 source of timed plots (tables, recordings, datagrams)."""
 
@@ -11,10 +11,10 @@ from collections.abc import Callable, Iterator, Mapping
 import numpy as np
 
 from mhtrack.attributes import of_columns
+from mhtrack.io.reorder import ReorderBuffer
 from mhtrack.records import Scan
 from mhtrack.sources.base import SourceStats
 from mhtrack.sources.framer import Frame, Framer
-from mhtrack.sources.reorder import ReorderBuffer
 
 
 class TimedStream:

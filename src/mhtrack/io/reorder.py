@@ -5,9 +5,13 @@ Rule (``docs/sources.md``, *Ordering*): with ``M`` the latest plot time seen so 
 ``W`` the window (s), a plot is held until ``M − t > W``, then released; held plots leave
 in time order, ties in arrival order. A plot whose time is before the last time already
 released cannot be put in order: it is dropped, counted, and its lateness ``M − t``
-recorded. A plot at most ``W`` older than ``M`` is therefore never dropped — the same
-rows that :func:`mhtrack.io.timed_plots.read_timed_plots` accepts (a row's time ≥ the
-largest time above it − ``W``) all come through, sorted.
+recorded. A plot at most ``W`` older than ``M`` is therefore never dropped.
+
+This is the one rule for every reader of timed plots: the sources (``track``, ``live``)
+push their plots through the buffer as they come, and
+:func:`mhtrack.io.timed_plots.read_timed_plots` (``read_plots``, ``evaluate --plots``)
+replays it on a whole file (:func:`kept`), so that both keep and drop the same rows, with
+the same warning line (:meth:`Late.line`).
 
 The buffer holds the plots of the last ``W`` seconds of the stream (plus the current
 batch), never the whole input.
@@ -21,7 +25,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from mhtrack.io.timed_plots import DEFAULT_REORDER_WINDOW_S
+#: Plots may come out of time order by this much (s) by default (network jitter between
+#: radars): a plot at most this much older than the latest one seen is never dropped.
+DEFAULT_REORDER_WINDOW_S = 2.0
 
 Columns = Mapping[str, np.ndarray]
 
@@ -148,13 +154,22 @@ def kept(time: np.ndarray, window_s: float = DEFAULT_REORDER_WINDOW_S) -> np.nda
     """Which plots (times in arrival order) :class:`ReorderBuffer` lets through: the
     buffer's own rule replayed on the times alone, so that what is surveyed before
     tracking (the plots' area) is what the tracker will get."""
+    return kept_and_late(time, window_s)[0]
+
+
+def kept_and_late(time: np.ndarray, window_s: float = DEFAULT_REORDER_WINDOW_S
+                  ) -> tuple[np.ndarray, Late]:
+    """:func:`kept`, and the :class:`Late` record of the dropped plots (``first["row"]``:
+    the 0-based arrival number of the first one)."""
     buf = ReorderBuffer(window_s)
-    seq = [buf.push({"time": np.asarray(time, float)}).get("seq"), buf.flush().get("seq")]
-    out = np.zeros(np.size(time), bool)
+    t = np.asarray(time, float)
+    seq = [buf.push({"time": t, "row": np.arange(t.size)}).get("seq"),
+           buf.flush().get("seq")]
+    out = np.zeros(t.size, bool)
     for s in seq:
         if s is not None:
             out[s] = True
-    return out
+    return out, buf.late
 
 
 def _scalar(v: object) -> object:

@@ -25,6 +25,7 @@ pytest.importorskip("asterix.generated", reason="libasterix not installed")
 pyasteryx = pytest.importorskip("pyasteryx", reason="pyasteryx (extra [reference])")
 pd = pytest.importorskip("pandas", reason="pandas (extra [pandas])")
 
+from sim_recording import simulated_recording  # noqa: E402
 from udp_drain import drain  # noqa: E402
 
 from mhtrack.io.asterix.cat062 import lsb062  # noqa: E402
@@ -40,21 +41,10 @@ def _env() -> dict[str, str]:
 
 @pytest.fixture(scope="module")
 def recording(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    from click.testing import CliRunner
-
-    from mhtrack.cli.main import cli
-
-    out = tmp_path_factory.mktemp("live")
-    for args in (["simulate", "opensky-radars", "--seed", "1", "--scans", "8", "--out",
-                  str(out)],
-                 ["export", str(out / "plots.csv"), "--sensors", str(out / "sensors.toml"),
-                  "--out", str(out / "radar.pcap")],
-                 ["track", str(out / "radar.pcap"), "--sensors", str(out / "sensors.toml"),
-                  "--output", "online", "--birth-density", DENSITY, "--out",
-                  str(out / "online.csv")]):
-        r = CliRunner().invoke(cli, args)
-        assert r.exit_code == 0, r.output
-    return out
+    return simulated_recording(
+        tmp_path_factory.mktemp("live"), seed=1, scans=8, name="radar.pcap",
+        then=(["track", "{out}/radar.pcap", "--sensors", "{out}/sensors.toml", "--output",
+               "online", "--birth-density", DENSITY, "--out", "{out}/online.csv"],))
 
 
 def _drain(sock: socket.socket) -> list[bytes]:

@@ -18,6 +18,8 @@ import pytest
 
 pytest.importorskip("asterix.generated", reason="libasterix not installed")
 
+from sim_recording import simulated_recording  # tests/helpers
+
 from mhtrack.io.sensors import read_sensors
 from mhtrack.pipeline import Pipeline, TrackOptions
 from mhtrack.pipeline.health import Health
@@ -30,18 +32,7 @@ OPTIONS = TrackOptions(output="online", new_target_density=1e-10)
 
 @pytest.fixture(scope="module")
 def rec(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    from click.testing import CliRunner
-
-    from mhtrack.cli.main import cli
-
-    out = tmp_path_factory.mktemp("live")
-    for args in (["simulate", "opensky-radars", "--seed", "2", "--scans", "5", "--out",
-                  str(out)],
-                 ["export", str(out / "plots.csv"), "--sensors", str(out / "sensors.toml"),
-                  "--out", str(out / "radar.ast")]):
-        r = CliRunner().invoke(cli, args)
-        assert r.exit_code == 0, r.output
-    return out
+    return simulated_recording(tmp_path_factory.mktemp("live"), seed=2, scans=5)
 
 
 def _pipe(data: bytes) -> tuple[BinaryIO, threading.Thread]:

@@ -290,3 +290,22 @@ def test_not_a_recording_without_sensors(recs: dict[str, Path]) -> None:
     with pytest.raises(InputError, match=r"no plot with a measured position of a radar "
                        r"with a known site \(radars 1 \(SAC 0, SIC 1\), "):
         open_source(recs[".ast"]).survey()  # simulated: no I034/120, no sensors file
+
+
+@pytest.mark.parametrize("lag", [0.1, 1.0, 3.0, 20.0])
+def test_a_second_lan_behind_changes_nothing(opensky2: Path, recs: dict[str, Path],
+                                             lag: float) -> None:
+    """Every datagram again on a second LAN ``lag`` s of capture time behind, merged in
+    time order: the frames of the one LAN, one duplicate per datagram (before: a second
+    LAN 1 s behind — past the 0.5 s duplicate window, within the 2 s re-order window —
+    doubled every plot, and one 3 s behind the plots at the last time released)."""
+    data = recs[".pcap"].read_bytes()
+    grams = [(bytes(p), when) for _, when, p in units(data, "pcap", "x", {34, 48},
+                                                       Problems())]
+    two = sorted(grams + [(p, t + lag) for p, t in grams], key=lambda g: g[1])
+    sensors = read_sensors(opensky2 / "sensors.toml")
+    ref = list(DatagramSource(grams, sensors=sensors))
+    src = DatagramSource(two, sensors=sensors)
+    assert differences(ref, list(src)) == []
+    assert src.problems.counts.get("duplicate", 0) == len(grams)
+    assert src.stats.late_dropped == 0

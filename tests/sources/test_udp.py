@@ -63,6 +63,25 @@ def test_two_lans_merged_every_datagram_once() -> None:
     assert sorted(s.per_input.values()) == [200, 300]
 
 
+def test_two_lans_read_in_turn() -> None:
+    """The kernel holds 400 copies on each of two LANs (sent as a replay sends them: each
+    datagram to one, then to the other) before the reader looks: it reads them in turn,
+    so neither LAN's copies fall behind the other's by more than one (one socket emptied
+    first put one LAN 400 datagrams behind)."""
+    reader = UdpReader(["udp://127.0.0.1:0", "udp://127.0.0.1:0"])
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as s:
+        for i in range(400):
+            for k in (0, 1):
+                s.sendto(b"%d%04d" % (k, i), ("127.0.0.1", reader.addresses[k][1]))
+    reader.stop.set()  # the stop reads what the kernel holds, then ends
+    got = [d for d, _ in reader]
+    assert len(got) == 800
+    lag = [abs(sum(d[:1] == b"0" for d in got[:n]) - sum(d[:1] == b"1" for d in got[:n]))
+           for n in range(len(got) + 1)]
+    assert max(lag) <= 1
+    assert [d for d in got if d[:1] == b"1"] == [b"1%04d" % i for i in range(400)]
+
+
 def test_ipv6_loopback() -> None:
     try:
         reader = UdpReader(["udp://[::1]:0"])

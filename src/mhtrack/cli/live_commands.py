@@ -33,26 +33,66 @@ class Speed(click.ParamType):
         return v
 
 
+class DelayArg(click.ParamType):
+    """``P:SECONDS``: a chance in [0, 1] and a delay in seconds ≥ 0."""
+
+    name = "P:SECONDS"
+
+    def convert(self, value: object, param: click.Parameter | None,
+                ctx: click.Context | None) -> tuple[float, float]:
+        if isinstance(value, tuple):
+            return value  # type: ignore[return-value]
+        try:
+            p, s = (float(x) for x in str(value).split(":"))
+        except ValueError:
+            p = s = math.nan
+        if not (0 <= p <= 1 and 0 <= s < math.inf):
+            self.fail(f"{value!r} is not P:SECONDS (a chance in [0, 1], seconds >= 0)",
+                      param, ctx)
+        return p, s
+
+
 @click.command()
 @click.argument("recording", type=click.Path(exists=True, dir_okay=False, path_type=Path))
-@click.option("--to", "to", required=True, help="Destination udp://HOST:PORT (IPv6: "
-              "udp://[ADDR]:PORT; a multicast group is sent to with TTL 1).")
+@click.option("--to", "to", required=True, multiple=True, help="Destination "
+              "udp://HOST:PORT (IPv6: udp://[ADDR]:PORT; a multicast group is sent to with "
+              "TTL 1); repeat for redundant LANs: every datagram goes to each.")
 @click.option("--speed", type=Speed(), default=None,
               help="Time scale: 1 real time, 10 ten times faster, max as fast as the socket "
               "takes them [1].")
 @click.option("--loop", is_flag=True, help="Play the recording again and again until "
               "Ctrl-C (times of day repeat: for load, not for one track picture).")
+@click.option("--drop", type=click.FloatRange(0, 1), default=None,
+              help="Damage (tests): each copy of a datagram is not sent with this chance "
+              "[0].")
+@click.option("--delay", type=DelayArg(), default=None,
+              help="Damage (tests): each copy is sent SECONDS of recording time late with "
+              "chance P (the delay scaled by --speed as the spacing is).")
+@click.option("--seed", type=click.IntRange(min=0), default=None,
+              help="Seed of --drop and --delay's draws: the same seed damages the same "
+              "copies at any speed [0].")
 @needs_libasterix
-def replay(recording: Path, to: str, speed: float | None, loop: bool) -> None:
+def replay(recording: Path, to: tuple[str, ...], speed: float | None, loop: bool,
+           drop: float | None, delay: tuple[float, float] | None, seed: int | None
+           ) -> None:
     """Send RECORDING's ASTERIX datagrams over UDP with their original spacing."""
+    from mhtrack.sources.damage import Damage
     from mhtrack.sources.replay import replay as play
     from mhtrack.sources.udp import stop_on_signals
 
+    p, s = delay or (Damage.delay, Damage.delay_s)
+    drop = Damage.drop if drop is None else drop
+    if drop + p > 1:
+        raise click.BadParameter(f"--drop {drop} and --delay's chance {p} add up to "
+                                 "more than 1", param_hint="--drop/--delay")
+    damage = Damage(drop, p, s, Damage.seed if seed is None else seed)
     with stop_on_signals(threading.Event()) as stop:
-        stats = play(recording, to, loops=None if loop else 1, stop=stop,
+        stats = play(recording, to, loops=None if loop else 1, stop=stop, damage=damage,
                      **({} if speed is None else {"speed": speed}))
+    hurt = (f"; {stats.dropped} copies dropped, {stats.delayed} delayed"
+            if drop or p else "")
     say(f"sent {stats.datagrams} datagrams ({stats.bytes} bytes, {stats.passes} "
-        f"passes) to {to}")
+        f"passes) to {', '.join(to)}{hurt}")
 
 
 @click.command()

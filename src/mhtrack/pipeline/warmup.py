@@ -28,6 +28,7 @@ from typing import Any
 import numpy as np
 
 from mhtrack.io.asterix.decode import MARKS, Decoder, sweep_periods
+from mhtrack.io.asterix.duplicates import stream_filter
 from mhtrack.io.asterix.problems import Problems
 from mhtrack.io.asterix.timeaxis import TimeAxis
 from mhtrack.models.radars import SensorSet
@@ -61,7 +62,8 @@ def warm_up(datagrams: Iterator[tuple[bytes, float]], sensors: SensorSet, *, nam
 
     given = {s.id: float(s.period) for s in sensors.sensors if s.period is not None}
     ids = {s.id for s in sensors.sensors if s.kind == "polar"}  # radars waited for
-    decoder, problems, axis = Decoder(), Problems(), TimeAxis()
+    decoder = Decoder(duplicates=stream_filter())
+    problems, axis = Problems(), TimeAxis()
     held: list[tuple[bytes, float]] = []
     marks: list[tuple[Any, ...]] = []
     seen: set[int] = set()

@@ -2,10 +2,11 @@
 file's packets) decoded in memory, chunk by chunk, into frames (``docs/sources.md``).
 
 Each datagram's data blocks are decoded by :class:`~mhtrack.io.asterix.decode.Decoder`
-(a block received twice within the duplicate window is dropped — redundant LANs —;
-CAT048 and CAT001 plots, reports that are no plots left out; CAT034/CAT002 sweep marks
-and sites; other parts counted and skipped, one warning line per kind at the end); times
-of day go on one monotonic axis (:class:`~mhtrack.io.asterix.timeaxis.TimeAxis`, with the
+(a block equal to one of the last 4 096 received, however late, is dropped — redundant
+LANs, :func:`~mhtrack.io.asterix.duplicates.stream_filter` —; CAT048 and CAT001 plots,
+reports that are no plots left out; CAT034/CAT002 sweep marks and sites; other parts
+counted and skipped, one warning line per kind at the end); times of day go on one
+monotonic axis (:class:`~mhtrack.io.asterix.timeaxis.TimeAxis`, with the
 datagrams' capture times where given); every :data:`CHUNK` plots are converted to the
 local frame — ground range (:func:`~mhtrack.io.asterix.api.ground_ranges`) then
 :func:`~mhtrack.io.timed_plots.polar_plots`, the conversion of ``mhtrack convert`` +
@@ -42,6 +43,7 @@ from mhtrack.errors import InputError
 from mhtrack.frames import frame_lengths
 from mhtrack.io.asterix.api import ground_ranges
 from mhtrack.io.asterix.decode import MARKS, PLOT_COLUMNS, Decoder, plot_columns, sweep_periods
+from mhtrack.io.asterix.duplicates import stream_filter
 from mhtrack.io.asterix.problems import Problems
 from mhtrack.io.asterix.sites import sensors_with_sites, skipped_line
 from mhtrack.io.asterix.timeaxis import TimeAxis
@@ -129,7 +131,8 @@ class DatagramSource(Source):
         x, y, R, file_row, offset``; radars without a site left out) or, with ``convert``
         false, as decoded (:data:`~mhtrack.io.asterix.decode.PLOT_COLUMNS` with the time
         on the axis, ``offset``); sweep marks (time on the axis) go to ``sweeps``."""
-        self._decoder = decoder = Decoder(fast=self.fast)
+        self._decoder = decoder = Decoder(fast=self.fast,
+                                          duplicates=stream_filter())
         self.axis = axis = TimeAxis()
         axis.day0, axis.latest = self.axis_start
         self.decoded = 0

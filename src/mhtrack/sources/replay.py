@@ -8,16 +8,19 @@ datagram, at the time of day of the block's first CAT048/CAT034 record (on one a
 across midnight, :class:`TimeAxis`; a block without one keeps the previous time). The
 spacing of the times is kept, divided by ``speed`` (``math.inf``: as fast as the socket
 takes them). ``loops`` plays the file that many times
-(``None``: until ``stop``), each pass starting one mean spacing after the last.
+(``None``: until ``stop``), each pass starting one mean spacing after the last. Several
+destinations (redundant LANs) get every datagram each; ``damage`` drops and delays copies
+at random, reproducibly (:mod:`~mhtrack.sources.damage`).
 """
 
 from __future__ import annotations
 
+import math
 import mmap
 import socket
 import threading
 import time
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -26,6 +29,7 @@ from mhtrack.io.asterix.framings import recognise, units
 from mhtrack.io.asterix.problems import Problems
 from mhtrack.io.asterix.timeaxis import TimeAxis
 from mhtrack.io.paths import check_input_file
+from mhtrack.sources.damage import Damage, DamageCounts, damaged
 from mhtrack.sources.udp import Endpoint, parse_endpoint
 
 
@@ -69,6 +73,9 @@ class ReplayStats:
     datagrams: int = 0
     bytes: int = 0
     passes: int = 0
+    #: Copies dropped and delayed by the ``damage`` (:mod:`~mhtrack.sources.damage`).
+    dropped: int = 0
+    delayed: int = 0
 
 
 def schedule(times: list[float], speed: float, loops: int | None
@@ -88,35 +95,57 @@ def schedule(times: list[float], speed: float, loops: int | None
         n += 1
 
 
-def replay(path: str | Path, to: str | Endpoint, *, speed: float = 1.0,
-           loops: int | None = 1, stop: threading.Event | None = None,
+def replay(path: str | Path, to: str | Endpoint | Sequence[str | Endpoint], *,
+           speed: float = 1.0, loops: int | None = 1, stop: threading.Event | None = None,
            clock: Callable[[], float] = time.monotonic,
-           sleep: Callable[[float], object] | None = None) -> ReplayStats:
-    """Send the datagrams of recording ``path`` to ``to`` (``udp://HOST:PORT``) on the
-    :func:`schedule` of ``speed`` and ``loops``, until done or ``stop`` is set (a wait
-    ends at once when it is: default ``sleep`` is ``stop.wait``)."""
+           sleep: Callable[[float], object] | None = None,
+           damage: Damage | None = None) -> ReplayStats:
+    """Send the datagrams of recording ``path`` to ``to`` (``udp://HOST:PORT``, or
+    several: every datagram to each) on the :func:`schedule` of ``speed`` and ``loops``,
+    each copy dropped or delayed by ``damage`` (:func:`~mhtrack.sources.damage.damaged`),
+    until done or ``stop`` is set (a wait ends at once when it is: default ``sleep`` is
+    ``stop.wait``). ``datagrams`` counts the copies sent."""
     if sleep is None:
         sleep = time.sleep if stop is None else stop.wait
     if not speed > 0:
         raise ValueError(f"speed must be above 0, got {speed!r}")
     if loops is not None and loops < 1:
         raise ValueError(f"loops must be at least 1, got {loops!r}")
-    ep = to if isinstance(to, Endpoint) else parse_endpoint(to)
+    eps = [to] if isinstance(to, str | Endpoint) else list(to)
+    if not eps:
+        raise ValueError("replay needs at least one destination")
+    eps = [e if isinstance(e, Endpoint) else parse_endpoint(e) for e in eps]
     items = recording_datagrams(path)
-    addr = socket.getaddrinfo(ep.host, ep.port, ep.family, socket.SOCK_DGRAM)[0][4][:2]
-    stats = ReplayStats()
-    with socket.socket(ep.family, socket.SOCK_DGRAM) as sock:
+    addrs = [socket.getaddrinfo(e.host, e.port, e.family, socket.SOCK_DGRAM)[0][4][:2]
+             for e in eps]
+    stats, counts = ReplayStats(), DamageCounts()
+    socks = [socket.socket(e.family, socket.SOCK_DGRAM) for e in eps]
+    last = len(items) - 1
+    try:
         start = clock()
-        for i, due in schedule([t for _, t in items], speed, loops):
+        plan = damaged(_passes(schedule([t for _, t in items], 1.0, loops), last, stats),
+                       len(eps), damage or Damage(), counts)
+        for i, k, due in plan:
             if stop is not None and stop.is_set():
                 break
-            wait = start + due - clock()
+            wait = start + (due / speed if speed < math.inf else 0.0) - clock()
             if wait > 0:
                 sleep(wait)
                 if stop is not None and stop.is_set():
                     break
-            sock.sendto(items[i][0], addr)
+            socks[k].sendto(items[i][0], addrs[k])
             stats.datagrams += 1
             stats.bytes += len(items[i][0])
-            stats.passes += i == len(items) - 1
+    finally:
+        for s in socks:
+            s.close()
+    stats.dropped, stats.delayed = counts.dropped, counts.delayed
     return stats
+
+
+def _passes(items: Iterator[tuple[int, float]], last: int, stats: ReplayStats
+            ) -> Iterator[tuple[int, float]]:
+    """``items``, counting in ``stats.passes`` each pass whose last datagram is reached."""
+    for i, due in items:
+        yield i, due
+        stats.passes += i == last

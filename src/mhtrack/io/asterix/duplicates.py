@@ -7,6 +7,12 @@ so the same SAC/SIC, times and plots); the second is dropped when it arrives wit
 within the last ``span`` data blocks. A radar that sends an identical block again later
 (the same plots a rotation later cannot be: its time of day differs) is not affected.
 
+A stream of datagrams (``mhtrack live``, :func:`stream_filter`) takes a copy for a copy
+whatever its delay within the last ``span`` blocks: a copy later than the window would be
+decoded again and its plots — not dropped as late when within the re-order window, or at
+the time of the last plot already released — tracked twice (a second LAN 1 s behind
+doubled every plot). The octets hold the block's time of day: only a copy can equal them.
+
 Streaming: one :meth:`DuplicateFilter.keep` call per data block, in file order; memory
 is bounded by ``span`` digests (16-octet BLAKE2b of each block) whatever the window.
 """
@@ -14,6 +20,7 @@ is bounded by ``span`` digests (16-octet BLAKE2b of each block) whatever the win
 from __future__ import annotations
 
 import hashlib
+import math
 from collections import OrderedDict
 
 #: Default window (s): redundant LANs deliver both copies within milliseconds; a radar's
@@ -58,3 +65,10 @@ class DuplicateFilter:
                     break
                 self.seen.popitem(last=False)
         return True
+
+
+
+def stream_filter(span: int = SPAN) -> DuplicateFilter:
+    """The filter of a stream: every block equal to one of the last ``span`` is a copy,
+    however late (module docstring)."""
+    return DuplicateFilter(window=math.inf, span=span)

@@ -43,6 +43,10 @@ LEAF_COLUMNS: dict[str, tuple[str, tuple[Any, ...]]] = {
 ADDRESS_COLUMNS: dict[str, tuple[str, tuple[Any, ...]]] = {
     "track": ("iu", ()), "address": ("iu", ()), "time": ("f", ()),
 }
+#: Columns of the callsigns (``callsigns__<name>``, :mod:`mhtrack.mht.track_attributes`).
+CALLSIGN_COLUMNS: dict[str, tuple[str, tuple[Any, ...]]] = {
+    "track": ("iu", ()), "callsign": ("U", ()), "time": ("f", ()),
+}
 #: Columns of one logged scan of the tentative history (``history__<i>__<name>``).
 HISTORY_COLUMNS: dict[str, tuple[str, tuple[Any, ...]]] = {
     "node": ("iu", ()), "parent": ("iu", ()), "x": ("f", (4,)), "P": ("f", (4, 4)),
@@ -258,6 +262,12 @@ def check_arrays(path: PathArg, arrays: Mapping[str, np.ndarray], meta: Mapping[
         v = book["track"]
         if v.size and (v.min() < 0 or v.max() >= meta["next_track"]):
             raise c.fail("addresses__track", f"ids must be in [0, {meta['next_track']}) "
+                         f"(the saved next_track), got {v.min()} to {v.max()}")
+    if any(k.startswith("callsigns__") for k in arrays):  # mht/track_attributes.Callsigns
+        names = c.part("callsigns__", CALLSIGN_COLUMNS, {})
+        v = names["track"]
+        if v.size and (v.min() < 0 or v.max() >= meta["next_track"]):
+            raise c.fail("callsigns__track", f"ids must be in [0, {meta['next_track']}) "
                          f"(the saved next_track), got {v.min()} to {v.max()}")
     if "history__count" not in arrays:
         return

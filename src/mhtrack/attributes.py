@@ -150,7 +150,7 @@ def of_columns(cols: Mapping[str, np.ndarray]) -> PlotAttributes | None:
 FPM_PER_FL_S = 6000.0
 #: The columns of :class:`TrackAttributes`, in tracks-file order (``docs/file-formats.md``).
 TRACK_COLUMNS = ("flight_level", "rate_of_climb", "mode_3a", "address", "callsign",
-                 "sigma_major", "sigma_minor", "sigma_orient")
+                 "sigma_major", "sigma_minor", "sigma_orient", "sensors", "sensor_ages")
 
 
 def accuracy(P: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -173,7 +173,10 @@ class TrackAttributes:
     unknown; its last validated ``mode_3a`` code and its Mode S ``address`` (``-1``
     absent); its latest ``callsign`` (``""`` absent); its position's ``sigma_major``,
     ``sigma_minor`` (m) and ``sigma_orient`` (degrees, the major axis' bearing from north
-    clockwise in [0, 180); :func:`accuracy`), NaN when unknown."""
+    clockwise in [0, 180); :func:`accuracy`), NaN when unknown; the ``sensors`` that
+    updated it (text, ids in increasing order joined by ``;``) and the ``sensor_ages``
+    of their last updates (text, seconds, the same order; :mod:`mhtrack.mht.sensor_ages`),
+    ``""`` when none is known."""
 
     flight_level: np.ndarray
     rate_of_climb: np.ndarray
@@ -183,6 +186,8 @@ class TrackAttributes:
     sigma_major: np.ndarray
     sigma_minor: np.ndarray
     sigma_orient: np.ndarray
+    sensors: np.ndarray
+    sensor_ages: np.ndarray
 
     def __len__(self) -> int:
         return len(self.mode_3a)
@@ -198,7 +203,8 @@ class TrackAttributes:
         nan = np.full(n, np.nan)
         sig = (nan, nan, nan) if P is None else accuracy(P)
         return cls(nan, nan, np.full(n, ABSENT, np.int64), np.full(n, ABSENT, np.int64),
-                   np.full(n, "", object), *sig)
+                   np.full(n, "", object), *sig, np.full(n, "", object),
+                   np.full(n, "", object))
 
     @classmethod
     def concat(cls, parts: list[TrackAttributes]) -> TrackAttributes:

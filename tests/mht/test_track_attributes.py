@@ -134,3 +134,33 @@ def test_save_restore_keeps_the_callsigns(tmp_path):
                           attrs=PlotAttributes.from_columns(
                               {"address": np.array([0x3C4591])}, 1)))
     assert out.attrs.callsign.tolist() == ["BOX413"]
+
+
+def test_sensors_and_their_ages_by_hand():
+    """One aircraft seen by sensor 1 at even scans and sensor 2 at scans 0-19 (odd),
+    1 s apart: each row names the sensors that updated the track and how long ago."""
+    rng = np.random.default_rng(8)
+    trk, outs = MHTTracker(), []
+    row = 0
+    for k in range(30):
+        sensor = 1 if k % 2 == 0 else 2
+        if sensor == 2 and k >= 20:
+            z = np.zeros((0, 2))
+        else:
+            z = np.array([[200.0 * k, 0.0]]) + rng.normal(scale=30.0, size=(1, 2))
+        m = len(z)
+        attrs = PlotAttributes.from_columns({"address": np.full(m, 0xABC)}, m)
+        outs.append(trk.step(Scan(k, float(k), z, np.full(m, sensor, np.int64),
+                                  np.arange(row, row + m), attrs=attrs)))
+        row += m
+    tt = TrackTable.concat(outs)
+    assert np.unique(tt.track_id).size == 1
+    a = tt.attrs
+    for k, s, ages in zip(tt.scan.tolist(), a.sensors.tolist(), a.sensor_ages.tolist(),
+                          strict=True):
+        if k < 4:
+            continue  # confirmation: the first rows may name one sensor only
+        assert s == "1;2", (k, s)
+        age1, age2 = (float(v) for v in ages.split(";"))
+        assert age1 == k % 2  # sensor 1 updated at the last even scan
+        assert age2 == (k - 19 if k >= 20 else (k + 1) % 2)

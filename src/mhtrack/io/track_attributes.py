@@ -4,7 +4,8 @@ attributes"), written when the plots had attributes and read back into
 
 ``flight_level`` (FL) and ``rate_of_climb`` (ft/min), ``mode_3a`` four octal digits,
 ``address`` six hexadecimal digits, ``callsign`` text, ``sigma_major``, ``sigma_minor``
-(m) and ``sigma_orient`` (degrees from grid north, clockwise, [0, 180)). Empty cells
+(m) and ``sigma_orient`` (degrees from grid north, clockwise, [0, 180)), ``sensors``
+(ids joined by ``;``) and ``sensor_ages`` (seconds, the same order). Empty cells
 (Parquet nulls) are absent values; every column is written once any is, so that a file's
 columns do not depend on its rows.
 """
@@ -28,8 +29,8 @@ from mhtrack.io.plot_attributes import _parsed, _text
 
 _NUMBERS = ("flight_level", "rate_of_climb", "sigma_major", "sigma_minor", "sigma_orient")
 #: Column kinds for :func:`~mhtrack.io._frame.read_frame` (TIME: read as text).
-KINDS = dict.fromkeys(_NUMBERS, FLOAT) | dict.fromkeys(("mode_3a", "address",
-                                                          "callsign"), TIME)
+KINDS = dict.fromkeys(_NUMBERS, FLOAT) | dict.fromkeys(
+    ("mode_3a", "address", "callsign", "sensors", "sensor_ages"), TIME)
 
 
 def track_attribute_columns(a: TrackAttributes) -> dict[str, pa.Array]:
@@ -74,6 +75,29 @@ def read_track_attributes(f: Frame) -> TrackAttributes | None:
     for name, parse in (("mode_3a", code_value), ("address", address_value)):
         if f.has(name):
             cols[name] = _parsed(f, name, parse)
-    if f.has("callsign"):
-        cols["callsign"] = np.array(_text(f, "callsign"), object)
+    for name in ("callsign", "sensors", "sensor_ages"):
+        if f.has(name):
+            cols[name] = np.array(_text(f, name), object)
+    _check_ages(f, cols["sensors"], cols["sensor_ages"])
     return TrackAttributes(**cols)
+
+
+def _check_ages(f: Frame, sensors: np.ndarray, ages: np.ndarray) -> None:
+    """``sensors`` non-negative integers and ``sensor_ages`` as many non-negative numbers,
+    both joined by ``;`` (located errors)."""
+    def bad(r: int) -> str | None:
+        s = [v for v in str(sensors[r]).split(";") if v != ""]
+        a = [v for v in str(ages[r]).split(";") if v != ""]
+        if not all(v.isdigit() for v in s):
+            return f"sensors {sensors[r]!r} are not ids joined by ';'"
+        try:
+            nums = [float(v) for v in a]
+        except ValueError:
+            return f"sensor_ages {ages[r]!r} are not numbers joined by ';'"
+        if len(nums) != len(s) or any(not v >= 0 for v in nums):
+            return f"sensor_ages {ages[r]!r}: one age >= 0 s per sensor of {sensors[r]!r}"
+        return None
+
+    problems = [bad(r) for r in range(len(sensors))]
+    f.check(np.array([p is not None for p in problems], bool), "sensor_ages",
+            lambda r: str(problems[r]))

@@ -12,6 +12,8 @@ address, its latest callsign and its position's accuracy
   (:class:`Callsigns`); identification comes in Mode S replies only when the aircraft
   is interrogated for it (BDS 2,0), not with every plot.
 * **Accuracy**: the position covariance's ellipse (:func:`~mhtrack.attributes.accuracy`).
+* **Sensors**: those whose plots updated the confirmed track, with the age of each one's
+  last update at the row's time (:class:`~mhtrack.mht.sensor_ages.SensorAges`).
 """
 
 from __future__ import annotations
@@ -20,6 +22,7 @@ import numpy as np
 
 from mhtrack.attributes import FPM_PER_FL_S, PlotAttributes, TrackAttributes, accuracy
 from mhtrack.mht.attribute_scores import positions
+from mhtrack.mht.sensor_ages import SensorAges
 from mhtrack.mht.tree import Leaves
 
 
@@ -73,10 +76,12 @@ def says_anything(attrs: PlotAttributes | None, leaves: Leaves) -> bool:
 
 
 def track_attributes(leaves: Leaves, sel: np.ndarray, attrs: PlotAttributes,
-                     rows: np.ndarray, callsigns: Callsigns, time: float
+                     rows: np.ndarray, callsigns: Callsigns, time: float, *,
+                     sensor: np.ndarray, plot_t: np.ndarray, ages: SensorAges
                      ) -> TrackAttributes:
     """The attributes (module docstring) of the reported leaves ``sel`` (in row order),
-    from the frame's plots' ``attrs`` (row ids ``rows``) at frame time ``time``."""
+    from the frame's plots' ``attrs`` (row ids ``rows``, sensors ``sensor``, times
+    ``plot_t``) at frame time ``time``."""
     lv = leaves.level.take(sel, axis=0)
     t = leaves.time.take(sel)
     h = lv[:, 0] + lv[:, 1] * (t - lv[:, 5])
@@ -87,8 +92,13 @@ def track_attributes(leaves: Leaves, sel: np.ndarray, attrs: PlotAttributes,
                      zip(cs.tolist(), j.tolist(), strict=True)], "U8")
     ident = leaves.ident.take(sel, axis=0)
     major, minor, orient = accuracy(leaves.P.take(sel, axis=0))
+    tid = leaves.track.take(sel)
+    hit = j >= 0
+    ages.update(tid[hit], sensor[j[hit]], plot_t[j[hit]], time)
+    sensors, age = ages.of(tid, t)
     return TrackAttributes(
         flight_level=h, rate_of_climb=lv[:, 1] * FPM_PER_FL_S,
         mode_3a=ident[:, 0].copy(), address=ident[:, 1].copy(),
         callsign=callsigns.latest(leaves.track.take(sel), seen, time).astype(object),
-        sigma_major=major, sigma_minor=minor, sigma_orient=orient)
+        sigma_major=major, sigma_minor=minor, sigma_orient=orient, sensors=sensors,
+        sensor_ages=age)

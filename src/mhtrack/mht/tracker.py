@@ -77,6 +77,7 @@ from mhtrack.mht.pruning import prune_after_solve, prune_children, removed_after
 from mhtrack.mht.report import StepStats, confirmed_windows, report
 from mhtrack.mht.resume import AddressBook
 from mhtrack.mht.scoring import miss_increment, miss_increments, update_increment
+from mhtrack.mht.sensor_ages import SensorAges
 from mhtrack.mht.sprt import SPRT
 from mhtrack.mht.state import load_state, located, save_state
 from mhtrack.mht.timed import gate_looked, split_looked
@@ -142,6 +143,7 @@ class MHTTracker:
         self._cap_warnings = CapWarnings()
         self._book = AddressBook(self.attributes.resume_s)
         self._callsigns = Callsigns(self.attributes.resume_s)
+        self._ages = SensorAges(self.attributes.resume_s)
         self.last_stats: StepStats | None = None
         #: The clutter intensity κ̂ (per m² per scan, floored) the last :meth:`step` scored
         #: each of its plots with (kept for the pipeline's DEBUG line, not recomputed).
@@ -305,7 +307,9 @@ class MHTTracker:
         self._leaves, self._last_time, self._last_index = leaves, frame.time, frame.index
         attrs = frame.scan.attrs
         identity = None if not says_anything(attrs, leaves) else lambda sel: \
-            track_attributes(leaves, sel, attrs, frame.rows, self._callsigns, frame.time)
+            track_attributes(leaves, sel, attrs, frame.rows, self._callsigns, frame.time,
+                             sensor=frame.scan.sensor, plot_t=frame.scan.plot_times(),
+                             ages=self._ages)
         return report(frame.scan, leaves, stepped, rep, identity=identity)
 
     def _forget(self, leaves: Leaves, rows: np.ndarray, rep: np.ndarray) -> None:
@@ -345,7 +349,8 @@ class MHTTracker:
                  "history": self._history.arrays(), "coverage": self.coverage.arrays(),
                  "addresses": self._book.arrays(),
                  **({"callsigns": self._callsigns.arrays()} if self._callsigns.track.size
-                    else {})}
+                    else {}),
+                 **({"ages": self._ages.arrays()} if self._ages.track.size else {})}
         save_state(path, parts, self.clutter, self.config, {
             "last_time": self._last_time, "last_index": self._last_index,
             "next_tree": self.trees.next, "next_track": self.tracks.next,
@@ -376,7 +381,7 @@ class MHTTracker:
         trk.nodes = Counter(meta["next_node"])
         for part, owner in (("history", trk._history), ("birth", trk.birth),
                             ("coverage", trk.coverage), ("addresses", trk._book),
-                            ("callsigns", trk._callsigns)):
+                            ("callsigns", trk._callsigns), ("ages", trk._ages)):
             with located(path, f"{part}__*"):
                 owner.set_arrays(saved.part(part))
         return trk

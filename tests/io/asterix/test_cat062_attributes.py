@@ -33,7 +33,8 @@ def _table(n=400):
                            zip(rng.integers(1, 99999, n), some[4], strict=True)], object),
         sigma_major=np.where(some[5], major, np.nan),
         sigma_minor=np.where(some[5], major * rng.uniform(0.05, 1, n), np.nan),
-        sigma_orient=np.where(some[5], rng.uniform(0, 180, n), np.nan))
+        sigma_orient=np.where(some[5], rng.uniform(0, 180, n), np.nan),
+        sensors=np.full(n, "", object), sensor_ages=np.full(n, "", object))
     return TrackTable(scan=np.arange(n), time=1000.0 + np.arange(n) * 0.25,
                       track_id=rng.integers(0, 5000, n), x=rng.uniform(-2e5, 2e5, n),
                       y=rng.uniform(-2e5, 2e5, n), vx=rng.uniform(-250, 250, n),

@@ -144,3 +144,69 @@ def of_columns(cols: Mapping[str, np.ndarray]) -> PlotAttributes | None:
     source's batch), ``None`` when there are none."""
     mine = {k: v for k, v in cols.items() if k in COLUMNS}
     return PlotAttributes.from_columns(mine, len(cols["time"])) if mine else None
+
+
+#: Feet per minute in one flight level per second (1 FL = 100 ft).
+FPM_PER_FL_S = 6000.0
+#: The columns of :class:`TrackAttributes`, in tracks-file order (``docs/file-formats.md``).
+TRACK_COLUMNS = ("flight_level", "rate_of_climb", "mode_3a", "address", "callsign",
+                 "sigma_major", "sigma_minor", "sigma_orient", "sensors", "sensor_ages")
+
+
+def accuracy(P: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(σ_major, σ_minor, orientation)`` of the position covariances of states ``P``
+    (n, 4, 4) ``[x, vx, y, vy]``: the square roots of the eigenvalues of ``[[Pxx, Pxy],
+    [Pxy, Pyy]]``, ``λ = (a + c)/2 ± √(((a − c)/2)² + b²)``, and the major axis' bearing
+    in degrees clockwise from the frame's north (y), in [0, 180): ``90° − ½ atan2(2b,
+    a − c)`` (the eigenvector's angle from x, counter-clockwise)."""
+    a, b, c = P[:, 0, 0], P[:, 0, 2], P[:, 2, 2]
+    mid, half = (a + c) / 2, np.hypot((a - c) / 2, b)
+    theta = 0.5 * np.degrees(np.arctan2(2 * b, a - c))
+    return (np.sqrt(mid + half), np.sqrt(np.maximum(mid - half, 0.0)),
+            np.mod(90.0 - theta, 180.0))
+
+
+@dataclass(frozen=True)
+class TrackAttributes:
+    """What a track says besides its state, one row per track row: ``flight_level`` (FL)
+    and ``rate_of_climb`` (ft/min) of its vertical state at the row's time, NaN when
+    unknown; its last validated ``mode_3a`` code and its Mode S ``address`` (``-1``
+    absent); its latest ``callsign`` (``""`` absent); its position's ``sigma_major``,
+    ``sigma_minor`` (m) and ``sigma_orient`` (degrees, the major axis' bearing from north
+    clockwise in [0, 180); :func:`accuracy`), NaN when unknown; the ``sensors`` that
+    updated it (text, ids in increasing order joined by ``;``) and the ``sensor_ages``
+    of their last updates (text, seconds, the same order; :mod:`mhtrack.mht.sensor_ages`),
+    ``""`` when none is known."""
+
+    flight_level: np.ndarray
+    rate_of_climb: np.ndarray
+    mode_3a: np.ndarray
+    address: np.ndarray
+    callsign: np.ndarray
+    sigma_major: np.ndarray
+    sigma_minor: np.ndarray
+    sigma_orient: np.ndarray
+    sensors: np.ndarray
+    sensor_ages: np.ndarray
+
+    def __len__(self) -> int:
+        return len(self.mode_3a)
+
+    def __getitem__(self, idx: np.ndarray | slice) -> TrackAttributes:
+        """Rows ``idx`` (index array, mask or slice), in that order."""
+        return TrackAttributes(**{k: getattr(self, k)[idx] for k in TRACK_COLUMNS})
+
+    @classmethod
+    def absent(cls, n: int, P: np.ndarray | None = None) -> TrackAttributes:
+        """``n`` rows with nothing known, but the accuracy of covariances ``P`` when
+        given (the tentative past of a track: its states, without its attributes)."""
+        nan = np.full(n, np.nan)
+        sig = (nan, nan, nan) if P is None else accuracy(P)
+        return cls(nan, nan, np.full(n, ABSENT, np.int64), np.full(n, ABSENT, np.int64),
+                   np.full(n, "", object), *sig, np.full(n, "", object),
+                   np.full(n, "", object))
+
+    @classmethod
+    def concat(cls, parts: list[TrackAttributes]) -> TrackAttributes:
+        return cls(**{k: np.concatenate([getattr(p, k) for p in parts])
+                      for k in TRACK_COLUMNS})

@@ -26,7 +26,7 @@ from typing import Any
 
 import numpy as np
 
-from mhtrack.attributes import PlotAttributes
+from mhtrack.attributes import PlotAttributes, TrackAttributes
 
 CLUTTER = -1
 NO_PLOT = -1
@@ -259,7 +259,8 @@ class TrackTable:
     vy, plot`` (``plot`` = plot-table row used at that scan, ``-1`` on a miss), optionally
     the track ``score`` (log-likelihood ratio), state covariance ``P`` (n, 4, 4) and
     ``tentative`` (bool: the row was reported after the scan, when the track was confirmed
-    later, see :mod:`mhtrack.mht.history`)."""
+    later, see :mod:`mhtrack.mht.history`) and, when the plots had attributes, ``attrs``
+    (:class:`~mhtrack.attributes.TrackAttributes`: flight level, codes, accuracy)."""
 
     scan: np.ndarray
     time: np.ndarray
@@ -272,6 +273,7 @@ class TrackTable:
     score: np.ndarray | None = None
     P: np.ndarray | None = None
     tentative: np.ndarray | None = None
+    attrs: TrackAttributes | None = field(default=None, repr=False)
 
     def __len__(self) -> int:
         return len(self.scan)
@@ -348,7 +350,13 @@ class TrackTable:
             vals = [getattr(p, name) for p in parts]
             return None if any(v is None for v in vals) else np.concatenate(vals)
 
-        return cls(**{f: cat(f) for f in cls.__dataclass_fields__})  # type: ignore[arg-type]
+        attrs = None  # parts without attributes (a tentative past): absent, but accuracy
+        if any(p.attrs is not None for p in parts):
+            attrs = TrackAttributes.concat([
+                p.attrs if p.attrs is not None else TrackAttributes.absent(len(p), p.P)
+                for p in parts])
+        return cls(**{f: cat(f) for f in cls.__dataclass_fields__ if f != "attrs"},
+                   attrs=attrs)  # type: ignore[arg-type]
 
 
 #: The required columns of a tracks table, in order.

@@ -24,11 +24,18 @@ from mhtrack.sinks.spill import SortedRows
 CHUNK = 7  # rows per chunk: many chunks, so the streaming path is exercised
 
 
-@pytest.fixture(scope="module")
-def plots_dir(tmp_path_factory):
+@pytest.fixture(scope="module", params=[False, True], ids=["plain", "attributes"])
+def plots_dir(tmp_path_factory, request):
+    """The plots of opensky-radars, without and with secondary-radar attributes (then
+    the tracks file has the attribute columns: :mod:`mhtrack.io.track_attributes`)."""
+    from mhtrack.scenario.identity import AttributeOptions, add_attributes, opensky_identities
+
     d = tmp_path_factory.mktemp("rec")
     sc = apply_overrides(preset("opensky-radars"), scans=5)
-    write_plots(simulate(sc, seed=1).plots, d / "plots.csv")
+    plots = simulate(sc, seed=1).plots
+    if request.param:
+        plots = add_attributes(plots, opensky_identities(), AttributeOptions(), 1)
+    write_plots(plots, d / "plots.csv")
     write_sensors(sc.sensor_set(), d / "sensors.toml")
     return d
 
@@ -56,6 +63,9 @@ def test_streamed_file_has_the_bytes_of_the_in_memory_path(plots_dir, tmp_path, 
 
     pipe.run([sink, rows, CallbackSink(look)])
     assert any(seen), "the rows were never streamed to a temporary"
+    with_attrs = "callsign" in pq.read_table(out).column_names if suffix == ".parquet" \
+        else "callsign" in out.read_text().splitlines()[0]
+    assert with_attrs == (rows.tracks().attrs is not None)
     assert len(rows.tracks()) > 10 * CHUNK
     _former(pipe, rows, tmp_path / f"ref{suffix}", CHUNK)
     assert out.read_bytes() == (tmp_path / f"ref{suffix}").read_bytes()

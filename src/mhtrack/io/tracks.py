@@ -1,4 +1,5 @@
-"""Tracks files: ``scan, time, track_id, x, y, vx, vy, plot`` [, ``score``, ``tentative``] —
+"""Tracks files: ``scan, time, track_id, x, y, vx, vy, plot`` [, ``score``, ``tentative``,
+the attribute columns of :mod:`mhtrack.io.track_attributes`] —
 tracker output, one row per reported track and scan, in non-decreasing scan order. ``plot``
 is the 0-based row of the plots file that the track used at that scan, empty (CSV) or null
 (Parquet) on a miss; ``tentative`` is 1 on rows reported after their scan, when the track
@@ -13,6 +14,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from mhtrack.attributes import TrackAttributes
 from mhtrack.errors import InputError
 from mhtrack.io import _geodetic
 from mhtrack.io._checks import check_scan_order, check_unique, num
@@ -29,6 +31,11 @@ from mhtrack.io._frame import (
 from mhtrack.io._source import PathArg, file_format
 from mhtrack.io._times import seconds, time_column
 from mhtrack.io.plots import NOT_A_ROW, plots_to_file_rows, plots_to_table_rows
+from mhtrack.io.track_attributes import (
+    KINDS,
+    read_track_attributes,
+    track_attribute_columns,
+)
 from mhtrack.io.truth import read_truth
 from mhtrack.records import NO_PLOT, PlotTable, TrackTable, TruthTable
 
@@ -43,7 +50,7 @@ REQUIRED = ("scan", "time", "track_id", "x", "y", "vx", "vy", "plot")
 TIMED_REQUIRED = ("frame", *REQUIRED[1:])
 COLUMNS = dict.fromkeys((*REQUIRED, "score"), FLOAT) | {
     "scan": INT, "frame": INT, "track_id": INT, "plot": INT, "tentative": INT, "time": TIME
-} | _geodetic.COLUMNS
+} | _geodetic.COLUMNS | KINDS
 
 
 def tracks_from_truth(truth: TruthTable) -> TrackTable:
@@ -136,7 +143,7 @@ def read_tracks(
                 f"the plots file ({len(plots)} plots)")
         plot = rows
     return TrackTable(scan=scan, time=time, track_id=tid, plot=plot, score=score,
-                      tentative=tentative, **cols)
+                      tentative=tentative, attrs=read_track_attributes(f), **cols)
 
 
 def write_tracks(
@@ -164,21 +171,25 @@ ROW_GROUP = 4096
 
 def write_track_rows(table: TrackTable, path: PathArg, frame: LocalFrame | None = None, *,
                      timed: bool = False, iso: bool = False,
-                     row_group_size: int = ROW_GROUP) -> None:
+                     row_group_size: int = ROW_GROUP, attrs: bool | None = None) -> None:
     """Write ``table`` whose ``plot`` already holds the input's own rows (a sink's
     :meth:`~mhtrack.sources.base.Source.file_rows`), as :func:`write_tracks` does; ``timed``:
     rows numbered by ``frame`` (tracks of timed plots), else by ``scan``; ``iso``: times
     as ISO-8601 (the plots' times were; :func:`~mhtrack.io._times.time_column`). Parquet
     row groups of ``row_group_size`` rows."""
-    write_frame(path, track_columns(table, file_format(path), frame, timed=timed, iso=iso),
+    write_frame(path, track_columns(table, file_format(path), frame, timed=timed, iso=iso,
+                                    attrs=attrs),
                 row_group_size=row_group_size)
 
 
 def track_columns(table: TrackTable, fmt: str, frame: LocalFrame | None = None, *,
-                  timed: bool = False, iso: bool = False) -> dict[str, pa.Array]:
+                  timed: bool = False, iso: bool = False, attrs: bool | None = None
+                  ) -> dict[str, pa.Array]:
     """The columns :func:`write_track_rows` writes of ``table`` to a ``fmt`` (``"csv"`` or
     ``"parquet"``) file; row by row, so the columns of consecutive slices are the slices
-    of the columns."""
+    of the columns. ``attrs``: whether to write the attribute columns
+    (:mod:`mhtrack.io.track_attributes`; rows without them empty), default when
+    ``table.attrs`` is given."""
     plot = table.plot
     time = time_column(table.time, iso, fmt) if iso else float_array(table.time)
     cols = _geodetic.row_columns(("frame" if timed else "scan", table.scan), time,
@@ -189,4 +200,10 @@ def track_columns(table: TrackTable, fmt: str, frame: LocalFrame | None = None, 
         cols["score"] = float_array(table.score)
     if table.tentative is not None:
         cols["tentative"] = int_array(table.tentative.astype(np.int64))
+    if attrs is None:
+        attrs = table.attrs is not None
+    if attrs:
+        cols.update(track_attribute_columns(
+            table.attrs if table.attrs is not None else
+            TrackAttributes.absent(len(table), table.P)))
     return cols

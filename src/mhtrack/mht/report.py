@@ -3,10 +3,12 @@ global hypothesis (:func:`report`) and the step's statistics (:class:`StepStats`
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
 
+from mhtrack.attributes import TrackAttributes
 from mhtrack.mht.context import FrameContext
 from mhtrack.mht.hypothesis import GlobalHypothesis
 from mhtrack.mht.tree import Leaves
@@ -57,11 +59,14 @@ def confirmed_windows(leaves: Leaves, rep: np.ndarray | None = None) -> np.ndarr
 
 
 def report(scan: Scan, leaves: Leaves, stepped: np.ndarray | None = None,
-           rep: np.ndarray | None = None) -> TrackTable:
+           rep: np.ndarray | None = None, *,
+           identity: Callable[[np.ndarray], TrackAttributes] | None = None) -> TrackTable:
     """Confirmed tracks of the best hypothesis at ``scan``, ordered by track id; each row
     at its state's own time (``Leaves.time``). ``stepped`` (mask): only the leaves this
     frame stepped (a frame of one radar's sector reports the tracks it looked at).
-    ``rep``: :meth:`Leaves.reported`, when known (not modified)."""
+    ``rep``: :meth:`Leaves.reported`, when known (not modified). ``identity``: the
+    attributes of the reported leaves (their rows, in order) when the plots have them
+    (:func:`~mhtrack.mht.track_attributes.track_attributes`)."""
     rep = leaves.reported() if rep is None else rep
     if stepped is not None:
         rep = rep & stepped
@@ -82,4 +87,5 @@ def report(scan: Scan, leaves: Leaves, stepped: np.ndarray | None = None,
         score=leaves.score.take(sel),
         P=leaves.P.take(sel, axis=0),
         tentative=np.zeros(n, bool),
+        attrs=None if identity is None else identity(sel),
     )

@@ -43,6 +43,14 @@ LEAF_COLUMNS: dict[str, tuple[str, tuple[Any, ...]]] = {
 ADDRESS_COLUMNS: dict[str, tuple[str, tuple[Any, ...]]] = {
     "track": ("iu", ()), "address": ("iu", ()), "time": ("f", ()),
 }
+#: Columns of the callsigns (``callsigns__<name>``, :mod:`mhtrack.mht.track_attributes`).
+CALLSIGN_COLUMNS: dict[str, tuple[str, tuple[Any, ...]]] = {
+    "track": ("iu", ()), "callsign": ("U", ()), "time": ("f", ()),
+}
+#: Columns of the sensors' last updates (``ages__<name>``, :mod:`mhtrack.mht.sensor_ages`).
+AGE_COLUMNS: dict[str, tuple[str, tuple[Any, ...]]] = {
+    "track": ("iu", ()), "sensor": ("iu", ()), "time": ("f", ()),
+}
 #: Columns of one logged scan of the tentative history (``history__<i>__<name>``).
 HISTORY_COLUMNS: dict[str, tuple[str, tuple[Any, ...]]] = {
     "node": ("iu", ()), "parent": ("iu", ()), "x": ("f", (4,)), "P": ("f", (4, 4)),
@@ -263,6 +271,13 @@ def check_arrays(path: PathArg, arrays: Mapping[str, np.ndarray], meta: Mapping[
         v = book["track"]
         if v.size and (v.min() < 0 or v.max() >= meta["next_track"]):
             raise c.fail("addresses__track", f"ids must be in [0, {meta['next_track']}) "
+                         f"(the saved next_track), got {v.min()} to {v.max()}")
+    for part, columns in (("callsigns", CALLSIGN_COLUMNS), ("ages", AGE_COLUMNS)):
+        if not any(k.startswith(f"{part}__") for k in arrays):  # mht/track_attributes
+            continue
+        v = c.part(f"{part}__", columns, {})["track"]
+        if v.size and (v.min() < 0 or v.max() >= meta["next_track"]):
+            raise c.fail(f"{part}__track", f"ids must be in [0, {meta['next_track']}) "
                          f"(the saved next_track), got {v.min()} to {v.max()}")
     if "history__count" not in arrays:
         return

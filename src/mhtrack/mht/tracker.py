@@ -77,9 +77,11 @@ from mhtrack.mht.pruning import prune_after_solve, prune_children, removed_after
 from mhtrack.mht.report import StepStats, confirmed_windows, report
 from mhtrack.mht.resume import AddressBook
 from mhtrack.mht.scoring import miss_increment, miss_increments, update_increment
+from mhtrack.mht.sensor_ages import SensorAges
 from mhtrack.mht.sprt import SPRT
 from mhtrack.mht.state import load_state, located, save_state
 from mhtrack.mht.timed import gate_looked, split_looked
+from mhtrack.mht.track_attributes import Callsigns, says_anything, track_attributes
 from mhtrack.mht.tree import Leaves, contains
 from mhtrack.mht.validate import validate_scan
 from mhtrack.models.motion import MotionModel
@@ -140,6 +142,8 @@ class MHTTracker:
         self._history = TentativeHistory(cfg.history_scans)
         self._cap_warnings = CapWarnings()
         self._book = AddressBook(self.attributes.resume_s)
+        self._callsigns = Callsigns(self.attributes.resume_s)
+        self._ages = SensorAges(self.attributes.resume_s)
         self.last_stats: StepStats | None = None
         #: The clutter intensity κ̂ (per m² per scan, floored) the last :meth:`step` scored
         #: each of its plots with (kept for the pipeline's DEBUG line, not recomputed).
@@ -301,7 +305,12 @@ class MHTTracker:
         self._book.record(leaves, rep, frame.time)
         self._forget(leaves, frame.rows, rep)
         self._leaves, self._last_time, self._last_index = leaves, frame.time, frame.index
-        return report(frame.scan, leaves, stepped, rep)
+        attrs = frame.scan.attrs
+        identity = None if not says_anything(attrs, leaves) else lambda sel: \
+            track_attributes(leaves, sel, attrs, frame.rows, self._callsigns, frame.time,
+                             sensor=frame.scan.sensor, plot_t=frame.scan.plot_times(),
+                             ages=self._ages)
+        return report(frame.scan, leaves, stepped, rep, identity=identity)
 
     def _forget(self, leaves: Leaves, rows: np.ndarray, rep: np.ndarray) -> None:
         """The plots the confirmed tracks used (``rep``: the leaves that report them)
@@ -338,7 +347,10 @@ class MHTTracker:
         e.g. a live run's frame number and time axis)."""
         parts = {"leaves": self._leaves.arrays(), "birth": self.birth.arrays(),
                  "history": self._history.arrays(), "coverage": self.coverage.arrays(),
-                 "addresses": self._book.arrays()}
+                 "addresses": self._book.arrays(),
+                 **({"callsigns": self._callsigns.arrays()} if self._callsigns.track.size
+                    else {}),
+                 **({"ages": self._ages.arrays()} if self._ages.track.size else {})}
         save_state(path, parts, self.clutter, self.config, {
             "last_time": self._last_time, "last_index": self._last_index,
             "next_tree": self.trees.next, "next_track": self.tracks.next,
@@ -368,7 +380,8 @@ class MHTTracker:
         trk.trees, trk.tracks = Counter(meta["next_tree"]), Counter(meta["next_track"])
         trk.nodes = Counter(meta["next_node"])
         for part, owner in (("history", trk._history), ("birth", trk.birth),
-                            ("coverage", trk.coverage), ("addresses", trk._book)):
+                            ("coverage", trk.coverage), ("addresses", trk._book),
+                            ("callsigns", trk._callsigns), ("ages", trk._ages)):
             with located(path, f"{part}__*"):
                 owner.set_arrays(saved.part(part))
         return trk

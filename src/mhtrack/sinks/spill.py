@@ -83,6 +83,7 @@ class TrackRowsWriter:
         self._atomic: Any = None  # the atomic_path context, once the first chunk is out
         self._fh: BinaryIO | None = None
         self._pq: Any = None
+        self._attrs: bool | None = None  # attribute columns: set by the first chunk
 
     def add(self, rows: TrackTable | None) -> None:
         """Append ``rows`` (their ``plot`` the input's rows); whole chunks are written."""
@@ -128,8 +129,10 @@ class TrackRowsWriter:
         self._atomic = None
 
     def _chunk(self, rows: TrackTable) -> None:
+        if self._attrs is None:  # the first chunk decides the columns of the file
+            self._attrs = rows.attrs is not None
         table = pa.table(track_columns(rows, self.fmt, self.frame, timed=self.timed,
-                                       iso=self.iso))
+                                       iso=self.iso, attrs=self._attrs))
         try:
             if self._atomic is None:
                 self._open(table)

@@ -3,7 +3,10 @@
 WGS-84 position, 185 Cartesian velocity (east, north) and 080 track status (CNF
 tentative, CST coasting), by libasterix (edition 1.18); and read back
 (:func:`read_system_tracks`) by the same library (docs/file-formats.md, "ASTERIX
-recordings").
+recordings"). With the tracks' attributes (issue 29 item 5,
+:class:`~mhtrack.attributes.TrackAttributes`) also, where known: 060 Mode 3/A code, 136
+measured flight level, 220 rate of climb, 380 ADR (Mode S address) and ID (callsign),
+500 APC and COV (the position's σx, σy and ``sign(Pxy) √|Pxy|``, :mod:`.cat062_items`).
 """
 
 from __future__ import annotations
@@ -18,21 +21,24 @@ import mhtrack.io.asterix._lib as _lib
 from mhtrack.errors import InputError
 from mhtrack.io._frame import FLOAT, INT, TIME, read_frame
 from mhtrack.io._times import seconds
+from mhtrack.io.asterix.cat062_items import attribute_items
 from mhtrack.io.asterix.container import blocks
 from mhtrack.io.asterix.encode import Message, encode_blocks, raw_tod
 from mhtrack.io.asterix.framings import recognise, units
 from mhtrack.io.asterix.problems import Problems
 from mhtrack.io.asterix.timeaxis import DAY_S, unwrap_days
 from mhtrack.io.asterix.writer import write_blocks
+from mhtrack.io.track_attributes import KINDS, read_track_attributes
 from mhtrack.models.radars import SensorSet
 from mhtrack.progress import Count
 from mhtrack.records import TrackTable
 
 if TYPE_CHECKING:
+    from mhtrack.attributes import TrackAttributes
     from mhtrack.models.geodesy import LocalFrame
 
 _TRACKS = {"time": TIME, "track_id": INT, "lat": FLOAT, "lon": FLOAT, "x": FLOAT,
-           "y": FLOAT, "vx": FLOAT, "vy": FLOAT, "plot": INT, "tentative": INT}
+           "y": FLOAT, "vx": FLOAT, "vy": FLOAT, "plot": INT, "tentative": INT} | KINDS
 #: Columns of :func:`read_system_tracks`.
 TRACK_COLUMNS = ("time", "sac", "sic", "track_number", "lat", "lon", "vx", "vy",
                  "tentative", "coasting")
@@ -94,7 +100,7 @@ def export_tracks(tracks: str | Path, sensors: SensorSet | None, out: str | Path
     tentative = (f.ints("tentative", nullable=True, fill=0) != 0).astype(int) \
         if f.has("tentative") else np.zeros(f.n, int)
     messages = track_messages(time, tn, lat, lon, ve, vn, coasting, tentative, f.check,
-                              sac=sac, sic=sic)
+                              sac=sac, sic=sic, attrs=read_track_attributes(f))
     with Count(f.n, "export", "row", progress) as bar:
         n = write_blocks(out, encode_blocks(messages, bar))
     return f.n, n
@@ -121,15 +127,18 @@ def table_messages(tracks: TrackTable, frame: LocalFrame, name: str, *,
                              f"{float(tracks.time[r]):g} s, {column}: {text(r)}")
 
     return track_messages(np.asarray(tracks.time, float), tracks.track_id, lat, lon, ve, vn,
-                          coasting, tentative, check, sac=sac, sic=sic)
+                          coasting, tentative, check, sac=sac, sic=sic, attrs=tracks.attrs)
 
 
 def track_messages(time: np.ndarray, track_id: np.ndarray, lat: np.ndarray,
                    lon: np.ndarray, ve: np.ndarray, vn: np.ndarray, coasting: np.ndarray,
                    tentative: np.ndarray, check: Check, *, sac: int | None = None,
-                   sic: int | None = None) -> list[Message]:
-    """One CAT062 message per track row (I062/010, 070, 105, 185, 040, 080), values
-    rounded to the items' LSBs (:func:`lsb062`); ``check`` reports rows that do not fit."""
+                   sic: int | None = None, attrs: TrackAttributes | None = None
+                   ) -> list[Message]:
+    """One CAT062 message per track row (I062/010, 070, 105, 185, 040, 080; with
+    ``attrs`` the items of :func:`~mhtrack.io.asterix.cat062_items.attribute_items` where
+    known), values rounded to the items' LSBs (:func:`lsb062`); ``check`` reports rows
+    that do not fit."""
     sac = DEFAULT_SAC if sac is None else sac
     sic = DEFAULT_SIC if sic is None else sic
     check(time < 0, "time", lambda r: f"time {time[r]:g} s is negative (ASTERIX times "
@@ -146,11 +155,13 @@ def track_messages(time: np.ndarray, track_id: np.ndarray, lat: np.ndarray,
     lon_raw = np.round(((lon + 180.0) % 360.0 - 180.0) / L["deg"]).astype(np.int64)
     tod = raw_tod(time)
     sid = (sac << 8) | sic
+    extra = attribute_items(attrs, check) if attrs is not None else None
     return [Message(float(time[i]), sid, 62, {
         "010": (("SAC", sac), ("SIC", sic)), "070": int(tod[i]),
         "105": (("LAT", int(lat_raw[i])), ("LON", int(lon_raw[i]))),
         "185": (("VX", int(raw["vx"][i])), ("VY", int(raw["vy"][i]))),
         "040": int(tn[i]), "080": _status(int(tentative[i]), int(coasting[i])),
+        **({} if extra is None else extra(i)),
     }) for i in range(len(time))]
 
 

@@ -1,0 +1,96 @@
+"""The CAT062 items of a track's attributes (issue 29 item 5; EUROCONTROL ASTERIX
+CAT062 edition 1.18, encoded by libasterix): I062/060 Mode 3/A code (V, G, CH 0: the
+code kept is the last validated one), 136 measured flight level (1/4 FL), 220 rate of
+climb (6.25 ft/min), 380 subfields ADR (24-bit address) and ID (callsign, up to eight
+characters of the 6-bit ICAO set), 500 subfields APC (σ of x and y, 0.5 m) and COV
+(``sign(Pxy) √|Pxy|``, 0.5 m). Each item only where its value is known.
+
+σx, σy and Pxy come from the tracks file's ellipse (σ major ``M``, minor ``m``, the
+major axis' bearing ``β`` from north): with the axis ``u = (sin β, cos β)``,
+``P = M² u uᵀ + m² v vᵀ``, so ``Pxx = M² sin²β + m² cos²β``, ``Pyy = M² cos²β + m²
+sin²β``, ``Pxy = (M² − m²) sin β cos β``. σ beyond the items' 16 bits (32 767.5 m) is
+written as the largest value (saturated).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+
+import mhtrack.io.asterix._lib as _lib
+from mhtrack.attributes import TrackAttributes, code_text
+
+#: Characters of I062/380 ID (ICAO 6-bit: A–Z, 0–9, space).
+ID_CHARS = frozenset("ABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789 ")
+
+
+def lsb_attributes() -> dict[str, float]:
+    """LSBs of the items written, from libasterix (raw 1 read back)."""
+    rec = _lib.cat062().cv_record
+    apc = rec.spec("500").cv_rule.cv_variation.cv_items_dict["APC"]
+    return {"fl": float(rec.spec("136").create(1).variation.content.as_quantity("FL")),
+            "fpm": float(rec.spec("220").create(1).variation.content.as_quantity("ft/min")),
+            "m": float(apc.create((("X", 1), ("Y", 1))).variation.get_item("X")
+                       .variation.content.as_quantity("m"))}
+
+
+def cartesian(a: TrackAttributes) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(σx, σy, Pxy)`` of the ellipses of ``a`` (module docstring)."""
+    b = np.radians(a.sigma_orient)
+    M2, m2 = a.sigma_major ** 2, a.sigma_minor ** 2
+    s, c = np.sin(b), np.cos(b)
+    return np.sqrt(M2 * s * s + m2 * c * c), np.sqrt(M2 * c * c + m2 * s * s), \
+        (M2 - m2) * s * c
+
+
+def attribute_items(a: TrackAttributes, check: Callable[..., None]
+                    ) -> Callable[[int], dict[str, Any]]:
+    """A function of a row giving its items (module docstring) for libasterix's
+    ``create``; ``check(bad rows, column, message)`` reports values an item cannot
+    hold (a flight level beyond −15…1 500 FL, a rate beyond ±204 793 ft/min, a
+    callsign of other characters)."""
+    L = lsb_attributes()
+    fl = np.round(np.nan_to_num(a.flight_level) / L["fl"]).astype(np.int64)
+    check(np.isfinite(a.flight_level) & ((fl < -60) | (fl > 6000)), "flight_level",
+          lambda r: f"flight level {a.flight_level[r]:g} is outside I062/136's "
+          "-15 to 1500 FL")
+    roc = np.round(np.nan_to_num(a.rate_of_climb) / L["fpm"]).astype(np.int64)
+    check(np.isfinite(a.rate_of_climb) & (np.abs(roc) > 0x7FFF), "rate_of_climb",
+          lambda r: f"rate of climb {a.rate_of_climb[r]:g} ft/min beyond I062/220")
+    names = [str(c).upper() for c in a.callsign.tolist()]
+    check(np.array([len(n) > 8 or not set(n) <= ID_CHARS for n in names], bool),
+          "callsign", lambda r: f"callsign {names[r]!r} is not up to eight of A-Z, 0-9, "
+          "space (I062/380 ID)")
+    sx, sy, cxy = cartesian(a)
+    known = np.isfinite(sx) & np.isfinite(sy)
+    top = 0xFFFF
+
+    def raw(v: np.ndarray, lo: int, hi: int) -> np.ndarray:
+        return np.clip(np.round(np.nan_to_num(v) / L["m"]), lo, hi).astype(np.int64)
+
+    ax, ay = raw(sx, 0, top), raw(sy, 0, top)
+    cov = raw(np.sign(cxy) * np.sqrt(np.abs(cxy)), -0x8000, 0x7FFF)
+
+    def items(i: int) -> dict[str, Any]:
+        out: dict[str, Any] = {}
+        if a.mode_3a[i] >= 0:
+            out["060"] = (0, 0, 0, 0, ("MODE3A", code_text(int(a.mode_3a[i]))))
+        if np.isfinite(a.flight_level[i]):
+            out["136"] = int(fl[i])
+        if np.isfinite(a.rate_of_climb[i]):
+            out["220"] = int(roc[i])
+        adr: dict[str, Any] = {}
+        if a.address[i] >= 0:
+            adr["ADR"] = int(a.address[i])
+        if names[i]:
+            adr["ID"] = names[i].ljust(8)
+        if adr:
+            out["380"] = adr
+        if known[i]:
+            out["500"] = {"APC": (("X", int(ax[i])), ("Y", int(ay[i]))),
+                          "COV": int(cov[i])}
+        return out
+
+    return items

@@ -1,0 +1,103 @@
+"""The optional attribute columns of a tracks file (docs/file-formats.md, "Track
+attributes"), written when the plots had attributes and read back into
+:class:`~mhtrack.attributes.TrackAttributes`.
+
+``flight_level`` (FL) and ``rate_of_climb`` (ft/min), ``mode_3a`` four octal digits,
+``address`` six hexadecimal digits, ``callsign`` text, ``sigma_major``, ``sigma_minor``
+(m) and ``sigma_orient`` (degrees from grid north, clockwise, [0, 180)), ``sensors``
+(ids joined by ``;``) and ``sensor_ages`` (seconds, the same order). Empty cells
+(Parquet nulls) are absent values; every column is written once any is, so that a file's
+columns do not depend on its rows.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pyarrow as pa
+
+from mhtrack.attributes import (
+    TRACK_COLUMNS,
+    TrackAttributes,
+    address_text,
+    address_value,
+    code_text,
+    code_value,
+)
+from mhtrack.io._checks import num
+from mhtrack.io._frame import FLOAT, TIME, Frame, float_array
+from mhtrack.io.plot_attributes import _parsed, _text
+
+_NUMBERS = ("flight_level", "rate_of_climb", "sigma_major", "sigma_minor", "sigma_orient")
+#: Column kinds for :func:`~mhtrack.io._frame.read_frame` (TIME: read as text).
+KINDS = dict.fromkeys(_NUMBERS, FLOAT) | dict.fromkeys(
+    ("mode_3a", "address", "callsign", "sensors", "sensor_ages"), TIME)
+
+
+def track_attribute_columns(a: TrackAttributes) -> dict[str, pa.Array]:
+    """The columns of ``a`` in :data:`~mhtrack.attributes.TRACK_COLUMNS` order, absent
+    values as empty cells."""
+    out: dict[str, pa.Array] = {}
+    for name in TRACK_COLUMNS:
+        v = getattr(a, name)
+        if name in _NUMBERS:
+            out[name] = float_array(v, nan_as_null=True)
+        elif name == "mode_3a":
+            out[name] = _strings([code_text(c) for c in v.tolist()])
+        elif name == "address":
+            out[name] = _strings([address_text(c) for c in v.tolist()])
+        else:
+            out[name] = _strings([str(c) for c in v.tolist()])
+    return out
+
+
+def _strings(values: list[str]) -> pa.Array:
+    return pa.array(values, pa.string(), mask=np.array([v == "" for v in values], bool))
+
+
+def read_track_attributes(f: Frame) -> TrackAttributes | None:
+    """The attribute columns of a tracks file ``f`` (the others absent), ``None`` when it
+    has none; a located :class:`~mhtrack.errors.InputError` for the first bad cell."""
+    if not any(f.has(c) for c in TRACK_COLUMNS):
+        return None
+    out = TrackAttributes.absent(f.n)
+    cols = {name: getattr(out, name) for name in TRACK_COLUMNS}
+    for name in _NUMBERS:
+        if f.has(name):
+            cols[name] = f.floats(name, nullable=True)
+    sig = cols["sigma_major"], cols["sigma_minor"]
+    for v, name in zip(sig, ("sigma_major", "sigma_minor"), strict=True):
+        f.check(v < 0, name, lambda r, v=v: f"σ {num(v[r])} m is negative")
+    f.check(cols["sigma_minor"] > cols["sigma_major"], "sigma_minor",
+            lambda r: f"σ minor {num(sig[1][r])} m exceeds σ major {num(sig[0][r])} m")
+    o = cols["sigma_orient"]
+    f.check((o < 0) | (o >= 180), "sigma_orient",
+            lambda r: f"orientation {num(o[r])}° is outside [0, 180)")
+    for name, parse in (("mode_3a", code_value), ("address", address_value)):
+        if f.has(name):
+            cols[name] = _parsed(f, name, parse)
+    for name in ("callsign", "sensors", "sensor_ages"):
+        if f.has(name):
+            cols[name] = np.array(_text(f, name), object)
+    _check_ages(f, cols["sensors"], cols["sensor_ages"])
+    return TrackAttributes(**cols)
+
+
+def _check_ages(f: Frame, sensors: np.ndarray, ages: np.ndarray) -> None:
+    """``sensors`` non-negative integers and ``sensor_ages`` as many non-negative numbers,
+    both joined by ``;`` (located errors)."""
+    def bad(r: int) -> str | None:
+        s = [v for v in str(sensors[r]).split(";") if v != ""]
+        a = [v for v in str(ages[r]).split(";") if v != ""]
+        if not all(v.isdigit() for v in s):
+            return f"sensors {sensors[r]!r} are not ids joined by ';'"
+        try:
+            nums = [float(v) for v in a]
+        except ValueError:
+            return f"sensor_ages {ages[r]!r} are not numbers joined by ';'"
+        if len(nums) != len(s) or any(not v >= 0 for v in nums):
+            return f"sensor_ages {ages[r]!r}: one age >= 0 s per sensor of {sensors[r]!r}"
+        return None
+
+    problems = [bad(r) for r in range(len(sensors))]
+    f.check(np.array([p is not None for p in problems], bool), "sensor_ages",
+            lambda r: str(problems[r]))

@@ -1,0 +1,148 @@
+"""CAT062 items of the tracks' attributes (issue 29 item 5): a tracks file with attribute
+columns exported, decoded back by pyasteryx (an independent decoder), every item equal to
+the file within one LSB and absent where the file's cell is empty; a tracker run's
+CAT062 sink the same bytes as the export of its tracks file."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from mhtrack.attributes import TrackAttributes, address_text, code_text
+from mhtrack.io.asterix.cat062 import export_tracks
+from mhtrack.io.asterix.cat062_items import cartesian
+from mhtrack.io.tracks import read_tracks, write_tracks
+from mhtrack.models.geodesy import LocalFrame
+from mhtrack.records import TrackTable
+
+pyasteryx = pytest.importorskip("pyasteryx")
+
+FRAME = LocalFrame(51.47, -0.45)
+
+
+def _table(n=400):
+    rng = np.random.default_rng(4)
+    some = rng.random((6, n)) < 0.8  # each attribute known on 80 % of the rows
+    major = rng.uniform(5, 3000, n)
+    a = TrackAttributes(
+        flight_level=np.where(some[0], rng.uniform(-10, 450, n), np.nan),
+        rate_of_climb=np.where(some[1], rng.uniform(-6000, 6000, n), np.nan),
+        mode_3a=np.where(some[2], rng.integers(0, 0o10000, n), -1),
+        address=np.where(some[3], rng.integers(0, 1 << 24, n), -1),
+        callsign=np.array([f"BAW{int(k)}" if s else "" for k, s in
+                           zip(rng.integers(1, 99999, n), some[4], strict=True)], object),
+        sigma_major=np.where(some[5], major, np.nan),
+        sigma_minor=np.where(some[5], major * rng.uniform(0.05, 1, n), np.nan),
+        sigma_orient=np.where(some[5], rng.uniform(0, 180, n), np.nan),
+        sensors=np.full(n, "", object), sensor_ages=np.full(n, "", object))
+    return TrackTable(scan=np.arange(n), time=1000.0 + np.arange(n) * 0.25,
+                      track_id=rng.integers(0, 5000, n), x=rng.uniform(-2e5, 2e5, n),
+                      y=rng.uniform(-2e5, 2e5, n), vx=rng.uniform(-250, 250, n),
+                      vy=rng.uniform(-250, 250, n),
+                      plot=np.where(rng.random(n) < 0.2, -1, np.arange(n)),
+                      tentative=rng.random(n) < 0.1, attrs=a)
+
+
+def _decoded(path):
+    return [m.items for m in pyasteryx.Decoder().decode_file(str(path))]
+
+
+def _compare(tracks: TrackTable, items: list[dict]) -> None:
+    """Each record against its row of the tracks file (the same track number and time
+    of day, in 1/128 s: records are written in time order; a track reported twice at one
+    time, by two frames, may match either), within one LSB."""
+    a = tracks.attrs
+    sx, sy, cxy = cartesian(a)
+    assert len(items) == len(tracks)
+    rows: dict[tuple[int, int], list[int]] = {}
+    for i, (t, s) in enumerate(zip(tracks.track_id.tolist(), tracks.time.tolist(),
+                                   strict=True)):
+        rows.setdefault((int(t), round(s * 128)), []).append(i)
+
+    def wrong(m: dict, i: int) -> list[str]:
+        bad = []
+        if m["I062/080"]["CNF"] != int(tracks.tentative[i]):
+            bad.append("080 CNF")
+        if m.get("I062/060", {}).get("Mode3A") != (code_text(a.mode_3a[i]) or None):
+            bad.append("060")
+        fl, roc = a.flight_level[i], a.rate_of_climb[i]
+        got = m.get("I062/136", {}).get("MFL")  # 1/4 FL; pyasteryx gives feet
+        if (got is None) != np.isnan(fl) or (got is not None and abs(got / 100 - fl) > 0.25):
+            bad.append("136")
+        got = m.get("I062/220", {}).get("RoC")
+        if (got is None) != np.isnan(roc) or (got is not None and abs(got - roc) > 6.25):
+            bad.append("220")
+        adr = m.get("I062/380", {})
+        if adr.get("ADR", {}).get("ADR") != (address_text(a.address[i]) or None):
+            bad.append("380 ADR")
+        if adr.get("ID", {}).get("ACID") != (a.callsign[i] or None):
+            bad.append("380 ID")
+        acc = m.get("I062/500")
+        if (acc is None) != np.isnan(a.sigma_major[i]):
+            bad.append("500 present")
+        elif acc is not None:
+            cov = np.sign(cxy[i]) * np.sqrt(abs(cxy[i]))
+            if abs(acc["APC"]["APC_X"] - sx[i]) > 0.5 or \
+                    abs(acc["APC"]["APC_Y"] - sy[i]) > 0.5 or \
+                    abs(acc["COV"]["COV_XY"] - cov) > 0.5:
+                bad.append("500")
+        return bad
+
+    for m in items:
+        found = rows[(m["I062/040"]["TrkN"], round(m["I062/070"]["ToT"] * 128))]
+        problems = [wrong(m, i) for i in found]
+        assert any(not p for p in problems), (m, problems)
+
+
+@pytest.mark.parametrize("suffix", [".csv", ".parquet"])
+def test_items_decoded_by_pyasteryx_equal_the_tracks_file(tmp_path, suffix):
+    write_tracks(_table(), tmp_path / f"t{suffix}", FRAME)
+    back = read_tracks(tmp_path / f"t{suffix}")
+    n, _ = export_tracks(tmp_path / f"t{suffix}", None, tmp_path / "t.ast")
+    assert n == len(back) == 400
+    _compare(back, _decoded(tmp_path / "t.ast"))
+
+
+def test_a_file_without_attributes_exports_none(tmp_path):
+    t = _table()
+    write_tracks(TrackTable(**{f: getattr(t, f) for f in ("scan", "time", "track_id", "x",
+                                                            "y", "vx", "vy", "plot")}),
+                 tmp_path / "t.csv", FRAME)
+    export_tracks(tmp_path / "t.csv", None, tmp_path / "t.ast")
+    new = {"I062/060", "I062/136", "I062/220", "I062/380", "I062/500"}
+    assert not any(new & set(m) for m in _decoded(tmp_path / "t.ast"))
+
+
+def test_a_callsign_outside_the_icao_set_is_named(tmp_path):
+    t = _table(8)
+    t.attrs.callsign[3] = "baw_12"
+    write_tracks(t, tmp_path / "t.csv", FRAME)
+    with pytest.raises(Exception, match=r"line 5.*callsign.*BAW_12"):
+        export_tracks(tmp_path / "t.csv", None, tmp_path / "t.ast")
+
+
+def test_a_tracker_run_exports_its_attributes(tmp_path):
+    """opensky-radars with attributes through the pipeline: the CAT062 sink's bytes are
+    the export of the tracks file, whose every item pyasteryx decodes back."""
+    from mhtrack.io import write_plots
+    from mhtrack.io.sensors import write_sensors
+    from mhtrack.pipeline import Pipeline, TrackOptions
+    from mhtrack.scenario import preset, simulate
+    from mhtrack.scenario.identity import AttributeOptions, add_attributes, opensky_identities
+    from mhtrack.scenario.overrides import apply_overrides
+    from mhtrack.sinks import Cat062Sink, TracksFileSink
+
+    sc = apply_overrides(preset("opensky-radars"), scans=4)
+    plots = add_attributes(simulate(sc, seed=2).plots, opensky_identities(),
+                           AttributeOptions(), 2)
+    write_plots(plots, tmp_path / "plots.csv")
+    write_sensors(sc.sensor_set(), tmp_path / "sensors.toml")
+    pipe = Pipeline.open(str(tmp_path / "plots.csv"), TrackOptions())
+    pipe.run([TracksFileSink(tmp_path / "tracks.csv", frame=pipe.frame, output=pipe.output),
+              Cat062Sink(tmp_path / "sink.ast", pipe.frame, output=pipe.output)])
+    export_tracks(tmp_path / "tracks.csv", None, tmp_path / "export.ast")
+    assert (tmp_path / "sink.ast").read_bytes() == (tmp_path / "export.ast").read_bytes()
+    tracks = read_tracks(tmp_path / "tracks.csv")
+    online = ~tracks.tentative  # the tentative past has no identity
+    assert tracks.attrs is not None and (tracks.attrs.address[online] >= 0).mean() > 0.9
+    _compare(tracks, _decoded(tmp_path / "export.ast"))

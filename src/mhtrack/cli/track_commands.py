@@ -140,6 +140,9 @@ def track_options(tracker: str, tracker_pd: float | None, meas_sigma: float | No
               default=DEFAULT_CLUTTER_FRAME, show_default=True, help="Timed plots: estimate "
               "each radar's clutter in the local east-north plane or in the radar's own "
               "range and bearing (docs/clutter.md).")
+@click.option("--sector-frames", is_flag=True, help="A recording: cut frames at each "
+              "radar's own CAT034 sector crossings instead of eighths of its rotation "
+              "(docs/real-radar.md: measured, and why it is not the default).")
 @click.option("--estimate-bias", is_flag=True, help="Estimate each radar's registration "
               "bias (range offset, range gain, azimuth offset) online from aircraft that "
               "several sensors see, and correct its plots (docs/registration.md).")
@@ -159,7 +162,8 @@ def track(plots: Path, tracker: str, tracker_pd: float | None, meas_sigma: float
           clutter_density: float | None,
           birth_density: float | None, nscan: int | None, out: Path,
           scenario_file: Path | None, sensors_file: Path | None,
-          reorder_window_s: float | None, clutter_frame: str, birth: str,
+          reorder_window_s: float | None, clutter_frame: str, sector_frames: bool,
+          birth: str,
           birth_theta: float | None, fusion: str | None, output: str | None,
           estimate_bias: bool = False, bias_reference: int | None = None,
           bias_init: Path | None = None, bias_out: Path | None = None) -> None:
@@ -185,7 +189,7 @@ def track(plots: Path, tracker: str, tracker_pd: float | None, meas_sigma: float
     bars = show_progress()
     pipe = Pipeline.open(plots, options, scenario_file=scenario_file,
                          sensors_file=sensors_file, reorder_window_s=reorder_window_s,
-                         progress=bars)
+                         progress=bars, sectors=sector_frames)
     result = pipe.run([TracksFileSink(out, frame=pipe.frame, output=pipe.output)],
                       progress=bars, keep_stats=False)
     say(f"{result.describe()} -> {out}")

@@ -60,9 +60,10 @@ def input_files(path: str | Path, scenario_file: str | Path | None = None,
 
 def open_input(path: str | Path, *, scenario_file: str | Path | None = None,
                sensors_file: str | Path | None = None,
-               reorder_window_s: float | None = None) -> Source:
+               reorder_window_s: float | None = None, sectors: bool = False) -> Source:
     """The source of ``mhtrack track PATH``: the files of :func:`input_files` read, and
-    the plots table or recording opened with them."""
+    the plots table or recording opened with them (``sectors``: as
+    :func:`~mhtrack.sources.open_source`)."""
     scenario_file, sensors_file = input_files(path, scenario_file, sensors_file)
     sensors = scenario = None
     if sensors_file is not None:
@@ -76,4 +77,4 @@ def open_input(path: str | Path, *, scenario_file: str | Path | None = None,
     from mhtrack.sources import open_source
 
     return open_source(path, sensors=sensors, scenario=scenario,
-                       reorder_window_s=reorder_window_s)
+                       reorder_window_s=reorder_window_s, sectors=sectors)

@@ -239,13 +239,15 @@ class Pipeline:
     @classmethod
     def open(cls, path: str | Path, options: TrackOptions | None = None, *,
              scenario_file: str | None = None, sensors_file: str | None = None,
-             reorder_window_s: float | None = None, progress: bool = False) -> Pipeline:
-        """A pipeline on a plots file or a recording (:func:`~mhtrack.pipeline.open_input`);
-        ``progress``: a bar over the source's survey (:attr:`Source.progress`)."""
+             reorder_window_s: float | None = None, progress: bool = False,
+             sectors: bool = False) -> Pipeline:
+        """A pipeline on a plots file or a recording (:func:`~mhtrack.pipeline.open_input`;
+        ``sectors``: a recording's frames at its radars' own sectors); ``progress``: a
+        bar over the source's survey (:attr:`Source.progress`)."""
         from mhtrack.pipeline.inputs import open_input
 
         source = open_input(path, scenario_file=scenario_file, sensors_file=sensors_file,
-                            reorder_window_s=reorder_window_s)
+                            reorder_window_s=reorder_window_s, sectors=sectors)
         source.progress = progress
         return cls(source, options)
 

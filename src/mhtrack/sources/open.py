@@ -16,7 +16,7 @@ if TYPE_CHECKING:
 
 def open_source(path: PathArg, *, sensors: SensorSet | None = None,
                 scenario: Scenario | None = None,
-                reorder_window_s: float | None = None) -> Source:
+                reorder_window_s: float | None = None, sectors: bool = False) -> Source:
     """The :class:`Source` of a plots table or an ASTERIX recording at ``path``.
 
     ``sensors``: the radars of timed plots and recordings (a recording without them, or
@@ -24,7 +24,9 @@ def open_source(path: PathArg, *, sensors: SensorSet | None = None,
     without one: :mod:`mhtrack.io.asterix.sites`);
     ``scenario``: the sensors and scan times of a scan table; ``reorder_window_s``: the
     re-order window of timed plots (default
-    :data:`~mhtrack.io.reorder.DEFAULT_REORDER_WINDOW_S`). Nothing else is guessed:
+    :data:`~mhtrack.io.reorder.DEFAULT_REORDER_WINDOW_S`); ``sectors``: a recording's
+    frames cut at its radars' own CAT034 sector crossings (``docs/real-radar.md``; a
+    plots table has none: refused). Nothing else is guessed:
     a sensors file beside the plots is the caller's choice."""
     from mhtrack.io.asterix.api import is_recording
 
@@ -34,7 +36,11 @@ def open_source(path: PathArg, *, sensors: SensorSet | None = None,
                              "sensors file, not a scenario")
         from mhtrack.sources.recording import AsterixSource
 
-        return AsterixSource(path, sensors=sensors, reorder_window_s=reorder_window_s)
+        return AsterixSource(path, sensors=sensors, reorder_window_s=reorder_window_s,
+                             sectors=sectors)
+    if sectors:
+        raise ValueError(f"{path} is a plots table: frames at the radars' own sectors need "
+                         "a recording with their CAT034 sector crossings")
     from mhtrack.sources.tables import TableSource
 
     return TableSource(path, sensors=sensors, scenario=scenario,

@@ -131,3 +131,45 @@ def test_own_tracks_as_cat062_reference_score_as_themselves(
     lsb_m = lsb062()["deg"] * 111_320.0  # one LSB of latitude, in metres
     assert m.motp <= lsb_m
     assert ev.coverage == 1.0
+
+
+def test_adsb_reports_as_the_reference(tmp_path: Path) -> None:
+    """A recording with CAT021 ADS-B reports and no CAT062 is read as the aircraft's own
+    reports: one reference target per address, a report flagged simulated and one with
+    no identity left out and counted at their blocks; tracks on the same straight lines
+    match it with no miss, false track or switch (positions within the I021/131 LSB)."""
+    from mhtrack.io import read_tracks
+    from mhtrack.io.asterix import encode_other
+    from mhtrack.io.reference import read_reference
+    from mhtrack.models.geodesy import LocalFrame
+
+    station = 0x0709
+    tracks = [(-2e4, 1e4, 150.0, -40.0, 0, 30), (3e4, -5e3, -90.0, 120.0, 100, 30)]
+    csv = tmp_path / "tracks.csv"
+    _write_tracks(csv, tracks)
+    frame = LocalFrame(*ORIGIN)
+    blocks = []
+    for k, (x0, y0, vx, vy, first, n) in enumerate(tracks):
+        t = (first + np.arange(n) * 256 + (np.arange(n) * 37 % 11)) / 128.0
+        lat, lon = frame.to_geodetic(x0 + vx * (t - t[0]), y0 + vy * (t - t[0]))
+        blocks += [(float(t[i]), encode_other.report021(
+            float(t[i]), station, float(lat[i]), float(lon[i]), address=f"{0xA00000 + k:06X}"))
+            for i in range(n)]
+    lat0, lon0 = frame.to_geodetic(np.array([0.0]), np.array([0.0]))
+    bad = [(5.0, encode_other.report021(5.0, station, float(lat0[0]), float(lon0[0]),
+                                        address="ABCDEF", sim=1)),
+           (6.0, encode_other.report021(6.0, station, float(lat0[0]), float(lon0[0])))]
+    reports = sorted(blocks + bad, key=lambda b: b[0])
+    ast = tmp_path / "adsb.ast"
+    ast.write_bytes(b"".join(b for t, r in reports
+                             for _, _, b in encode_other.blocks([(t, station, 21, r)])))
+    ref = read_reference(ast, frame)
+    assert sorted(set(ref.key.tolist())) == [0xA00000, 0xA00001]
+    assert len(ref) == 60
+    assert ref.problems.counts == {"not_plot": 1, "no_identity": 1}
+    ours = read_tracks(csv, frame=frame, geodetic=True, accept_truth=False)
+    ev, _, _ = evaluate_reference(ours, ref.time, ref.key, ref.state, max_gap_s=15.0)
+    m = ev.clear_mot
+    assert m.n_misses == 0 and m.n_false == 0 and m.id_switches == 0
+    assert ev.n_targets == 2
+    assert m.motp <= 180.0 / 2**30 * 111_320.0 * 2  # I021/131: 180/2³⁰ ° a step

@@ -130,7 +130,8 @@ def _write_rotating(sim: Any, out: Path, fmt: str) -> None:
 @click.argument("truth", type=click.Path(dir_okay=False, path_type=Path), required=False)
 @click.option("--reference", "reference", type=click.Path(dir_okay=False, path_type=Path),
               default=None, help="Score TRACKS against a reference system's tracks, an "
-              "ASTERIX CAT062 recording, instead of TRUTH (docs/metrics.md).")
+              "ASTERIX CAT062 recording (without CAT062: its CAT021 ADS-B reports), "
+              "instead of TRUTH (docs/metrics.md).")
 @click.option("--reference-period", "reference_period", type=click.FloatRange(
               min=0, min_open=True), default=None, help="With --reference: the times the "
               "reference is sampled at, every S seconds [default: its own median update "

@@ -18,6 +18,13 @@ counted in ``problems``, never passed on):
 
 Tentative (I062/080 CNF) and coasting (CST) updates are kept: they are states the
 reference system reported.
+
+A recording without CAT062 but with **ADS-B reports** (CAT021) is read as the aircraft's
+own reports instead (issue 28: ADS-B as the reference): key = the 24-bit target address
+(I021/080), else 2²⁴ + station · 65 536 + the ground station's track number (I021/161);
+velocity 0 (the reference is sampled between reports, never extrapolated); reports
+flagged simulated, test or field monitor (I021/040 SIM, TST, RAB) are left out and
+counted, as are reports with no identity.
 """
 
 from __future__ import annotations
@@ -63,20 +70,66 @@ class ReferenceUpdates:
 
 
 def read_reference(path: str | Path, frame: LocalFrame | None = None) -> ReferenceUpdates:
-    """The CAT062 updates of recording ``path`` (module docstring); the records skipped
-    are in ``problems`` (the caller warns: one line per kind, naming ``path`` and the
-    byte offset of the first)."""
-    from mhtrack.io.asterix.cat062 import read_system_tracks
+    """The CAT062 updates of recording ``path`` — or, without CAT062, its CAT021 ADS-B
+    reports (module docstring); the records skipped are in ``problems`` (the caller
+    warns: one line per kind, naming ``path`` and the byte offset of the first)."""
+    from mhtrack.io.asterix.cat062 import block062, track_columns
+    from mhtrack.io.asterix.category_file import category_rows
 
-    cols, problems = read_system_tracks(path)
+    rows, problems = category_rows(path, 62, block062)
+    if rows:
+        cols = track_columns(rows)
+        source = cols["sac"].astype(np.int64) * 256 + cols["sic"].astype(np.int64)
+        key = source * 65536 + cols["track_number"].astype(np.int64)
+        velocity = tuple(np.nan_to_num(np.asarray(cols[k], float)) for k in ("vx", "vy"))
+    else:
+        cols, key, problems = _adsb_reports(path)
+        velocity = (np.zeros(key.size), np.zeros(key.size))
     if frame is None:
         from mhtrack.models.geodesy import LocalFrame
 
         frame = LocalFrame(float(cols["lat"][0]), float(cols["lon"][0]))
-    source = cols["sac"].astype(np.int64) * 256 + cols["sic"].astype(np.int64)
-    key = source * 65536 + cols["track_number"].astype(np.int64)
     x, y = frame.to_local(cols["lat"], cols["lon"])
-    ve, vn = (np.nan_to_num(np.asarray(cols[k], float)) for k in ("vx", "vy"))
-    vx, vy = frame.velocity_to_local(cols["lat"], cols["lon"], ve, vn)
+    vx, vy = frame.velocity_to_local(cols["lat"], cols["lon"], *velocity)
     state = np.column_stack([np.asarray(v, float) for v in (x, y, vx, vy)])
     return ReferenceUpdates(np.asarray(cols["time"], float), key, state, frame, problems)
+
+
+def _adsb_reports(path: str | Path) -> tuple[dict[str, np.ndarray], np.ndarray, Problems]:
+    """The CAT021 reports of ``path`` as reference updates: columns ``time`` (continued
+    across midnight), ``lat``, ``lon``; their keys; the parts skipped."""
+    from mhtrack.errors import InputError
+    from mhtrack.io.asterix.cat021 import COLUMNS, block021
+    from mhtrack.io.asterix.category_file import category_rows
+    from mhtrack.io.asterix.timeaxis import unwrap_days
+
+    at: list[int] = []
+
+    def rows_of(raw: bytes, offset: int, problems: Problems) -> list[tuple[object, ...]] | None:
+        found = block021(raw, offset, problems)
+        if found is not None:
+            at.extend([offset] * len(found))
+        return found
+
+    rows, problems = category_rows(path, 21, rows_of)
+    if not rows:
+        raise InputError(f"{path}: no CAT062 track nor CAT021 ADS-B report with a position "
+                         "and a time: not a reference", file=str(path))
+    c = {k: np.array(v) for k, v in zip(COLUMNS, zip(*rows, strict=True), strict=True)}
+    where = np.asarray(at, np.int64)
+    flagged = (c["sim"] == 1) | (c["tst"] == 1) | (c["rab"] == 1)
+    for i in np.flatnonzero(flagged):
+        problems.add("not_plot", int(where[i]))
+    address = np.array([int(a, 16) if a else -1 for a in c["address"].tolist()], np.int64)
+    tn = c["track_number"].astype(np.int64)
+    key = np.where(address >= 0, address,
+                   np.where(tn >= 0, 2**24 + c["sensor"].astype(np.int64) * 65536 + tn, -1))
+    for i in np.flatnonzero(~flagged & (key < 0)):
+        problems.add("no_identity", int(where[i]))
+    keep = ~flagged & (key >= 0)
+    if not keep.any():
+        raise InputError(f"{path}: no CAT021 ADS-B report of an aircraft with an address "
+                         "or a track number: not a reference", file=str(path))
+    cols = {"time": unwrap_days(c["time"][keep].astype(float)),
+            "lat": c["lat"][keep].astype(float), "lon": c["lon"][keep].astype(float)}
+    return cols, key[keep], problems

@@ -22,9 +22,8 @@ from mhtrack.errors import InputError
 from mhtrack.io._frame import FLOAT, INT, TIME, read_frame
 from mhtrack.io._times import seconds
 from mhtrack.io.asterix.cat062_items import attribute_items
-from mhtrack.io.asterix.container import blocks
+from mhtrack.io.asterix.category_file import category_rows
 from mhtrack.io.asterix.encode import Message, encode_blocks, raw_tod
-from mhtrack.io.asterix.framings import recognise, units
 from mhtrack.io.asterix.problems import Problems
 from mhtrack.io.asterix.timeaxis import DAY_S, unwrap_days
 from mhtrack.io.asterix.writer import write_blocks
@@ -171,31 +170,21 @@ def read_system_tracks(path: str | Path) -> tuple[dict[str, np.ndarray], Problem
     midnight. A reference system's tracks for ``evaluate``: physically impossible records
     (|lat| > 90°, |lon| > 180°, time of day ≥ 86 400 s) are refused and counted
     (``impossible``), never passed on."""
-    gen = _lib.modules()[1]
     name = str(path)
-    data = Path(path).read_bytes()
-    cats = {int(c) for c in gen.manifest["CATS"]} | {62}
-    kind = recognise(data, name, cats)
-    problems = Problems()
-    rows: list[tuple[Any, ...]] = []
-    for offset, _, payload in units(data, kind, name, cats, problems):
-        for at, cat, raw in blocks(payload, offset, problems):
-            if cat != 62:
-                problems.add("unknown_category", at, detail=f"category {cat}")
-                continue
-            found = block062(raw, at, problems)
-            if found is None:
-                problems.add("undecodable", at, detail="category 62: records do not fill "
-                             "the block")
-                continue
-            rows += found
+    rows, problems = category_rows(path, 62, block062)
     if not rows:
         raise InputError(f"{name}: no CAT062 track with I062/010, 040, 070 and 105",
                          file=name)
+    return track_columns(rows), problems
+
+
+def track_columns(rows: list[tuple[Any, ...]]) -> dict[str, np.ndarray]:
+    """Rows of :func:`block062` (at least one) as columns :data:`TRACK_COLUMNS`, times
+    continued across midnight."""
     cols = {k: np.array(v) for k, v in zip(TRACK_COLUMNS, zip(*rows, strict=True),
                                              strict=True)}
     cols["time"] = unwrap_days(cols["time"].astype(float))
-    return cols, problems
+    return cols
 
 
 def block062(raw: bytes, at: int, problems: Problems) -> list[tuple[Any, ...]] | None:

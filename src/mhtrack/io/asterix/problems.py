@@ -30,6 +30,8 @@ KINDS = {
                    "sigma for their station in the sensors file skipped",
     "not_plot": "{n} report(s) that are not plots (no detection, test target, field "
                 "monitor, simulated) left out",
+    "no_identity": "{n} ADS-B report(s) with neither a target address (I021/080) nor a "
+                   "track number (I021/161) skipped",
 }
 
 

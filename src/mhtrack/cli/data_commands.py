@@ -157,6 +157,13 @@ def _write_rotating(sim: Any, out: Path, fmt: str) -> None:
               help="At truth times: the oldest track state (s) still predicted; with "
               "--reference: the longest gap between a track's updates interpolated "
               "across [15].")
+@click.option("--identity", is_flag=True, help="Add the identity figures: ids per "
+              "aircraft, wrong code/address rate (--plots with attributes and origins), "
+              "horizontal RMS error, probability of update, extra and dubious track rates "
+              "(docs/metrics.md).")
+@click.option("--update-interval", "update_interval", type=click.FloatRange(
+              min=0, min_open=True), default=None, help="With --identity: the probability "
+              "of update's interval (s) [default: the truth's median time step].")
 @click.option("--json", "as_json", is_flag=True, help="Print one JSON object.")
 @click.option("--out", "-o", "out", type=click.Path(dir_okay=False, path_type=Path),
               default=None, help="Write the table (.txt) or the JSON (.json) to FILE "
@@ -164,7 +171,8 @@ def _write_rotating(sim: Any, out: Path, fmt: str) -> None:
 def evaluate(tracks: Path, truth: Path | None, reference: Path | None,
              reference_period: float | None, plots: Path | None, cutoff: float,
              order: float, match_distance: float | None, sensors_file: Path | None,
-             at: str | None, max_age_s: float | None, as_json: bool, out: Path | None) -> None:
+             at: str | None, max_age_s: float | None, identity: bool,
+             update_interval: float | None, as_json: bool, out: Path | None) -> None:
     """Score TRACKS against TRUTH (or a reference system's CAT062 tracks, --reference
     REC): OSPA, GOSPA, cardinality, CLEAR-MOT, coverage."""
     import logging
@@ -181,6 +189,10 @@ def evaluate(tracks: Path, truth: Path | None, reference: Path | None,
         raise click.UsageError("give TRUTH or --reference REC (one of them)")
     if reference_period is not None and reference is None:
         raise click.UsageError("--reference-period applies to --reference only")
+    if update_interval is not None and not identity:
+        raise click.UsageError("--update-interval applies to --identity only")
+    if reference is not None and identity:
+        raise click.UsageError("--identity applies to TRUTH only")
     if reference is not None and (plots is not None or at is not None):
         raise click.UsageError("--plots and --at apply to TRUTH only (--reference scores "
                                "at the reference's own times)")
@@ -211,7 +223,8 @@ def evaluate(tracks: Path, truth: Path | None, reference: Path | None,
                 _check_same_times(plots, pl, truth, gt)
         ev = run_evaluation(tr, gt, plots=pl, cutoff=cutoff, order=order,
                             match_distance=match_distance, at=at, stages=run,
-                            max_age_s=age)
+                            max_age_s=age, identity=identity,
+                            update_interval=update_interval)
     finally:
         run.close()
     logging.getLogger("mhtrack.metrics").info(

@@ -29,6 +29,7 @@ from mhtrack.metrics.clearmot import clear_mot_indexed
 from mhtrack.metrics.evaluation import Evaluation
 from mhtrack.metrics.gospa import gospa_indexed
 from mhtrack.metrics.hota import hota_indexed
+from mhtrack.metrics.identity import DEFAULT_DUBIOUS_DISTANCE, identity_figures
 from mhtrack.metrics.ospa import ospa_indexed
 from mhtrack.metrics.ospa2 import DEFAULT_OSPA2_WINDOW, check_window, ospa2_indexed
 from mhtrack.metrics.resample import (
@@ -59,11 +60,16 @@ def evaluate(
     ospa2_window: int = DEFAULT_OSPA2_WINDOW,
     hota_distance: float | None = None,
     stages: Stages | None = None,
+    identity: bool = False,
+    update_interval: float | None = None,
+    dubious_distance: float = DEFAULT_DUBIOUS_DISTANCE,
 ) -> Evaluation:
     """Score ``tracks`` against ``truth``: OSPA, GOSPA (α = 2), cardinality, CLEAR-MOT and
     P1 Table 3's Rcc, Rmc, Rfg, Lmin/Lavg/Lmax (:func:`association_metrics`), OSPA(2)
     (:func:`~mhtrack.metrics.ospa2.ospa2_per_scan`, same ``c`` and ``p``) and HOTA
-    (:func:`~mhtrack.metrics.hota.hota`).
+    (:func:`~mhtrack.metrics.hota.hota`); with ``identity`` also the identity figures
+    (:func:`~mhtrack.metrics.identity.identity_figures`: ids per aircraft, wrong-code
+    rate, ESASSP-style figures).
 
     **Alignment** (``at``). ``"scans"``: tracks and truth are compared scan by scan; the
     scans evaluated are the sorted union of the truth's scans, the tracks' scans, every
@@ -107,6 +113,11 @@ def evaluate(
         pair falls to 0 at this distance; defaults to ``cutoff``.
     stages : mhtrack.progress.Stages, optional
         Runs each metric as a stage of a progress bar (``evaluate``'s, ``report``'s).
+    identity : bool, default False
+        Compute :attr:`Evaluation.identity` (off: the result is that of before).
+    update_interval, dubious_distance : float
+        The probability of update's interval ``T`` (s; default the truth's median time
+        step) and the dubious-track threshold (m, default 1 NM); ``identity`` only.
 
     Returns
     -------
@@ -124,6 +135,7 @@ def evaluate(
     window = check_window(ospa2_window, "ospa2_window")
     d_max = c if hota_distance is None else check_cutoff(hota_distance, "hota_distance")
     how = alignment(tracks, truth, plots, at)
+    raw_tracks, raw_plots = tracks, plots
     n_tracks = len(np.unique(tracks.track_id))
     if how == "scans":
         idx = scan_union(truth.scan, tracks.scan, p_scans, extra)
@@ -152,4 +164,7 @@ def evaluate(
         max_age_s=None if how == "scans" else age,
         ospa2=run("OSPA(2)", ospa2_indexed, data, c, p, window),
         hota=run("HOTA", hota_indexed, data, d_max),
+        identity=identity_figures(raw_tracks, truth, tracks, mot.matching, raw_plots,
+                                  update_interval=update_interval,
+                                  dubious_distance=dubious_distance) if identity else None,
     )

@@ -16,6 +16,7 @@ from mhtrack.metrics.cardinality import CardinalityPerScan
 from mhtrack.metrics.clearmot import CLEARMOTResult
 from mhtrack.metrics.gospa import GOSPAPerScan
 from mhtrack.metrics.hota import HOTA_KEYS, HOTAResult
+from mhtrack.metrics.identity import IdentityFigures
 from mhtrack.metrics.ospa import OSPAPerScan
 from mhtrack.metrics.ospa2 import OSPA2PerScan
 from mhtrack.metrics.resample import Alignment
@@ -46,6 +47,8 @@ class Evaluation:
         Largest age of a track state used at a truth time (s); ``None`` with ``"scans"``.
     ospa2, hota : OSPA2PerScan, HOTAResult or None
         OSPA(2) on ``scans`` (``cutoff``, ``order``, ``ospa2.window`` scans); HOTA.
+    identity : IdentityFigures or None
+        Issue 29's identity figures (:mod:`mhtrack.metrics.identity`), when asked for.
     """
 
     cutoff: float
@@ -63,6 +66,7 @@ class Evaluation:
     max_age_s: float | None = None
     ospa2: OSPA2PerScan | None = None
     hota: HOTAResult | None = None
+    identity: IdentityFigures | None = None
 
     @property
     def n_track_ids(self) -> int:
@@ -112,7 +116,9 @@ class Evaluation:
         ``cardinality_true``. Issue 14's keys: ``at``, ``coverage``, ``n_track_ids`` and,
         with ``at = "truth-times"`` only, ``max_age_s``. Issue 19's: ``ospa2_mean,
         ospa2_window``, the per-scan list ``ospa2``, and ``hota, deta, assa, loca,
-        hota_distance`` (means over α; ``None`` / empty when not computed).
+        hota_distance`` (means over α; ``None`` / empty when not computed). Issue 29's
+        (only when :attr:`identity` was computed): :data:`~mhtrack.metrics.identity.
+        IDENTITY_KEYS`.
         """
         m = self.clear_mot
         return {
@@ -141,6 +147,9 @@ class Evaluation:
             "coverage": _num(self.coverage),
             "n_track_ids": self.n_track_ids,
             **self._issue19_dict(),
+            **({} if self.identity is None else
+               {k: v if isinstance(v, int) else _num(v)
+                for k, v in self.identity.to_dict().items()}),
             "scans": [int(s) for s in self.scans],
             "ospa": [float(v) for v in self.ospa.distance],
             "gospa": [float(v) for v in self.gospa.distance],
@@ -176,6 +185,19 @@ class Evaluation:
             (f"HOTA (d_max={_fmt(h.d_max)} m)", _fmt(h.hota)),
             ("  DetA / AssA / LocA", f"{_fmt(h.deta)} / {_fmt(h.assa)} / {_fmt(h.loca)}")])
 
+    def _identity_rows(self) -> list[tuple[str, str]]:
+        i = self.identity
+        if i is None:
+            return []
+        return [("ids per aircraft (mean)", _fmt(i.ids_per_aircraft)),
+                (f"wrong code/address rate ({i.n_code_rows} rows)", _fmt(i.wrong_code_rate)),
+                ("horizontal RMS position error", _fmt(i.rms_horizontal, " m")),
+                (f"probability of update (T={_fmt(i.update_interval)} s)",
+                 _fmt(i.p_update)),
+                ("extra track rate (unmatched states)", _fmt(i.extra_track_rate)),
+                (f"dubious track rate (> {_fmt(i.dubious_distance)} m)",
+                 _fmt(i.dubious_track_rate))]
+
     def to_table(self, *, per_scan: bool = False) -> str:
         """Plain-text (ASCII) table of the summary metrics, for a terminal.
 
@@ -200,6 +222,7 @@ class Evaluation:
             ("coverage (matched truth states)", _fmt(self.coverage)),
             ("identity switches", str(m.id_switches)),
             ("fragmentations", str(m.fragmentations)),
+            *self._identity_rows(),
             (
                 "matches / misses / false / truth",
                 f"{m.n_matches} / {m.n_misses} / {m.n_false} / {m.n_truth}",

@@ -162,3 +162,24 @@ def test_timed_branching_is_the_same_with_all_pairs_or_the_kd_tree(seed, n, chi2
         logic.BRUTE_PAIRS = old
     for x, y in zip(a, b, strict=True):
         np.testing.assert_array_equal(x, y)
+
+
+def test_the_timed_logic_loads_no_scipy():
+    """The timed gates take their candidates from all pairs: a timed birth (``mhtrack
+    track`` of timed plots with ``--birth logic``) loads no scipy, as every-plot births."""
+    import subprocess
+    import sys
+    code = (
+        "import sys, numpy as np\n"
+        "from mhtrack.initiation import Window\n"
+        "from mhtrack.initiation.logic import branch_tracks\n"
+        "from mhtrack.records import Scan\n"
+        "sc = [Scan(s, 4.0 * s, np.array([[200.0 * 4 * s, 0.0]]), np.zeros(1, np.int64),\n"
+        "           np.array([s]), np.eye(2)[None] * 100.0, None, np.array([4.0 * s]))\n"
+        "      for s in range(4)]\n"
+        "p, _, _ = branch_tracks(Window.from_scans(sc), np.array([np.pi]))\n"
+        "print(len(p), sorted(m for m in sys.modules if m.startswith('scipy')))\n")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         check=True)
+    n, modules = out.stdout.split(maxsplit=1)
+    assert int(n) >= 1 and modules.strip() == "[]", out.stdout  # the line found, no scipy

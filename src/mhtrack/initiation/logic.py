@@ -217,7 +217,6 @@ def branch_tracks(window: Window, thetas: np.ndarray, *, gate_radius: float = 30
     n_scans) flat plot indices (``-1`` a miss) and their intervals ``lo``, ``hi``; the
     tracks of limit ``θ`` are ``path[(lo <= θ) & (θ < hi)]``, in the initiator's order.
     """
-    from scipy.spatial import cKDTree
     ths = np.sort(np.asarray(thetas, float))
     N, M = n_scans, min_plots
     max_miss = N - M
@@ -237,7 +236,10 @@ def branch_tracks(window: Window, thetas: np.ndarray, *, gate_radius: float = 30
             prev = previous_plot(path)
             hits = (path >= 0).sum(axis=1)
             miss = c - hits  # slots 0..c−1 are decided: each a plot or a miss
-            tree = cKDTree(z[rows]) if len(rows) and tp is None else None
+            tree = None
+            if len(rows) and tp is None:  # P2's scans; the timed gates need no tree
+                from scipy.spatial import cKDTree
+                tree = cKDTree(z[rows])
             q_all, j_all, a_all = [], [], []
             one = np.flatnonzero(hits == 1)
             if len(one) and len(rows) and tp is not None:

@@ -2,6 +2,8 @@
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from mhtrack.build import make_initiator
 from mhtrack.initiation import LogicInitiator, Window, leg_angle
@@ -102,3 +104,82 @@ def test_window_stacks_scans():
     np.testing.assert_array_equal(w.start, [0, 1, 1, 2, 3])
     np.testing.assert_array_equal(w.slot, [0, 2, 3])
     np.testing.assert_allclose(w.R_inv[0], np.eye(2) / 400.0)
+
+
+def _pairs_by_tree(pts, centres, r):
+    """The k-d tree ball query with the widened radius (the former prefilter)."""
+    from scipy.spatial import cKDTree
+
+    from mhtrack.initiation.logic import _ball
+    return _ball(cKDTree(pts), centres, r * (1.0 + 1e-12) + 1e-9)
+
+
+@settings(max_examples=60, deadline=None)
+@given(seed=st.integers(0, 10_000), n=st.integers(0, 30), m=st.integers(1, 30))
+def test_candidate_pairs_equal_the_kd_tree_query_and_hold_every_pair_in_range(seed, n, m):
+    """All-pairs prefilter against scipy's ball query (same pairs, same order) and against
+    the rule ``‖p − c‖ ≤ r``: every pair within the radius is kept."""
+    from mhtrack.initiation import logic
+    rng = np.random.default_rng(seed)
+    pts = rng.uniform(0, 3000.0, (m, 2))
+    centres = rng.uniform(0, 3000.0, (n, 2))
+    r = rng.uniform(0, 1500.0, n)
+    q, j = logic._candidates(pts, centres, r)
+    tq, tj = _pairs_by_tree(pts, centres, r)
+    np.testing.assert_array_equal(q, tq)
+    np.testing.assert_array_equal(j, tj)
+    d = np.hypot(*(pts[None] - centres[:, None]).transpose(2, 0, 1))
+    inside = set(zip(*np.nonzero(d <= r[:, None]), strict=True))
+    assert inside <= set(zip(q.tolist(), j.tolist(), strict=True))
+
+
+@settings(max_examples=40, deadline=None)
+@given(seed=st.integers(0, 10_000), n=st.integers(1, 20), chi2=st.sampled_from([None, 9.0]))
+def test_timed_branching_is_the_same_with_all_pairs_or_the_kd_tree(seed, n, chi2):
+    """The timed logic (plots at their own times) finds the same tracks, in the same order,
+    whether its gates take candidates from all pairs or from the k-d tree (the former
+    code path, forced by a zero pair limit)."""
+    from mhtrack.initiation import logic
+    from mhtrack.initiation.logic import branch_tracks
+    rng = np.random.default_rng(seed)
+    scans = []
+    for s in range(4):
+        t = 4.0 * s + rng.uniform(0, 1.0, n)
+        z = np.array([1000.0, 500.0]) + np.array([200.0, -90.0]) * t[:, None] \
+            + rng.normal(0, 150.0, (n, 2)) * rng.integers(0, 2, (n, 1)) \
+            + rng.uniform(-2000.0, 2000.0, (n, 2)) * rng.integers(0, 2, (n, 1))
+        scans.append(Scan(s, 4.0 * s + 1.0, z, np.zeros(n, np.int64), np.arange(n) + n * s,
+                          np.broadcast_to(np.diag([90.0**2, 400.0**2]), (n, 2, 2)).copy(),
+                          None, t))
+    w = Window.from_scans(scans)
+    th = np.radians([20.0, 180.0])
+    a = branch_tracks(w, th, gate_chi2=chi2)
+    old = logic.BRUTE_PAIRS
+    try:
+        logic.BRUTE_PAIRS = 0
+        b = branch_tracks(w, th, gate_chi2=chi2)
+    finally:
+        logic.BRUTE_PAIRS = old
+    for x, y in zip(a, b, strict=True):
+        np.testing.assert_array_equal(x, y)
+
+
+def test_the_timed_logic_loads_no_scipy():
+    """The timed gates take their candidates from all pairs: a timed birth (``mhtrack
+    track`` of timed plots with ``--birth logic``) loads no scipy, as every-plot births."""
+    import subprocess
+    import sys
+    code = (
+        "import sys, numpy as np\n"
+        "from mhtrack.initiation import Window\n"
+        "from mhtrack.initiation.logic import branch_tracks\n"
+        "from mhtrack.records import Scan\n"
+        "sc = [Scan(s, 4.0 * s, np.array([[200.0 * 4 * s, 0.0]]), np.zeros(1, np.int64),\n"
+        "           np.array([s]), np.eye(2)[None] * 100.0, None, np.array([4.0 * s]))\n"
+        "      for s in range(4)]\n"
+        "p, _, _ = branch_tracks(Window.from_scans(sc), np.array([np.pi]))\n"
+        "print(len(p), sorted(m for m in sys.modules if m.startswith('scipy')))\n")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         check=True)
+    n, modules = out.stdout.split(maxsplit=1)
+    assert int(n) >= 1 and modules.strip() == "[]", out.stdout  # the line found, no scipy

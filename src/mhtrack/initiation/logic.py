@@ -71,13 +71,34 @@ def _ball(tree: cKDTree, centres: np.ndarray, radius: np.ndarray | float,
     return q, j
 
 
-def _second_timed(tree: cKDTree, tp: np.ndarray, z: np.ndarray, rows: np.ndarray,
+#: Above this many (centre, plot) pairs :func:`_candidates` builds a k-d tree.
+BRUTE_PAIRS = 1 << 16
+
+
+def _candidates(pts: np.ndarray, centres: np.ndarray, radius: np.ndarray
+                ) -> tuple[np.ndarray, np.ndarray]:
+    """(centre, plot) pairs with ``‖pts[j] − centres[q]‖ ≤ radius[q]`` (a superset: the
+    radius is widened by a relative 1e-12 so that rounding never drops a pair), sorted
+    by ``q`` then ``j``. The callers apply their exact gate to these pairs, so this is a
+    prefilter only: all pairs at once for the few plots of a timed slot, a k-d tree ball
+    query beyond :data:`BRUTE_PAIRS` pairs."""
+    r = radius * (1.0 + 1e-12) + 1e-9
+    if len(centres) * len(pts) > BRUTE_PAIRS:
+        from scipy.spatial import cKDTree
+        return _ball(cKDTree(pts), centres, r)
+    dx = pts[None, :, 0] - centres[:, None, 0]
+    dy = pts[None, :, 1] - centres[:, None, 1]
+    q, j = np.nonzero(np.hypot(dx, dy) <= r[:, None])
+    return q, j
+
+
+def _second_timed(tp: np.ndarray, z: np.ndarray, rows: np.ndarray,
                   last: np.ndarray, v_min: float, v_max: float
                   ) -> tuple[np.ndarray, np.ndarray]:
     """Velocity gate of the second plot with each plot at its own time ``tp``: the pairs
     ``(query row, slot row)`` with ``v_min·Δt ≤ ‖z − z_a‖ ≤ v_max·Δt``, ``Δt > 0``."""
     dt_max = np.maximum(tp[rows].max() - tp[last], 0.0)
-    q, j = _ball(tree, z[last], v_max * dt_max)
+    q, j = _candidates(z[rows], z[last], v_max * dt_max)
     dt = tp[rows[j]] - tp[last[q]]
     d = np.hypot(*(z[rows[j]] - z[last[q]]).T)
     ok = (dt > 0) & (d >= v_min * dt) & (d <= v_max * dt)
@@ -91,7 +112,7 @@ def _lmax(R: np.ndarray) -> np.ndarray:
     return h + np.hypot(d, R[..., 0, 1])
 
 
-def _later_timed(tree: cKDTree, w: Window, rows: np.ndarray, a: np.ndarray, b: np.ndarray,
+def _later_timed(w: Window, rows: np.ndarray, a: np.ndarray, b: np.ndarray,
                  gate_radius: float, gate_chi2: float | None
                  ) -> tuple[np.ndarray, np.ndarray]:
     """Position gate of a later plot with each plot at its own time (``w.t``): the
@@ -114,7 +135,7 @@ def _later_timed(tree: cKDTree, w: Window, rows: np.ndarray, a: np.ndarray, b: n
                  + float(_lmax(w.R[rows]).max()))
         radius = np.maximum(radius, np.sqrt(gate_chi2 * bound))
     radius = radius + np.hypot(vel[:, 0], vel[:, 1]) * 0.5 * (thi - tlo)
-    q, j = _ball(tree, centre, radius)
+    q, j = _candidates(z[rows], centre, radius)
     if len(q) == 0:
         return q, j
     aq, bq, jr = a[q], b[q], rows[j]
@@ -196,7 +217,6 @@ def branch_tracks(window: Window, thetas: np.ndarray, *, gate_radius: float = 30
     n_scans) flat plot indices (``-1`` a miss) and their intervals ``lo``, ``hi``; the
     tracks of limit ``θ`` are ``path[(lo <= θ) & (θ < hi)]``, in the initiator's order.
     """
-    from scipy.spatial import cKDTree
     ths = np.sort(np.asarray(thetas, float))
     N, M = n_scans, min_plots
     max_miss = N - M
@@ -216,11 +236,14 @@ def branch_tracks(window: Window, thetas: np.ndarray, *, gate_radius: float = 30
             prev = previous_plot(path)
             hits = (path >= 0).sum(axis=1)
             miss = c - hits  # slots 0..c−1 are decided: each a plot or a miss
-            tree = cKDTree(z[rows]) if len(rows) else None
+            tree = None
+            if len(rows) and tp is None:  # P2's scans; the timed gates need no tree
+                from scipy.spatial import cKDTree
+                tree = cKDTree(z[rows])
             q_all, j_all, a_all = [], [], []
             one = np.flatnonzero(hits == 1)
-            if len(one) and tree is not None and tp is not None:
-                q, j = _second_timed(tree, tp, z, rows, last[one], v_min, v_max)
+            if len(one) and len(rows) and tp is not None:
+                q, j = _second_timed(tp, z, rows, last[one], v_min, v_max)
                 q_all.append(one[q])
                 j_all.append(rows[j])
                 a_all.append(np.full(len(q), -np.inf))  # no angle test
@@ -233,12 +256,13 @@ def branch_tracks(window: Window, thetas: np.ndarray, *, gate_radius: float = 30
                 j_all.append(rows[j[ok]])
                 a_all.append(np.full(int(ok.sum()), -np.inf))  # no angle test
             more = np.flatnonzero(hits >= 2)
-            if len(more) and tree is not None:
+            if len(more) and len(rows):
                 a, b = prev[more], last[more]
                 leg = z[b] - z[a]
                 if tp is not None:
-                    q, j = _later_timed(tree, window, rows, a, b, gate_radius, gate_chi2)
+                    q, j = _later_timed(window, rows, a, b, gate_radius, gate_chi2)
                 else:
+                    assert tree is not None
                     step = (t[c] - t[window.slot[b]]) / (t[window.slot[b]] - t[window.slot[a]])
                     pred = z[b] + leg * step[:, None]
                     q, j = _ball(tree, pred, gate_radius)

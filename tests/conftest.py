@@ -2,6 +2,11 @@
 
 from __future__ import annotations
 
+# Every command gets the shared options (-q/--quiet, --progress, -v, --log-file) when the
+# ``mhtrack`` group is assembled; tests that invoke a command object directly would
+# otherwise see them or not depending on which test imported the group first.
+import mhtrack.cli.main  # noqa: F401
+
 
 def pytest_terminal_summary(terminalreporter) -> None:
     """The measurements the browser tests record (``record_property("measured", …)``),

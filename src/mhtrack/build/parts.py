@@ -225,10 +225,10 @@ def load_tracker(path: str | os.PathLike[str]) -> MHTTracker:
 
     meta = saved_meta(path)
     recipe = meta.get("recipe")
-    if not isinstance(recipe, dict):
-        raise ValueError(f"{path}: saved by a tracker not made by mhtrack.build.make_tracker "
-                         "(no recipe): use MHTTracker.load(path, clutter, motion=..., "
-                         "birth=..., coverage=...)")
+    if not isinstance(recipe, dict):  # absent (assembled by hand) or damaged
+        raise member_error(path, "meta", "saved by a tracker not made by "
+                           "mhtrack.build.make_tracker (no recipe): use MHTTracker.load("
+                           "path, clutter, motion=..., birth=..., coverage=...)")
     try:
         sensors = (None if recipe.get("sensors") is None
                    else sensors_from_recipe(recipe["sensors"]))

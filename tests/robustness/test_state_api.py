@@ -10,12 +10,10 @@ after null mixture weights); the property test mutates the JSON of real saved st
 
 from __future__ import annotations
 
-import io
 import json
 import math
 import sys
 import warnings
-import zipfile
 from pathlib import Path
 from typing import Any
 
@@ -32,25 +30,12 @@ from mhtrack.scenario import preset, simulate
 
 sys.path.insert(0, str(Path(__file__).parents[1] / "mht"))
 from async_fixture import simulate_async
+from npz_members import members as read_members  # tests/helpers
+from npz_members import write_members
 
 FUZZ = settings(derandomize=True, deadline=None, max_examples=150, database=None,
                 suppress_health_check=[HealthCheck.function_scoped_fixture,
                                        HealthCheck.too_slow])
-
-
-def _members(path: Path) -> dict[str, np.ndarray]:
-    with np.load(path, allow_pickle=False) as data:
-        return {k: data[k] for k in data.files}
-
-
-def _write(path: Path, members: dict[str, np.ndarray]) -> Path:
-    with zipfile.ZipFile(path, "w") as zf:
-        for name, a in members.items():
-            buf = io.BytesIO()
-            np.lib.format.write_array(buf, np.asanyarray(a), allow_pickle=False)
-            zf.writestr(zipfile.ZipInfo(f"{name}.npy", date_time=(2020, 1, 1, 0, 0, 0)),
-                        buf.getvalue())
-    return path
 
 
 @pytest.fixture(scope="module")
@@ -64,14 +49,14 @@ def states(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
     for s in scans[:7]:
         trk.step(s)
     trk.save(folder / "agmm.npz")
-    out["agmm"] = (_members(folder / "agmm.npz"), scans[7:])
+    out["agmm"] = (read_members(folder / "agmm.npz"), scans[7:])
     sim = simulate_async(duration=40.0)
     frames = list(sim.plots.scans())
     trk = build.make_tracker("mht-agmm", sensors=sim.sensors)
     for f in frames[: len(frames) // 2]:
         trk.step(f)
     trk.save(folder / "async.npz")
-    out["async"] = (_members(folder / "async.npz"), frames[len(frames) // 2:][:3])
+    out["async"] = (read_members(folder / "async.npz"), frames[len(frames) // 2:][:3])
     return out
 
 
@@ -145,7 +130,7 @@ def test_damaged_meta_raises_input_error_at_loading(tmp_path: Path, states: dict
         _set(meta, keys, value)
     except (KeyError, IndexError, TypeError):
         pytest.skip("that state has no such field")
-    path = _write(tmp_path / "s.npz", _with_meta(members, meta))
+    path = write_members(tmp_path / "s.npz", _with_meta(members, meta))
     with pytest.raises(InputError) as e:
         build.load_tracker(path)
     assert str(e.value).startswith(f"{path}, member '"), str(e.value)
@@ -157,7 +142,7 @@ def test_leaf_time_beyond_the_bound_is_refused(tmp_path: Path, states: dict[str,
     members, _ = states["agmm"]
     bad = {**members, "leaves__time": np.full_like(members["leaves__time"], 1e300)}
     with pytest.raises(InputError, match=r"member 'leaves__time': leaf times must be"):
-        build.load_tracker(_write(tmp_path / "s.npz", bad))
+        build.load_tracker(write_members(tmp_path / "s.npz", bad))
 
 
 def test_scan_time_beyond_the_bound_is_an_input_error() -> None:
@@ -173,10 +158,10 @@ def test_valid_states_round_trip_bit_for_bit(tmp_path: Path, states: dict[str, A
     """Loading and saving again gives the same members, value for value; and the loaded
     tracker continues as the one that was saved (the reference: a second load)."""
     for name, (members, scans) in states.items():
-        path = _write(tmp_path / f"{name}.npz", members)
+        path = write_members(tmp_path / f"{name}.npz", members)
         trk = build.load_tracker(path)
         trk.save(tmp_path / f"{name}2.npz")
-        again = _members(tmp_path / f"{name}2.npz")
+        again = read_members(tmp_path / f"{name}2.npz")
         assert sorted(again) == sorted(members)
         for k, a in members.items():
             assert a.dtype == again[k].dtype and np.array_equal(
@@ -212,7 +197,7 @@ def test_any_meta_field_made_hostile_loads_or_raises_input_error(
     meta = _meta(members)
     paths = _paths(meta)
     _set(meta, paths[pick % len(paths)], value)
-    _load_and_step(_write(tmp_path / "h.npz", _with_meta(members, meta)), scans[:2])
+    _load_and_step(write_members(tmp_path / "h.npz", _with_meta(members, meta)), scans[:2])
 
 
 def _hostile_array(kind: int, a: np.ndarray) -> np.ndarray | None:
@@ -240,7 +225,7 @@ def test_any_array_member_made_hostile_loads_or_raises_input_error(
         del changed[name]
     else:
         changed[name] = new
-    _load_and_step(_write(tmp_path / "h.npz", changed), scans[:2])
+    _load_and_step(write_members(tmp_path / "h.npz", changed), scans[:2])
 
 
 def test_tracker_load_names_a_wrong_estimator_as_input_error(
@@ -250,7 +235,7 @@ def test_tracker_load_names_a_wrong_estimator_as_input_error(
     members, _ = states["agmm"]
     meta = _meta(members)
     meta["clutter_name"] = "known"
-    path = _write(tmp_path / "s.npz", _with_meta(members, meta))
+    path = write_members(tmp_path / "s.npz", _with_meta(members, meta))
     from mhtrack.clutter import AGMMClutter
 
     with pytest.raises(InputError, match=r"member 'meta': field 'clutter_name'"):
@@ -265,7 +250,7 @@ def test_recipe_origin_not_two_numbers_is_an_input_error(
     members, _ = states["async"]
     meta = _meta(members)
     meta["recipe"]["sensors"]["origin"] = origin
-    path = _write(tmp_path / "s.npz", _with_meta(members, meta))
+    path = write_members(tmp_path / "s.npz", _with_meta(members, meta))
     with pytest.raises(InputError) as e:
         build.load_tracker(path)
     assert str(e.value).startswith(f"{path}, member 'meta': field 'recipe.sensors.origin'")
@@ -277,7 +262,7 @@ def test_recipe_that_cannot_be_rebuilt_is_an_input_error(
     """Whatever the checks let through and the rebuild refuses is an InputError naming
     the file and the member (before: a plain ValueError)."""
     members, _ = states["async"]
-    path = _write(tmp_path / "s.npz", members)
+    path = write_members(tmp_path / "s.npz", members)
 
     def refuse(*args: Any, **kwargs: Any) -> None:
         raise ValueError("refused")

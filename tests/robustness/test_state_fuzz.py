@@ -17,6 +17,8 @@ import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+from npz_members import members as read_members  # tests/helpers
+from npz_members import write_members
 
 from mhtrack.clutter.known import KnownClutter
 from mhtrack.errors import InputError
@@ -48,20 +50,11 @@ def saved(tmp_path_factory: pytest.TempPathFactory) -> dict[str, np.ndarray]:
     trk.run(_scans(6))
     path = tmp_path_factory.mktemp("state") / "state.npz"
     trk.save(path)
-    with np.load(path, allow_pickle=False) as data:
-        return {k: data[k] for k in data.files}
+    return read_members(path)
 
 
-def _write(path: Path, members: dict[str, np.ndarray]) -> Path:
-    """``np.savez``'s layout with a fixed timestamp: the same bytes every run (so the
-    byte-flipping examples are the same every run)."""
-    with zipfile.ZipFile(path, "w") as zf:
-        for name, a in members.items():
-            buf = io.BytesIO()
-            np.lib.format.write_array(buf, np.asanyarray(a), allow_pickle=True)
-            zf.writestr(zipfile.ZipInfo(f"{name}.npy", date_time=(2020, 1, 1, 0, 0, 0)),
-                        buf.getvalue())
-    return path
+def _write(path: Path, arrays: dict[str, np.ndarray]) -> Path:
+    return write_members(path, arrays, allow_pickle=True)
 
 
 def _load(path: Path) -> None:

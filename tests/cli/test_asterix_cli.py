@@ -36,7 +36,7 @@ def test_export_convert(sim: Path, tmp_path: Path) -> None:
     assert r.exit_code == 0, r.output  # type: ignore[attr-defined]
     assert "2000 plots in" in r.output  # type: ignore[attr-defined]
     out = tmp_path / "plots.csv"
-    r = _run("convert", rec, out, "--sensors", sim / "sensors.toml")
+    r = _run("convert", rec, "--out", out, "--sensors", sim / "sensors.toml")
     assert r.exit_code == 0, r.output  # type: ignore[attr-defined]
     assert r.output.startswith("pcap recording: 2000 plots")  # type: ignore[attr-defined]
     t = pacsv.read_csv(out)
@@ -44,6 +44,24 @@ def test_export_convert(sim: Path, tmp_path: Path) -> None:
                               "flight_level", "mode_3a", "address", "callsign",
                               "track_number", "typ", "plot_type", "range"]
     assert t.num_rows == 2000
+
+
+def test_convert_output_spellings(sim: Path, tmp_path: Path) -> None:
+    """``-o``, ``--out`` and the older positional OUTPUT write the same plots file; none
+    or two of them is a usage error that names --out (issue 31, one vocabulary)."""
+    rec = tmp_path / "rec.ast"
+    assert _run("export", sim / "plots.csv", "--sensors", sim / "sensors.toml", "--out",
+                rec).exit_code == 0  # type: ignore[attr-defined]
+    outs = [tmp_path / f"{k}.csv" for k in "abc"]
+    for args in (["-o", outs[0]], ["--out", outs[1]], [outs[2]]):
+        r = _run("convert", rec, *args)
+        assert r.exit_code == 0, r.output  # type: ignore[attr-defined]
+    assert outs[0].read_bytes() == outs[1].read_bytes() == outs[2].read_bytes()
+    for args in ([], [tmp_path / "d.csv", "--out", tmp_path / "e.csv"]):
+        r = _run("convert", rec, *args)
+        assert r.exit_code == 2
+        assert "--out FILE" in r.output  # type: ignore[attr-defined]
+    assert not (tmp_path / "d.csv").exists() and not (tmp_path / "e.csv").exists()
 
 
 def test_export_refuses_other_extensions(sim: Path, tmp_path: Path) -> None:

@@ -35,14 +35,24 @@ def needs_libasterix(f: Callable[..., Any]) -> Callable[..., Any]:
 
 @click.command()
 @click.argument("recording", type=_EXISTING)
-@click.argument("output", type=click.Path(dir_okay=False, path_type=Path))
+@click.argument("output", type=click.Path(dir_okay=False, path_type=Path), required=False,
+                metavar="[OUTPUT]")
+@click.option("-o", "--out", type=click.Path(dir_okay=False, path_type=Path), default=None,
+              help="Plots file to write (.csv or .parquet). The positional OUTPUT is the "
+              "older spelling of the same, kept for one release.")
 @click.option("--sensors", "sensors_file", type=_EXISTING, default=None,
               help="Sensors file (TOML) with the radars' sites (id = SAC·256 + SIC, lat, "
               "lon, alt): adds the ground range column 'range'.")
 @needs_libasterix
-def convert(recording: Path, output: Path, sensors_file: Path | None) -> None:
+def convert(recording: Path, output: Path | None, out: Path | None,
+            sensors_file: Path | None) -> None:
     """Decode an ASTERIX RECORDING (CAT048 plots, CAT034 sweeps; pcap, pcapng or raw
-    data blocks, recognised by content) into a plots OUTPUT (.csv or .parquet)."""
+    data blocks, recognised by content) into a plots file (--out, .csv or .parquet)."""
+    target = out or output
+    if target is None or (out is not None and output is not None):
+        raise click.UsageError("give the plots file to write once: --out FILE (or the "
+                               "older positional OUTPUT)")
+    output = target
     from mhtrack.io.asterix import convert as run_convert
     from mhtrack.io.paths import check_output_file
     from mhtrack.io.sensors import read_sensors

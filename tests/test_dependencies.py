@@ -18,7 +18,7 @@ DISTRIBUTION = {"tomli_w": "tomli-w", "distributed": "dask", "sklearn": "scikit-
                 "mpl_toolkits": "matplotlib"}
 #: Packages src/mhtrack may import only as an extra: import name → the extra.
 OPTIONAL = {"plotly": "report", "asterix": "asterix", "stonesoup": "stonesoup",
-            "distributed": "dask", "pandas": "pandas"}
+            "distributed": "dask", "pandas": "pandas", "numba": "fast"}
 
 
 def _name(requirement: str) -> str:
@@ -57,5 +57,5 @@ def test_every_dependency_is_imported_and_optional_ones_are_extras() -> None:
 
 def test_the_readme_names_each_extra() -> None:
     readme = (ROOT / "README.md").read_text(encoding="utf-8")
-    for extra in ("report", "asterix", "stonesoup", "dask", "pandas"):
+    for extra in ("report", "asterix", "stonesoup", "dask", "pandas", "fast"):
         assert f"mhtrack[{extra}]" in readme, extra

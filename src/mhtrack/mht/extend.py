@@ -78,22 +78,13 @@ def grow_children(frame: FrameContext, leaves: Leaves, pred: States, children: C
     z, R, rows, time = frame.z, frame.R, frame.rows, frame.time
     plot_time = frame.t
     par, plot = children.parent, children.plot
-    st = pred.take(par)
     child_time = np.full(len(par), float(time), float)
     is_upd = plot >= 0
     upd = is_upd.nonzero()[0]
-    # the update block by block of rows: a block's copies stay in the CPU cache (the
-    # update is row by row: the floats of one pass)
-    for s in range(0, upd.size, UPDATE_BLOCK):
-        u = upd[s:s + UPDATE_BLOCK]
-        pj = plot[u]
-        pairs = children.pair[u]
-        start = pred.take(par[u]) if pair_pred is None else pair_pred.take(pairs)
-        zu, Ru = z.take(pj, axis=0), R if R.ndim == 2 else R.take(pj, axis=0)
-        # posterior only when the model's gating_scores gave one: a model written against
-        # update(states, z, R) keeps working
-        st.put(u, motion.update(start, zu, Ru) if posterior is None
-               else motion.update(start, zu, Ru, posterior=posterior[pairs]))
+    st = None if pair_pred is not None else motion.children_states(
+        pred, par, plot, children.pair, z, R, posterior)
+    if st is None:
+        st = _grow_states(pred, children, upd, z, R, motion, pair_pred, posterior)
     if upd.size and plot_time is not None:
         child_time[upd] = plot_time[plot[upd]]
     new_col = np.full(len(par), NO_PLOT, np.int64)
@@ -120,3 +111,24 @@ def grow_children(frame: FrameContext, leaves: Leaves, pred: States, children: C
         level=leaves.level.take(par, axis=0),
         ident=leaves.ident.take(par, axis=0),
     )
+
+
+def _grow_states(pred: States, children: Children, upd: np.ndarray, z: np.ndarray,
+                 R: np.ndarray, motion: MotionModel, pair_pred: States | None,
+                 posterior: Any) -> States:
+    """The children's states (:func:`grow_children`): the parents' predictions, the
+    updates' rows replaced by the motion model's update, block by block of rows (a block's
+    copies stay in the CPU cache; the update is row by row: the floats of one pass)."""
+    par, plot = children.parent, children.plot
+    st = pred.take(par)
+    for s in range(0, upd.size, UPDATE_BLOCK):
+        u = upd[s:s + UPDATE_BLOCK]
+        pj = plot[u]
+        pairs = children.pair[u]
+        start = pred.take(par[u]) if pair_pred is None else pair_pred.take(pairs)
+        zu, Ru = z.take(pj, axis=0), R if R.ndim == 2 else R.take(pj, axis=0)
+        # posterior only when the model's gating_scores gave one: a model written against
+        # update(states, z, R) keeps working
+        st.put(u, motion.update(start, zu, Ru) if posterior is None
+               else motion.update(start, zu, Ru, posterior=posterior[pairs]))
+    return st

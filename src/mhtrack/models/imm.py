@@ -24,11 +24,11 @@ from __future__ import annotations
 import functools
 import math
 from dataclasses import dataclass
-from typing import ClassVar
+from typing import Any, ClassVar
 
 import numpy as np
 
-from mhtrack.models import kalman
+from mhtrack.models import imm_rows, kalman
 from mhtrack.models.linalg2 import gaussian_loglik2, sym_mahalanobis2
 from mhtrack.models.motion import ConstantVelocity, MotionModel, States
 
@@ -109,6 +109,13 @@ class CVModelSet(MotionModel):
         xm, Pm, mu = states.xm, states.Pm, states.mu
         mubar, pim, Q = self._mixing(mu, dt)
         M = len(mu)
+        if (k := imm_rows.kernels(M)) is not None:  # the same floats, compiled
+            out = States(np.empty((M, 4)), np.empty((M, 4, 4)), np.empty(xm.shape),
+                         np.empty(Pm.shape), mubar)
+            k["predict"](*_c(xm, Pm, mu, mubar, pim, np.atleast_1d(np.asarray(dt, float)),
+                             Q if Q.ndim == 4 else Q[None]),
+                         out.x, out.P, out.xm, out.Pm)
+            return out
         if M <= BLOCK:
             xp, Pp = _mix_predict(xm, Pm, mu, mubar, pim, dt, Q)
             return States(*combine(xp, Pp, mubar), xp, Pp, mubar)
@@ -130,6 +137,18 @@ class CVModelSet(MotionModel):
         (:meth:`gating_scores`: the same floats). Block by block of rows as
         :meth:`predict` (the same floats)."""
         K = len(states.mu)
+        if (k := imm_rows.kernels(K)) is not None:  # the same floats, compiled
+            R = np.asarray(R, float)
+            if posterior is None:
+                _, mu, total = _mixture(states.mu, model_logliks(states.xm, states.Pm, z, R))
+                mu /= total[:, None]
+            else:
+                mu = posterior.probabilities()
+            out = States(np.empty((K, 4)), np.empty((K, 4, 4)), np.empty(states.xm.shape),
+                         np.empty(states.Pm.shape), mu)
+            k["update"](*_c(states.xm, states.Pm, mu, z, R if R.ndim == 3 else R[None]),
+                        out.x, out.P, out.xm, out.Pm)
+            return out
         if K <= BLOCK:
             xm, Pm, mu = update(states.xm, states.Pm, states.mu, z, R, posterior)
             return States(*combine(xm, Pm, mu), xm, Pm, mu)
@@ -143,6 +162,25 @@ class CVModelSet(MotionModel):
                                 None if posterior is None else posterior[b])
             out.x[b], out.P[b] = combine(xm, Pm, mu)
             out.xm[b], out.Pm[b], out.mu[b] = xm, Pm, mu
+        return out
+
+    def children_states(self, pred: States, parent: np.ndarray, plot: np.ndarray,
+                        pair: np.ndarray, z: np.ndarray, R: np.ndarray,
+                        posterior: Any) -> States | None:
+        """The children's states in one compiled pass (:func:`mhtrack.models.imm_rows.
+        grow_rows`: the floats of ``pred.take(parent)`` and :meth:`update` of the updates
+        with ``posterior[pair]``), or ``None`` where the compiled loops are not used."""
+        C = len(parent)
+        if not isinstance(posterior, Posterior) or (k := imm_rows.kernels(C)) is None:
+            return None
+        r = self.r
+        out = States(np.empty((C, 4)), np.empty((C, 4, 4)), np.empty((C, r, 4)),
+                     np.empty((C, r, 4, 4)), np.empty((C, r)))
+        R = np.asarray(R, float)
+        k["grow"](*_c(pred.x, pred.P, pred.xm, pred.Pm, pred.mu),
+                  *(np.ascontiguousarray(a, dtype=np.int64) for a in (parent, plot, pair)),
+                  *_c(posterior.weight, posterior.total, z, R if R.ndim == 3 else R[None]),
+                  out.x, out.P, out.xm, out.Pm, out.mu)
         return out
 
     def gating_loglik(
@@ -172,6 +210,11 @@ class CVModelSet(MotionModel):
         r = self.r
         return States(x, P, np.repeat(x[:, None], r, axis=1), np.repeat(P[:, None], r, axis=1),
                       self.initial_mu(len(x)))
+
+
+def _c(*arrays: np.ndarray) -> list[np.ndarray]:
+    """C-contiguous float arrays (one compiled signature for every call)."""
+    return [np.ascontiguousarray(a, dtype=float) for a in arrays]
 
 
 #: Rows per block of :meth:`CVModelSet.predict` (a block's temporaries, ~40 arrays of

@@ -113,6 +113,15 @@ class MotionModel(ABC):
         Default: :meth:`gating_loglik` and ``None``."""
         return self.gating_loglik(pred, track, plot, z, R, loglik), None
 
+    def children_states(self, pred: States, parent: np.ndarray, plot: np.ndarray,
+                        pair: np.ndarray, z: np.ndarray, R: np.ndarray,
+                        posterior: Any) -> States | None:
+        """Optional: the children's states in one pass — a miss (``plot < 0``) its
+        parent's prediction ``pred[parent]``, an update :meth:`update` of it with
+        ``z[plot]`` (``R`` shared or by plot) and ``posterior[pair]`` — the same floats, or
+        ``None`` (default) to let the caller take the rows and update them."""
+        return None
+
     def new_states(self, x: np.ndarray, P: np.ndarray) -> States:
         """States of new tracks starting at ``x``, ``P``. Default: no per-model arrays."""
         n = len(x)

@@ -61,37 +61,46 @@ def own_intensity(radar: RotatingRadar, xy: np.ndarray,
 
 
 class RadarTruth:
-    """``κ_s(x, t)`` of every radar of a rotating-radar ``scenario`` on fixed plane
-    points ``xy`` (module docstring), with the parts that do not change over time (the
-    coverage mask, the radar's own clutter) computed once per radar."""
+    """``κ_s(x, t)`` of every radar of a rotating-radar ``scenario`` (module docstring):
+    at fixed plane points ``xy`` (a grid), with the parts that do not change over time
+    (coverage, the radar's own clutter) computed once per radar, or at any points."""
 
-    def __init__(self, scenario: Any, xy: np.ndarray) -> None:
+    def __init__(self, scenario: Any, xy: np.ndarray | None = None) -> None:
         if not scenario.rotating:
             raise ValueError(f"scenario {scenario.name!r}: the true intensity per radar "
                              "needs rotating radars")
         self.scenario = scenario
-        self.xy = np.asarray(xy, float).reshape(-1, 2)
+        self.xy = np.zeros((0, 2)) if xy is None else np.asarray(xy, float).reshape(-1, 2)
         self.sensors = scenario.sensor_set()
         self.radars = {s.id: s for s in scenario.sensors}
         self._static: dict[int, tuple[np.ndarray, np.ndarray]] = {}
+        #: The last points asked for per radar, with their parts (the same points again
+        #: are not recomputed: a grid probed after every frame).
+        self._last: dict[int, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
 
     def site(self, sensor_id: int) -> tuple[float, float]:
         return self.sensors.site_xy(sensor_id)
 
+    def _parts(self, sensor_id: int, xy: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Coverage mask and the radar's own clutter at ``xy``."""
+        from mhtrack.models.geodesy import local_to_polar
+
+        radar = self.radars[sensor_id]
+        cover = np.ones(len(xy), bool)
+        if radar.max_range is not None:
+            rho, _ = local_to_polar(self.sensors.frame(), *self.sensors.site_latlon(sensor_id),
+                                    xy[:, 0], xy[:, 1])
+            cover = rho <= radar.max_range
+        return cover, np.where(cover, own_intensity(radar, xy, self.site(sensor_id)), 0.0)
+
     def _fixed(self, sensor_id: int) -> tuple[np.ndarray, np.ndarray]:
         if sensor_id not in self._static:
-            from mhtrack.models.geodesy import local_to_polar
-
-            radar = self.radars[sensor_id]
-            cover = np.ones(len(self.xy), bool)
-            if radar.max_range is not None:
-                rho, _ = local_to_polar(self.sensors.frame(),
-                                        *self.sensors.site_latlon(sensor_id),
-                                        self.xy[:, 0], self.xy[:, 1])
-                cover = rho <= radar.max_range
-            own = own_intensity(radar, self.xy, self.site(sensor_id))
-            self._static[sensor_id] = (cover, np.where(cover, own, 0.0))
+            self._static[sensor_id] = self._parts(sensor_id, self.xy)
         return self._static[sensor_id]
+
+    def coverage(self, sensor_id: int) -> np.ndarray:
+        """The fixed points within the radar's ``max_range`` (geodesic)."""
+        return self._fixed(int(sensor_id))[0]
 
     def rotation_time(self, sensor_id: int, t: float) -> float:
         """``τ_n``: the middle of the radar's rotation under way at ``t``."""
@@ -99,12 +108,19 @@ class RadarTruth:
 
         return float(rotation_middle(self.radars[sensor_id], t))
 
-    def intensity(self, sensor_id: int, t: float) -> np.ndarray:
-        """``κ_s(x, t)`` at the points (per m² per rotation)."""
-        cover, own = self._fixed(int(sensor_id))
+    def intensity(self, sensor_id: int, t: float, xy: np.ndarray | None = None) -> np.ndarray:
+        """``κ_s(x, t)`` (per m² per rotation) at the fixed points, or at ``xy``."""
+        sid = int(sensor_id)
+        if xy is None:
+            pts, (cover, own) = self.xy, self._fixed(sid)
+        else:
+            pts = np.asarray(xy, float).reshape(-1, 2)
+            last = self._last.get(sid)
+            if last is None or last[0].shape != pts.shape or not np.array_equal(last[0], pts):
+                last = self._last[sid] = (pts.copy(), *self._parts(sid, pts))
+            cover, own = last[1], last[2]
         scene = self.scenario.clutter_scene
         if scene is None:
             return own.copy()
-        tau = self.rotation_time(int(sensor_id), t)
-        return own + np.where(cover, scene.intensity(int(sensor_id), self.xy, tau,
-                                                     self.site(int(sensor_id))), 0.0)
+        tau = self.rotation_time(sid, t)
+        return own + np.where(cover, scene.intensity(sid, pts, tau, self.site(sid)), 0.0)

@@ -49,8 +49,9 @@ PRESET = "radars-clutter"
 DEFAULT_RUNS = 50
 #: The tracker whose defaults every method shares (its estimator is replaced).
 TRACKER = "mht-gmm"
-#: IAE grid: 150² cells (about 0.9 × 0.7 km on ``radars-clutter``).
-RESOLUTION = 150
+#: IAE grid: 100² cells (1.35 × 1.08 km on ``radars-clutter``; its narrowest clutter, the
+#: ground clutter, has L = 4 km).
+RESOLUTION = 100
 #: Metrics compared: key → (label, higher is better, decimals).
 METRICS: dict[str, tuple[str, bool, int]] = {
     "iae_mean": ("clutter error ∫|κ̂ − κ| (plots/rotation)", False, 2),

@@ -8,7 +8,8 @@ site, ``max_range`` ``R`` and period ``P`` — so that it fits any number of rad
 sites:
 
 * ``weather`` — three rain cells drifting with one wind (:data:`WIND`, 20 m/s towards
-  east-north-east), each σ₀ = 3 % of ``min(W, H)`` growing to twice that over the run;
+  east-north-east), each σ₀ = 3 % of ``min(W, H)`` at its ``t_on``, growing by σ₀ every
+  ``D`` (``g = σ₀/D``);
   cell 1 at ``(0.30 W, 0.60 H)`` at ``t_a`` (on before the run, fading by
   ``t_a + 0.7 D``), cell 2 at ``(0.50 W, 0.35 H)`` (from ``t_a + 0.2 D``), cell 3 at
   ``(0.70 W, 0.65 H)`` (from ``t_a + 0.4 D``); peaks 40, 30, 50 plots per rotation;

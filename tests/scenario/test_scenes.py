@@ -124,3 +124,20 @@ def test_the_scene_round_trips_through_the_toml_form_and_errors_name_the_key():
     bad["clutter_scene"]["parts"][0] = {"kind": "fog"}
     with pytest.raises(ValueError, match=r"clutter_scene\.parts\[0\]\.kind: expected one of"):
         Scenario.from_dict(bad)
+
+
+def test_simulate_writes_the_scene_into_scenario_toml(tmp_path):
+    from click.testing import CliRunner
+
+    from mhtrack.cli.data_commands import simulate as simulate_cmd
+    from mhtrack.scenario import load_scenario
+
+    out = tmp_path / "sim"
+    res = CliRunner().invoke(simulate_cmd, ["radars-clutter", "--scans", "12", "--seed", "2",
+                                            "--clutter-scene", "burst", "--out", str(out)])
+    assert res.exit_code == 0, res.output
+    sc = load_scenario(out / "scenario.toml")
+    assert sc == with_clutter_scene(preset("radars-clutter", scans=12), "burst")
+    bad = CliRunner().invoke(simulate_cmd, ["crossing", "--clutter-scene", "burst", "--out",
+                                            str(tmp_path / "x")])
+    assert bad.exit_code != 0 and "--clutter-scene" in bad.output

@@ -22,7 +22,7 @@ EXAMPLE = Path(__file__).resolve().parents[2] / "docs" / "examples" / "drifting-
 
 def test_names():
     assert PRESETS == ("crossing", "crossing-wide", "multiradar", "opensky", "opensky-radars",
-                       "crossing-changing")
+                       "crossing-changing", "radars-clutter")
     with pytest.raises(ValueError, match=r"unknown preset 'cross' \(expected crossing, "):
         preset("cross")
 

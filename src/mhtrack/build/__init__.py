@@ -38,6 +38,7 @@ from mhtrack.build.parts import (
     make_birth,
     make_clutter_estimator,
     make_tracker,
+    radar_clutter,
     takes_clutter_density,
     tracker_fuser,
 )
@@ -81,6 +82,7 @@ __all__ = [
     "make_tracker",
     "misses_to_delete",
     "plots_area",
+    "radar_clutter",
     "radar_rule",
     "sensors_from_recipe",
     "sensors_recipe",

@@ -138,19 +138,33 @@ def make_tracker(
     periods = {s.id: s.period for s in sensors.sensors}
     config = config_with(config, confirm_min_plots=max(config.confirm_min_plots,
                                                        TIMED_CONFIRM_MIN_PLOTS))
+    clutter = radar_clutter(estimator, sensors, kappa=kappa, params=params,
+                            clutter_frame=clutter_frame)
+    return _assemble(config, clutter, RadarCoverage(sensors), recipe, periods)
+
+
+def radar_clutter(estimator: str, sensors: SensorSet, *, kappa: float | None = None,
+                  params: dict[str, Any] | None = None,
+                  clutter_frame: str = names.DEFAULT_CLUTTER_FRAME) -> PerSensorClutter:
+    """The clutter estimator of timed plots (:func:`make_tracker` with ``sensors``): one
+    ``estimator`` (:func:`make_clutter_estimator`, with ``kappa`` and ``params``) per
+    radar, fed a rotation at a time, in the radar's range and bearing
+    (``clutter_frame="polar"``, radars with a site; ``known`` is never wrapped) or in the
+    local plane (``"plane"``); ``kappa`` (default :data:`DEFAULT_CLUTTER_DENSITY`) before
+    a radar's first rotation."""
     if clutter_frame not in names.CLUTTER_FRAMES:
         raise ValueError(f"unknown clutter frame {clutter_frame!r} "
                          f"(expected one of {', '.join(names.CLUTTER_FRAMES)})")
+    kw = dict(params or {})
     wrap = None
     if clutter_frame == "polar" and estimator != "known":
         def wrap(sid: int, inner: ClutterEstimator) -> ClutterEstimator:
             s = sensors.sensor(sid)
             return inner if not s.has_site else PolarClutter(inner, sensors.site_xy(sid))
-    clutter = PerSensorClutter(
-        lambda: make_clutter_estimator(estimator, kappa=kappa, **params),
+    return PerSensorClutter(
+        lambda: make_clutter_estimator(estimator, kappa=kappa, **kw),
         {s.id: s.period for s in sensors.sensors},
         initial=DEFAULT_CLUTTER_DENSITY if kappa is None else kappa, wrap=wrap)
-    return _assemble(config, clutter, RadarCoverage(sensors), recipe, periods)
 
 
 def _assemble(config: MHTConfig, clutter: ClutterEstimator, coverage: Coverage,

@@ -166,6 +166,27 @@ def scenario_options(f: Callable[..., Any]) -> Callable[..., Any]:
     return f
 
 
+def clutter_scene_option(f: Callable[..., Any]) -> Callable[..., Any]:
+    """``--clutter-scene NAME`` (:data:`mhtrack.scenario.scenes.SCENES`)."""
+    return click.option(
+        "--clutter-scene", "clutter_scene", default=None, metavar="NAME",
+        help="Rotating radars: add a changing clutter scene (weather, coastal, burst, "
+             "storm; docs/clutter.md, Clutter scenes), e.g. with radars-clutter.")(f)
+
+
+def with_scene_arg(scenario: Any, name: str | None) -> Any:
+    """``scenario`` with the clutter scene ``name`` (None: unchanged); a bad name or a
+    scenario without rotating radars is a usage error naming ``--clutter-scene``."""
+    if name is None:
+        return scenario
+    from mhtrack.scenario.scenes import with_clutter_scene
+
+    try:
+        return with_clutter_scene(scenario, name)
+    except ValueError as e:
+        raise click.BadParameter(str(e), param_hint="--clutter-scene") from None
+
+
 def load_scenario_arg(
     scenario: str, clutter: str | None, clutter_rate: float | None, pd: float | None,
     scans: int | None,

@@ -9,10 +9,12 @@ import click
 
 from mhtrack.cli.common import (
     InputProblem,
+    clutter_scene_option,
     echo_json,
     load_scenario_arg,
     scenario_options,
     table_path,
+    with_scene_arg,
 )
 from mhtrack.cli.terminal import say, show_progress
 
@@ -36,10 +38,11 @@ from mhtrack.cli.terminal import say, show_progress
               help="With --attributes: probability of a secondary-only detection [0.1].")
 @click.option("--garble", type=click.FloatRange(0, 1), default=None,
               help="With --attributes: probability of a garbled reply [0.02].")
+@clutter_scene_option
 def simulate(scenario: str, seed: int, clutter: str | None, clutter_rate: float | None,
              pd: float | None, scans: int | None, out: Path, fmt: str, attributes: bool,
              psr_only: float | None, ssr_only: float | None, garble: float | None,
-             biases: tuple[str, ...] = ()) -> None:
+             biases: tuple[str, ...] = (), clutter_scene: str | None = None) -> None:
     """Simulate SCENARIO (a preset or a TOML file) and write DIR/plots, DIR/truth and the
     full parameters in DIR/scenario.toml.
 
@@ -53,6 +56,7 @@ def simulate(scenario: str, seed: int, clutter: str | None, clutter_rate: float 
     scenario_path = Path(scenario) if Path(scenario).is_file() else None
     check_output_dir(out, inputs=(scenario_path,), what="simulation files")
     sc = load_scenario_arg(scenario, clutter, clutter_rate, pd, scans)
+    sc = with_scene_arg(sc, clutter_scene)
     if biases:
         from mhtrack.scenario.biases import parse_bias, with_biases
 

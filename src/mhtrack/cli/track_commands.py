@@ -9,7 +9,13 @@ from typing import Any
 import click
 
 from mhtrack.cli.asterix_commands import needs_libasterix
-from mhtrack.cli.common import echo_json, load_scenario_arg, scenario_options
+from mhtrack.cli.common import (
+    clutter_scene_option,
+    echo_json,
+    load_scenario_arg,
+    scenario_options,
+    with_scene_arg,
+)
 from mhtrack.cli.terminal import say, show_progress
 from mhtrack.names import (
     BIRTHS,
@@ -222,14 +228,15 @@ def track(plots: Path, tracker: str, tracker_pd: float | None, meas_sigma: float
               "parameters; needs mhtrack[report]).")
 @birth_options
 @output_option
+@clutter_scene_option
 def run(scenario: str, seed: int, clutter: str | None, clutter_rate: float | None,
         pd: float | None, scans: int | None, tracker: str, tracker_pd: float | None,
         meas_sigma: float | None, accel_sigma: float | None, imm_accel_sigma: float | None,
         clutter_density: float | None,
         birth_density: float | None, nscan: int | None, out: Path | None,
         cutoff: float | None, order: float | None, as_json: bool, html_report: bool,
-        birth: str, birth_theta: float | None, fusion: str | None, output: str | None
-        ) -> None:
+        birth: str, birth_theta: float | None, fusion: str | None, output: str | None,
+        clutter_scene: str | None = None) -> None:
     """Simulate SCENARIO, track, evaluate and plot, in one go.
 
     Writes plots, truth, tracks, scenario.toml, metrics.json, scene.png (truth, plots,
@@ -244,7 +251,8 @@ def run(scenario: str, seed: int, clutter: str | None, clutter_rate: float | Non
 
         check_output_dir(out, inputs=(Path(scenario) if Path(scenario).is_file() else None,),
                          what="run's files")
-    sc = load_scenario_arg(scenario, clutter, clutter_rate, pd, scans)
+    sc = with_scene_arg(load_scenario_arg(scenario, clutter, clutter_rate, pd, scans),
+                        clutter_scene)
     options = track_options(tracker, tracker_pd, meas_sigma, accel_sigma, imm_accel_sigma,
                             clutter_density, birth_density, nscan, birth, birth_theta,
                             fusion, output, sensor_pd=pd)

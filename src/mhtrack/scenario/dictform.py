@@ -111,7 +111,7 @@ def clutter_to_dict(c: ClutterSpec) -> dict[str, Any]:
 # ---------------------------------------------------------------------- from dict
 _TOP_REQUIRED = {"T", "scans", "region", "sensors"}
 _TOP_OPTIONAL = {"name", "description", "targets", "truth_sigma_v", "seed", "clutter",
-                 "origin", "truth_dt"}
+                 "origin", "truth_dt", "clutter_scene"}
 
 
 def scenario_fields(d: Mapping[str, Any]) -> dict[str, Any]:
@@ -164,6 +164,10 @@ def scenario_fields(d: Mapping[str, Any]) -> dict[str, Any]:
         extra["origin"] = (ck.number(o["lat"], "origin.lat", lo=-90.0, hi=90.0, unit="degrees"),
                            ck.number(o["lon"], "origin.lon", lo=-180.0, hi=180.0,
                                      unit="degrees"))
+    if "clutter_scene" in d:
+        from mhtrack.scenario.scenedict import scene_from_dict
+
+        extra["clutter_scene"] = scene_from_dict(d["clutter_scene"])
     if "truth_dt" in d:
         extra["truth_dt"] = ck.number(d["truth_dt"], "truth_dt", lo=0.0, lo_open=True, hi=MAX_T,
                                       unit="s")

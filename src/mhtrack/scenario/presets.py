@@ -25,6 +25,8 @@
   Clee Hill, RAF Waddington — with periods 4, 10, 12 s, their own noises, ``P_D`` and
   clutter (uniform in range–azimuth and one patch each), 1200 s *(all ours;*
   :data:`OPENSKY_ROTATING_RADARS`, ``docs/scenarios.md``).
+* ``radars-clutter``: two rotating radars and six aircraft, five minutes, for the
+  clutter scenes of :mod:`mhtrack.scenario.scenes` (``--clutter-scene``) *(all ours)*.
 
 Overrides (``None`` values are ignored, so a CLI can pass unset options through):
 ``clutter`` (``"uniform"``: a uniform model over the region with the same rate;
@@ -57,7 +59,7 @@ from mhtrack.scenario.trajectory import bridge_gaps
 
 #: Names accepted by :func:`preset`.
 PRESETS: tuple[str, ...] = ("crossing", "crossing-wide", "multiradar", "opensky",
-                            "opensky-radars", "crossing-changing")
+                            "opensky-radars", "crossing-changing", "radars-clutter")
 #: Keyword overrides accepted by :func:`preset`.
 PRESET_OVERRIDES: tuple[str, ...] = (*OVERRIDES, "heading_seed")
 
@@ -337,6 +339,10 @@ def preset(name: str, **overrides: Any) -> Scenario:
         s = _multiradar(n_scans, seed)
     elif name == "opensky":
         s = _opensky(n_scans)
+    elif name == "radars-clutter":
+        from mhtrack.scenario.scenes import radars_clutter
+
+        s = radars_clutter(n_scans)
     else:
         s = _opensky_radars(n_scans)
     return apply_overrides(s, **ov)

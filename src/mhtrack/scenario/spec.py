@@ -33,6 +33,7 @@ from mhtrack.models.clutter import (
     TimeVaryingClutter,
     UniformClutter,
 )
+from mhtrack.models.clutter_scene import ClutterScene
 from mhtrack.models.sensors import CartesianSensor, PolarRadar, RotatingRadar, Sensor
 from mhtrack.scenario import _check as ck
 from mhtrack.scenario.dictform import (
@@ -80,6 +81,8 @@ class Scenario:
         (then the first sensor with ``lat``/``lon``): the geodetic frame of
         :meth:`sensor_set` and of rotating radars.
     truth_dt : with rotating radars, the truth is sampled every ``truth_dt`` s (default 1).
+    clutter_scene : with rotating radars, a changing clutter scene each radar draws per
+        rotation on top of its own clutter (:mod:`mhtrack.models.clutter_scene`), or None.
     description : free text (where the parameters come from).
 
     Two scenarios compare equal when their dict forms are equal, numbers to 1e-12
@@ -98,6 +101,7 @@ class Scenario:
     description: str = field(default="")
     origin: tuple[float, float] | None = None
     truth_dt: float = 1.0
+    clutter_scene: ClutterScene | None = None
 
     def __post_init__(self) -> None:
         ck.string(self.name, "name")
@@ -178,7 +182,12 @@ class Scenario:
         object.__setattr__(self, "truth_dt", ck.number(
             self.truth_dt, "truth_dt", lo=0.0, lo_open=True, hi=MAX_T, unit="s"))
         if not self.rotating:
+            if self.clutter_scene is not None:
+                raise ValueError("clutter_scene: drawn by rotating radars only (give the "
+                                 "sensors a period)")
             return
+        if self.clutter_scene is not None and not isinstance(self.clutter_scene, ClutterScene):
+            raise ValueError("clutter_scene: expected a ClutterScene")
         for i, s in enumerate(self.sensors):
             if not isinstance(s, RotatingRadar):
                 raise ValueError(
@@ -221,7 +230,8 @@ class Scenario:
             turns = [self.T / s.period for s in self.sensors]  # type: ignore[union-attr]
             looks = sum(turns)
             clutter = self.n_scans * sum(
-                n * s.mean_clutter() for n, s in zip(turns, self.sensors, strict=True))  # type: ignore[union-attr]
+                n * (s.mean_clutter() + self._scene_rate(s.id))  # type: ignore[union-attr]
+                for n, s in zip(turns, self.sensors, strict=True))
         total = clutter + looks * target_scans
         if total <= MAX_PLOTS:
             return
@@ -242,6 +252,12 @@ class Scenario:
             f"the maximum {ck.fmt(MAX_PLOTS)} (MAX_PLOTS); lower the clutter rate or the "
             f"number of scans"
         )
+
+    def _scene_rate(self, sensor_id: int) -> float:
+        """Mean scene clutter per rotation of a radar over the run (0 without a scene)."""
+        sc = self.clutter_scene
+        return 0.0 if sc is None else sc.mean_rate(sensor_id, self.first * self.T,
+                                                   self.last * self.T)
 
     # ------------------------------------------------------------------ derived values
     @property
@@ -306,6 +322,10 @@ class Scenario:
             extra["origin"] = {"lat": self.origin[0], "lon": self.origin[1]}
         if self.rotating:
             extra["truth_dt"] = float(self.truth_dt)
+        if self.clutter_scene is not None:
+            from mhtrack.scenario.scenedict import scene_to_dict
+
+            extra["clutter_scene"] = scene_to_dict(self.clutter_scene)
         return {
             "name": self.name,
             "description": self.description,

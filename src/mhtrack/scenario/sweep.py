@@ -35,7 +35,16 @@ frame with its covariance by :func:`~mhtrack.models.geodesy.polar_to_local`.
 **Random streams** (integer spawn keys, as in :mod:`mhtrack.scenario.simulate`):
 ``(2, sensor id, target id)`` for a target's detections and noise by one radar,
 ``(3, sensor id, rotation)`` for one rotation's clutter (rotation 0: the one under way at
-the start).
+the start), ``(4, sensor id, rotation)`` for its :class:`~mhtrack.models.clutter_scene.
+ClutterScene` clutter.
+
+**Clutter scene** (a scenario's ``clutter_scene``): each rotation ``n`` of a radar also
+draws the scene's clutter as it stands at the rotation's middle ``τ_n = t₀ + P/2``
+(``t₀``: the beam at north), in the local plane about the radar's site
+(:meth:`ClutterScene.sample`); each point gets its exact range and bearing
+(:func:`~mhtrack.models.geodesy.local_to_polar`), is dropped beyond ``max_range`` and is
+timed when the beam points at it. The true intensity of that rotation is
+:func:`mhtrack.scenario.scene_truth.radar_intensity` at ``τ_n``.
 """
 
 from __future__ import annotations
@@ -44,6 +53,7 @@ import numpy as np
 
 from mhtrack.frames import frame_lengths, make_frames
 from mhtrack.models.clutter import sample_range_azimuth
+from mhtrack.models.clutter_scene import ClutterScene
 from mhtrack.models.geodesy import LocalFrame, local_to_polar, polar_to_local
 from mhtrack.models.sensors import RotatingRadar
 from mhtrack.records import CLUTTER, PlotTable
@@ -56,6 +66,7 @@ MAX_ITER = 30
 
 _DETECTION_STREAM = 2
 _CLUTTER_STREAM = 3
+_SCENE_STREAM = 4
 
 
 def _rng(seed: int, *key: int) -> np.random.Generator:
@@ -118,9 +129,12 @@ def radar_plots(
     segs: list[Segment],
     window: tuple[float, float],
     seed: int,
+    scene: ClutterScene | None = None,
+    site_xy: tuple[float, float] | None = None,
 ) -> dict[str, np.ndarray]:
     """One radar's plots over ``window`` (s, inclusive): columns ``time, range, bearing,
-    origin`` (unsorted: targets in ``segs`` order, then clutter by rotation)."""
+    origin`` (unsorted: targets in ``segs`` order, then clutter by rotation, then the
+    ``scene``'s clutter by rotation about the site's plane position ``site_xy``)."""
     cols: dict[str, list[np.ndarray]] = {k: [] for k in ("time", "range", "bearing", "origin")}
     for seg in segs:
         t = crossings(radar, frame, site, seg)
@@ -151,7 +165,38 @@ def radar_plots(
         cols["range"].append(r[keep])
         cols["bearing"].append(b[keep])
         cols["origin"].append(np.full(int(keep.sum()), CLUTTER, np.int64))
+    if scene is not None:
+        for k, v in _scene_plots(radar, frame, site, site_xy, scene, window, seed).items():
+            cols[k].append(v)
     return {k: np.concatenate(v) if v else np.zeros(0) for k, v in cols.items()}
+
+
+def rotation_middle(radar: RotatingRadar, t: np.ndarray | float) -> np.ndarray:
+    """``τ``: the middle of the rotation (north to north) under way at time(s) ``t``."""
+    k = np.floor((radar.phase + radar.rate_deg * np.asarray(t, float)) / 360.0)
+    return (360.0 * k - radar.phase) / radar.rate_deg + 0.5 * radar.period
+
+
+def _scene_plots(radar: RotatingRadar, frame: LocalFrame, site: tuple[float, float],
+                 site_xy: tuple[float, float] | None, scene: ClutterScene,
+                 window: tuple[float, float], seed: int) -> dict[str, np.ndarray]:
+    """The scene's clutter of one radar, rotation by rotation (module docstring)."""
+    if site_xy is None:
+        raise ValueError("a clutter scene needs the radar's site in the local frame")
+    cols: dict[str, list[np.ndarray]] = {k: [] for k in ("time", "range", "bearing", "origin")}
+    for n, t0 in enumerate(_rotation_starts(radar, *window).tolist()):
+        rng = _rng(seed, _SCENE_STREAM, radar.id, n)
+        xy = scene.sample(rng, radar.id, t0 + 0.5 * radar.period, site_xy)
+        r, b = local_to_polar(frame, *site, xy[:, 0], xy[:, 1])
+        t = t0 + b / radar.rate_deg
+        keep = (window[0] <= t) & (t <= window[1])
+        if radar.max_range is not None:
+            keep &= r <= radar.max_range
+        cols["time"].append(t[keep])
+        cols["range"].append(r[keep])
+        cols["bearing"].append(b[keep])
+        cols["origin"].append(np.full(int(keep.sum()), CLUTTER, np.int64))
+    return {k: np.concatenate(v) for k, v in cols.items()}
 
 
 def rotating_plots(
@@ -161,15 +206,19 @@ def rotating_plots(
     segs: list[Segment],
     window: tuple[float, float],
     seed: int,
+    scene: ClutterScene | None = None,
+    sites_xy: dict[int, tuple[float, float]] | None = None,
 ) -> PlotTable:
     """The timed :class:`~mhtrack.records.PlotTable` of several rotating radars
     ``(radar, P_D)`` at ``sites`` (id → lat, lon): rows cut into frames by
     :func:`~mhtrack.frames.make_frames` (one radar, at most an eighth of its rotation)
-    and sorted by frame, then time; ``x, y, R`` from
+    and sorted by frame, then time; ``scene``: a clutter scene drawn about ``sites_xy``
+    (id → local x, y) on top of each radar's own clutter; ``x, y, R`` from
     :func:`~mhtrack.models.geodesy.polar_to_local`; ``origin`` target id or −1."""
     parts = []
     for radar, pd in radars:
-        c = radar_plots(radar, pd, frame, sites[radar.id], segs, window, seed)
+        c = radar_plots(radar, pd, frame, sites[radar.id], segs, window, seed, scene,
+                        None if sites_xy is None else sites_xy[radar.id])
         z, R = polar_to_local(frame, *sites[radar.id], c["range"], c["bearing"],
                               radar.sigma_range, radar.sigma_bearing_deg)
         c.update(sensor=np.full(len(c["time"]), radar.id, np.int64), z=z.reshape(-1, 2),

@@ -1,0 +1,118 @@
+"""``reproduce clutter-scenes`` on a tiny study: the oracle's clutter error is 0, every
+verdict and interval follows from the per-run records (recomputed here with scipy's t),
+the report prints every sentence, the records do not depend on the number of workers,
+and an estimator registered by name joins the study."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+from scipy import stats
+
+from mhtrack.clutter.base import ClutterEstimator
+from mhtrack.experiments.clutter_scenes import METRICS, POOLED, clutter_scenes, study_pairs
+from mhtrack.experiments.scene_methods import all_methods
+from mhtrack.metrics.paired import verdict_of
+from mhtrack.reports.clutter_scenes import write_clutter_scenes_report
+from mhtrack.scenario import preset
+
+TINY = {"runs": 2, "resolution": 24, "scenes": ("storm",),
+        "methods": ("known", "uniform", "gmm")}
+
+
+@pytest.fixture(scope="module")
+def tiny(tmp_path_factory):
+    out = tmp_path_factory.mktemp("scenes")
+    study = clutter_scenes(out, base=preset("radars-clutter", scans=14), workers=1, **TINY)
+    return study
+
+
+def _strip(rec: dict) -> dict:
+    return {k: v for k, v in rec.items() if not k.startswith("t_")}
+
+
+def test_the_oracle_has_no_clutter_error_and_the_others_have_some(tiny):
+    recs = tiny.records["storm"]
+    assert not tiny.errors and tiny.computed == 6
+    assert [r["iae_mean"] for r in recs["known"]] == [0.0, 0.0]
+    assert all(r["iae_mean"] > 0 for m in ("uniform", "gmm") for r in recs[m])
+    assert POOLED not in tiny.paired  # one scene: nothing to pool
+
+
+def test_every_verdict_and_interval_follows_from_the_runs(tiny):
+    recs = tiny.records["storm"]
+    cs = tiny.paired["storm"]
+    assert {(c.a, c.b) for c in cs} == {("gmm", "uniform"), ("known", "gmm")}
+    assert {c.metric for c in cs} == set(METRICS)
+    for c in cs:
+        a = np.array([r[c.metric] for r in recs[c.a]], float)
+        b = np.array([r[c.metric] for r in recs[c.b]], float)
+        d = a - b
+        half = stats.t.ppf(0.975, len(d) - 1) * d.std(ddof=1) / math.sqrt(len(d))
+        if half > 0:
+            assert (c.ci_low, c.ci_high) == pytest.approx((d.mean() - half, d.mean() + half))
+        assert c.verdict == verdict_of(c.ci_low, c.ci_high, c.higher_better)
+        assert (f"{c.a} is {c.verdict} than {c.b}" if c.verdict in ("better", "worse")
+                else "no detectable difference") in c.sentence
+    rep = write_clutter_scenes_report(tiny)
+    text = rep.report_path.read_text(encoding="utf-8")
+    assert all(c.sentence in text for c in cs)
+    res = json.loads(rep.results_path.read_text(encoding="utf-8"))
+    assert res["means"]["storm"]["known"]["iae_mean"] == 0.0
+
+
+def test_same_records_with_two_workers(tiny, tmp_path):
+    two = clutter_scenes(tmp_path, base=preset("radars-clutter", scans=14), workers=2, **TINY)
+    for m, recs in tiny.records["storm"].items():
+        assert [_strip(r) for r in recs] == [_strip(r) for r in two.records["storm"][m]]
+
+
+class Flat(ClutterEstimator):
+    """A constant κ̂ (a stand-in for an estimator registered by another module)."""
+
+    name = "flat"
+
+    def update(self, scan, in_track_gates=None):
+        pass
+
+    def intensity(self, z):
+        return np.full(len(np.asarray(z).reshape(-1, 2)), 1e-8)
+
+    def get_state(self):
+        return {}
+
+    def set_state(self, state):
+        pass
+
+
+def test_an_estimator_registered_by_name_joins_the_study(monkeypatch, tmp_path):
+    from mhtrack.build import CLUTTER_ESTIMATOR_CLASSES
+
+    monkeypatch.setitem(CLUTTER_ESTIMATOR_CLASSES, "flat", Flat)
+    assert all_methods() == ("known", "uniform", "gmm", "agmm", "flat")
+    assert ("flat", "gmm") in study_pairs(all_methods())
+    assert ("flat", "uniform") in study_pairs(all_methods())
+    st = clutter_scenes(tmp_path, runs=1, base=preset("radars-clutter", scans=10),
+                        scenes=("burst",), methods=("known", "flat"), resolution=16,
+                        workers=1)
+    (rec,) = st.records["burst"]["flat"]
+    assert rec["iae_mean"] > 0 and rec["n_frames"] > 0
+
+
+def test_cli_writes_the_report(tmp_path):
+    from mhtrack.cli.reproduce_commands import reproduce
+
+    out = tmp_path / "cs"
+    res = CliRunner().invoke(reproduce, ["clutter-scenes", "--runs", "1", "--scans",
+                                    "10", "--scene", "weather", "--method", "known",
+                                    "--method", "gmm", "--workers", "1", "--out", str(out)])
+    assert res.exit_code == 0, res.output
+    assert "known against gmm: clutter error" in res.output
+    assert (out / "report.md").is_file() and (out / "results.json").is_file()
+    bad = CliRunner().invoke(reproduce, ["clutter-scenes", "--scene", "fog",
+                                    "--out", str(tmp_path / "x")])
+    assert bad.exit_code != 0 and "unknown scene(s) fog" in bad.output

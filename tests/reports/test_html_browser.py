@@ -39,10 +39,10 @@ def test_run_report_renders(run_dir, open_in_browser, track_ids):
     check = open_in_browser(run_dir / REPORT_FILE)
     _clean(check)
     got = {f["id"]: f["drawn"] for f in check.figures}
-    # scene: clutter, target plots, truth line, births, deaths, the tracks; curves: OSPA,
-    # cardinality, the true number of targets (no OSPA(2) in this evaluation)
+    # scene: clutter, target plots, truth line, births, deaths, the tracks and their
+    # labels; curves: OSPA, cardinality, the true number of targets (no OSPA(2) here)
     confirmed, tentative = track_ids(run_dir / "tracks.csv")
-    scene = 2 + 3 + len(confirmed) + tentative
+    scene = 2 + 3 + len(confirmed) + 1 + tentative
     m = json.loads((run_dir / "metrics.json").read_text())
     curves = 3 + bool([v for v in m.get("ospa2") or [] if v is not None])
     assert got == {"fig-scene": scene, "fig-curves": curves, "fig-lengths": 1}
@@ -58,9 +58,10 @@ def test_geographic_report_renders(geo_dir, open_in_browser, tmp_path, track_ids
     page = write_html_report(geo_dir, tmp_path / "geo.html")
     check = open_in_browser(page)
     _clean(check)
-    # scene: lat/lon grid and its labels, clutter, target plots, truth (3), tracks, sites
+    # scene: lat/lon grid and its labels, clutter, target plots, truth (3), tracks and
+    # their labels, sites
     confirmed, tentative = track_ids(geo_dir / "tracks.csv")
-    scene = 2 + 2 + 3 + len(confirmed) + tentative + 1
+    scene = 2 + 2 + 3 + len(confirmed) + 1 + tentative + 1
     assert {f["id"]: f["drawn"] for f in check.figures}["fig-scene"] == scene
 
 
@@ -100,11 +101,11 @@ def test_recording_report_renders(recording_dir, open_in_browser, tmp_path, trac
     check = open_in_browser(page)
     _clean(check)
     confirmed, tentative = track_ids(recording_dir / "tracks.csv")
-    # scene: lat/lon grid and its labels, plots (no origin column kept? it is: clutter and
-    # target plots), tracks, sites; lengths: one bar trace
+    # scene: lat/lon grid and its labels, plots (clutter and target plots when the file
+    # has an origin column), tracks and their labels, sites; lengths: one bar trace
     with open(recording_dir / "plots.csv", newline="") as fh:
         kinds = 2 if "origin" in next(csv.reader(fh)) else 1
-    scene = 2 + kinds + len(confirmed) + tentative + 1
+    scene = 2 + kinds + len(confirmed) + 1 + tentative + 1
     assert {f["id"]: f["drawn"] for f in check.figures} == {"fig-scene": scene,
                                                             "fig-lengths": 1}
     text = page.read_text()

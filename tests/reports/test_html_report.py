@@ -84,7 +84,14 @@ def test_scene_traces_follow_the_files(run_dir, track_ids):
     page = report_page(run_dir)
     confirmed, tentative = track_ids(run_dir / "tracks.csv")
     html = page.render()
-    assert html.count('"legendgroup":"tracks"') == len(confirmed)  # one trace per id
+    # one trace per id, and one of their labels (the ids, at the tracks' ends)
+    assert html.count('"legendgroup":"tracks"') == len(confirmed) + 1
+    from mhtrack.io import read_tracks
+    from mhtrack.reports.html_scene import track_traces
+
+    traces = track_traces(read_tracks(run_dir / "tracks.csv"), 1.0)
+    labels = [t for t in traces if t["name"] == "track labels"]
+    assert len(labels) == 1 and sorted(labels[0]["text"]) == sorted(confirmed)
     assert ('"name":"tracks before confirmation"' in html) == tentative
     assert '"name":"clutter"' in html and '"name":"target plots"' in html
     assert '"name":"truth"' in html

@@ -27,8 +27,10 @@ if TYPE_CHECKING:
 
     from mhtrack.models.geodesy import LocalFrame
 
-#: Most plots drawn (SVG markers); more are thinned to every k-th plot.
-MAX_PLOTS = 10_000
+#: Most plots of each kind drawn (SVG markers); more are thinned to every k-th plot.
+#: Each marker is one SVG path: 5 000 per kind keeps a 20-minute three-radar scene's
+#: drawing under half a second (docs/reports.md, *Load time*).
+MAX_PLOTS = 5_000
 #: Most tracks drawn as one trace each (hover, own colour); more share one trace.
 MAX_TRACK_TRACES = 250
 #: Most track rows drawn; more are thinned to every k-th row of each track.
@@ -161,7 +163,9 @@ def track_traces(tracks: TrackTable, scale: float, details: dict[str, np.ndarray
                  = None, *, word: str = "scan") -> list[dict[str, Any]]:
     """Tracks: one trace per id (its own colour, labelled at its end) up to
     :data:`MAX_TRACK_TRACES` ids, else one trace for all; rows reported before the track
-    was confirmed (``tentative``, the history output) in one dotted trace. Hover: id,
+    was confirmed (``tentative``, the history output) in one dotted trace; the ids at
+    the tracks' ends in one text trace (a ``lines+text`` trace per track would make one
+    SVG text element per row, blank or not). Hover: id,
     ``word`` (scan or frame), time and the ``details`` given per row (speed, heading,
     flight level, score, sensor; code, callsign and sensors per track —
     :func:`mhtrack.reports.html_recording.track_details`). More than
@@ -201,15 +205,26 @@ def track_traces(tracks: TrackTable, scale: float, details: dict[str, np.ndarray
         out.append(trace(solid, name=f"tracks ({len(solid)}{note})",
                          line={"color": "#1f77b4", "width": 1.4}))
         return out
+    ends_x: list[float] = []
+    ends_y: list[float] = []
+    labels: list[str] = []
+    colours: list[str] = []
     for j, (r, full) in enumerate(zip(solid, whole, strict=True)):
         tid = int(tracks.track_id[r[0]])
-        t = trace([r], _track_labels(full, details),
-                  name="tracks" + (f" ({note[2:]})" if note else ""), showlegend=j == 0,
-                  mode="lines+text", line={"color": PALETTE[tid % len(PALETTE)], "width": 1.8})
-        t["text"] = [""] * (len(r) - 1) + [str(tid), ""]
-        t["textposition"] = "top right"
-        t["textfont"] = {"color": PALETTE[tid % len(PALETTE)], "size": 10}
-        out.append(t)
+        colour = PALETTE[tid % len(PALETTE)]
+        out.append(trace([r], _track_labels(full, details),
+                         name="tracks" + (f" ({note[2:]})" if note else ""),
+                         showlegend=j == 0, line={"color": colour, "width": 1.8}))
+        ends_x.append(float(tracks.x[r[-1]] / scale))
+        ends_y.append(float(tracks.y[r[-1]] / scale))
+        labels.append(str(tid))
+        colours.append(colour)
+    if labels:  # one text trace for every track's label: one SVG text per track
+        out.append({"type": "scatter", "mode": "text", "name": "track labels",
+                    "legendgroup": "tracks", "showlegend": False, "hoverinfo": "skip",
+                    "x": np.array(ends_x, DRAWN), "y": np.array(ends_y, DRAWN),
+                    "text": labels, "textposition": "top right",
+                    "textfont": {"color": colours, "size": 10}})
     return out
 
 

@@ -109,3 +109,21 @@ def open_in_browser(chromium, tmp_path):
 
     return run
 
+
+NATURAL_EARTH = Path(__file__).parents[1] / "io" / "data" / "naturalearth"
+
+
+@pytest.fixture
+def cached_coastlines(tmp_path, monkeypatch):
+    """The tiny Natural Earth fixture in a cache of this test's own; any download fails
+    the test (never at test time)."""
+    from mhtrack.io import basemap
+
+    shutil.copytree(NATURAL_EARTH, tmp_path / "cache" / "naturalearth")
+    monkeypatch.setenv("MHTRACK_CACHE", str(tmp_path / "cache"))
+
+    def no_network(url):
+        raise AssertionError(f"downloaded {url} at test time")
+
+    monkeypatch.setattr(basemap, "_download", no_network)
+    return tmp_path / "cache" / "naturalearth"

@@ -65,6 +65,18 @@ def test_geographic_report_renders(geo_dir, open_in_browser, tmp_path, track_ids
     assert {f["id"]: f["drawn"] for f in check.figures}["fig-scene"] == scene
 
 
+def test_geographic_report_with_coastlines_renders(geo_dir, open_in_browser, tmp_path,
+                                                  track_ids, cached_coastlines):
+    """The tiny Natural Earth fixture from the cache: two more traces drawn, coastlines
+    and borders, nothing fetched."""
+    page = write_html_report(geo_dir, tmp_path / "geo-coast.html", coastlines=True)
+    check = open_in_browser(page)
+    _clean(check)
+    confirmed, tentative = track_ids(geo_dir / "tracks.csv")
+    scene = 2 + 2 + 2 + 3 + len(confirmed) + 1 + tentative + 1
+    assert {f["id"]: f["drawn"] for f in check.figures}["fig-scene"] == scene
+
+
 def test_study_report_renders(study_dir, open_in_browser, tmp_path, monkeypatch):
     monkeypatch.delattr(montecarlo, "paired_comparisons", raising=False)
     d = tmp_path / "mc"

@@ -293,6 +293,38 @@ def latlon_grid(frame: LocalFrame, box: tuple[float, float, float, float],
     ]
 
 
+def basemap_traces(layers: dict[str, list[np.ndarray]], frame: LocalFrame,
+                   box: tuple[float, float, float, float], scale: float
+                   ) -> list[dict[str, Any]]:
+    """Coastlines and borders (``layers``: name → lines of ``(lat, lon)``,
+    :func:`mhtrack.io.basemap.basemap`) over ``box`` and a quarter of its size around
+    it, projected by ``frame``; one trace per layer, points beyond that cut out."""
+    x0, x1, y0, y1 = box
+    m = 0.25 * max(x1 - x0, y1 - y0, 1.0)
+    gx, gy = np.meshgrid(np.linspace(x0 - m, x1 + m, 9), np.linspace(y0 - m, y1 + m, 9))
+    lat, lon = frame.to_geodetic(gx.ravel(), gy.ravel())
+    lat_lo, lat_hi, lon_lo, lon_hi = lat.min(), lat.max(), lon.min(), lon.max()
+    out = []
+    for name, lines in layers.items():
+        xs, ys = [], []
+        for line in lines:
+            near = ((line[:, 0] >= lat_lo) & (line[:, 0] <= lat_hi)
+                    & (line[:, 1] >= lon_lo) & (line[:, 1] <= lon_hi))
+            if not near.any():
+                continue
+            x, y = frame.to_local(line[:, 0], line[:, 1])
+            inside = (x >= x0 - m) & (x <= x1 + m) & (y >= y0 - m) & (y <= y1 + m)
+            if inside.any():
+                xs.append(np.where(inside, x / scale, np.nan))
+                ys.append(np.where(inside, y / scale, np.nan))
+        if xs:
+            out.append({"type": "scatter", "mode": "lines", "name": name,
+                        "x": _gapped(xs), "y": _gapped(ys), "hoverinfo": "skip",
+                        "line": {"color": "#6b7280", "width": 1.0,
+                                 **({"dash": "dot"} if name == "borders" else {})}})
+    return out
+
+
 def _decimals(step: float) -> int:
     return max(0, -math.floor(math.log10(step) + 1e-9)) if step < 1 else 0
 
@@ -312,11 +344,13 @@ def _box(tables: Sequence[Any], sites: Sequence[Site]) -> tuple[float, float, fl
 def scene_figure(plots: PlotTable | None = None, truth: TruthTable | None = None,
                  tracks: TrackTable | None = None, *, sites: Sequence[Site] = (),
                  frame: LocalFrame | None = None, title: str = "",
-                 details: dict[str, np.ndarray] | None = None) -> go.Figure:
+                 details: dict[str, np.ndarray] | None = None,
+                 basemap: dict[str, list[np.ndarray]] | None = None) -> go.Figure:
     """The scene as a :class:`plotly.graph_objects.Figure`: plots, truth, tracks, radar
     ``sites`` and, when ``frame`` is given (a geographic scene), the lat/lon grid.
     Equal axes, kilometres when the scene spans more than 10 km. ``details``: per track
-    row, what the hover shows besides id, scan and time (:func:`track_traces`)."""
+    row, what the hover shows besides id, scan and time (:func:`track_traces`);
+    ``basemap``: coastlines and borders of a geographic scene (:func:`basemap_traces`)."""
     import plotly.graph_objects as go
 
     box = _box((plots, truth, tracks), sites)
@@ -326,6 +360,8 @@ def scene_figure(plots: PlotTable | None = None, truth: TruthTable | None = None
     traces: list[dict[str, Any]] = []
     if frame is not None:
         traces += latlon_grid(frame, box, scale)
+        if basemap:
+            traces += basemap_traces(basemap, frame, box, scale)
     if plots is not None and len(plots):
         traces += plot_traces(plots, scale, word="frame" if plots.timed else "scan")
     if truth is not None and len(truth):

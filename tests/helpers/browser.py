@@ -77,6 +77,12 @@ class PageCheck:
     requests: list[str] = field(default_factory=list)
     screenshot: Path | None = None
     load_ms: float = float("nan")
+    #: CPU seconds of Chromium's processes from the navigation until drawn (Linux's
+    #: /proc; NaN elsewhere): the page's cost, less sensitive to a busy machine than
+    #: ``load_ms``.
+    cpu_s: float = float("nan")
+    #: The value of the ``probe`` expression evaluated once the page was drawn.
+    probe: Any = None
 
 
 class Chromium:
@@ -201,18 +207,42 @@ class Chromium:
         self.log.close()
 
 
-def check_page(exe: str, page: Path, work: Path, *, width: int = 1400) -> PageCheck:
+def process_group_cpu_s(pgid: int) -> float:
+    """User + system CPU seconds of the live processes of group ``pgid`` (Linux /proc;
+    NaN where there is none)."""
+    proc = Path("/proc")
+    if not proc.is_dir():
+        return float("nan")
+    ticks = 0
+    for d in proc.iterdir():
+        if not d.name.isdigit():
+            continue
+        try:
+            stat = (d / "stat").read_text()
+        except OSError:
+            continue
+        f = stat[stat.rindex(")") + 2:].split()
+        if int(f[2]) == pgid:  # fields after the name: state ppid pgrp ... utime stime
+            ticks += int(f[11]) + int(f[12])
+    return ticks / os.sysconf("SC_CLK_TCK")
+
+
+def check_page(exe: str, page: Path, work: Path, *, width: int = 1400,
+               probe: str | None = None) -> PageCheck:
     """Open ``page`` in headless Chromium, wait until Plotly has drawn every figure
-    (:data:`DRAWN_JS`), and
-    report (see :class:`PageCheck`); the screenshot goes to ``work/<page stem>.png``."""
+    (:data:`DRAWN_JS`), evaluate ``probe`` (JavaScript) if given, and report (see
+    :class:`PageCheck`); the screenshot goes to ``work/<page stem>.png``."""
     work.mkdir(parents=True, exist_ok=True)
     b = Chromium(exe, work / "profile")
     try:
+        cpu0 = process_group_cpu_s(b.pid)
         b.open(page.resolve().as_uri(), width)
         load_ms = float(b.evaluate(DRAWN_JS, await_promise=True))
+        cpu_s = process_group_cpu_s(b.pid) - cpu0
         figures = json.loads(b.evaluate(FIGURES_JS))
+        value = None if probe is None else b.evaluate(probe, await_promise=True)
         shot = b.screenshot(work / f"{page.stem}.png", width)
         errors, requests = b.problems()
-        return PageCheck(figures, errors, requests, shot, load_ms)
+        return PageCheck(figures, errors, requests, shot, load_ms, cpu_s, value)
     finally:
         b.close()

@@ -216,7 +216,8 @@ def run_page(directory: Path, stages: Stages | None = None, *, coastlines: bool 
               + ". Hover a track for its speed, heading and what the files give (flight "
               "level, code, score, sensors). Drag to pan, wheel or box to zoom, "
               "double-click to reset, click a legend entry to hide it."
-              + (" Dashed lines: latitude and longitude (WGS-84), no map." if frame else ""))
+              + (" Dashed lines: latitude and longitude (WGS-84)"
+                 + ("" if coastlines else ", no map") + "." if frame else ""))
     n_track_rows = 0 if tracks is None else len(tracks)
     if (plots is not None and len(plots) > MAX_PLOTS) or n_track_rows > MAX_TRACK_POINTS:
         page.note(f"Thinned for drawing: at most {MAX_PLOTS} plots of each kind and about "

@@ -199,3 +199,36 @@ def _open(url: str, work: Path, frame: int) -> dict[str, Any]:
     assert errors == [], errors
     assert {r.split("/")[2] for r in requests} <= {url.split("/")[2]}, requests
     return got
+
+
+def test_cli_serves_the_view(rec: Path) -> None:
+    """``mhtrack live --view 127.0.0.1:0``: stderr names the page; ``/`` is the page,
+    ``/view.json`` lists the radars of the sensors file; SIGTERM ends it with status 0."""
+    import os
+    import signal
+    import subprocess
+    import sys
+
+    src = str(Path(__file__).resolve().parents[2] / "src")
+    env = {**os.environ, "PYTHONPATH": src + os.pathsep + os.environ.get("PYTHONPATH", "")}
+    live = subprocess.Popen(
+        [sys.executable, "-c", "from mhtrack.cli.main import main; main()", "live",
+         "--listen", "udp://127.0.0.1:0", "--sensors", str(rec / "sensors.toml"),
+         "--birth-density", "1e-10", "--view", "127.0.0.1:0"],
+        stderr=subprocess.PIPE, stdout=subprocess.DEVNULL, text=True, env=env)
+    try:
+        lines = [live.stderr.readline() for _ in range(2)]
+        url = next((ln.split()[-1] for ln in lines if ln.startswith("view on ")), None)
+        assert url is not None and url.startswith("http://127.0.0.1:"), lines
+        with urllib.request.urlopen(url, timeout=10) as r:  # 127.0.0.1 only
+            assert r.read() == page_html()
+        v = _get(url + "view.json")
+        assert [r["id"] for r in v["radars"]] == [
+            s.id for s in read_sensors(rec / "sensors.toml").sensors]
+        assert v["tracks"] == [] and v["frame"] is None
+        live.send_signal(signal.SIGTERM)
+        _, err = live.communicate(timeout=60)
+    finally:
+        if live.poll() is None:
+            live.kill()
+    assert live.returncode == 0, err

@@ -59,6 +59,7 @@ def test_run_report_is_self_contained(run_dir):
     assert scripts and not [s for s in scripts if "src" in s]
     assert page.count("Plotly.newPlot(") == 3  # the scene, the curves, the track lengths
     assert "plotly.js v" in page[:5_000_000]  # the library itself, inlined
+    assert page.count("plotly.js v") == 1  # once, whatever the number of figures
     for heading in ("Scene", "Metrics over time", "Metrics", "Parameters and caps"):
         assert f"<h2>{heading}</h2>" in page
 
@@ -299,3 +300,17 @@ def test_coastlines_off_where_unavailable_or_flat(geo_dir, run_dir, tmp_path, mo
            "unreachable)." in html and '"name":"coastlines"' not in html
     flat = report_page(run_dir, coastlines=True).render()
     assert "Coastlines off: the scene has no geodetic origin" in flat
+
+
+def test_report_command_coastlines_flag(geo_dir, tmp_path, cached_coastlines):
+    """``mhtrack report DIR --coastlines`` draws the cached layers; without the flag the
+    page has none."""
+    d = tmp_path / "geo"
+    shutil.copytree(geo_dir, d)
+    code, _, err = invoke("report", str(d), "--coastlines", "--out", str(d / "c.html"),
+                          "--quiet")
+    assert code == 0, err
+    assert '"name":"coastlines"' in (d / "c.html").read_text()
+    code, _, err = invoke("report", str(d), "--out", str(d / "n.html"), "--quiet")
+    assert code == 0, err
+    assert '"name":"coastlines"' not in (d / "n.html").read_text()

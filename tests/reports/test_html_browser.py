@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import csv
 import json
+import re
 import shutil
 import struct
 
@@ -39,10 +40,10 @@ def test_run_report_renders(run_dir, open_in_browser, track_ids):
     check = open_in_browser(run_dir / REPORT_FILE)
     _clean(check)
     got = {f["id"]: f["drawn"] for f in check.figures}
-    # scene: clutter, target plots, truth line, births, deaths, the tracks; curves: OSPA,
-    # cardinality, the true number of targets (no OSPA(2) in this evaluation)
+    # scene: clutter, target plots, truth line, births, deaths, the tracks and their
+    # labels; curves: OSPA, cardinality, the true number of targets (no OSPA(2) here)
     confirmed, tentative = track_ids(run_dir / "tracks.csv")
-    scene = 2 + 3 + len(confirmed) + tentative
+    scene = 2 + 3 + len(confirmed) + 1 + tentative
     m = json.loads((run_dir / "metrics.json").read_text())
     curves = 3 + bool([v for v in m.get("ospa2") or [] if v is not None])
     assert got == {"fig-scene": scene, "fig-curves": curves, "fig-lengths": 1}
@@ -58,9 +59,22 @@ def test_geographic_report_renders(geo_dir, open_in_browser, tmp_path, track_ids
     page = write_html_report(geo_dir, tmp_path / "geo.html")
     check = open_in_browser(page)
     _clean(check)
-    # scene: lat/lon grid and its labels, clutter, target plots, truth (3), tracks, sites
+    # scene: lat/lon grid and its labels, clutter, target plots, truth (3), tracks and
+    # their labels, sites
     confirmed, tentative = track_ids(geo_dir / "tracks.csv")
-    scene = 2 + 2 + 3 + len(confirmed) + tentative + 1
+    scene = 2 + 2 + 3 + len(confirmed) + 1 + tentative + 1
+    assert {f["id"]: f["drawn"] for f in check.figures}["fig-scene"] == scene
+
+
+def test_geographic_report_with_coastlines_renders(geo_dir, open_in_browser, tmp_path,
+                                                  track_ids, cached_coastlines):
+    """The tiny Natural Earth fixture from the cache: two more traces drawn, coastlines
+    and borders, nothing fetched."""
+    page = write_html_report(geo_dir, tmp_path / "geo-coast.html", coastlines=True)
+    check = open_in_browser(page)
+    _clean(check)
+    confirmed, tentative = track_ids(geo_dir / "tracks.csv")
+    scene = 2 + 2 + 2 + 3 + len(confirmed) + 1 + tentative + 1
     assert {f["id"]: f["drawn"] for f in check.figures}["fig-scene"] == scene
 
 
@@ -100,16 +114,66 @@ def test_recording_report_renders(recording_dir, open_in_browser, tmp_path, trac
     check = open_in_browser(page)
     _clean(check)
     confirmed, tentative = track_ids(recording_dir / "tracks.csv")
-    # scene: lat/lon grid and its labels, plots (no origin column kept? it is: clutter and
-    # target plots), tracks, sites; lengths: one bar trace
+    # scene: lat/lon grid and its labels, plots (clutter and target plots when the file
+    # has an origin column), tracks and their labels, sites; lengths: one bar trace
     with open(recording_dir / "plots.csv", newline="") as fh:
         kinds = 2 if "origin" in next(csv.reader(fh)) else 1
-    scene = 2 + kinds + len(confirmed) + tentative + 1
+    scene = 2 + kinds + len(confirmed) + 1 + tentative + 1
     assert {f["id"]: f["drawn"] for f in check.figures} == {"fig-scene": scene,
                                                             "fig-lengths": 1}
     text = page.read_text()
     for heading in ("Scene", "Radars", "Tracks", "Parameters and caps"):
         assert f"<h2>{heading}</h2>" in text
+
+
+#: Hover the middle one of the rows with a plot of the first per-track trace whose hover
+#: names a code (Plotly's own hover, as a pointer would), and return the label's text.
+HOVER_JS = """(() => {
+  const gd = document.getElementById('fig-scene');
+  const i = gd.data.findIndex(t => t.legendgroup === 'tracks' && t.mode === 'lines'
+                                   && (t.hovertemplate || '').includes('code'));
+  if (i < 0) return 'no track trace with a code';
+  const k = Number(gd.data[i].hovertemplate.match(/plot of sensor %{customdata.(\\d+)/)[1]);
+  const cd = gd._fullData[i].customdata;
+  const hits = Array.from({length: cd.length}, (_, p) => p).filter(p => cd[p][k] >= 0);
+  Plotly.Fx.hover(gd, [{curveNumber: i, pointNumber: hits[Math.floor(hits.length / 2)]}]);
+  return Array.from(gd.querySelectorAll('g.hoverlayer g.hovertext'))
+    .map(g => g.textContent).join(' | ');
+})()"""
+
+
+def test_recording_hover_and_tables(recording_dir, open_in_browser, tmp_path):
+    """A recording whose plots carry a flight level and a Mode 3/A code (as converted
+    from ASTERIX): hovering a track's row with a plot in the browser shows its id, speed,
+    heading, flight level, score, the plot's sensor, its code and sensors (a coasting
+    row shows FL NaN and sensor -1: no plot); the radars table has a row
+    per radar with its plots counted, the tracks table the durations."""
+    d = tmp_path / "rec-fl"
+    d.mkdir()
+    for name in ("sensors.toml", "tracks.csv"):
+        shutil.copy(recording_dir / name, d / name)
+    with open(recording_dir / "plots.csv", newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    with open(d / "plots.csv", "w", newline="") as fh:
+        w = csv.DictWriter(fh, [*rows[0], "flight_level", "mode_3a"])
+        w.writeheader()
+        for r in rows:  # FL 310, 320, 330 by radar; code 7000 on the target plots
+            w.writerow({**r, "flight_level": str(300 + 10 * int(r["sensor"])),
+                        "mode_3a": "7000" if r["origin"] != "-1" else ""})
+    page = write_html_report(d, d / "report.html")
+    check = open_in_browser(page, probe=HOVER_JS)
+    _clean(check)
+    hover = check.probe
+    assert re.search(r"^track \d+, frame \d+, t = [\d.]+ s", hover), hover
+    for part in (r"speed \d+ m/s", r"heading \d+°", r"FL 3[123]0", r"score -?[\d.]+",
+                 r"plot of sensor [123]", r"code 7000", r"sensors [123](, [123])*"):
+        assert re.search(part, hover), (part, hover)
+    text = page.read_text()
+    radars = text[text.index("<h2>Radars</h2>"):text.index("<h2>Tracks</h2>")]
+    counts = {s: sum(r["sensor"] == s for r in rows) for s in {r["sensor"] for r in rows}}
+    for s, n in counts.items():
+        assert f"<tr><td>{s}</td><td class=\"num\">{n}</td>" in radars
+    assert "track duration min / median / mean / max (s)" in text
 
 
 @pytest.fixture(scope="module")
@@ -135,8 +199,9 @@ def twenty_minutes(tmp_path_factory):
 @pytest.mark.parametrize("plotlyjs", ["inline", "file"])
 def test_twenty_minute_report_size_and_load_time(plotlyjs, twenty_minutes, open_in_browser,
                                                  tmp_path, record_property):
-    """A 20-minute three-radar recording's report renders cleanly; its size and the time
-    until every figure is drawn (the browser's own clock) are logged, not asserted."""
+    """A 20-minute three-radar recording's report renders cleanly and says it was thinned
+    for drawing; its size, the time until every figure is drawn (the browser's own
+    clock) and Chromium's CPU time meanwhile are logged, not asserted."""
     d = tmp_path / "rec"
     shutil.copytree(twenty_minutes, d)
     page = write_html_report(d, d / f"report-{plotlyjs}.html", plotlyjs=plotlyjs)
@@ -144,8 +209,12 @@ def test_twenty_minute_report_size_and_load_time(plotlyjs, twenty_minutes, open_
     _clean(check)
     js = sum(p.stat().st_size for p in d.glob("plotly-*.min.js"))
     assert (js > 0) == (plotlyjs == "file")
+    text = page.read_text()
+    assert "Thinned for drawing: at most 5000 plots of each kind" in text
+    assert re.search(r'"name":"(clutter|target plots) \(5000 of \d+ drawn\)"', text)
     record_property("measured", (
         f"20-minute 3-radar report (plotly.js {plotlyjs}): page "
         f"{page.stat().st_size / 1e6:.2f} MB" + (f" + plotly.js {js / 1e6:.2f} MB" if js
                                                   else "")
-        + f", drawn {check.load_ms / 1000:.2f} s after navigation (headless Chromium)"))
+        + f", drawn {check.load_ms / 1000:.2f} s after navigation, Chromium CPU "
+        f"{check.cpu_s:.2f} s (headless Chromium)"))

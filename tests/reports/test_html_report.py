@@ -59,6 +59,7 @@ def test_run_report_is_self_contained(run_dir):
     assert scripts and not [s for s in scripts if "src" in s]
     assert page.count("Plotly.newPlot(") == 3  # the scene, the curves, the track lengths
     assert "plotly.js v" in page[:5_000_000]  # the library itself, inlined
+    assert page.count("plotly.js v") == 1  # once, whatever the number of figures
     for heading in ("Scene", "Metrics over time", "Metrics", "Parameters and caps"):
         assert f"<h2>{heading}</h2>" in page
 
@@ -84,7 +85,14 @@ def test_scene_traces_follow_the_files(run_dir, track_ids):
     page = report_page(run_dir)
     confirmed, tentative = track_ids(run_dir / "tracks.csv")
     html = page.render()
-    assert html.count('"legendgroup":"tracks"') == len(confirmed)  # one trace per id
+    # one trace per id, and one of their labels (the ids, at the tracks' ends)
+    assert html.count('"legendgroup":"tracks"') == len(confirmed) + 1
+    from mhtrack.io import read_tracks
+    from mhtrack.reports.html_scene import track_traces
+
+    traces = track_traces(read_tracks(run_dir / "tracks.csv"), 1.0)
+    labels = [t for t in traces if t["name"] == "track labels"]
+    assert len(labels) == 1 and sorted(labels[0]["text"]) == sorted(confirmed)
     assert ('"name":"tracks before confirmation"' in html) == tentative
     assert '"name":"clutter"' in html and '"name":"target plots"' in html
     assert '"name":"truth"' in html
@@ -248,3 +256,61 @@ def test_run_json_with_report_keeps_stdout_json(tmp_path):
     assert code == 0, stderr
     assert json.loads(stdout)["tracker"] == "mht-agmm"
     assert f"wrote {out / REPORT_FILE}" in stderr and (out / REPORT_FILE).is_file()
+
+
+def test_coastlines_in_a_geographic_scene(geo_dir, cached_coastlines):
+    """The fixture's lines near the scene, through the sensors' frame; the far one
+    (Japan) left out; the page names the source and the cache."""
+    from mhtrack.io import read_tracks
+    from mhtrack.io.sensors import read_sensors
+    from mhtrack.reports.html_scene import basemap_traces
+
+    frame = read_sensors(geo_dir / "sensors.toml").frame()
+    html = report_page(geo_dir, coastlines=True).render()
+    assert "Coastlines and borders: Natural Earth 1:50m (public domain), from " \
+           f"{cached_coastlines}." in html
+    assert '"name":"coastlines"' in html and '"name":"borders"' in html
+    assert report_page(geo_dir).render().count('"name":"coastlines"') == 0  # off by default
+    from mhtrack.io.basemap import basemap
+
+    layers, _ = basemap(fetch=False)
+    t = read_tracks(geo_dir / "tracks.csv")
+    box = (float(t.x.min()), float(t.x.max()), float(t.y.min()), float(t.y.max()))
+    coast, borders = basemap_traces(layers, frame, box, 1000.0)
+    x, y = (np.asarray(coast[k], float) for k in ("x", "y"))
+    ex, ey = frame.to_local([50.5, 50.6, 50.8, 51.2], [-4.0, -2.0, 0.0, 1.0])
+    assert np.allclose(x[:4] * 1000, ex, atol=1.0) and np.allclose(y[:4] * 1000, ey, atol=1.0)
+    assert np.isnan(x[4])  # a gap between lines
+    far_x, _ = frame.to_local(35.0, 140.0)
+    assert not np.any(np.isclose(x * 1000, far_x, atol=1000.0))
+    assert np.count_nonzero(~np.isnan(np.asarray(borders["x"], float))) == 4
+
+
+def test_coastlines_off_where_unavailable_or_flat(geo_dir, run_dir, tmp_path, monkeypatch):
+    from mhtrack.io import basemap
+
+    monkeypatch.setenv("MHTRACK_CACHE", str(tmp_path / "empty"))
+
+    def unreachable(url):
+        raise OSError("Network is unreachable")
+
+    monkeypatch.setattr(basemap, "_download", unreachable)
+    html = report_page(geo_dir, coastlines=True).render()
+    assert "Coastlines off: ne_50m_coastline.geojson could not be downloaded (Network is " \
+           "unreachable)." in html and '"name":"coastlines"' not in html
+    flat = report_page(run_dir, coastlines=True).render()
+    assert "Coastlines off: the scene has no geodetic origin" in flat
+
+
+def test_report_command_coastlines_flag(geo_dir, tmp_path, cached_coastlines):
+    """``mhtrack report DIR --coastlines`` draws the cached layers; without the flag the
+    page has none."""
+    d = tmp_path / "geo"
+    shutil.copytree(geo_dir, d)
+    code, _, err = invoke("report", str(d), "--coastlines", "--out", str(d / "c.html"),
+                          "--quiet")
+    assert code == 0, err
+    assert '"name":"coastlines"' in (d / "c.html").read_text()
+    code, _, err = invoke("report", str(d), "--out", str(d / "n.html"), "--quiet")
+    assert code == 0, err
+    assert '"name":"coastlines"' not in (d / "n.html").read_text()

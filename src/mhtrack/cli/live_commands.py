@@ -129,6 +129,9 @@ def replay(recording: Path, to: tuple[str, ...], speed: float | None, loop: bool
 @click.option("--metrics-http", default=None, metavar="HOST:PORT",
               help="Serve the Prometheus text at http://HOST:PORT/metrics (:PORT: on "
               "127.0.0.1).")
+@click.option("--view", "view", default=None, metavar="HOST:PORT",
+              help="Serve a live view — tracks, radars and status on a lat/lon grid, "
+              "updated every second — at http://HOST:PORT/ (:PORT: on 127.0.0.1).")
 @click.option("--checkpoint", type=click.Path(dir_okay=False, path_type=Path), default=None,
               help="Save the tracker's state to this file (atomically) when the run ends "
               "and every --checkpoint-every minutes of data time.")
@@ -149,7 +152,7 @@ def live(listen: tuple[str, ...], stdin: str | None, sensors_file: Path,
          day_from: str | None, out_udp: tuple[str, ...], out: Path | None,
          part_frames: int | None, as_json: bool, period_out: float | None,
          status_every: float | None, status_json: Path | None, prometheus: Path | None,
-         metrics_http: str | None, checkpoint: Path | None,
+         metrics_http: str | None, view: str | None, checkpoint: Path | None,
          checkpoint_every: float | None, resume: bool, reorder_window_s: float | None,
          tracker: str, tracker_pd: float | None,
          meas_sigma: float | None, accel_sigma: float | None,
@@ -168,7 +171,7 @@ def live(listen: tuple[str, ...], stdin: str | None, sensors_file: Path,
                            part_frames=part_frames, json=as_json,
                            period_out_s=period_out, status_every_s=status_every,
                            status_json=status_json, prometheus=prometheus,
-                           metrics_http=metrics_http, checkpoint=checkpoint,
+                           metrics_http=metrics_http, view=view, checkpoint=checkpoint,
                            checkpoint_every_s=(None if checkpoint_every is None
                                                else 60.0 * checkpoint_every),
                            resume=resume, reorder_window_s=reorder_window_s,

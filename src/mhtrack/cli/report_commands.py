@@ -10,14 +10,16 @@ from mhtrack.cli.terminal import say, show_progress
 
 
 def write_report_or_fail(directory: Path, output: Path | None = None, *,
-                         plotlyjs: str | None = None, progress: bool = False) -> Path:
+                         plotlyjs: str | None = None, progress: bool = False,
+                         coastlines: bool = False) -> Path:
     """:func:`~mhtrack.reports.html_report.write_html_report` (``plotlyjs`` ``None``: its
     default), the missing optional extra turned into one line (exit 1)."""
     try:
         from mhtrack.reports.html_report import write_html_report
 
         js = {} if plotlyjs is None else {"plotlyjs": plotlyjs}
-        return write_html_report(directory, output, progress=progress, **js)
+        return write_html_report(directory, output, progress=progress,
+                                 coastlines=coastlines, **js)
     except ImportError as e:
         raise click.ClickException(str(e)) from None
 
@@ -32,8 +34,12 @@ def write_report_or_fail(directory: Path, output: Path | None = None, *,
               help="Plotly's JavaScript (4.8 MB) inlined in the page (one self-contained "
               "file), or written once beside it as plotly-VERSION.min.js and shared by "
               "every report in that folder [inline].")
+@click.option("--coastlines", is_flag=True, help="Draw Natural Earth's coastlines and "
+              "borders (public domain) in a geographic scene: downloaded once into the "
+              "user's cache ($MHTRACK_CACHE, else ~/.cache/mhtrack), left off with a note "
+              "on the page where unavailable.")
 def report(directory: Path, out: Path | None, output_alias: Path | None,
-           plotlyjs: str | None) -> None:
+           plotlyjs: str | None, coastlines: bool) -> None:
     """Write one HTML page of DIR (opens from disk, no network).
 
     DIR is a run (``run``'s output, or plots, truth, tracks and sensors files, with
@@ -50,7 +56,7 @@ def report(directory: Path, out: Path | None, output_alias: Path | None,
     if out is not None:
         check_output_file(out, inputs=(), suffixes=(".html",), what="report", option="--out")
     path = write_report_or_fail(directory, out, plotlyjs=plotlyjs,
-                                progress=show_progress())
+                                progress=show_progress(), coastlines=coastlines)
     say(f"wrote {path}")
 
 

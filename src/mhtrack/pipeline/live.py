@@ -36,9 +36,10 @@ from mhtrack.pipeline.checkpoint import (
     read_checkpoint,
 )
 from mhtrack.pipeline.health import Health
-from mhtrack.pipeline.monitor import MetricsServer, prometheus_text, write_status
+from mhtrack.pipeline.monitor import MetricsServer, host_port, prometheus_text, write_status
 from mhtrack.pipeline.options import TrackOptions
 from mhtrack.pipeline.run import Pipeline, RunResult
+from mhtrack.pipeline.view import ViewServer, ViewSink, radar_list
 from mhtrack.pipeline.warmup import Warmup, warm_up
 from mhtrack.sinks.base import FrameOutput, Sink
 
@@ -83,6 +84,9 @@ class LiveOptions:
     status_json: Path | None = None
     prometheus: Path | None = None
     metrics_http: str | None = None
+    #: The live view's page and JSON at ``http://HOST:PORT/`` (``:PORT``: 127.0.0.1;
+    #: :mod:`~mhtrack.pipeline.view`).
+    view: str | None = None
     #: Tracker checkpoints: the file, every this many seconds of data time (``None``:
     #: only at the end); ``resume``: start from it when it exists.
     checkpoint: Path | None = None
@@ -92,14 +96,6 @@ class LiveOptions:
     sac: int | None = None
     sic: int | None = None
     reorder_window_s: float | None = None
-
-
-def _host_port(text: str) -> tuple[str, int]:
-    """``HOST:PORT`` (or ``:PORT``: 127.0.0.1) of the metrics endpoint."""
-    host, sep, port = text.rpartition(":")
-    if not sep or not port.isdigit():
-        raise ValueError(f"{text}: expected HOST:PORT for the metrics endpoint")
-    return host.strip("[]") or "127.0.0.1", int(port)
 
 
 @dataclass(frozen=True)
@@ -247,6 +243,8 @@ class Live:
         live, frame = self.live, self.pipeline.frame
         if frame is None and (live.out_udp or live.out_file is not None):
             raise ValueError("live: CAT062 output needs the sensors' geodetic reference")
+        if frame is None and live.view is not None:
+            raise ValueError("live: the view needs the sensors' geodetic reference")
         self.udp = [Cat062UdpSink(to, frame, sac=live.sac, sic=live.sic)  # type: ignore[arg-type]
                     for to in live.out_udp]
         self.files = None if live.out_file is None else Cat062Sink(
@@ -275,8 +273,14 @@ class Live:
         self.checkpoints = None if live.checkpoint is None else CheckpointSink(
             live.checkpoint, lambda: self.pipeline.tracker, self._state,
             live.checkpoint_every_s)
+        #: The live view's tracks (``--view``), or ``None``.
+        self.view: ViewSink | None = None if live.view is None else ViewSink(
+            lambda: self.pipeline.tracker, frame)  # type: ignore[arg-type]
+        self._radars = radar_list(sensors)
         # the health sink comes after the outputs (its time is the frame's out time)
         self.sinks: list[Sink] = [*outputs, self.health]
+        if self.view is not None:
+            self.sinks.append(self.view)
         if self.checkpoints is not None:
             self.sinks.append(self.checkpoints)
 
@@ -309,6 +313,14 @@ class Live:
         trk = self.pipeline.tracker
         scan = empty_frame(-1, trk.last_time or 0.0) if out is None else out.frame
         return report(scan, trk.leaves)
+
+    def view_state(self) -> dict[str, Any]:
+        """What ``/view.json`` serves: the view's tracks (:meth:`ViewSink.picture`), the
+        radars (:func:`~mhtrack.pipeline.view.radar_list`) and ``status``, the health
+        snapshot (as ``--status-json``)."""
+        picture = {"frame": None, "time": None, "tracks": []} if self.view is None \
+            else self.view.picture()
+        return {**picture, "radars": self._radars, "status": self.health.snapshot()}
 
     def _state(self) -> LiveState:
         axis = self.source.axis
@@ -344,12 +356,19 @@ class Live:
         live = self.live
         server = None
         if live.metrics_http is not None:
-            server = MetricsServer(*_host_port(live.metrics_http))
+            server = MetricsServer(*host_port(live.metrics_http, "metrics endpoint"))
             #: The metrics endpoint's bound ``host, port``.
             self.metrics_address = server.address
             if self.emit is not None:
                 self.emit(f"metrics on http://{server.address[0]}:{server.address[1]}"
                           "/metrics")
+        view = None
+        if live.view is not None:
+            view = ViewServer(*host_port(live.view, "view"), self.view_state)
+            #: The view's bound ``host, port`` and its page's URL.
+            self.view_address, self.view_url = view.address, view.url
+            if self.emit is not None:
+                self.emit(f"view on {view.url}")
         done = threading.Event()
         reporter = None
         if (live.status_every_s and self.emit is not None) or live.status_json or \
@@ -364,6 +383,8 @@ class Live:
             self.stop.set()
             if reporter is not None:
                 reporter.join()
+            if view is not None:
+                view.close()
         self._publish(server, False)  # the final figures
         if server is not None:
             server.close()

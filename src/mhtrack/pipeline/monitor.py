@@ -1,7 +1,7 @@
 """A live run's status for monitoring (``docs/live.md``, *Health and latency*): the
 snapshot of :class:`~mhtrack.pipeline.health.Health` as a JSON file, as Prometheus text
 (a file, or ``GET /metrics`` on a small HTTP endpoint of the standard library's
-``http.server``).
+``http.server``, :class:`HttpEndpoint`, which also serves the live view).
 
 Prometheus text exposition format 0.0.4 (Prometheus' *Exposition formats*): per metric a
 ``# HELP name text`` and a ``# TYPE name counter|gauge|summary`` line, then its samples
@@ -15,7 +15,7 @@ from __future__ import annotations
 import json
 import math
 import threading
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
 from pathlib import Path
 from typing import Any
@@ -80,41 +80,67 @@ def write_status(snap: Mapping[str, Any], json_path: Path | None,
         atomic_write(prometheus_path, prometheus_text(snap))
 
 
-class MetricsServer:
-    """``GET /metrics`` → the latest Prometheus text, served from a daemon thread on
-    ``host:port`` (port 0: a free port, :attr:`address`); :meth:`update` sets the text,
-    :meth:`close` stops."""
+#: What an :class:`HttpEndpoint` route returns: content type and body, made per request.
+Route = Callable[[], tuple[str, bytes]]
 
-    def __init__(self, host: str = "127.0.0.1", port: int = 0) -> None:
-        self._text = b""
-        server = self
+
+def host_port(text: str, what: str = "endpoint") -> tuple[str, int]:
+    """``HOST:PORT`` (``:PORT``: 127.0.0.1, the loopback interface only; IPv6 in
+    brackets) of an HTTP endpoint; ``what`` names it in the error."""
+    host, sep, port = text.rpartition(":")
+    if not sep or not port.isdigit():
+        raise ValueError(f"{text}: expected HOST:PORT for the {what}")
+    return host.strip("[]") or "127.0.0.1", int(port)
+
+
+class HttpEndpoint:
+    """A small HTTP server (the standard library's ``http.server``) in a daemon thread
+    on ``host:port`` (port 0: a free port, :attr:`address`): ``GET`` of a path of
+    ``routes`` answers what its function makes now; any other path is a 404.
+    :meth:`close` stops it."""
+
+    def __init__(self, host: str, port: int, routes: Mapping[str, Route],
+                 name: str = "mhtrack-http") -> None:
+        paths = dict(routes)
 
         class Handler(BaseHTTPRequestHandler):
             def do_GET(self) -> None:
-                if self.path.split("?")[0] != "/metrics":
-                    self.send_error(404, "only /metrics")
+                route = paths.get(self.path.split("?")[0])
+                if route is None:
+                    self.send_error(404, "only " + ", ".join(sorted(paths)))
                     return
-                body = server._text
+                kind, body = route()
                 self.send_response(200)
-                self.send_header("Content-Type", CONTENT_TYPE)
+                self.send_header("Content-Type", kind)
                 self.send_header("Content-Length", str(len(body)))
+                self.send_header("Cache-Control", "no-store")
                 self.end_headers()
                 self.wfile.write(body)
 
             def log_message(self, format: str, *args: Any) -> None:
-                pass  # no line per scrape on stderr
+                pass  # no line per request on stderr
 
         self._httpd = ThreadingHTTPServer((host, port), Handler)
         self._httpd.daemon_threads = True
         self.address = self._httpd.server_address[:2]
-        self._thread = threading.Thread(target=self._httpd.serve_forever,
-                                        name="mhtrack-metrics", daemon=True)
+        self._thread = threading.Thread(target=self._httpd.serve_forever, name=name,
+                                        daemon=True)
         self._thread.start()
-
-    def update(self, text: str) -> None:
-        self._text = text.encode()
 
     def close(self) -> None:
         self._httpd.shutdown()
         self._httpd.server_close()
         self._thread.join()
+
+
+class MetricsServer(HttpEndpoint):
+    """``GET /metrics`` → the latest Prometheus text (:class:`HttpEndpoint`);
+    :meth:`update` sets the text."""
+
+    def __init__(self, host: str = "127.0.0.1", port: int = 0) -> None:
+        self._text = b""
+        super().__init__(host, port, {"/metrics": lambda: (CONTENT_TYPE, self._text)},
+                         "mhtrack-metrics")
+
+    def update(self, text: str) -> None:
+        self._text = text.encode()

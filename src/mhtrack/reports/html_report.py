@@ -177,8 +177,12 @@ def _recording_sections(page: Page, plots: Any, tracks: Any, details: dict[str, 
 RUN_STAGES = 7
 
 
-def run_page(directory: Path, stages: Stages | None = None) -> Page:
-    """The page of a run directory (module docstring); ``stages`` shows its progress."""
+def run_page(directory: Path, stages: Stages | None = None, *, coastlines: bool = False
+             ) -> Page:
+    """The page of a run directory (module docstring); ``stages`` shows its progress;
+    ``coastlines``: Natural Earth's coastlines and borders in a geographic scene,
+    downloaded once into the cache if missing, off (the page says why) where
+    unavailable (:mod:`mhtrack.io.basemap`)."""
     from mhtrack.io import read_plots, read_toml, read_tracks, read_truth
     from mhtrack.reports.html_recording import sensor_rows, track_details
     from mhtrack.reports.html_scene import MAX_PLOTS, MAX_TRACK_POINTS, scene_figure
@@ -212,14 +216,23 @@ def run_page(directory: Path, stages: Stages | None = None) -> Page:
               + ". Hover a track for its speed, heading and what the files give (flight "
               "level, code, score, sensors). Drag to pan, wheel or box to zoom, "
               "double-click to reset, click a legend entry to hide it."
-              + (" Dashed lines: latitude and longitude (WGS-84), no map." if frame else ""))
+              + (" Dashed lines: latitude and longitude (WGS-84)"
+                 + ("" if coastlines else ", no map") + "." if frame else ""))
     n_track_rows = 0 if tracks is None else len(tracks)
     if (plots is not None and len(plots) > MAX_PLOTS) or n_track_rows > MAX_TRACK_POINTS:
         page.note(f"Thinned for drawing: at most {MAX_PLOTS} plots of each kind and about "
                   f"{MAX_TRACK_POINTS} track rows are drawn (every k-th, evenly spread; the "
                   "legend says how many); the tables count every row.")
+    layers = None
+    if coastlines:
+        from mhtrack.io.basemap import basemap
+
+        layers, where = basemap(fetch=True) if frame is not None else ({}, (
+            "Coastlines off: the scene has no geodetic origin (a sensors file or "
+            "scenario with one)."))
+        page.note(where)
     page.figure(run("scene", scene_figure, plots, truth, tracks, sites=sites, frame=frame,
-                    title=title, details=details), "scene")
+                    title=title, details=details, basemap=layers), "scene")
     if truth is not None or summary is not None:
         page.section("Metrics over time")
         page.note(source)
@@ -292,23 +305,27 @@ def study_page(directory: Path) -> Page:
     return page
 
 
-def report_page(directory: str | Path, stages: Stages | None = None) -> Page:
-    """The page of ``directory``: a study when it holds ``montecarlo.json``, else a run."""
+def report_page(directory: str | Path, stages: Stages | None = None, *,
+                coastlines: bool = False) -> Page:
+    """The page of ``directory``: a study when it holds ``montecarlo.json``, else a run
+    (``coastlines``: :func:`run_page`)."""
     directory = Path(directory)
     require_plotly()
     if not directory.is_dir():
         raise FileNotFoundError(f"{directory}: no such directory")
     if (directory / STUDY_FILE).is_file():
         return study_page(directory)
-    return run_page(directory, stages)
+    return run_page(directory, stages, coastlines=coastlines)
 
 
 def write_html_report(directory: str | Path, out: str | Path | None = None, *,
-                      plotlyjs: str = "inline", progress: bool = False) -> Path:
+                      plotlyjs: str = "inline", progress: bool = False,
+                      coastlines: bool = False) -> Path:
     """Write the report of ``directory`` to ``out`` (default ``DIR/report.html``),
     atomically; returns its path. ``plotlyjs="file"`` writes Plotly's JavaScript once
     beside the page (:func:`~mhtrack.reports.html_page.plotlyjs_name`, kept when already
-    there) instead of inlining it. ``progress``: a bar over the stages on stderr."""
+    there) instead of inlining it. ``progress``: a bar over the stages on stderr.
+    ``coastlines``: :func:`run_page`."""
     from plotly.offline import get_plotlyjs
 
     from mhtrack.reports.html_page import plotlyjs_name
@@ -317,7 +334,8 @@ def write_html_report(directory: str | Path, out: str | Path | None = None, *,
     path = Path(out) if out is not None else directory / REPORT_FILE
     run = Stages(RUN_STAGES + 1, "report", progress)
     try:
-        text = run("render", report_page(directory, run).render, plotlyjs)
+        text = run("render", report_page(directory, run, coastlines=coastlines).render,
+                   plotlyjs)
         if plotlyjs == "file" and not (js := path.parent / plotlyjs_name()).is_file():
             atomic_write(js, get_plotlyjs())
         written = atomic_write(path, text)

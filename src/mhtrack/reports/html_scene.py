@@ -27,8 +27,10 @@ if TYPE_CHECKING:
 
     from mhtrack.models.geodesy import LocalFrame
 
-#: Most plots drawn (SVG markers); more are thinned to every k-th plot.
-MAX_PLOTS = 10_000
+#: Most plots of each kind drawn (SVG markers); more are thinned to every k-th plot.
+#: Each marker is one SVG path: 5 000 per kind keeps a 20-minute three-radar scene's
+#: drawing under half a second (docs/reports.md, *Load time*).
+MAX_PLOTS = 5_000
 #: Most tracks drawn as one trace each (hover, own colour); more share one trace.
 MAX_TRACK_TRACES = 250
 #: Most track rows drawn; more are thinned to every k-th row of each track.
@@ -161,7 +163,9 @@ def track_traces(tracks: TrackTable, scale: float, details: dict[str, np.ndarray
                  = None, *, word: str = "scan") -> list[dict[str, Any]]:
     """Tracks: one trace per id (its own colour, labelled at its end) up to
     :data:`MAX_TRACK_TRACES` ids, else one trace for all; rows reported before the track
-    was confirmed (``tentative``, the history output) in one dotted trace. Hover: id,
+    was confirmed (``tentative``, the history output) in one dotted trace; the ids at
+    the tracks' ends in one text trace (a ``lines+text`` trace per track would make one
+    SVG text element per row, blank or not). Hover: id,
     ``word`` (scan or frame), time and the ``details`` given per row (speed, heading,
     flight level, score, sensor; code, callsign and sensors per track —
     :func:`mhtrack.reports.html_recording.track_details`). More than
@@ -201,15 +205,26 @@ def track_traces(tracks: TrackTable, scale: float, details: dict[str, np.ndarray
         out.append(trace(solid, name=f"tracks ({len(solid)}{note})",
                          line={"color": "#1f77b4", "width": 1.4}))
         return out
+    ends_x: list[float] = []
+    ends_y: list[float] = []
+    labels: list[str] = []
+    colours: list[str] = []
     for j, (r, full) in enumerate(zip(solid, whole, strict=True)):
         tid = int(tracks.track_id[r[0]])
-        t = trace([r], _track_labels(full, details),
-                  name="tracks" + (f" ({note[2:]})" if note else ""), showlegend=j == 0,
-                  mode="lines+text", line={"color": PALETTE[tid % len(PALETTE)], "width": 1.8})
-        t["text"] = [""] * (len(r) - 1) + [str(tid), ""]
-        t["textposition"] = "top right"
-        t["textfont"] = {"color": PALETTE[tid % len(PALETTE)], "size": 10}
-        out.append(t)
+        colour = PALETTE[tid % len(PALETTE)]
+        out.append(trace([r], _track_labels(full, details),
+                         name="tracks" + (f" ({note[2:]})" if note else ""),
+                         showlegend=j == 0, line={"color": colour, "width": 1.8}))
+        ends_x.append(float(tracks.x[r[-1]] / scale))
+        ends_y.append(float(tracks.y[r[-1]] / scale))
+        labels.append(str(tid))
+        colours.append(colour)
+    if labels:  # one text trace for every track's label: one SVG text per track
+        out.append({"type": "scatter", "mode": "text", "name": "track labels",
+                    "legendgroup": "tracks", "showlegend": False, "hoverinfo": "skip",
+                    "x": np.array(ends_x, DRAWN), "y": np.array(ends_y, DRAWN),
+                    "text": labels, "textposition": "top right",
+                    "textfont": {"color": colours, "size": 10}})
     return out
 
 
@@ -278,6 +293,38 @@ def latlon_grid(frame: LocalFrame, box: tuple[float, float, float, float],
     ]
 
 
+def basemap_traces(layers: dict[str, list[np.ndarray]], frame: LocalFrame,
+                   box: tuple[float, float, float, float], scale: float
+                   ) -> list[dict[str, Any]]:
+    """Coastlines and borders (``layers``: name → lines of ``(lat, lon)``,
+    :func:`mhtrack.io.basemap.basemap`) over ``box`` and a quarter of its size around
+    it, projected by ``frame``; one trace per layer, points beyond that cut out."""
+    x0, x1, y0, y1 = box
+    m = 0.25 * max(x1 - x0, y1 - y0, 1.0)
+    gx, gy = np.meshgrid(np.linspace(x0 - m, x1 + m, 9), np.linspace(y0 - m, y1 + m, 9))
+    lat, lon = frame.to_geodetic(gx.ravel(), gy.ravel())
+    lat_lo, lat_hi, lon_lo, lon_hi = lat.min(), lat.max(), lon.min(), lon.max()
+    out = []
+    for name, lines in layers.items():
+        xs, ys = [], []
+        for line in lines:
+            near = ((line[:, 0] >= lat_lo) & (line[:, 0] <= lat_hi)
+                    & (line[:, 1] >= lon_lo) & (line[:, 1] <= lon_hi))
+            if not near.any():
+                continue
+            x, y = frame.to_local(line[:, 0], line[:, 1])
+            inside = (x >= x0 - m) & (x <= x1 + m) & (y >= y0 - m) & (y <= y1 + m)
+            if inside.any():
+                xs.append(np.where(inside, x / scale, np.nan))
+                ys.append(np.where(inside, y / scale, np.nan))
+        if xs:
+            out.append({"type": "scatter", "mode": "lines", "name": name,
+                        "x": _gapped(xs), "y": _gapped(ys), "hoverinfo": "skip",
+                        "line": {"color": "#6b7280", "width": 1.0,
+                                 **({"dash": "dot"} if name == "borders" else {})}})
+    return out
+
+
 def _decimals(step: float) -> int:
     return max(0, -math.floor(math.log10(step) + 1e-9)) if step < 1 else 0
 
@@ -297,11 +344,13 @@ def _box(tables: Sequence[Any], sites: Sequence[Site]) -> tuple[float, float, fl
 def scene_figure(plots: PlotTable | None = None, truth: TruthTable | None = None,
                  tracks: TrackTable | None = None, *, sites: Sequence[Site] = (),
                  frame: LocalFrame | None = None, title: str = "",
-                 details: dict[str, np.ndarray] | None = None) -> go.Figure:
+                 details: dict[str, np.ndarray] | None = None,
+                 basemap: dict[str, list[np.ndarray]] | None = None) -> go.Figure:
     """The scene as a :class:`plotly.graph_objects.Figure`: plots, truth, tracks, radar
     ``sites`` and, when ``frame`` is given (a geographic scene), the lat/lon grid.
     Equal axes, kilometres when the scene spans more than 10 km. ``details``: per track
-    row, what the hover shows besides id, scan and time (:func:`track_traces`)."""
+    row, what the hover shows besides id, scan and time (:func:`track_traces`);
+    ``basemap``: coastlines and borders of a geographic scene (:func:`basemap_traces`)."""
     import plotly.graph_objects as go
 
     box = _box((plots, truth, tracks), sites)
@@ -311,6 +360,8 @@ def scene_figure(plots: PlotTable | None = None, truth: TruthTable | None = None
     traces: list[dict[str, Any]] = []
     if frame is not None:
         traces += latlon_grid(frame, box, scale)
+        if basemap:
+            traces += basemap_traces(basemap, frame, box, scale)
     if plots is not None and len(plots):
         traces += plot_traces(plots, scale, word="frame" if plots.timed else "scan")
     if truth is not None and len(truth):

@@ -33,6 +33,10 @@ After each scan, as the cells drift:
 * *birth*: plots beyond χ²₂(0.99) of every Gaussian (at least ``min_points``) seed new
   components by k-means++, taking their background mass (as the GMM's warm start).
 
+As the GMM's warm start, each scan's EM starts with ``π₀ ≥ 0.05``, and a fresh start
+gives the background half the plots, so that broad Gaussians do not swallow uniform
+clutter before the contrast test can see them.
+
 The count is the discounted Poisson ML ``M̂_k = C_k / N_k``, ``C ← γC + n_k``,
 ``N ← γN + 1`` (the window mean of :mod:`mhtrack.clutter.mixture` with forgetting).
 """
@@ -58,6 +62,8 @@ from mhtrack.models.clutter import Region
 from mhtrack.records import Scan
 
 CHI2_2_99 = 9.2103
+#: Each scan's EM starts with ``π₀`` at least this (the GMM's warm start does the same).
+START_WEIGHT = 0.05
 _SPLIT_OFFSET = 0.5  # children at μ ± ½√λ₁ v
 
 
@@ -125,6 +131,7 @@ class ForgettingGMMClutter(ClutterEstimator):
         self.bg_mass_ = 0.0
         self.count_sum_, self.looks_ = 0.0, 0.0
         self.box_: tuple[float, float, float, float] | None = None
+        self.extent_: tuple[float, float, float, float] | None = None  # plots seen, unpadded
         self.n_updates_ = 0
         self.mixture_: Mixture | None = None
         #: the mixture the last scan's EM started from
@@ -132,26 +139,37 @@ class ForgettingGMMClutter(ClutterEstimator):
 
     # ------------------------------------------------------------------ the mixture
     def _box(self, z: np.ndarray) -> tuple[float, float, float, float] | None:
-        """The background's box: ``region``, else the plots seen so far (padded)."""
+        """The background's box: ``region``, else the box of every plot seen so far
+        (``extent_``), padded by 5 % and to at least ``min_extent``."""
         if not self.background:
             return None
         if self.region is not None:
             r = self.region
             return (r.xmin, r.xmax, r.ymin, r.ymax)
         lo, hi = z.min(axis=0), z.max(axis=0)
-        if self.box_ is not None:
-            lo = np.minimum(lo, [self.box_[0], self.box_[2]])
-            hi = np.maximum(hi, [self.box_[1], self.box_[3]])
+        if self.extent_ is not None:
+            lo = np.minimum(lo, [self.extent_[0], self.extent_[2]])
+            hi = np.maximum(hi, [self.extent_[1], self.extent_[3]])
+        self.extent_ = (float(lo[0]), float(hi[0]), float(lo[1]), float(hi[1]))
+        return self._padded()
+
+    def _padded(self) -> tuple[float, float, float, float] | None:
+        if self.extent_ is None:
+            return None
+        x0, x1, y0, y1 = self.extent_
+        lo, hi = np.array([x0, y0]), np.array([x1, y1])
         pad = np.maximum(0.05 * (hi - lo), 0.5 * np.maximum(self.min_extent - (hi - lo), 0))
         return (float(lo[0] - pad[0]), float(hi[0] + pad[0]), float(lo[1] - pad[1]),
                 float(hi[1] + pad[1]))
 
-    def _mixture(self, m: np.ndarray, bg: float) -> Mixture:
+    def _mixture(self, m: np.ndarray, bg: float, floor: float = 0.0) -> Mixture:
+        """The mixture of statistics ``m`` and background mass ``bg`` (``π₀`` at least
+        ``background_floor`` and ``floor``)."""
         w, means, cov = mean_cov(m, self.anchors_, self.reg_covar)
         total = w.sum() + bg
         if self.box_ is None:
             return Mixture(w / w.sum(), means, cov)
-        w0 = max(bg / total, self.background_floor) if total > 0 else 1.0
+        w0 = max(bg / total, self.background_floor, floor) if total > 0 else 1.0
         gw = w.sum()
         return Mixture(w * (1.0 - w0) / gw if gw > 0 else w, means, cov, w0, self.box_)
 
@@ -182,9 +200,12 @@ class ForgettingGMMClutter(ClutterEstimator):
             if not len(new):
                 self._finish()
                 return
-        self.start_ = self._mixture(past + new, past_bg + new_bg)
-        for _ in range(self.max_iter):
-            mix = self._mixture(past + new, past_bg + new_bg)
+            if self.box_ is not None:  # the background starts with half the plots
+                new, new_bg = 0.5 * new, 0.5 * len(z)
+        self.start_ = self._mixture(past + new, past_bg + new_bg, START_WEIGHT)
+        for it in range(self.max_iter):
+            mix = (self.start_ if it == 0 else
+                   self._mixture(past + new, past_bg + new_bg))
             wlp = mix.weighted_log_prob(z)
             norm = logsumexp_rows(wlp)
             ll = float(norm.mean())
@@ -312,13 +333,14 @@ class ForgettingGMMClutter(ClutterEstimator):
         return {"moments": self.moments_.copy(), "anchors": self.anchors_.copy(),
                 "bg_mass": float(self.bg_mass_), "count_sum": float(self.count_sum_),
                 "looks": float(self.looks_), "n_updates": int(self.n_updates_),
-                "box": None if self.box_ is None else list(self.box_)}
+                "box": None if self.box_ is None else list(self.box_),
+                "extent": None if self.extent_ is None else list(self.extent_)}
 
     def set_state(self, state: dict[str, Any]) -> None:
         from mhtrack.clutter.state_checks import check_forgetting
 
-        m, a, box = check_forgetting(state, self.n_components, self.forgetting)
-        self.moments_, self.anchors_, self.box_ = m, a, box
+        m, a, box, extent = check_forgetting(state, self.n_components, self.forgetting)
+        self.moments_, self.anchors_, self.box_, self.extent_ = m, a, box, extent
         self.bg_mass_ = float(state["bg_mass"])
         self.count_sum_, self.looks_ = float(state["count_sum"]), float(state["looks"])
         self.n_updates_ = int(state["n_updates"])

@@ -158,7 +158,7 @@ def check_map(state: Mapping[str, Any], n_azimuth: int, max_rings: int, gamma: f
 
 
 def check_forgetting(state: Mapping[str, Any], max_components: int, gamma: float
-                     ) -> tuple[np.ndarray, np.ndarray, tuple[float, float, float, float] | None]:
+                     ) -> tuple[np.ndarray, np.ndarray, Any, Any]:
     """A forgetting mixture's state (:meth:`ForgettingGMMClutter.get_state`): at most
     ``max_components`` rows of 15 moments and 2 anchor coordinates, each weight ``M_00`` > 0
     with a positive definite covariance; masses, counts ≥ 0; ``looks`` in
@@ -182,10 +182,14 @@ def check_forgetting(state: Mapping[str, Any], max_components: int, gamma: float
     top = float(MAX_INDEX) if gamma >= 1.0 else 1.0 / (1.0 - gamma) + 1e-9
     number(state["looks"], f"{f}.looks", 0.0, top)
     number(state["n_updates"], f"{f}.n_updates", 0, MAX_INDEX, integer=True)
-    box = state["box"]
-    if box is not None:
-        x0, x1, y0, y1 = (float(v) for v in array(box, f"{f}.box", (4,), bound=MAX_COORDINATE))
-        if not (x0 < x1 and y0 < y1):
-            raise _fail(f"{f}.box", "expected x0 < x1 and y0 < y1")
-        box = (x0, x1, y0, y1)
-    return np.ascontiguousarray(m), np.ascontiguousarray(a, dtype=float), box
+    boxes = []
+    for key in ("box", "extent"):
+        box = state[key]
+        if box is not None:
+            x0, x1, y0, y1 = (float(v) for v in array(box, f"{f}.{key}", (4,),
+                                                      bound=MAX_COORDINATE))
+            if not (x0 <= x1 and y0 <= y1) or (key == "box" and not (x0 < x1 and y0 < y1)):
+                raise _fail(f"{f}.{key}", "expected x0 < x1 and y0 < y1")
+            box = (x0, x1, y0, y1)
+        boxes.append(box)
+    return np.ascontiguousarray(m), np.ascontiguousarray(a, dtype=float), boxes[0], boxes[1]

@@ -72,7 +72,7 @@ class ForgettingGMMClutter(ClutterEstimator):
 
     Parameters
     ----------
-    forgetting : ``γ`` in (0, 1]; memory ``1/(1 − γ)`` scans. Default 0.8.
+    forgetting : ``γ`` in (0, 1]; memory ``1/(1 − γ)`` scans. Default 0.7.
     n_components : most Gaussians. Default 8.
     background : a uniform component over ``region`` or the box of the plots seen so far
         (padded 5 %, at least ``min_extent`` wide). Default True.
@@ -89,7 +89,7 @@ class ForgettingGMMClutter(ClutterEstimator):
 
     name = "fgmm"
 
-    def __init__(self, *, forgetting: float = 0.8, n_components: int = 8,
+    def __init__(self, *, forgetting: float = 0.7, n_components: int = 8,
                  background: bool = True, background_floor: float = 0.01,
                  region: Region | tuple[float, float, float, float] | None = None,
                  reg_covar: float = 100.0, tol: float = 1e-4, max_iter: int = 20,
@@ -210,11 +210,12 @@ class ForgettingGMMClutter(ClutterEstimator):
             norm = logsumexp_rows(wlp)
             ll = float(norm.mean())
             resp = np.exp(wlp - norm[:, None])
-            new = plot_moments(z, self.anchors_, resp[:, 1:].T)
+            new = plot_moments(z, self.anchors_, resp[:, 1:].T, order=2)
             new_bg = float(resp[:, 0].sum())
             if abs(ll - prev) < self.tol * abs(prev):
                 break
             prev = ll
+        new = plot_moments(z, self.anchors_, resp[:, 1:].T)  # all orders, the last E-step
         self.moments_, self.bg_mass_ = past + new, past_bg + new_bg
         self._reanchor()
         self._prune()

@@ -23,6 +23,7 @@ POWERS: tuple[tuple[int, int], ...] = tuple(
     (p, t - p) for t in range(5) for p in range(t, -1, -1))
 _IDX = {pq: i for i, pq in enumerate(POWERS)}
 N_MOMENTS = len(POWERS)
+_UPTO = {o: sum(1 for p, q in POWERS if p + q <= o) for o in range(5)}
 _P = np.array([p for p, _ in POWERS])
 _Q = np.array([q for _, q in POWERS])
 _TERMS = np.array([(_IDX[(p, q)], _IDX[(a, b)], comb(p, a) * comb(q, b), p - a, q - b)
@@ -33,12 +34,22 @@ _I4 = np.array([_IDX[(a, 4 - a)] for a in range(5)])
 _C4 = np.array([comb(4, a) for a in range(5)], float)
 
 
-def plot_moments(z: np.ndarray, anchors: np.ndarray, resp: np.ndarray) -> np.ndarray:
+def plot_moments(z: np.ndarray, anchors: np.ndarray, resp: np.ndarray,
+                 order: int = 4) -> np.ndarray:
     """(K, 15) ``Σ_i r_ki dx^p dy^q`` of plots ``z`` (n, 2) about ``anchors`` (K, 2) with
-    responsibilities ``resp`` (K, n)."""
-    d = z[None, :, :] - anchors[:, None, :]
-    pw = d[:, :, None, 0] ** _P * d[:, :, None, 1] ** _Q  # (K, n, 15)
-    return np.einsum("kn,knm->km", resp, pw)
+    responsibilities ``resp`` (K, n), for ``p + q ≤ order`` (the other columns 0)."""
+    k, n = resp.shape
+    dx = z[None, :, 0] - anchors[:, 0, None]
+    dy = z[None, :, 1] - anchors[:, 1, None]
+    px, py = [np.ones((k, n)), dx], [np.ones((k, n)), dy]
+    for _ in range(2, order + 1):
+        px.append(px[-1] * dx)
+        py.append(py[-1] * dy)
+    out = np.zeros((k, N_MOMENTS))
+    for i, (p, q) in enumerate(POWERS[:_UPTO[order]]):
+        out[:, i] = np.einsum("kn,kn->k", resp, px[p] * py[q] if p and q else
+                              px[p] if p else py[q])
+    return out
 
 
 def shift(m: np.ndarray, delta: np.ndarray) -> np.ndarray:

@@ -43,6 +43,7 @@ one pass over the cells.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Any, Literal
 
 import numpy as np
@@ -247,6 +248,38 @@ class ClutterMap(ClutterEstimator):
         self.n_updates_ = int(state["n_updates"])
         self.n_outside_ = int(state["n_outside"])
         self._last = last
+
+
+@dataclass(frozen=True)
+class MapSnapshot:
+    """A clutter map at one time, for drawing: its site, ring width, and ``intensity``
+    (n_rings, n_azimuth) per m² per look; ``time`` of the last scan it was fed."""
+
+    site: tuple[float, float]
+    range_cell: float
+    intensity: np.ndarray
+    time: float
+
+    def edges(self) -> tuple[np.ndarray, np.ndarray]:
+        """(n_rings + 1, n_azimuth + 1) x and y of the cells' corners."""
+        n_r, n_a = self.intensity.shape
+        r = np.arange(n_r + 1) * self.range_cell
+        t = np.linspace(0.0, 2.0 * np.pi, n_a + 1)
+        return (self.site[0] + r[:, None] * np.sin(t)[None, :],
+                self.site[1] + r[:, None] * np.cos(t)[None, :])
+
+
+def map_snapshots(clutter: ClutterEstimator, time: float) -> dict[int, MapSnapshot]:
+    """The clutter maps an estimator holds, by sensor id: a :class:`ClutterMap` (id 0) or
+    each fed map of a :class:`~mhtrack.clutter.per_sensor.PerSensorClutter`."""
+    from mhtrack.clutter.per_sensor import PerSensorClutter
+
+    maps: dict[int, ClutterEstimator] = {0: clutter}
+    if isinstance(clutter, PerSensorClutter):
+        maps = {i: clutter.estimator(i) for i in sorted(clutter._inner)
+                if clutter.has_estimate(i)}
+    return {i: MapSnapshot(m.site, m.range_cell, m.intensity_map(), float(time))
+            for i, m in maps.items() if isinstance(m, ClutterMap)}
 
 
 def birth_scale(kappa: np.ndarray, reference: float, beta: float) -> np.ndarray:

@@ -136,6 +136,7 @@ class ForgettingGMMClutter(ClutterEstimator):
         self.mixture_: Mixture | None = None
         #: the mixture the last scan's EM started from
         self.start_: Mixture | None = None
+        self._last_z = None  # the last scan's plots, for forget
 
     # ------------------------------------------------------------------ the mixture
     def _box(self, z: np.ndarray) -> tuple[float, float, float, float] | None:
@@ -188,6 +189,7 @@ class ForgettingGMMClutter(ClutterEstimator):
         rng = np.random.default_rng(np.random.SeedSequence(self.seed,
                                                            spawn_key=(self.n_updates_,)))
         self.n_updates_ += 1
+        self._last_z: np.ndarray | None = z
         if len(z) == 0:
             self._finish()
             return
@@ -316,6 +318,30 @@ class ForgettingGMMClutter(ClutterEstimator):
         self._reanchor()
 
     # ------------------------------------------------------------------ ClutterEstimator
+    def forget(self, used: np.ndarray) -> None:
+        """Take the last scan's plots that confirmed tracks used (``used``, a mask over
+        them) out of the count and of the statistics, with their responsibilities under
+        the current mixture; a Gaussian left with no weight or a degenerate covariance
+        goes back to the background."""
+        z = self._last_z
+        used = np.asarray(used, bool).reshape(-1)
+        if z is None or used.shape != (len(z),) or not used.any():
+            return
+        zu = z[used]
+        self.count_sum_ = max(self.count_sum_ - len(zu), 0.0)
+        if self.mixture_ is not None and len(self.moments_):
+            wlp = self.mixture_.weighted_log_prob(zu)
+            resp = np.exp(wlp - logsumexp_rows(wlp)[:, None])
+            self.moments_ = self.moments_ - plot_moments(zu, self.anchors_, resp[:, 1:].T)
+            self.bg_mass_ = max(self.bg_mass_ - float(resp[:, 0].sum()), 0.0)
+            w, _, cov = mean_cov(self.moments_, self.anchors_, 0.0)
+            ok = (w > 1e-9) & (cov[:, 0, 0] > 0) & (np.linalg.det(cov) > 0)
+            if not ok.all():
+                self.moments_[~ok, I00] = np.maximum(self.moments_[~ok, I00], 0.0)
+                self._drop(ok)
+            self._finish()
+        self._last_z = None
+
     @property
     def count_(self) -> float:
         """``M̂_k = C_k / N_k``."""
@@ -335,16 +361,19 @@ class ForgettingGMMClutter(ClutterEstimator):
                 "bg_mass": float(self.bg_mass_), "count_sum": float(self.count_sum_),
                 "looks": float(self.looks_), "n_updates": int(self.n_updates_),
                 "box": None if self.box_ is None else list(self.box_),
-                "extent": None if self.extent_ is None else list(self.extent_)}
+                "extent": None if self.extent_ is None else list(self.extent_),
+                "last_z": np.zeros((0, 2)) if self._last_z is None else self._last_z.copy()}
 
     def set_state(self, state: dict[str, Any]) -> None:
-        from mhtrack.clutter.state_checks import check_forgetting
+        from mhtrack.clutter.state_checks import MAX_COORDINATE, array, check_forgetting
 
         m, a, box, extent = check_forgetting(state, self.n_components, self.forgetting)
         self.moments_, self.anchors_, self.box_, self.extent_ = m, a, box, extent
         self.bg_mass_ = float(state["bg_mass"])
         self.count_sum_, self.looks_ = float(state["count_sum"]), float(state["looks"])
         self.n_updates_ = int(state["n_updates"])
+        last = array(state["last_z"], "clutter_state.last_z", (-1, 2), bound=MAX_COORDINATE)
+        self._last_z = np.asarray(last, float) if len(last) else None
         self._finish()
 
 

@@ -155,3 +155,22 @@ def test_state_round_trip_and_hostile_states() -> None:
                {"merge_distance": -1.0}, {"max_iter": 0}, {"reg_covar": 0.0}):
         with pytest.raises(ValueError, match=next(iter(kw))):
             ForgettingGMMClutter(**kw)
+
+
+def test_forget_takes_the_tracks_plots_out_of_count_and_statistics() -> None:
+    """``M̂`` after forgetting m of the last scan's n plots is ``(γC + n − m)/N``; the
+    statistics lose exactly the responsibilities of those plots (total mass)."""
+    rng = np.random.default_rng(9)
+    e = ForgettingGMMClutter(forgetting=0.5, split_kurtosis=0.0)
+    a = _clumps(rng, [(0, 0), (3000, 0)], 20, 200.0)
+    b = _clumps(rng, [(0, 0), (3000, 0)], 20, 200.0)
+    e.update(_scan(0, a))
+    e.update(_scan(1, b))
+    mass = e.moments_[:, 0].sum() + e.bg_mass_
+    used = np.arange(len(b)) % 4 == 0
+    e.forget(used)
+    assert e.count_ == pytest.approx((0.5 * 40 + 40 - used.sum()) / 1.5)
+    assert e.moments_[:, 0].sum() + e.bg_mass_ == pytest.approx(mass - used.sum())
+    assert np.isfinite(e.intensity(b)).all()
+    e.forget(used)  # once per scan: a second call changes nothing
+    assert e.count_ == pytest.approx((0.5 * 40 + 40 - used.sum()) / 1.5)

@@ -4,8 +4,9 @@ per-radar clutter map; ``fgmm``, the forgetting mixture) beside the GMM's, in on
 Run: ``python benchmarks/bench_clutter_map.py [--seeds N] [--figure PATH]``.
 
 * scan path, ``crossing-changing`` (one sensor, 90 scans): each estimator fed every scan
-  (``update`` + ``intensity`` at the scan's plots: the tracker's clutter stage) — median
-  and mean ms per scan, ratio to the GMM's measured in the same run, and the clutter error
+  (``update`` + ``intensity`` at the scan's plots: the tracker's clutter stage), the
+  estimators taking turns scan by scan — median and mean ms per scan, ratios to the GMM's
+  (of the medians, the median of the per-scan ratios, of the means), and the clutter error
   ``IAE = ∫|κ̂ − κ|`` (plots per scan, 100² grid) averaged over scans and seeds;
 * timed path, ``opensky-radars`` (rotating radars, frames of one sensor's sector): the
   tracker's per-radar estimator (``PerSensorClutter`` of maps, of GMMs in polar) fed the
@@ -33,18 +34,36 @@ from mhtrack.scenario import preset, simulate
 NAMES = ("gmm", "agmm", "fgmm", "map")
 
 
-def feed(est: ClutterEstimator, scans: list[Scan],
-         probe: Callable[[Scan], None] | None = None) -> np.ndarray:
-    """Seconds of ``update`` + ``intensity`` per scan (the probe is not timed)."""
-    out = []
+def interleaved(ests: dict[str, ClutterEstimator], scans: list[Scan],
+                probe: Callable[[str, ClutterEstimator, Scan], None] | None = None
+                ) -> dict[str, np.ndarray]:
+    """Seconds of ``update`` + ``intensity`` per scan of each estimator, the estimators
+    taking turns scan by scan (so that a shared machine's load falls on all alike)."""
+    out: dict[str, list[float]] = {n: [] for n in ests}
     for s in scans:
-        t0 = time.perf_counter()
-        est.update(s, None)
-        est.intensity(s.z)
-        out.append(time.perf_counter() - t0)
-        if probe is not None:
-            probe(s)
-    return np.array(out)
+        for n, est in ests.items():
+            t0 = time.perf_counter()
+            est.update(s, None)
+            est.intensity(s.z)
+            out[n].append(time.perf_counter() - t0)
+            if probe is not None:
+                probe(n, est, s)
+    return {n: np.array(v) for n, v in out.items()}
+
+
+def _table(times: dict[str, list[np.ndarray]], unit: str,
+           iae: dict[str, list[float]] | None = None) -> None:
+    ref = np.concatenate(times["gmm"])
+    print(f"| estimator | median ms/{unit} | mean ms/{unit} | × GMM (medians) | "
+          f"median of per-{unit} ratios | × GMM (means) |" + (" IAE (plots/scan) |" if iae
+                                                            else ""))
+    print("|---|---|---|---|---|---|" + ("---|" if iae else ""))
+    for n, ts in times.items():
+        t = np.concatenate(ts)
+        ratio = np.median(t / np.maximum(ref, 1e-9))
+        row = (f"| {n} | {1e3 * np.median(t):.3f} | {1e3 * t.mean():.3f} | "
+               f"{np.median(t) / np.median(ref):.2f} | {ratio:.2f} | {t.mean() / ref.mean():.2f} |")
+        print(row + (f" {np.mean(iae[n]):.2f} |" if iae else ""))
 
 
 def scan_path(seeds: int) -> None:
@@ -54,25 +73,19 @@ def scan_path(seeds: int) -> None:
     iae: dict[str, list[float]] = {n: [] for n in NAMES}
     for seed in range(1, seeds + 1):
         sim = simulate(sc, seed=seed)
-        scans = list(sim.plots.scans())
-        for n in NAMES:
-            est = make_clutter_estimator(n)
-            errs: list[float] = []
+        errs: dict[str, list[float]] = {n: [] for n in NAMES}
 
-            def probe(s: Scan, est: ClutterEstimator = est, errs: list[float] = errs,
-                      sim: object = sim) -> None:
-                errs.append(integrated_absolute_error(
-                    est.intensity(grid), true_intensity_grid(sim, int(s.index), grid), cell))
-            times[n].append(feed(est, scans, probe))
-            iae[n].append(float(np.mean(errs)))
+        def probe(n: str, est: ClutterEstimator, s: Scan, sim: object = sim,
+                  errs: dict[str, list[float]] = errs) -> None:
+            errs[n].append(integrated_absolute_error(
+                est.intensity(grid), true_intensity_grid(sim, int(s.index), grid), cell))
+        res = interleaved({n: make_clutter_estimator(n) for n in NAMES},
+                          list(sim.plots.scans()), probe)
+        for n in NAMES:
+            times[n].append(res[n])
+            iae[n].append(float(np.mean(errs[n])))
     print(f"scan path: crossing-changing, seeds 1..{seeds}, 90 scans each")
-    gmm = np.median(np.concatenate(times["gmm"]))
-    print("| estimator | median ms/scan | mean ms/scan | × GMM (median) | IAE (plots/scan) |")
-    print("|---|---|---|---|---|")
-    for n in NAMES:
-        t = np.concatenate(times[n])
-        print(f"| {n} | {1e3 * np.median(t):.3f} | {1e3 * t.mean():.3f} | "
-              f"{np.median(t) / gmm:.2f} | {np.mean(iae[n]):.2f} |")
+    _table(times, "scan", iae)
 
 
 def timed_path(figure: str | None) -> None:
@@ -85,22 +98,16 @@ def timed_path(figure: str | None) -> None:
     snaps: list[dict] = []
     print(f"timed path: opensky-radars seed 1, {len(frames)} frames, "
           f"{sum(len(f) for f in frames)} plots")
-    print("| estimator | median ms/frame | mean ms/frame | × GMM (mean) |")
-    print("|---|---|---|---|")
-    res = {}
-    for n in ("gmm", "fgmm", "map"):
-        clutter = make_tracker(f"mht-{n}", sensors=sensors).clutter
-        nxt = [0]
+    clutters = {n: make_tracker(f"mht-{n}", sensors=sensors).clutter
+                for n in ("gmm", "fgmm", "map")}
+    nxt = [0]
 
-        def probe(s: Scan, clutter: ClutterEstimator = clutter, n: str = n,
-                  nxt: list[int] = nxt) -> None:
-            if n == "map" and nxt[0] < len(when) and float(s.time) >= when[nxt[0]]:
-                snaps.append(map_snapshots(clutter, float(s.time)))
-                nxt[0] += 1
-        res[n] = feed(clutter, frames, probe)
-    for n, t in res.items():
-        print(f"| {n} | {1e3 * np.median(t):.3f} | {1e3 * t.mean():.3f} | "
-              f"{t.mean() / res['gmm'].mean():.2f} |")
+    def probe(n: str, clutter: ClutterEstimator, s: Scan) -> None:
+        if n == "map" and nxt[0] < len(when) and float(s.time) >= when[nxt[0]]:
+            snaps.append(map_snapshots(clutter, float(s.time)))
+            nxt[0] += 1
+    res = interleaved(clutters, frames, probe)
+    _table({n: [t] for n, t in res.items()}, "frame")
     if figure:
         from mhtrack.plotting.clutter_map import plot_clutter_maps
         from mhtrack.plotting.scene import save_figure

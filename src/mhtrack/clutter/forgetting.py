@@ -48,7 +48,17 @@ from typing import Any
 import numpy as np
 
 from mhtrack.clutter.base import ClutterEstimator
-from mhtrack.clutter.density import Mixture, logsumexp_rows
+from mhtrack.clutter.density import (
+    Mixture,
+    _lse_t,
+    log_pdf_t,
+    logsumexp_rows,
+    maha_det_t,
+    mahalanobis2,
+    offsets_t,
+    plots_t,
+    weighted_t,
+)
 from mhtrack.clutter.moments import (
     I00,
     gaussian_moments,
@@ -59,6 +69,7 @@ from mhtrack.clutter.moments import (
 )
 from mhtrack.clutter.seeding import kmeanspp_centres
 from mhtrack.models.clutter import Region
+from mhtrack.models.linalg2 import sym_mahalanobis2
 from mhtrack.records import Scan
 
 CHI2_2_99 = 9.2103
@@ -205,19 +216,24 @@ class ForgettingGMMClutter(ClutterEstimator):
             if self.box_ is not None:  # the background starts with half the plots
                 new, new_bg = 0.5 * new, 0.5 * len(z)
         self.start_ = self._mixture(past + new, past_bg + new_bg, START_WEIGHT)
-        for it in range(self.max_iter):
-            mix = (self.start_ if it == 0 else
-                   self._mixture(past + new, past_bg + new_bg))
-            wlp = mix.weighted_log_prob(z)
-            norm = logsumexp_rows(wlp)
-            ll = float(norm.mean())
-            resp = np.exp(wlp - norm[:, None])
-            new = plot_moments(z, self.anchors_, resp[:, 1:].T, order=2)
-            new_bg = float(resp[:, 0].sum())
-            if abs(ll - prev) < self.tol * abs(prev):
-                break
-            prev = ll
-        new = plot_moments(z, self.anchors_, resp[:, 1:].T)  # all orders, the last E-step
+        z_t = plots_t(z)
+        with np.errstate(divide="ignore"):
+            log_bg = self.start_.log_background(z)
+            for it in range(self.max_iter):  # E-step (P1 eq. 9) on this scan's plots
+                mix = (self.start_ if it == 0 else
+                       self._mixture(past + new, past_bg + new_bg))
+                maha, det = maha_det_t(*offsets_t(z_t, mix.means), mix.covariances)
+                wlp = weighted_t(mix.background_weight, mix.weights, log_pdf_t(maha, det),
+                                 log_bg)
+                norm = _lse_t(wlp)
+                ll = float(norm.mean())
+                resp = np.exp(wlp - norm)  # (K+1, n), row 0 the background
+                new = plot_moments(z, self.anchors_, resp[1:], order=2)  # M-step's sums
+                new_bg = float(resp[0].sum())
+                if abs(ll - prev) < self.tol * abs(prev):
+                    break
+                prev = ll
+        new = plot_moments(z, self.anchors_, resp[1:])  # all orders, the last E-step
         self.moments_, self.bg_mass_ = past + new, past_bg + new_bg
         self._reanchor()
         self._prune()
@@ -225,12 +241,14 @@ class ForgettingGMMClutter(ClutterEstimator):
         self._split()
         if len(self.moments_):
             mix = self._mixture(self.moments_, self.bg_mass_)
-            wlp = mix.weighted_log_prob(z)
-            resp0 = np.exp(wlp[:, 0] - logsumexp_rows(wlp))
-            d2 = _mahalanobis(z, mix.means, mix.covariances).min(axis=1)
+            d2 = mahalanobis2(z, mix.means, mix.covariances).min(axis=1)
             far = d2 > CHI2_2_99
             if np.count_nonzero(far) >= max(self.min_points, 1):
-                self._birth(z[far], resp0[far], rng)
+                wlp = mix.weighted_log_prob(z[far])
+                self._birth(z[far], np.exp(wlp[:, 0] - logsumexp_rows(wlp)), rng)
+            if len(self.moments_) == mix.n_components:  # no birth: the mixture is at hand
+                self.mixture_ = mix
+                return
         else:
             self._birth(z, np.ones(len(z)), rng)
         self._finish()
@@ -268,7 +286,8 @@ class ForgettingGMMClutter(ClutterEstimator):
             k = len(means)
             i, j = np.triu_indices(k, 1)
             d = means[i] - means[j]
-            d2 = np.einsum("ni,nij,nj->n", d, np.linalg.inv(0.5 * (cov[i] + cov[j])), d)
+            s = 0.5 * (cov[i] + cov[j])
+            d2, _ = sym_mahalanobis2(d[:, 0], d[:, 1], s[:, 0, 0], s[:, 0, 1], s[:, 1, 1])
             best = int(np.argmin(d2))
             if d2[best] >= self.merge_distance**2:
                 return
@@ -375,9 +394,3 @@ class ForgettingGMMClutter(ClutterEstimator):
         last = array(state["last_z"], "clutter_state.last_z", (-1, 2), bound=MAX_COORDINATE)
         self._last_z = np.asarray(last, float) if len(last) else None
         self._finish()
-
-
-def _mahalanobis(z: np.ndarray, means: np.ndarray, cov: np.ndarray) -> np.ndarray:
-    """(n, K) squared Mahalanobis distances."""
-    d = z[:, None, :] - means[None]
-    return np.einsum("nki,kij,nkj->nk", d, np.linalg.inv(cov), d)

@@ -28,6 +28,7 @@ _P = np.array([p for p, _ in POWERS])
 _Q = np.array([q for _, q in POWERS])
 _TERMS = np.array([(_IDX[(p, q)], _IDX[(a, b)], comb(p, a) * comb(q, b), p - a, q - b)
                    for (p, q) in POWERS for a in range(p + 1) for b in range(q + 1)])
+_TO_TARGET = np.eye(N_MOMENTS)[_TERMS[:, 0]]  # (terms, 15): each term's target column
 I00, I10, I01, I20, I02, I11 = (_IDX[k] for k in ((0, 0), (1, 0), (0, 1), (2, 0), (0, 2),
                                                    (1, 1)))
 _I4 = np.array([_IDX[(a, 4 - a)] for a in range(5)])
@@ -54,12 +55,9 @@ def plot_moments(z: np.ndarray, anchors: np.ndarray, resp: np.ndarray,
 
 def shift(m: np.ndarray, delta: np.ndarray) -> np.ndarray:
     """Moments ``m`` (K, 15) about anchors ``a`` re-expressed about ``a + delta`` (K, 2)."""
-    t, s, c, ex, ey = _TERMS.T
+    _, s, c, ex, ey = _TERMS.T
     f = c * (-delta[:, None, 0]) ** ex * (-delta[:, None, 1]) ** ey * m[:, s]
-    out = np.zeros_like(m)
-    for k in range(len(m)):
-        out[k] = np.bincount(t, weights=f[k], minlength=N_MOMENTS)
-    return out
+    return f @ _TO_TARGET
 
 
 def mean_cov(m: np.ndarray, anchors: np.ndarray, reg: float
@@ -67,12 +65,12 @@ def mean_cov(m: np.ndarray, anchors: np.ndarray, reg: float
     """Weights ``M_00`` (K,), means (K, 2) and covariances (K, 2, 2) (+ ``reg``·I) of
     moments about ``anchors``."""
     w = m[:, I00]
-    mx, my = m[:, I10] / w, m[:, I01] / w
-    sxx = m[:, I20] / w - mx * mx + reg
-    syy = m[:, I02] / w - my * my + reg
-    sxy = m[:, I11] / w - mx * my
-    cov = np.stack([np.stack([sxx, sxy], -1), np.stack([sxy, syy], -1)], -2)
-    return w, anchors + np.column_stack([mx, my]), cov
+    d = m[:, I10:I01 + 1] / w[:, None]  # mean − anchor
+    cov = np.empty((len(w), 2, 2))
+    cov[:, 0, 0] = m[:, I20] / w - d[:, 0] * d[:, 0] + reg
+    cov[:, 1, 1] = m[:, I02] / w - d[:, 1] * d[:, 1] + reg
+    cov[:, 0, 1] = cov[:, 1, 0] = m[:, I11] / w - d[:, 0] * d[:, 1]
+    return w, anchors + d, cov
 
 
 def principal_kurtosis(m: np.ndarray, cov: np.ndarray) -> tuple[np.ndarray, np.ndarray,
@@ -80,8 +78,11 @@ def principal_kurtosis(m: np.ndarray, cov: np.ndarray) -> tuple[np.ndarray, np.n
     """Per component (moments about its mean): the unit principal axis ``v`` (K, 2), its
     variance ``λ₁`` and the kurtosis ``β₂ = E[(v·d)⁴] / λ₁²`` along it (3 for a Gaussian,
     1.8 for a uniform bar, below 2 for two well separated equal clumps)."""
-    vals, vecs = np.linalg.eigh(cov)
-    v, lam = vecs[:, :, 1], vals[:, 1]
+    a, b, c = cov[:, 0, 0], cov[:, 0, 1], cov[:, 1, 1]
+    lam = 0.5 * (a + c) + np.hypot(0.5 * (a - c), b)  # the larger eigenvalue, closed form
+    v = np.where((np.abs(b) > 0)[:, None], np.column_stack([b, lam - a]),
+                 np.where((a >= c)[:, None], [[1.0, 0.0]], [[0.0, 1.0]]))
+    v = v / np.linalg.norm(v, axis=1, keepdims=True)
     a = np.arange(5)
     proj = _C4 * v[:, None, 0] ** a * v[:, None, 1] ** (4 - a)
     m4 = (proj * m[:, _I4]).sum(axis=1) / m[:, I00]

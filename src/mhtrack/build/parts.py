@@ -126,7 +126,10 @@ def make_tracker(
     larger).
 
     ``clutter_params``: keywords of the tracker's clutter estimator
-    (:func:`make_clutter_estimator`; e.g. ``{"bic": False}``); ``known`` ignores them."""
+    (:func:`make_clutter_estimator`; e.g. ``{"bic": False}``); ``known`` ignores them.
+    ``mht-map``'s clutter map is about each radar's own site, rings out to its
+    ``max_range``, whatever ``clutter_frame``; its ``birth_scaling`` β > 0 wraps the birth
+    process in :class:`~mhtrack.mht.births.clutter_scaled.ClutterScaledBirth`."""
     if name not in TRACKER_ESTIMATORS:
         raise ValueError(f"unknown tracker {name!r} "
                          f"(expected one of {', '.join(TRACKER_ESTIMATORS)})")

@@ -30,13 +30,16 @@ from mhtrack.build.defaults import DEFAULT_CLUTTER_DENSITY, config_with
 from mhtrack.build.recipe import sensors_from_recipe, sensors_recipe
 from mhtrack.clutter.agmm import AGMMClutter
 from mhtrack.clutter.base import ClutterEstimator
+from mhtrack.clutter.forgetting import ForgettingGMMClutter
 from mhtrack.clutter.gmm import GMMClutter
 from mhtrack.clutter.known import KnownClutter
 from mhtrack.clutter.per_sensor import PerSensorClutter
 from mhtrack.clutter.polar import PolarClutter
+from mhtrack.clutter.radar_map import ClutterMap
 from mhtrack.initiation.fusion import AdaptiveKMeansFusion, KMeansFusion
 from mhtrack.mht import MHTConfig, MHTTracker
 from mhtrack.mht.births import Birth, InitiatorBirth, TimedInitiatorBirth, default_birth
+from mhtrack.mht.births.clutter_scaled import ClutterScaledBirth
 from mhtrack.mht.coverage import Coverage, Everywhere, RadarCoverage
 from mhtrack.mht.gating import gate_threshold
 from mhtrack.mht.scoring import miss_increment
@@ -57,14 +60,15 @@ from mhtrack.records import Scan
 TIMED_CONFIRM_MIN_PLOTS = 3
 #: Clutter-estimator name (:data:`mhtrack.names.CLUTTER_ESTIMATORS`) → class.
 CLUTTER_ESTIMATOR_CLASSES: dict[str, type[Any]] = dict(
-    zip(names.CLUTTER_ESTIMATORS, (KnownClutter, GMMClutter, AGMMClutter), strict=True))
+    zip(names.CLUTTER_ESTIMATORS, (KnownClutter, GMMClutter, AGMMClutter, ClutterMap,
+                                   ForgettingGMMClutter), strict=True))
 
 
 def make_clutter_estimator(name: str, *, kappa: float | None = None,
                            **params: Any) -> ClutterEstimator:
     """A fresh clutter estimator by name (:data:`CLUTTER_ESTIMATOR_CLASSES`). ``kappa`` is
     the constant of ``known`` (default :data:`DEFAULT_CLUTTER_DENSITY`, P1's plain MHT);
-    ``params`` go to the mixture estimators' constructors (``None`` values are left at
+    ``params`` go to the other estimators' constructors (``None`` values are left at
     their defaults)."""
     if name not in CLUTTER_ESTIMATOR_CLASSES:
         raise ValueError(f"unknown clutter estimator {name!r} "
@@ -82,7 +86,8 @@ def make_clutter_estimator(name: str, *, kappa: float | None = None,
 #: estimate it online by a GMM with a fixed deletion threshold / P1's adaptive GMM, each
 #: with its defaults and fed all plots (``docs/clutter.md`` says why not
 #: ``"outside-gates"``).
-TRACKER_ESTIMATORS: dict[str, str] = {"mht": "known", "mht-gmm": "gmm", "mht-agmm": "agmm"}
+TRACKER_ESTIMATORS: dict[str, str] = {"mht": "known", "mht-gmm": "gmm", "mht-agmm": "agmm",
+                                      "mht-map": "map", "mht-fgmm": "fgmm"}
 
 
 def takes_clutter_density(tracker: str) -> bool:
@@ -121,7 +126,10 @@ def make_tracker(
     larger).
 
     ``clutter_params``: keywords of the tracker's clutter estimator
-    (:func:`make_clutter_estimator`; e.g. ``{"bic": False}``); ``known`` ignores them."""
+    (:func:`make_clutter_estimator`; e.g. ``{"bic": False}``); ``known`` ignores them.
+    ``mht-map``'s clutter map is about each radar's own site, rings out to its
+    ``max_range``, whatever ``clutter_frame``; its ``birth_scaling`` β > 0 wraps the birth
+    process in :class:`~mhtrack.mht.births.clutter_scaled.ClutterScaledBirth`."""
     if name not in TRACKER_ESTIMATORS:
         raise ValueError(f"unknown tracker {name!r} "
                          f"(expected one of {', '.join(TRACKER_ESTIMATORS)})")
@@ -157,7 +165,12 @@ def radar_clutter(estimator: str, sensors: SensorSet, *, kappa: float | None = N
                          f"(expected one of {', '.join(names.CLUTTER_FRAMES)})")
     kw = dict(params or {})
     wrap = None
-    if clutter_frame == "polar" and estimator != "known":
+    if estimator == "map":  # a range–azimuth map about each radar's own site, any frame
+        def wrap(sid: int, inner: ClutterEstimator) -> ClutterEstimator:
+            s = sensors.sensor(sid)
+            return inner.placed(sensors.site_xy(sid) if s.has_site else (0.0, 0.0),
+                                s.max_range)  # type: ignore[attr-defined]
+    elif clutter_frame == "polar" and estimator != "known":
         def wrap(sid: int, inner: ClutterEstimator) -> ClutterEstimator:
             s = sensors.sensor(sid)
             return inner if not s.has_site else PolarClutter(inner, sensors.site_xy(sid))
@@ -174,8 +187,11 @@ def _assemble(config: MHTConfig, clutter: ClutterEstimator, coverage: Coverage,
     birth ``config.birth`` names (:func:`make_birth`, scored with the coverage's
     ``P_D``; ``periods`` of timed plots' radars), and the builder's ``recipe``."""
     motion = config.motion
-    trk = MHTTracker(config, clutter, motion=motion, coverage=coverage,
-                     birth=make_birth(config, motion, coverage.plot_pd, periods))
+    birth = make_birth(config, motion, coverage.plot_pd, periods)
+    beta = (recipe.get("clutter_params") or {}).get("birth_scaling")
+    if beta:  # the clutter map drives the birth density (mhtrack.mht.births.clutter_scaled)
+        birth = ClutterScaledBirth(birth, clutter, float(beta))
+    trk = MHTTracker(config, clutter, motion=motion, coverage=coverage, birth=birth)
     trk.recipe = recipe
     return trk
 

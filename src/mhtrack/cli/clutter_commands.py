@@ -42,7 +42,8 @@ def clutter(scenario: str, seed: int, clutter: str | None, clutter_rate: float |
     """Simulate SCENARIO, run a clutter estimator on every scan and score it against the
     true intensity: IAE = ∫|κ̂ − κ| per scan and the count error |M̂ − λ| (mean over
     scans). Writes DIR/clutter.json (per-scan arrays) and DIR/clutter.png (true and
-    estimated intensity maps at one scan)."""
+    estimated intensity maps at one scan) and, for the clutter map (--estimator map),
+    DIR/clutter_maps.png (the map at four scans)."""
     from mhtrack.build import make_clutter_estimator
     from mhtrack.experiments.clutter_study import clutter_accuracy
     from mhtrack.io.atomic import atomic_write
@@ -62,8 +63,9 @@ def clutter(scenario: str, seed: int, clutter: str | None, clutter_rate: float |
     est = make_clutter_estimator(estimator, kappa=kappa, n_components=components,
                                  window=window,
                                  source="outside-gates" if oracle_gates else None)
+    quarters = [int(idx[min(len(idx) - 1, len(idx) * q // 4)]) for q in (1, 2, 3, 4)]
     acc = clutter_accuracy(est, sim, resolution=resolution, oracle_gates=oracle_gates,
-                           map_scans=[k_map])
+                           map_scans=[k_map], snapshot_scans=quarters)
     summary = {"scenario": sc.name, "seed": seed, **acc.to_dict(), "map_scan": k_map}
     if estimator == "known":
         summary["clutter_density"] = kappa
@@ -78,6 +80,12 @@ def clutter(scenario: str, seed: int, clutter: str | None, clutter_rate: float |
         f"at this scan, mean {acc.iae_mean:.2f}",
     )
     save_maps(fig, out / "clutter.png")
+    written = "clutter.json, clutter.png"
+    if acc.snapshots:  # a clutter map: drawn per radar at four times
+        from mhtrack.reports.clutter_maps import write_clutter_maps
+
+        write_clutter_maps(out, acc.snapshots, title=f"{sc.name}, seed {seed}: clutter map")
+        written += ", clutter_maps.png"
     if as_json:
         echo_json(summary)
         return
@@ -85,7 +93,7 @@ def clutter(scenario: str, seed: int, clutter: str | None, clutter_rate: float |
         f"count_error_mean {acc.count_error_mean:.3f} "
         f"(true mean count {summary['rate_mean']:.2f}/scan), "
         f"{summary['ms_per_update']:.2f} ms/update")
-    say(f"wrote {out}/ (clutter.json, clutter.png)")
+    say(f"wrote {out}/ ({written})")
 
 
 COMMANDS = [clutter]

@@ -105,6 +105,14 @@ class PerSensorClutter(ClutterEstimator):
             return np.full(n, self.initial)
         return self._inner[self._current].intensity(z)
 
+    def reference_intensity(self) -> float:
+        """The current sensor's estimator's ``reference_intensity()`` (a clutter map's mean
+        intensity, for the birth scaling), 0 before its first rotation or without one."""
+        sid = self._current
+        ref = None if sid is None or sid not in self._fed else getattr(
+            self._inner[sid], "reference_intensity", None)
+        return float(ref()) if callable(ref) else 0.0
+
     def forget(self, used: np.ndarray) -> None:
         sid = self._current
         if sid is None:

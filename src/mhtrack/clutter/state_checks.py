@@ -134,3 +134,62 @@ def check_scan(d: Mapping[str, Any], field: str) -> None:
     t = array(d["t"], f"{field}.t", (n,), bound=MAX_TIME_S)
     if n and (t > d["time"]).any():
         raise _fail(f"{field}.t", "plot times after the scan's time")
+
+
+def check_map(state: Mapping[str, Any], n_azimuth: int, max_rings: int, gamma: float
+              ) -> tuple[np.ndarray, float, np.ndarray]:
+    """A clutter map's state (:meth:`ClutterMap.get_state`): ``sums`` (rings, ``n_azimuth``)
+    with at most ``max_rings`` rings, each ≥ 0; ``looks`` in ``[0, 1/(1 − γ)]`` (at most
+    ``MAX_INDEX`` for ``γ = 1``); ``last`` flat cells in ``[−1, cells)``."""
+    f = "clutter_state"
+    sums = array(state["sums"], f"{f}.sums", (-1, n_azimuth)).astype(float)
+    if sums.shape[0] > max_rings:
+        raise _fail(f"{f}.sums", f"has {sums.shape[0]} rings, more than {max_rings}")
+    if (sums < 0).any():
+        raise _fail(f"{f}.sums", "holds negative counts")
+    top = float(MAX_INDEX) if gamma >= 1.0 else 1.0 / (1.0 - gamma) + 1e-9
+    looks = float(number(state["looks"], f"{f}.looks", 0.0, top))
+    number(state["n_updates"], f"{f}.n_updates", 0, MAX_INDEX, integer=True)
+    number(state["n_outside"], f"{f}.n_outside", 0, MAX_INDEX, integer=True)
+    last = array(state["last"], f"{f}.last", (-1,), kind="i", bound=MAX_INDEX).astype(np.int64)
+    if last.size and (last.min() < -1 or last.max() >= sums.size):
+        raise _fail(f"{f}.last", f"cells must be in [-1, {sums.size})")
+    return np.ascontiguousarray(sums), looks, last
+
+
+def check_forgetting(state: Mapping[str, Any], max_components: int, gamma: float
+                     ) -> tuple[np.ndarray, np.ndarray, Any, Any]:
+    """A forgetting mixture's state (:meth:`ForgettingGMMClutter.get_state`): at most
+    ``max_components`` rows of 15 moments and 2 anchor coordinates, each weight ``M_00`` > 0
+    with a positive definite covariance; masses, counts ≥ 0; ``looks`` in
+    ``[0, 1/(1 − γ)]``; a box with ``x0 < x1``, ``y0 < y1`` or null."""
+    from mhtrack.clutter.moments import mean_cov
+
+    f = "clutter_state"
+    m = array(state["moments"], f"{f}.moments", (-1, 15)).astype(float)
+    a = array(state["anchors"], f"{f}.anchors", (len(m), 2), bound=MAX_COORDINATE)
+    if len(m) > max_components:
+        raise _fail(f"{f}.moments", f"{len(m)} components, more than {max_components}")
+    if len(m):
+        if not (m[:, 0] > 0).all():
+            raise _fail(f"{f}.moments", "a component has no weight")
+        _, _, cov = mean_cov(m, a.astype(float), 0.0)
+        det = cov[:, 0, 0] * cov[:, 1, 1] - cov[:, 0, 1] ** 2
+        if not (np.isfinite(det).all() and (cov[:, 0, 0] > 0).all() and (det > 0).all()):
+            raise _fail(f"{f}.moments", "a component's covariance is not positive definite")
+    number(state["bg_mass"], f"{f}.bg_mass", 0.0)
+    number(state["count_sum"], f"{f}.count_sum", 0.0)
+    top = float(MAX_INDEX) if gamma >= 1.0 else 1.0 / (1.0 - gamma) + 1e-9
+    number(state["looks"], f"{f}.looks", 0.0, top)
+    number(state["n_updates"], f"{f}.n_updates", 0, MAX_INDEX, integer=True)
+    boxes = []
+    for key in ("box", "extent"):
+        box = state[key]
+        if box is not None:
+            x0, x1, y0, y1 = (float(v) for v in array(box, f"{f}.{key}", (4,),
+                                                      bound=MAX_COORDINATE))
+            if not (x0 <= x1 and y0 <= y1) or (key == "box" and not (x0 < x1 and y0 < y1)):
+                raise _fail(f"{f}.{key}", "expected x0 < x1 and y0 < y1")
+            box = (x0, x1, y0, y1)
+        boxes.append(box)
+    return np.ascontiguousarray(m), np.ascontiguousarray(a, dtype=float), boxes[0], boxes[1]

@@ -20,6 +20,7 @@ from typing import Any
 import numpy as np
 
 from mhtrack.clutter.base import ClutterEstimator
+from mhtrack.clutter.radar_map import MapSnapshot, map_snapshots
 from mhtrack.metrics.clutter import (
     DEFAULT_RESOLUTION,
     integrated_absolute_error,
@@ -49,6 +50,9 @@ class ClutterAccuracy:
     quadrature_error: np.ndarray
     update_seconds: np.ndarray
     maps: dict[int, tuple[np.ndarray, np.ndarray]] = field(default_factory=dict, repr=False)
+    #: at each of ``snapshot_scans``, the clutter maps the estimator holds, by sensor id
+    #: (:func:`~mhtrack.clutter.radar_map.map_snapshots`; empty for other estimators)
+    snapshots: list[dict[int, MapSnapshot]] = field(default_factory=list, repr=False)
 
     @property
     def count_error(self) -> np.ndarray:
@@ -99,6 +103,7 @@ def clutter_accuracy(
     resolution: int = DEFAULT_RESOLUTION,
     oracle_gates: bool = False,
     map_scans: Iterable[int] = (),
+    snapshot_scans: Iterable[int] = (),
 ) -> ClutterAccuracy:
     """Feed ``estimator`` every scan of ``simulation`` and score it per scan.
 
@@ -109,6 +114,7 @@ def clutter_accuracy(
     resolution : cells per side of the IAE grid (``Region.grid``).
     oracle_gates : pass the true target plots as ``in_track_gates`` (default: ``None``).
     map_scans : scans whose true and estimated intensity grids to keep in ``maps``.
+    snapshot_scans : scans at which to keep the estimator's clutter maps in ``snapshots``.
     """
     if not (isinstance(resolution, int | np.integer) and resolution >= 2):
         raise ValueError(f"resolution must be an integer >= 2, got {resolution!r}")
@@ -118,6 +124,8 @@ def clutter_accuracy(
     region = simulation.scenario.region
     grid, cell = region.grid(int(resolution))
     want = {int(k) for k in map_scans}
+    snap_at = {int(k) for k in snapshot_scans}
+    snapshots: list[dict[int, MapSnapshot]] = []
     cache: dict[str, Any] = {}
     rows: dict[str, list[float]] = {k: [] for k in
                                     ("scan", "iae", "count", "rate", "ncl", "quad", "sec")}
@@ -141,6 +149,8 @@ def clutter_accuracy(
         rows["ncl"].append(float((scan.origin < 0).sum()) if scan.origin is not None
                            else float("nan"))
         rows["quad"].append(quadrature_relative_error(true, cell, lam))
+        if k in snap_at and (snap := map_snapshots(estimator, float(scan.time))):
+            snapshots.append(snap)
         if k in want:
             n = int(resolution)
             maps[k] = (true.reshape(n, n), est.reshape(n, n))
@@ -157,4 +167,5 @@ def clutter_accuracy(
         quadrature_error=a["quad"],
         update_seconds=a["sec"],
         maps=maps,
+        snapshots=snapshots,
     )

@@ -57,7 +57,8 @@ class MHTrackTracker(Tracker):
     detector: Any = Property(default=None, doc="Stone Soup detector: iterable of "
                              "(time, set of Detection)")
     tracker: str = Property(default="mht-agmm", doc="mhtrack tracker name "
-                            "(mhtrack.names.TRACKERS): mht, mht-gmm, mht-agmm")
+                            "(mhtrack.names.TRACKERS): mht, mht-gmm, mht-agmm, mht-map, "
+                            "mht-fgmm")
     config: Any = Property(default=None, doc="mhtrack.mht.MHTConfig (default: MHTConfig())")
     clutter_density: float = Property(default=None, doc="known clutter density per m² per "
                                       "scan of tracker 'mht'")

@@ -220,13 +220,15 @@ class DatagramSource(Source):
             x[adsb], y[adsb] = self.sensors.frame().to_local(p["lat"][adsb], p["lon"][adsb])
             R[adsb, 0, 0] = R[adsb, 1, 1] = p["sigma"][adsb] ** 2
         polar = ~adsb
+        types = p.get("plot_type")
         rng = ground_ranges(self.sensors, sensor[polar], p["slant_range"][polar],
                             p["bearing"][polar], p["flight_level"][polar])
         for sid in np.unique(sensor[polar]).tolist():
             mine = sensor == sid
             x[mine], y[mine], R[mine] = polar_plots(self.sensors, sid,
                                                     rng[sensor[polar] == sid],
-                                                    p["bearing"][mine])
+                                                    p["bearing"][mine],
+                                                    types[mine] if types is not None else None)
         return {**out, "x": x, "y": y, "R": R}
 
     def _adopt(self, radars: Sequence[int], adsb: Sequence[int] = (),

@@ -5,7 +5,8 @@ attributes"), written when the plots had attributes and read back into
 ``flight_level`` (FL) and ``rate_of_climb`` (ft/min), ``mode_3a`` four octal digits,
 ``address`` six hexadecimal digits, ``callsign`` text, ``sigma_major``, ``sigma_minor``
 (m) and ``sigma_orient`` (degrees from grid north, clockwise, [0, 180)), ``sensors``
-(ids joined by ``;``) and ``sensor_ages`` (seconds, the same order). Empty cells
+(ids joined by ``;``) and ``sensor_ages`` (seconds, the same order), ``age_psr``,
+``age_ssr``, ``age_mds`` (seconds since the last update of each technology). Empty cells
 (Parquet nulls) are absent values; every column is written once any is, so that a file's
 columns do not depend on its rows.
 """
@@ -27,7 +28,8 @@ from mhtrack.io._checks import num
 from mhtrack.io._frame import FLOAT, TIME, Frame, float_array
 from mhtrack.io.plot_attributes import _parsed, _text
 
-_NUMBERS = ("flight_level", "rate_of_climb", "sigma_major", "sigma_minor", "sigma_orient")
+_NUMBERS = ("flight_level", "rate_of_climb", "sigma_major", "sigma_minor", "sigma_orient",
+            "age_psr", "age_ssr", "age_mds")
 #: Column kinds for :func:`~mhtrack.io._frame.read_frame` (TIME: read as text).
 KINDS = dict.fromkeys(_NUMBERS, FLOAT) | dict.fromkeys(
     ("mode_3a", "address", "callsign", "sensors", "sensor_ages"), TIME)
@@ -69,6 +71,9 @@ def read_track_attributes(f: Frame) -> TrackAttributes | None:
         f.check(v < 0, name, lambda r, v=v: f"σ {num(v[r])} m is negative")
     f.check(cols["sigma_minor"] > cols["sigma_major"], "sigma_minor",
             lambda r: f"σ minor {num(sig[1][r])} m exceeds σ major {num(sig[0][r])} m")
+    for name in ("age_psr", "age_ssr", "age_mds"):
+        v = cols[name]
+        f.check(v < 0, name, lambda r, v=v: f"age {num(v[r])} s is negative")
     o = cols["sigma_orient"]
     f.check((o < 0) | (o >= 180), "sigma_orient",
             lambda r: f"orientation {num(o[r])}° is outside [0, 180)")

@@ -13,7 +13,8 @@ address, its latest callsign and its position's accuracy
   is interrogated for it (BDS 2,0), not with every plot.
 * **Accuracy**: the position covariance's ellipse (:func:`~mhtrack.attributes.accuracy`).
 * **Sensors**: those whose plots updated the confirmed track, with the age of each one's
-  last update at the row's time (:class:`~mhtrack.mht.sensor_ages.SensorAges`).
+  last update at the row's time (:class:`~mhtrack.mht.sensor_ages.SensorAges`), and the
+  age of its last PSR, SSR and Mode S update (by the plots' types).
 """
 
 from __future__ import annotations
@@ -22,7 +23,7 @@ import numpy as np
 
 from mhtrack.attributes import FPM_PER_FL_S, PlotAttributes, TrackAttributes, accuracy
 from mhtrack.mht.attribute_scores import positions
-from mhtrack.mht.sensor_ages import SensorAges
+from mhtrack.mht.sensor_ages import SensorAges, technology_updates
 from mhtrack.mht.tree import Leaves
 
 
@@ -95,10 +96,14 @@ def track_attributes(leaves: Leaves, sel: np.ndarray, attrs: PlotAttributes,
     tid = leaves.track.take(sel)
     hit = j >= 0
     ages.update(tid[hit], sensor[j[hit]], plot_t[j[hit]], time)
+    if len(attrs):
+        ages.update(*technology_updates(tid[hit], attrs.plot_type[j[hit]], plot_t[j[hit]]),
+                    time)
     sensors, age = ages.of(tid, t)
+    tech = ages.technologies(tid, t)
     return TrackAttributes(
         flight_level=h, rate_of_climb=lv[:, 1] * FPM_PER_FL_S,
         mode_3a=ident[:, 0].copy(), address=ident[:, 1].copy(),
         callsign=callsigns.latest(leaves.track.take(sel), seen, time).astype(object),
         sigma_major=major, sigma_minor=minor, sigma_orient=orient, sensors=sensors,
-        sensor_ages=age)
+        sensor_ages=age, age_psr=tech[:, 0], age_ssr=tech[:, 1], age_mds=tech[:, 2])

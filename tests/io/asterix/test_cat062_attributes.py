@@ -22,7 +22,7 @@ FRAME = LocalFrame(51.47, -0.45)
 
 def _table(n=400):
     rng = np.random.default_rng(4)
-    some = rng.random((6, n)) < 0.8  # each attribute known on 80 % of the rows
+    some = rng.random((9, n)) < 0.8  # each attribute known on 80 % of the rows
     major = rng.uniform(5, 3000, n)
     a = TrackAttributes(
         flight_level=np.where(some[0], rng.uniform(-10, 450, n), np.nan),
@@ -34,7 +34,11 @@ def _table(n=400):
         sigma_major=np.where(some[5], major, np.nan),
         sigma_minor=np.where(some[5], major * rng.uniform(0.05, 1, n), np.nan),
         sigma_orient=np.where(some[5], rng.uniform(0, 180, n), np.nan),
-        sensors=np.full(n, "", object), sensor_ages=np.full(n, "", object))
+        sensors=np.full(n, "", object), sensor_ages=np.full(n, "", object),
+        # ages up to 90 s: beyond I062/290's 63.75 s some are saturated
+        age_psr=np.where(some[6], rng.uniform(0, 90, n), np.nan),
+        age_ssr=np.where(some[7], rng.uniform(0, 90, n), np.nan),
+        age_mds=np.where(some[8], rng.uniform(0, 30, n), np.nan))
     return TrackTable(scan=np.arange(n), time=1000.0 + np.arange(n) * 0.25,
                       track_id=rng.integers(0, 5000, n), x=rng.uniform(-2e5, 2e5, n),
                       y=rng.uniform(-2e5, 2e5, n), vx=rng.uniform(-250, 250, n),
@@ -77,6 +81,16 @@ def _compare(tracks: TrackTable, items: list[dict]) -> None:
             bad.append("380 ADR")
         if adr.get("ID", {}).get("ACID") != (a.callsign[i] or None):
             bad.append("380 ID")
+        tid = m.get("I062/245")  # target identification: STI 0 (downlinked), CHR
+        if (tid is None) != (not a.callsign[i]) or (
+                tid is not None and (tid["STI"], tid["TId"]) != (0, a.callsign[i])):
+            bad.append("245")
+        ages = m.get("I062/290", {})
+        for k, v in (("PSR", a.age_psr[i]), ("SSR", a.age_ssr[i]), ("MDS", a.age_mds[i])):
+            got = ages.get(k, {}).get(k)
+            if (got is None) != np.isnan(v) or (
+                    got is not None and abs(got - min(v, 63.75)) > 0.25):
+                bad.append(f"290 {k}")
         acc = m.get("I062/500")
         if (acc is None) != np.isnan(a.sigma_major[i]):
             bad.append("500 present")
@@ -109,7 +123,8 @@ def test_a_file_without_attributes_exports_none(tmp_path):
                                                             "y", "vx", "vy", "plot")}),
                  tmp_path / "t.csv", FRAME)
     export_tracks(tmp_path / "t.csv", None, tmp_path / "t.ast")
-    new = {"I062/060", "I062/136", "I062/220", "I062/380", "I062/500"}
+    new = {"I062/060", "I062/136", "I062/220", "I062/380", "I062/500", "I062/245",
+           "I062/290"}
     assert not any(new & set(m) for m in _decoded(tmp_path / "t.ast"))
 
 
@@ -145,4 +160,7 @@ def test_a_tracker_run_exports_its_attributes(tmp_path):
     tracks = read_tracks(tmp_path / "tracks.csv")
     online = ~tracks.tentative  # the tentative past has no identity
     assert tracks.attrs is not None and (tracks.attrs.address[online] >= 0).mean() > 0.9
+    known = np.isfinite(np.column_stack((tracks.attrs.age_psr, tracks.attrs.age_ssr,
+                                         tracks.attrs.age_mds)))
+    assert known[online].any(axis=1).mean() > 0.9  # the technologies' ages are filled
     _compare(tracks, _decoded(tmp_path / "export.ast"))

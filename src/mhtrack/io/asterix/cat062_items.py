@@ -3,7 +3,11 @@ CAT062 edition 1.18, encoded by libasterix): I062/060 Mode 3/A code (V, G, CH 0:
 code kept is the last validated one), 136 measured flight level (1/4 FL), 220 rate of
 climb (6.25 ft/min), 380 subfields ADR (24-bit address) and ID (callsign, up to eight
 characters of the 6-bit ICAO set), 500 subfields APC (σ of x and y, 0.5 m) and COV
-(``sign(Pxy) √|Pxy|``, 0.5 m). Each item only where its value is known.
+(``sign(Pxy) √|Pxy|``, 0.5 m), 245 target identification (STI 0 "downlinked from the
+target": our callsigns come from Mode S replies, I048/240; CHR the callsign) and 290
+system track update ages PSR, SSR and MDS (¼ s, 8 bits: an age beyond 63.75 s is written
+as 63.75 s, saturated, as the item cannot hold more). Each item only where its value is
+known.
 
 σx, σy and Pxy come from the tracks file's ellipse (σ major ``M``, minor ``m``, the
 major axis' bearing ``β`` from north): with the axis ``u = (sin β, cos β)``,
@@ -33,7 +37,9 @@ def lsb_attributes() -> dict[str, float]:
     return {"fl": float(rec.spec("136").create(1).variation.content.as_quantity("FL")),
             "fpm": float(rec.spec("220").create(1).variation.content.as_quantity("ft/min")),
             "m": float(apc.create((("X", 1), ("Y", 1))).variation.get_item("X")
-                       .variation.content.as_quantity("m"))}
+                       .variation.content.as_quantity("m")),
+            "age": float(rec.spec("290").create({"PSR": 1}).variation.get_item("PSR")
+                         .variation.content.as_quantity("s"))}
 
 
 def cartesian(a: TrackAttributes) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -72,6 +78,9 @@ def attribute_items(a: TrackAttributes, check: Callable[..., None]
 
     ax, ay = raw(sx, 0, top), raw(sy, 0, top)
     cov = raw(np.sign(cxy) * np.sqrt(np.abs(cxy)), -0x8000, 0x7FFF)
+    ages = {k: (np.isfinite(v), np.clip(np.round(np.nan_to_num(v) / L["age"]), 0, 0xFF)
+                .astype(np.int64))
+            for k, v in (("PSR", a.age_psr), ("SSR", a.age_ssr), ("MDS", a.age_mds))}
 
     def items(i: int) -> dict[str, Any]:
         out: dict[str, Any] = {}
@@ -88,6 +97,11 @@ def attribute_items(a: TrackAttributes, check: Callable[..., None]
             adr["ID"] = names[i].ljust(8)
         if adr:
             out["380"] = adr
+        if names[i]:
+            out["245"] = (("STI", 0), 0, ("CHR", names[i].ljust(8)))
+        age = {k: int(raw_age[i]) for k, (has, raw_age) in ages.items() if has[i]}
+        if age:
+            out["290"] = age
         if known[i]:
             out["500"] = {"APC": (("X", int(ax[i])), ("Y", int(ay[i]))),
                           "COV": int(cov[i])}

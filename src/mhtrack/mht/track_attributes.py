@@ -106,4 +106,26 @@ def track_attributes(leaves: Leaves, sel: np.ndarray, attrs: PlotAttributes,
         mode_3a=ident[:, 0].copy(), address=ident[:, 1].copy(),
         callsign=callsigns.latest(leaves.track.take(sel), seen, time).astype(object),
         sigma_major=major, sigma_minor=minor, sigma_orient=orient, sensors=sensors,
-        sensor_ages=age, age_psr=tech[:, 0], age_ssr=tech[:, 1], age_mds=tech[:, 2])
+        sensor_ages=age, age_psr=tech[:, 0], age_ssr=tech[:, 1], age_mds=tech[:, 2],
+        **measured(attrs, j, sensor))
+
+
+def measured(attrs: PlotAttributes, j: np.ndarray, sensor: np.ndarray
+             ) -> dict[str, np.ndarray]:
+    """What the plots ``j`` (indices into the frame's plots, ``-1``: a miss) measured,
+    as the ``meas_*`` columns of :class:`~mhtrack.attributes.TrackAttributes`."""
+    hit = j >= 0
+    k = np.maximum(j, 0)
+    if not len(attrs):
+        k = np.zeros(0, np.int64)
+        hit = np.zeros(j.size, bool)
+
+    def take(v: np.ndarray, absent: float | int) -> np.ndarray:
+        return np.where(hit, v[k] if k.size else absent, absent)
+
+    return {"meas_sensor": take(np.asarray(sensor, np.int64), -1),
+            "meas_type": take(attrs.plot_type, 0),
+            "meas_mode_3a": take(attrs.mode_3a, -1),
+            "meas_mode_3a_vg": take(2 * attrs.mode_3a_v + attrs.mode_3a_g, 0),
+            "meas_flight_level": take(attrs.flight_level, np.nan),
+            "meas_flight_level_vg": take(2 * attrs.flight_level_v + attrs.flight_level_g, 0)}

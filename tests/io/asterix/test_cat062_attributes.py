@@ -193,7 +193,18 @@ def test_a_tracker_run_exports_its_attributes(tmp_path):
     export_tracks(tmp_path / "tracks.csv", None, tmp_path / "export.ast")
     assert (tmp_path / "sink.ast").read_bytes() == (tmp_path / "export.ast").read_bytes()
     tracks = read_tracks(tmp_path / "tracks.csv")
-    online = ~tracks.tentative  # the tentative past has no identity
+    online = ~tracks.tentative
+    # the tentative past carries the identity its branch had: the same address as the
+    # confirmed track wherever it had one
+    past = tracks.tentative & (tracks.attrs.address >= 0)
+    assert past.sum() > 0.5 * tracks.tentative.sum()
+    first = {int(t): int(a) for t, a in zip(tracks.track_id[online].tolist(),
+                                             tracks.attrs.address[online].tolist(),
+                                             strict=True)}
+    same = [first.get(int(t), a) == a for t, a in zip(tracks.track_id[past].tolist(),
+                                                       tracks.attrs.address[past].tolist(),
+                                                       strict=True)]
+    assert np.mean(same) > 0.99
     assert tracks.attrs is not None and (tracks.attrs.address[online] >= 0).mean() > 0.9
     known = np.isfinite(np.column_stack((tracks.attrs.age_psr, tracks.attrs.age_ssr,
                                          tracks.attrs.age_mds)))

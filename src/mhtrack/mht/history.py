@@ -18,7 +18,8 @@ from the scan after it.
 Backfilled rows are *tentative*: at their scans the tracker had not yet decided that the
 track is a target. When the plots had attributes, the log also keeps each tentative
 leaf's code, address and vertical state, so that these rows carry the track's identity
-as it was at their scans (callsign, sensors and the measured plot are not logged). :attr:`mhtrack.records.TrackTable.tentative` marks them, so the online
+as it was at their scans (callsign, sensors and the measured plot are not logged).
+:attr:`mhtrack.records.TrackTable.tentative` marks them, so the online
 view (``tentative == 0``) is always recoverable from a history output.
 """
 

@@ -27,6 +27,7 @@ import mhtrack.io.asterix._lib as _lib
 from mhtrack.io.asterix._lib import quantity
 from mhtrack.io.asterix.cat001 import TimeRestorer, block001, block002
 from mhtrack.io.asterix.cat021 import block021
+from mhtrack.io.asterix.characteristics import CHARACTERISTICS, characteristics
 from mhtrack.io.asterix.columns import columns
 from mhtrack.io.asterix.container import blocks
 from mhtrack.io.asterix.duplicates import DuplicateFilter
@@ -52,18 +53,6 @@ VG = "2·V + G"
 #: The columns an ADS-B report (CAT021) adds to :data:`PLOT_COLUMNS`: WGS-84 position
 #: (deg) and its σ per axis (m, from NACp/NUCp, :mod:`~mhtrack.io.asterix.cat021`).
 ADSB_EXTRA = ("lat", "lon", "sigma")
-#: The columns a plot with radar plot characteristics adds to :data:`PLOT_COLUMNS`
-#: (CAT048 I048/130; NaN where a subfield is absent): SSR plot runlength (°), number of
-#: received replies, amplitude of the (M)SSR reply (dBm), primary plot runlength (°),
-#: amplitude of the primary plot (dBm), range difference PSR − SSR (m; the item's
-#: 1/256 NM × 1 852) and azimuth difference PSR − SSR (°); then ``amplitude`` (dBm), the
-#: plot's amplitude as :class:`~mhtrack.attributes.PlotAttributes` holds it: SAM, else
-#: PAM (a primary-only plot). A CAT001 plot gives only ``amplitude``, its I001/131
-#: received power (I001/130's contents are defined by each radar, not by the standard).
-CHARACTERISTICS = ("srl", "srr", "sam", "prl", "pam", "rpd", "apd", "amplitude")
-#: The subfields of I048/130 in :data:`CHARACTERISTICS` order, with the unit read.
-SUBFIELDS_130 = (("SRL", "°"), ("SRR", None), ("SAM", "dBm"), ("PRL", "°"), ("PAM", "dBm"),
-                 ("RPD", "NM"), ("APD", "°"))
 #: Kinds of rows :meth:`Decoder.blocks` yields.
 PLOTS, MARKS, ADSB = "plots", "marks", "adsb"
 
@@ -288,22 +277,6 @@ def plot_row(rec: Any, at: int, problems: Problems) -> tuple[Any, ...] | None:
             callsign, tn, *flags048(rec), vg(i070), vg(i090),
             *(() if i130 is None else characteristics(i130)))
 
-
-def characteristics(item: Any) -> tuple[float, ...]:
-    """The :data:`CHARACTERISTICS` of a libasterix I048/130, NaN for an absent subfield;
-    RPD in metres; ``amplitude`` SAM, else PAM."""
-    out: list[float] = []
-    for name, unit in SUBFIELDS_130:
-        sub = item.variation.get_item(name)
-        if sub is None:
-            out.append(np.nan)
-        elif unit is None:
-            out.append(float(sub.variation.content.as_uint()))
-        else:
-            v = float(quantity(sub, unit))
-            out.append(v * NM_M if unit == "NM" else v)
-    sam, pam = out[2], out[4]
-    return (*out, sam if sam == sam else pam)
 
 
 def vg(item: Any) -> int:

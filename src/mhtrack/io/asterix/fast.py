@@ -36,16 +36,9 @@ from dataclasses import dataclass
 from typing import Any
 
 import mhtrack.io.asterix._lib as _lib
+from mhtrack.io.asterix.characteristics import characteristics
 from mhtrack.io.asterix.notplots import flags048_item
 from mhtrack.io.asterix.problems import Problems
-
-
-def characteristics(item: Any) -> tuple[float, ...]:
-    """I048/130's values (:func:`mhtrack.io.asterix.decode.characteristics`, imported
-    when first used: decode imports this module)."""
-    from mhtrack.io.asterix.decode import characteristics as read
-
-    return read(item)
 
 #: Distinct encodings remembered per variable-size item (then libasterix parses each).
 MAX_VARIANTS = 256

@@ -14,8 +14,8 @@ from mhtrack.io.asterix._lib import quantity
 NM_M = 1852.0
 
 #: The columns a plot with radar plot characteristics adds to
-#: :data:`mhtrack.io.asterix.decode.PLOT_COLUMNS` (CAT048 I048/130; NaN where a subfield is absent): SSR plot runlength (°), number of
-#: received replies, amplitude of the (M)SSR reply (dBm), primary plot runlength (°),
+#: :data:`mhtrack.io.asterix.decode.PLOT_COLUMNS` (CAT048 I048/130; NaN where a
+#: subfield is absent): SSR plot runlength (°), number of received replies, amplitude of the (M)SSR reply (dBm), primary plot runlength (°),
 #: amplitude of the primary plot (dBm), range difference PSR − SSR (m; the item's
 #: 1/256 NM × 1 852) and azimuth difference PSR − SSR (°); then ``amplitude`` (dBm), the
 #: plot's amplitude as :class:`~mhtrack.attributes.PlotAttributes` holds it: SAM, else

@@ -15,12 +15,13 @@ NM_M = 1852.0
 
 #: The columns a plot with radar plot characteristics adds to
 #: :data:`mhtrack.io.asterix.decode.PLOT_COLUMNS` (CAT048 I048/130; NaN where a
-#: subfield is absent): SSR plot runlength (°), number of received replies, amplitude of the (M)SSR reply (dBm), primary plot runlength (°),
-#: amplitude of the primary plot (dBm), range difference PSR − SSR (m; the item's
-#: 1/256 NM × 1 852) and azimuth difference PSR − SSR (°); then ``amplitude`` (dBm), the
-#: plot's amplitude as :class:`~mhtrack.attributes.PlotAttributes` holds it: SAM, else
-#: PAM (a primary-only plot). A CAT001 plot gives only ``amplitude``, its I001/131
-#: received power (I001/130's contents are defined by each radar, not by the standard).
+#: subfield is absent): SSR plot runlength (°), number of received replies, amplitude of
+#: the (M)SSR reply (dBm), primary plot runlength (°), amplitude of the primary plot
+#: (dBm), range difference PSR − SSR (m; the item's 1/256 NM × 1 852) and azimuth
+#: difference PSR − SSR (°); then ``amplitude`` (dBm), the plot's amplitude as
+#: :class:`~mhtrack.attributes.PlotAttributes` holds it: SAM, else PAM (a primary-only
+#: plot). A CAT001 plot gives only ``amplitude``, its I001/131 received power (I001/130's
+#: contents are defined by each radar, not by the standard).
 CHARACTERISTICS = ("srl", "srr", "sam", "prl", "pam", "rpd", "apd", "amplitude")
 #: The subfields of I048/130 in :data:`CHARACTERISTICS` order, with the unit read.
 SUBFIELDS_130 = (("SRL", "°"), ("SRR", None), ("SAM", "dBm"), ("PRL", "°"), ("PAM", "dBm"),

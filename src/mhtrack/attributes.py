@@ -150,7 +150,12 @@ def of_columns(cols: Mapping[str, np.ndarray]) -> PlotAttributes | None:
 FPM_PER_FL_S = 6000.0
 #: The columns of :class:`TrackAttributes`, in tracks-file order (``docs/file-formats.md``).
 TRACK_COLUMNS = ("flight_level", "rate_of_climb", "mode_3a", "address", "callsign",
-                 "sigma_major", "sigma_minor", "sigma_orient", "sensors", "sensor_ages")
+                 "sigma_major", "sigma_minor", "sigma_orient", "sensors", "sensor_ages",
+                 "age_psr", "age_ssr", "age_mds", "meas_sensor", "meas_type", "meas_mode_3a",
+                 "meas_mode_3a_vg", "meas_flight_level", "meas_flight_level_vg")
+#: The plot types that count as a detection of each technology of I062/290's ages:
+#: primary (PSR), secondary (SSR: Mode A/C replies) and Mode S.
+TECHNOLOGIES = {"psr": (PRIMARY, COMBINED), "ssr": (SECONDARY, COMBINED), "mds": (MODE_S,)}
 
 
 def accuracy(P: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -176,7 +181,12 @@ class TrackAttributes:
     clockwise in [0, 180); :func:`accuracy`), NaN when unknown; the ``sensors`` that
     updated it (text, ids in increasing order joined by ``;``) and the ``sensor_ages``
     of their last updates (text, seconds, the same order; :mod:`mhtrack.mht.sensor_ages`),
-    ``""`` when none is known."""
+    ``""`` when none is known; ``age_psr``, ``age_ssr``, ``age_mds`` the age (s) of the
+    track's last update by a plot of each technology (:data:`TECHNOLOGIES`), NaN when
+    none is known; and what the row's own plot measured (I062/340; on a miss: absent):
+    ``meas_sensor`` (its sensor id, ``-1``), ``meas_type`` (:data:`PLOT_TYPES` code, 0),
+    ``meas_mode_3a`` (its code as received, ``-1``) and ``meas_flight_level`` (FL, NaN)
+    with their validity bits ``meas_mode_3a_vg``, ``meas_flight_level_vg`` (``2·V + G``)."""
 
     flight_level: np.ndarray
     rate_of_climb: np.ndarray
@@ -188,6 +198,15 @@ class TrackAttributes:
     sigma_orient: np.ndarray
     sensors: np.ndarray
     sensor_ages: np.ndarray
+    age_psr: np.ndarray
+    age_ssr: np.ndarray
+    age_mds: np.ndarray
+    meas_sensor: np.ndarray
+    meas_type: np.ndarray
+    meas_mode_3a: np.ndarray
+    meas_mode_3a_vg: np.ndarray
+    meas_flight_level: np.ndarray
+    meas_flight_level_vg: np.ndarray
 
     def __len__(self) -> int:
         return len(self.mode_3a)
@@ -204,7 +223,10 @@ class TrackAttributes:
         sig = (nan, nan, nan) if P is None else accuracy(P)
         return cls(nan, nan, np.full(n, ABSENT, np.int64), np.full(n, ABSENT, np.int64),
                    np.full(n, "", object), *sig, np.full(n, "", object),
-                   np.full(n, "", object))
+                   np.full(n, "", object), nan.copy(), nan.copy(), nan.copy(),
+                   np.full(n, ABSENT, np.int64), np.zeros(n, np.int64),
+                   np.full(n, ABSENT, np.int64), np.zeros(n, np.int64), nan.copy(),
+                   np.zeros(n, np.int64))
 
     @classmethod
     def concat(cls, parts: list[TrackAttributes]) -> TrackAttributes:

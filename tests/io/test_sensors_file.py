@@ -110,7 +110,8 @@ CASES = [
     ("misspelt table", {1: "[orgin]"}, 1, "key 'orgin': unknown key; did you mean 'origin'?"),
     ("unknown key", {9: "colour = 'red'"}, 9,
      "key 'sensors[0].colour': unknown key; known keys: id, kind, pd, lat, lon, alt, position, "
-     "sigma_range, sigma_bearing_deg, sigma, period, max_range"),
+     "sigma_range, sigma_bearing_deg, sigma, period, max_range, primary, secondary, "
+     "combined, mode_s"),
     ("latitude 95", {7: "lat = 95.0"}, 7,
      "key 'sensors[0].lat': latitude must be within [-90, 90] degrees, got 95"),
     ("origin latitude -95", {2: "lat = -95"}, 2,

@@ -23,7 +23,16 @@ def _table(n=4, attrs=True):
         sigma_minor=np.array([3.25, np.nan, 100.0, 1.0])[:n],
         sigma_orient=np.array([116.8, np.nan, 0.0, 179.5])[:n],
         sensors=np.array(["1;3", "", "0", "2"], object)[:n],
-        sensor_ages=np.array(["0.000;12.250", "", "4.000", "0.500"], object)[:n])
+        sensor_ages=np.array(["0.000;12.250", "", "4.000", "0.500"], object)[:n],
+        age_psr=np.array([0.0, np.nan, 4.0, np.nan])[:n],
+        age_ssr=np.array([12.25, np.nan, np.nan, 0.5])[:n],
+        age_mds=np.array([np.nan, np.nan, 4.0, 0.5])[:n],
+        meas_sensor=np.array([6412, -1, 3, 4])[:n],
+        meas_type=np.array([4, 0, 1, 3])[:n],
+        meas_mode_3a=np.array([0o1174, -1, -1, 0o7700])[:n],
+        meas_mode_3a_vg=np.array([0, 0, 0, 3])[:n],
+        meas_flight_level=np.array([350.25, np.nan, np.nan, -5.0])[:n],
+        meas_flight_level_vg=np.array([2, 0, 0, 1])[:n])
     return TrackTable(scan=np.arange(n), time=np.arange(n) * 1.5, track_id=np.arange(n),
                       x=rng.normal(size=n), y=rng.normal(size=n), vx=rng.normal(size=n),
                       vy=rng.normal(size=n), plot=np.array([3, -1, 5, 7])[:n],
@@ -36,7 +45,9 @@ def test_attribute_columns_round_trip(tmp_path, suffix):
     write_tracks(t, tmp_path / f"t{suffix}")
     back = read_tracks(tmp_path / f"t{suffix}")
     for name in ("flight_level", "rate_of_climb", "sigma_major", "sigma_minor",
-                 "sigma_orient"):
+                 "sigma_orient", "age_psr", "age_ssr", "age_mds", "meas_sensor", "meas_type",
+                 "meas_mode_3a", "meas_mode_3a_vg", "meas_flight_level",
+                 "meas_flight_level_vg"):
         np.testing.assert_array_equal(getattr(back.attrs, name), getattr(t.attrs, name))
     for name in ("mode_3a", "address", "callsign", "sensors", "sensor_ages"):
         assert getattr(back.attrs, name).tolist() == getattr(t.attrs, name).tolist()
@@ -46,13 +57,17 @@ def test_csv_cells_as_written(tmp_path):
     write_tracks(_table(), tmp_path / "t.csv")
     lines = (tmp_path / "t.csv").read_text().splitlines()
     head = lines[0].split(",")
-    assert head[-10:] == ["flight_level", "rate_of_climb", "mode_3a", "address", "callsign",
+    assert head[-19:] == ["flight_level", "rate_of_climb", "mode_3a", "address", "callsign",
                           "sigma_major", "sigma_minor", "sigma_orient", "sensors",
-                          "sensor_ages"]
-    assert lines[1].split(",")[-10:] == ["350", "0", "1174", "3C4591", "BOX413", "30.5",
-                                         "3.25", "116.8", "1;3", "0.000;12.250"]
-    assert lines[2].split(",")[-10:] == [""] * 10  # nothing known: empty cells
-    assert lines[4].split(",")[-8:-5] == ["0000", "000001", "A"]
+                          "sensor_ages", "age_psr", "age_ssr", "age_mds", "meas_sensor",
+                          "meas_type", "meas_mode_3a", "meas_mode_3a_vg",
+                          "meas_flight_level", "meas_flight_level_vg"]
+    assert lines[1].split(",")[-19:] == ["350", "0", "1174", "3C4591", "BOX413", "30.5",
+                                         "3.25", "116.8", "1;3", "0.000;12.250", "0",
+                                         "12.25", "", "6412", "mode_s", "1174", "0",
+                                         "350.25", "2"]
+    assert lines[2].split(",")[-19:] == [""] * 19  # nothing known: empty cells
+    assert lines[4].split(",")[-17:-14] == ["0000", "000001", "A"]
 
 
 @pytest.mark.parametrize("suffix", [".csv", ".parquet"])

@@ -53,8 +53,10 @@ def test_hand_worked_figures():
     # default T: plot gaps of target 1 (20 s) and 2 (10, 10, 10, 0 s) → median of > 0 is 10;
     # target 1 updated at 0, 20, 30 s → intervals {0, 2} of 3; target 2 all 3 → 5 / 6
     assert i.update_interval == 10.0 and math.isclose(i.p_update, 5 / 6)
-    # 9 track states, 7 matched: 8@3 (3 km) and the false track 5
+    # 9 track states, 7 matched: 8@3 (3 km) and the false track 5; both have no target
+    # within the match distance (500 m): false, none multiple
     assert math.isclose(i.extra_track_rate, 2 / 9)
+    assert math.isclose(i.false_track_rate, 2 / 9) and i.multiple_track_rate == 0.0
     # tracks with a dominant target: 7, 8, 9; track 8 is 3 km > 1 NM from target 1 at scan 3
     assert math.isclose(i.dubious_track_rate, 1 / 3)
 
@@ -111,3 +113,17 @@ def test_cli_identity_flag(tmp_path):
     r = CliRunner().invoke(cli, ["evaluate", str(tracks), str(truth), "--update-interval",
                                  "4"])
     assert r.exit_code != 0 and "--identity" in r.stderr
+
+
+def test_a_second_track_on_a_target_is_multiple():
+    """Track 6 at scan 2, 100 m from target 1, which track 8 holds there: one multiple
+    state of 10; 8@3 and track 5 stay false."""
+    extra = TrackTable(scan=np.array([2]), time=np.array([20.0]), track_id=np.array([6]),
+                       x=np.array([100.0]), y=np.array([0.0]), vx=np.zeros(1),
+                       vy=np.zeros(1), plot=np.array([-1]))
+    both = TrackTable.concat([TRACKS, extra])
+    order = np.lexsort((both.track_id, both.scan))
+    i = evaluate(both.take(order), TRUTH, identity=True).identity
+    assert math.isclose(i.extra_track_rate, 3 / 10)
+    assert math.isclose(i.multiple_track_rate, 1 / 10)
+    assert math.isclose(i.false_track_rate, 2 / 10)

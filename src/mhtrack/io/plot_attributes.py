@@ -135,6 +135,7 @@ def decoded_attributes(p: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
         "plot_type": np.asarray(p.get("plot_type", np.zeros(n, np.int64)), np.int64),
         "flight_level": np.asarray(p.get("flight_level", np.full(n, np.nan)), float),
         "callsign": np.asarray(p.get("callsign", np.full(n, "", object)), object),
+        "amplitude": np.asarray(p.get("amplitude", np.full(n, np.nan)), float),
     }
     for name, parse in (("mode_3a", code_value), ("address", address_value)):
         text = np.asarray(p.get(name, np.full(n, "", object)), object).astype(str)

@@ -25,14 +25,20 @@ from mhtrack.errors import InputError
 from mhtrack.io._source import PathArg
 from mhtrack.io.atomic import atomic_write
 from mhtrack.io.tomlfile import read_toml
-from mhtrack.models.radars import RadarSensor, SensorFieldError, SensorSet
+from mhtrack.models.radars import (
+    PLOT_TYPE_KEYS,
+    PLOT_TYPE_NAMES,
+    RadarSensor,
+    SensorFieldError,
+    SensorSet,
+)
 
 #: Keys of the ``[origin]`` table (both required).
 ORIGIN_KEYS = ("lat", "lon")
 #: Keys of a ``[[sensors]]`` table, required ones first.
 REQUIRED_KEYS = ("id", "kind", "pd")
 SENSOR_KEYS = (*REQUIRED_KEYS, "lat", "lon", "alt", "position", "sigma_range",
-               "sigma_bearing_deg", "sigma", "period", "max_range")
+               "sigma_bearing_deg", "sigma", "period", "max_range", *PLOT_TYPE_NAMES)
 _NUMBERS = ("lat", "lon", "alt", "pd", "sigma_range", "sigma_bearing_deg", "sigma",
             "period", "max_range")
 
@@ -53,6 +59,8 @@ class _Locator:
                 name = m[2]
                 if m[1] == "[[" and name == "sensors":
                     table, count = f"sensors[{count}]", count + 1
+                elif name.startswith("sensors.") and count:  # [sensors.primary]: the last one's
+                    table = f"sensors[{count - 1}]{name[len('sensors'):]}"
                 else:
                     table = name
                 self.tables.setdefault(table, number)
@@ -66,8 +74,13 @@ class _Locator:
         table's top-level name (``sensors = [...]``), else None."""
         if key is not None and (where, key) in self.keys:
             return self.keys[where, key]
+        if key is not None and f"{where}.{key}" in self.tables:  # [sensors.primary]
+            return self.tables[f"{where}.{key}"]
         if where in self.tables:
             return self.tables[where]
+        parent, dot, last = where.rpartition(".")
+        if dot and (parent, last) in self.keys:  # an inline table: the line of its key
+            return self.keys[parent, last]
         return self.keys.get(("", where.split("[")[0]))
 
 
@@ -136,10 +149,22 @@ class _Reader:
                 raise self.fail(where, "position",
                                 f"expected [x, y], two numbers, got {_describe(p)}")
             fields["position"] = (float(p[0]), float(p[1]))
+        fields["plot_types"] = tuple(self.plot_type(t[name], f"{where}.{name}", name)
+                                     for name in PLOT_TYPE_NAMES if name in t)
         try:
             return RadarSensor(t["id"], t["kind"], **fields)
         except SensorFieldError as e:
+            head, dot, tail = e.key.partition(".")
+            if dot:  # a plot type's key
+                raise self.fail(f"{where}.{head}", tail, e.message) from None
             raise self.fail(where, e.key, e.message) from None
+
+    def plot_type(self, value: object, where: str, name: str
+                  ) -> tuple[str, float | None, float | None, float | None]:
+        """One plot type's table (``[sensors.primary]`` or ``primary = {...}``): its keys
+        are :data:`~mhtrack.models.radars.PLOT_TYPE_KEYS`, each optional."""
+        t = self.table(value, where, PLOT_TYPE_KEYS)
+        return (name, *(self.number(t, where, k) for k in PLOT_TYPE_KEYS))  # type: ignore[return-value]
 
     def read(self) -> SensorSet:
         self.table(self.data, "", ("origin", "sensors"))
@@ -182,9 +207,14 @@ def sensors_to_dict(sensors: SensorSet) -> dict[str, Any]:
     for s in sensors.sensors:
         d: dict[str, Any] = {"id": s.id, "kind": s.kind}
         for key in SENSOR_KEYS[2:]:
+            if key in PLOT_TYPE_NAMES:
+                continue
             v = getattr(s, key)
             if v is not None:
                 d[key] = list(v) if key == "position" else v
+        for name, *values in s.plot_types:
+            d[name] = {k: v for k, v in zip(PLOT_TYPE_KEYS, values, strict=True)
+                       if v is not None}
         out["sensors"].append(d)
     return out
 

@@ -121,28 +121,34 @@ def read_timed_columns(path: PathArg, sensors: SensorSet | None = None
                 "target id >= 0, or -1 for clutter)")
     rng, bearing = _range_bearing(f)
     lat, lon = _lat_lon(f)
+    attrs = read_attributes(f)
     if sensors is None:
         x, y, R = _without_sensors(f)
     else:
-        x, y, R = _convert(f, sensor, rng, bearing, lat, lon, sensors)
+        x, y, R = _convert(f, sensor, rng, bearing, lat, lon, sensors,
+                           None if attrs is None else attrs.plot_type)
     for name, v in (("x", x), ("y", y)):
         f.check(np.abs(v) > MAX_COORDINATE, name if f.has(name) else None,
                 lambda r, v=v, name=name: f"{name} = {num(v[r])} m is beyond "
                 f"±{MAX_COORDINATE:g} m of the frame's origin (a unit or parsing error?)")
-    return f, TimedColumns(time, sensor, x, y, rng, bearing, origin, R, read_attributes(f))
+    return f, TimedColumns(time, sensor, x, y, rng, bearing, origin, R, attrs)
 
 
-def polar_plots(sensors: SensorSet, sensor_id: int, rng: np.ndarray, bearing: np.ndarray
+def polar_plots(sensors: SensorSet, sensor_id: int, rng: np.ndarray, bearing: np.ndarray,
+                plot_type: np.ndarray | None = None
                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """``x, y, R`` in the sensors' local frame of polar radar ``sensor_id``'s plots at
     ground ``rng`` (m) and ``bearing`` (deg), by
-    :func:`~mhtrack.models.geodesy.polar_to_local` with the radar's σ. Element-wise: a
+    :func:`~mhtrack.models.geodesy.polar_to_local` with the radar's σ — per plot the σ of
+    its type (``plot_type``, codes of :data:`mhtrack.attributes.PLOT_TYPES`) where the
+    sensors file gives that type its own (:meth:`RadarSensor.sigmas`). Element-wise: a
     plot's result does not depend on the others (the sources convert chunk by chunk)."""
     from mhtrack.models.geodesy import polar_to_local  # pyproj only when converting
 
     s = sensors.sensor(sensor_id)
+    sr, sb = s.sigmas(plot_type)
     z, R = polar_to_local(sensors.frame(), *sensors.site_latlon(sensor_id), rng, bearing,
-                          s.sigma_range, s.sigma_bearing_deg)
+                          sr, sb)
     return z[:, 0], z[:, 1], R
 
 
@@ -211,8 +217,10 @@ def _without_sensors(f: Frame) -> tuple[np.ndarray, np.ndarray, None]:
 def _convert(
     f: Frame, sensor: np.ndarray, rng: np.ndarray | None, bearing: np.ndarray | None,
     lat: np.ndarray | None, lon: np.ndarray | None, sensors: SensorSet,
+    plot_type: np.ndarray | None = None,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Positions and covariances of every row in the sensors' local frame."""
+    """Positions and covariances of every row in the sensors' local frame (a polar
+    radar's plots with the σ of their ``plot_type`` where the sensors file gives it)."""
     ids = sensors.ids
     listed = ", ".join(str(i) for i in ids)
     f.check(~np.isin(sensor, np.asarray(ids, np.int64)), "sensor", lambda r: (
@@ -246,8 +254,9 @@ def _convert(
         if rows.size == 0:
             continue
         if s.kind == "polar":
-            x[rows], y[rows], R[rows] = polar_plots(sensors, s.id, rng[rows],  # type: ignore[index]
-                                                    bearing[rows])  # type: ignore[index]
+            x[rows], y[rows], R[rows] = polar_plots(
+                sensors, s.id, rng[rows], bearing[rows],  # type: ignore[index]
+                None if plot_type is None else plot_type[rows])
         else:
             x[rows], y[rows] = _cartesian(f, sensors, rows, s.id, lat, lon)
             R[rows] = np.eye(2) * _sigmas(f, s, rows)[:, None, None] ** 2

@@ -5,7 +5,10 @@ attributes"), written when the plots had attributes and read back into
 ``flight_level`` (FL) and ``rate_of_climb`` (ft/min), ``mode_3a`` four octal digits,
 ``address`` six hexadecimal digits, ``callsign`` text, ``sigma_major``, ``sigma_minor``
 (m) and ``sigma_orient`` (degrees from grid north, clockwise, [0, 180)), ``sensors``
-(ids joined by ``;``) and ``sensor_ages`` (seconds, the same order). Empty cells
+(ids joined by ``;``) and ``sensor_ages`` (seconds, the same order), ``age_psr``,
+``age_ssr``, ``age_mds`` (seconds since the last update of each technology), and the
+row's plot's measurements ``meas_sensor``, ``meas_type`` (plot type name),
+``meas_mode_3a``, ``meas_mode_3a_vg``, ``meas_flight_level``, ``meas_flight_level_vg``. Empty cells
 (Parquet nulls) are absent values; every column is written once any is, so that a file's
 columns do not depend on its rows.
 """
@@ -16,6 +19,7 @@ import numpy as np
 import pyarrow as pa
 
 from mhtrack.attributes import (
+    PLOT_TYPES,
     TRACK_COLUMNS,
     TrackAttributes,
     address_text,
@@ -24,13 +28,17 @@ from mhtrack.attributes import (
     code_value,
 )
 from mhtrack.io._checks import num
-from mhtrack.io._frame import FLOAT, TIME, Frame, float_array
-from mhtrack.io.plot_attributes import _parsed, _text
+from mhtrack.io._frame import FLOAT, INT, TIME, Frame, float_array, int_array
+from mhtrack.io.plot_attributes import _parsed, _text, _type_code
 
-_NUMBERS = ("flight_level", "rate_of_climb", "sigma_major", "sigma_minor", "sigma_orient")
+_NUMBERS = ("flight_level", "rate_of_climb", "sigma_major", "sigma_minor", "sigma_orient",
+            "age_psr", "age_ssr", "age_mds", "meas_flight_level")
+#: Integer columns and their absent value (written as an empty cell).
+_INTS = {"meas_sensor": -1, "meas_mode_3a_vg": 0, "meas_flight_level_vg": 0}
 #: Column kinds for :func:`~mhtrack.io._frame.read_frame` (TIME: read as text).
-KINDS = dict.fromkeys(_NUMBERS, FLOAT) | dict.fromkeys(
-    ("mode_3a", "address", "callsign", "sensors", "sensor_ages"), TIME)
+KINDS = dict.fromkeys(_NUMBERS, FLOAT) | dict.fromkeys(_INTS, INT) | dict.fromkeys(
+    ("mode_3a", "address", "callsign", "sensors", "sensor_ages", "meas_type",
+     "meas_mode_3a"), TIME)
 
 
 def track_attribute_columns(a: TrackAttributes) -> dict[str, pa.Array]:
@@ -41,7 +49,12 @@ def track_attribute_columns(a: TrackAttributes) -> dict[str, pa.Array]:
         v = getattr(a, name)
         if name in _NUMBERS:
             out[name] = float_array(v, nan_as_null=True)
-        elif name == "mode_3a":
+        elif name in _INTS:
+            out[name] = int_array(v, v == _INTS[name] if name == "meas_sensor" else
+                                  np.asarray(a.meas_sensor) < 0)
+        elif name == "meas_type":
+            out[name] = _strings(["" if c <= 0 else PLOT_TYPES[int(c)] for c in v.tolist()])
+        elif name in ("mode_3a", "meas_mode_3a"):
             out[name] = _strings([code_text(c) for c in v.tolist()])
         elif name == "address":
             out[name] = _strings([address_text(c) for c in v.tolist()])
@@ -69,12 +82,23 @@ def read_track_attributes(f: Frame) -> TrackAttributes | None:
         f.check(v < 0, name, lambda r, v=v: f"σ {num(v[r])} m is negative")
     f.check(cols["sigma_minor"] > cols["sigma_major"], "sigma_minor",
             lambda r: f"σ minor {num(sig[1][r])} m exceeds σ major {num(sig[0][r])} m")
+    for name in ("age_psr", "age_ssr", "age_mds"):
+        v = cols[name]
+        f.check(v < 0, name, lambda r, v=v: f"age {num(v[r])} s is negative")
     o = cols["sigma_orient"]
     f.check((o < 0) | (o >= 180), "sigma_orient",
             lambda r: f"orientation {num(o[r])}° is outside [0, 180)")
-    for name, parse in (("mode_3a", code_value), ("address", address_value)):
+    for name, parse in (("mode_3a", code_value), ("address", address_value),
+                        ("meas_mode_3a", code_value), ("meas_type", _type_code)):
         if f.has(name):
             cols[name] = _parsed(f, name, parse)
+    for name, absent in _INTS.items():
+        if f.has(name):
+            cols[name] = f.ints(name, nullable=True, fill=absent)
+    for name in ("meas_mode_3a_vg", "meas_flight_level_vg"):
+        v = cols[name]
+        f.check((v < 0) | (v > 3), name, lambda r, v=v: f"validity {v[r]} is not 2·V + G "
+                "(0 to 3)")
     for name in ("callsign", "sensors", "sensor_ages"):
         if f.has(name):
             cols[name] = np.array(_text(f, name), object)

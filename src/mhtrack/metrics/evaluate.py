@@ -166,5 +166,6 @@ def evaluate(
         hota=run("HOTA", hota_indexed, data, d_max),
         identity=identity_figures(raw_tracks, truth, tracks, mot.matching, raw_plots,
                                   update_interval=update_interval,
-                                  dubious_distance=dubious_distance) if identity else None,
+                                  dubious_distance=dubious_distance,
+                                  match_distance=d_match) if identity else None,
     )

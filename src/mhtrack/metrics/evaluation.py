@@ -195,6 +195,8 @@ class Evaluation:
                 (f"probability of update (T={_fmt(i.update_interval)} s)",
                  _fmt(i.p_update)),
                 ("extra track rate (unmatched states)", _fmt(i.extra_track_rate)),
+                ("  multiple / false track rate",
+                 f"{_fmt(i.multiple_track_rate)} / {_fmt(i.false_track_rate)}"),
                 (f"dubious track rate (> {_fmt(i.dubious_distance)} m)",
                  _fmt(i.dubious_track_rate))]
 

@@ -82,6 +82,12 @@ class Coverage(ABC):
         """``P_D`` of the sensor that made ``scan``'s plots (the update increment and the
         birth score, P1 eqs. 5 / 15)."""
 
+    def plot_pds(self, scan: Scan) -> float | np.ndarray:
+        """``P_D`` of each of ``scan``'s plots in the update increment: a float when every
+        plot has the same (default: :meth:`plot_pd`), else one per plot (a radar whose
+        plot types have their own ``P_D``, :class:`RadarCoverage`)."""
+        return self.plot_pd(scan)
+
     def arrays(self) -> dict[str, np.ndarray]:
         """State to save with the tracker (``coverage__*`` arrays). Default: none."""
         return {}
@@ -178,6 +184,18 @@ class RadarCoverage(Coverage):
 
     def plot_pd(self, scan: Scan) -> float:
         return min(self.sensors.sensor(self._sensor_id(scan)).pd, self.max_pd)
+
+    def plot_pds(self, scan: Scan) -> float | np.ndarray:
+        """Per plot the ``P_D`` of its type where the sensors file gives one
+        (:meth:`~mhtrack.models.radars.RadarSensor.pds`, capped at ``max_pd`` as the
+        sensor's), else :meth:`plot_pd`'s float: without type tables, or plots without
+        types, exactly today's."""
+        sensor = self.sensors.sensor(self._sensor_id(scan))
+        types = None if scan.attrs is None else scan.attrs.plot_type
+        pds = sensor.pds(types)
+        if isinstance(pds, float):
+            return min(pds, self.max_pd)
+        return np.minimum(pds, self.max_pd)
 
     def detection(self, scan: Scan, x: np.ndarray, P: np.ndarray,
                   time: np.ndarray) -> Looks:

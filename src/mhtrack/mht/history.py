@@ -16,17 +16,21 @@ that has since ended. The chain is cut at the first such scan; the track is then
 from the scan after it.
 
 Backfilled rows are *tentative*: at their scans the tracker had not yet decided that the
-track is a target. :attr:`mhtrack.records.TrackTable.tentative` marks them, so the online
+track is a target. When the plots had attributes, the log also keeps each tentative
+leaf's code, address and vertical state, so that these rows carry the track's identity
+as it was at their scans (callsign, sensors and the measured plot are not logged).
+:attr:`mhtrack.records.TrackTable.tentative` marks them, so the online
 view (``tentative == 0``) is always recoverable from a history output.
 """
 
 from __future__ import annotations
 
 from collections import deque
-from dataclasses import dataclass, fields
+from dataclasses import dataclass, fields, replace
 
 import numpy as np
 
+from mhtrack.attributes import FPM_PER_FL_S, TrackAttributes
 from mhtrack.kernels import changes
 from mhtrack.mht.tree import Leaves
 from mhtrack.records import TrackTable
@@ -45,6 +49,10 @@ class _Logged:
     plot: np.ndarray
     score: np.ndarray
     t: np.ndarray  # each leaf's own time
+    #: the leaves' codes/addresses and vertical states (``Leaves.ident``, ``level``), only
+    #: when some leaf has one (plots with attributes): ``None`` otherwise
+    ident: np.ndarray | None = None
+    level: np.ndarray | None = None
 
     @classmethod
     def of(cls, scan: int, time: float, leaves: Leaves,
@@ -56,9 +64,26 @@ class _Logged:
             sel = sel[node.argsort(kind="stable")]
             node = leaves.node[sel]
         # 2-D and wider rows by take (a copy without fancy indexing's set-up)
+        ident = leaves.ident.take(sel, axis=0)
+        level = leaves.level.take(sel, axis=0)
+        known = bool((ident >= 0).any() or np.isfinite(level[:, 0]).any())
         return cls(np.array([scan], np.int64), np.array([time], float), node,
                    leaves.parent[sel], leaves.x.take(sel, axis=0), leaves.P.take(sel, axis=0),
-                   leaves.window[:, -1][sel], leaves.score[sel], leaves.time[sel])
+                   leaves.window[:, -1][sel], leaves.score[sel], leaves.time[sel],
+                   ident if known else None, level if known else None)
+
+    def attributes(self, j: np.ndarray) -> TrackAttributes | None:
+        """The identity of logged leaves ``j`` at their own times (code, address, flight
+        level and rate of their vertical state, as :mod:`mhtrack.mht.track_attributes`
+        reports a track; the accuracy of their covariance), ``None`` when none was
+        logged."""
+        if self.ident is None or self.level is None:
+            return None
+        lv, ident = self.level.take(j, axis=0), self.ident.take(j, axis=0)
+        return replace(TrackAttributes.absent(j.size, self.P.take(j, axis=0)),
+                       flight_level=lv[:, 0] + lv[:, 1] * (self.t[j] - lv[:, 5]),
+                       rate_of_climb=lv[:, 1] * FPM_PER_FL_S, mode_3a=ident[:, 0].copy(),
+                       address=ident[:, 1].copy())
 
 
 class TentativeHistory:
@@ -130,7 +155,7 @@ class TentativeHistory:
                 scan=np.repeat(log.scan, n), time=log.t[j], track_id=tid,
                 x=x[:, 0].copy(), y=x[:, 2].copy(), vx=x[:, 1].copy(), vy=x[:, 3].copy(),
                 plot=plot, score=log.score[j], P=log.P.take(j, axis=0),
-                tentative=np.ones(n, bool)))
+                tentative=np.ones(n, bool), attrs=log.attributes(j)))
             cur = log.parent[j]
             live = cur >= 0
             cur, tid = cur[live], tid[live]
@@ -145,7 +170,8 @@ class TentativeHistory:
         out: dict[str, np.ndarray] = {"count": np.array([len(self._log)], np.int64)}
         for i, (log, claimed) in enumerate(zip(self._log, self._claimed, strict=True)):
             for f in fields(_Logged):
-                out[f"{i}__{f.name}"] = getattr(log, f.name)
+                if getattr(log, f.name) is not None:
+                    out[f"{i}__{f.name}"] = getattr(log, f.name)
             out[f"{i}__claimed"] = claimed
         return out
 

@@ -52,14 +52,17 @@ def miss_increments(p_detection: np.ndarray, gate_probability: float | None = No
 
 
 def update_increment(
-    loglik: np.ndarray, kappa: np.ndarray, p_detection: float, new_target_density: float,
-    plot: np.ndarray | None = None,
+    loglik: np.ndarray, kappa: np.ndarray, p_detection: float | np.ndarray,
+    new_target_density: float, plot: np.ndarray | None = None,
 ) -> np.ndarray:
     """Score increment of updating with a plot, P1 eqs. 5 / 15:
     ``ΔL = ln p(z|T) + ln P_D − ln(κ̂(z) + λ_v)``, with ``loglik = ln p(z|T)``. ``kappa``
     per pair, or per plot with ``plot`` each pair's plot: the plot's part
-    ``ln P_D − ln(κ̂ + λ_v)`` is then computed once per plot (the same floats)."""
-    per = math.log(p_detection) - np.log(kappa + new_target_density)
+    ``ln P_D − ln(κ̂ + λ_v)`` is then computed once per plot (the same floats).
+    ``p_detection`` one value, or one per plot like ``kappa`` (the ``P_D`` of each
+    plot's type, :meth:`~mhtrack.mht.coverage.Coverage.plot_pds`)."""
+    lpd = math.log(p_detection) if isinstance(p_detection, float) else np.log(p_detection)
+    per = lpd - np.log(kappa + new_target_density)
     return loglik + (per if plot is None else per.take(plot))
 
 

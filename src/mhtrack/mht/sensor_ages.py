@@ -2,11 +2,32 @@
 item 5; the tracks file's ``sensors`` and ``sensor_ages``, after CAT062's I062/290
 "system track update ages"): per track id, the time of the last plot of each sensor the
 confirmed track used, remembered for
-:attr:`~mhtrack.mht.attribute_scores.AttributeModel.resume_s`."""
+:attr:`~mhtrack.mht.attribute_scores.AttributeModel.resume_s`. The same store keeps the
+time of the last plot of each technology (:data:`~mhtrack.attributes.TECHNOLOGIES`: PSR,
+SSR, Mode S, by the plots' types) under the keys :data:`TECHNOLOGY_KEYS` (negative: no
+sensor id is), for I062/290's per-technology ages."""
 
 from __future__ import annotations
 
 import numpy as np
+
+from mhtrack.attributes import TECHNOLOGIES
+
+#: The store's key of each technology (in :data:`~mhtrack.attributes.TECHNOLOGIES` order).
+TECHNOLOGY_KEYS = {name: -1 - i for i, name in enumerate(TECHNOLOGIES)}
+
+
+def technology_updates(track: np.ndarray, plot_type: np.ndarray, time: np.ndarray
+                       ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(track, key, time)`` of the updates by plots of types ``plot_type``, one per
+    technology the type counts for (a combined plot: PSR and SSR)."""
+    ts, ks, ws = [], [], []
+    for name, types in TECHNOLOGIES.items():
+        m = np.isin(plot_type, types)
+        ts.append(track[m])
+        ks.append(np.full(int(m.sum()), TECHNOLOGY_KEYS[name], np.int64))
+        ws.append(time[m])
+    return np.concatenate(ts), np.concatenate(ks), np.concatenate(ws)
 
 
 class SensorAges:
@@ -41,9 +62,27 @@ class SensorAges:
         stop = np.searchsorted(self.track, track, "right")
         for a, b, t in zip(start.tolist(), stop.tolist(), np.asarray(at, float).tolist(),
                            strict=True):
-            sensors.append(";".join(str(v) for v in self.sensor[a:b].tolist()))
-            ages.append(";".join(f"{max(t - w, 0.0):.3f}" for w in self.time[a:b].tolist()))
+            mine = self.sensor[a:b] >= 0  # the technologies' keys are not sensors
+            sensors.append(";".join(str(v) for v in self.sensor[a:b][mine].tolist()))
+            ages.append(";".join(f"{max(t - w, 0.0):.3f}"
+                                 for w in self.time[a:b][mine].tolist()))
         return np.array(sensors, object), np.array(ages, object)
+
+    def technologies(self, track: np.ndarray, at: np.ndarray) -> np.ndarray:
+        """Per row (track id, time ``at``) the age (s, ``at − last update``, at least 0)
+        of each technology's last update, columns in
+        :data:`~mhtrack.attributes.TECHNOLOGIES` order; NaN when none is known."""
+        out = np.full((len(track), len(TECHNOLOGY_KEYS)), np.nan)
+        at = np.asarray(at, float)
+        for j, key in enumerate(TECHNOLOGY_KEYS.values()):
+            m = self.sensor == key
+            tr, w = self.track[m], self.time[m]  # sorted by track (one entry per track)
+            if not tr.size:
+                continue
+            k = np.minimum(np.searchsorted(tr, track), tr.size - 1)
+            hit = tr[k] == track
+            out[hit, j] = np.maximum(at[hit] - w[k[hit]], 0.0)
+        return out
 
     def arrays(self) -> dict[str, np.ndarray]:
         return {"track": self.track, "sensor": self.sensor, "time": self.time}

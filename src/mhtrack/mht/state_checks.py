@@ -54,7 +54,8 @@ AGE_COLUMNS: dict[str, tuple[str, tuple[Any, ...]]] = {
 #: Columns of one logged scan of the tentative history (``history__<i>__<name>``).
 HISTORY_COLUMNS: dict[str, tuple[str, tuple[Any, ...]]] = {
     "node": ("iu", ()), "parent": ("iu", ()), "x": ("f", (4,)), "P": ("f", (4, 4)),
-    "plot": ("iu", ()), "score": ("f", ()), "t": ("f", ()),
+    "plot": ("iu", ()), "score": ("f", ()), "t": ("f", ()), "ident": ("iu", (2,)),
+    "level": ("fn", (7,)),
 }
 #: Relative tolerance of the symmetry of a covariance.
 SYMMETRY_RTOL = 1e-9
@@ -290,6 +291,6 @@ def check_arrays(path: PathArg, arrays: Mapping[str, np.ndarray], meta: Mapping[
         prefix = f"history__{i}__"
         c.column(f"{prefix}scan", "iu", (1,))
         c.column(f"{prefix}time", "f", (1,))
-        log = c.part(prefix, HISTORY_COLUMNS, {}, optional=("t",))
+        log = c.part(prefix, HISTORY_COLUMNS, {}, optional=("t", "ident", "level"))
         c.covariances(f"{prefix}P", log["P"])
         c.column(f"{prefix}claimed", "iu", (-1,))

@@ -13,7 +13,8 @@ address, its latest callsign and its position's accuracy
   is interrogated for it (BDS 2,0), not with every plot.
 * **Accuracy**: the position covariance's ellipse (:func:`~mhtrack.attributes.accuracy`).
 * **Sensors**: those whose plots updated the confirmed track, with the age of each one's
-  last update at the row's time (:class:`~mhtrack.mht.sensor_ages.SensorAges`).
+  last update at the row's time (:class:`~mhtrack.mht.sensor_ages.SensorAges`), and the
+  age of its last PSR, SSR and Mode S update (by the plots' types).
 """
 
 from __future__ import annotations
@@ -22,7 +23,7 @@ import numpy as np
 
 from mhtrack.attributes import FPM_PER_FL_S, PlotAttributes, TrackAttributes, accuracy
 from mhtrack.mht.attribute_scores import positions
-from mhtrack.mht.sensor_ages import SensorAges
+from mhtrack.mht.sensor_ages import SensorAges, technology_updates
 from mhtrack.mht.tree import Leaves
 
 
@@ -95,10 +96,36 @@ def track_attributes(leaves: Leaves, sel: np.ndarray, attrs: PlotAttributes,
     tid = leaves.track.take(sel)
     hit = j >= 0
     ages.update(tid[hit], sensor[j[hit]], plot_t[j[hit]], time)
+    if len(attrs):
+        ages.update(*technology_updates(tid[hit], attrs.plot_type[j[hit]], plot_t[j[hit]]),
+                    time)
     sensors, age = ages.of(tid, t)
+    tech = ages.technologies(tid, t)
     return TrackAttributes(
         flight_level=h, rate_of_climb=lv[:, 1] * FPM_PER_FL_S,
         mode_3a=ident[:, 0].copy(), address=ident[:, 1].copy(),
         callsign=callsigns.latest(leaves.track.take(sel), seen, time).astype(object),
         sigma_major=major, sigma_minor=minor, sigma_orient=orient, sensors=sensors,
-        sensor_ages=age)
+        sensor_ages=age, age_psr=tech[:, 0], age_ssr=tech[:, 1], age_mds=tech[:, 2],
+        **measured(attrs, j, sensor))
+
+
+def measured(attrs: PlotAttributes, j: np.ndarray, sensor: np.ndarray
+             ) -> dict[str, np.ndarray]:
+    """What the plots ``j`` (indices into the frame's plots, ``-1``: a miss) measured,
+    as the ``meas_*`` columns of :class:`~mhtrack.attributes.TrackAttributes`."""
+    hit = j >= 0
+    k = np.maximum(j, 0)
+    if not len(attrs):
+        k = np.zeros(0, np.int64)
+        hit = np.zeros(j.size, bool)
+
+    def take(v: np.ndarray, absent: float | int) -> np.ndarray:
+        return np.where(hit, v[k] if k.size else absent, absent)
+
+    return {"meas_sensor": take(np.asarray(sensor, np.int64), -1),
+            "meas_type": take(attrs.plot_type, 0),
+            "meas_mode_3a": take(attrs.mode_3a, -1),
+            "meas_mode_3a_vg": take(2 * attrs.mode_3a_v + attrs.mode_3a_g, 0),
+            "meas_flight_level": take(attrs.flight_level, np.nan),
+            "meas_flight_level_vg": take(2 * attrs.flight_level_v + attrs.flight_level_g, 0)}

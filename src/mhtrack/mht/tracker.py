@@ -175,7 +175,7 @@ class MHTTracker:
         in_gates = plots_in_confirmed_gates(leaves, gated, f.n_plots)
         kappa = clutter_intensity(self.clutter, f, in_gates, self.config.min_clutter_density)
         self.last_kappa = kappa
-        update_dl = update_increment(gated.loglik, kappa, self.coverage.plot_pd(scan),
+        update_dl = update_increment(gated.loglik, kappa, self.coverage.plot_pds(scan),
                                      self.config.new_target_density, gated.plot)
         attrs = scan.attrs if scan.attrs is not None and scan.attrs.any() else None
         if attrs is not None:

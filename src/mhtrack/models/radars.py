@@ -39,6 +39,11 @@ MAX_SITE_DISTANCE_M = 3e6
 #: Largest instrumented range (m): 20 000 km, about half a meridian (the plots reader's
 #: bound on a range).
 MAX_RANGE_M = 2e7
+#: Names of the plot types a polar radar may give its own errors and ``P_D``
+#: (:data:`mhtrack.attributes.PLOT_TYPES` codes 1–4: PSR only, SSR only, PSR + SSR, Mode S).
+PLOT_TYPE_NAMES = {"primary": 1, "secondary": 2, "combined": 3, "mode_s": 4}
+#: The keys of one plot type's table.
+PLOT_TYPE_KEYS = ("pd", "sigma_range", "sigma_bearing_deg")
 #: Smallest errors accepted: ``σr``, ``σ`` ≥ 1 nm, ``σθ`` ≥ 10⁻¹² degree — far below any
 #: sensor (noise-free test geometries use them); smaller ones make ``σ²`` underflow
 #: towards 0 in float64 and the plots' covariances singular (1e-300 gave 0).
@@ -98,6 +103,10 @@ class RadarSensor:
     sigma: float | None = None
     period: float | None = None
     max_range: float | None = None
+    #: Per plot type (:data:`PLOT_TYPE_NAMES`) the errors and ``P_D`` that replace the
+    #: sensor's own for plots of that type: ``(name, pd, sigma_range, sigma_bearing_deg)``,
+    #: ``None`` where the sensor's applies (polar radars only; empty: every plot alike).
+    plot_types: tuple[tuple[str, float | None, float | None, float | None], ...] = ()
 
     def __post_init__(self) -> None:
         w = f"sensor {self.id}"
@@ -147,6 +156,73 @@ class RadarSensor:
         if self.max_range is not None and self.max_range > MAX_RANGE_M:
             raise SensorFieldError(w, "max_range", f"{self.max_range:g} m is beyond "
                                    f"{MAX_RANGE_M / 1e3:.0f} km, half-way round the Earth")
+        self._check_plot_types()
+
+    def _check_plot_types(self) -> None:
+        """Each plot type's table: a known type, once, on a polar radar, values in the
+        ranges of the sensor's own keys."""
+        w = f"sensor {self.id}"
+        seen: set[str] = set()
+        out = []
+        for entry in self.plot_types:
+            name, *values = entry
+            if name not in PLOT_TYPE_NAMES:
+                raise SensorFieldError(w, str(name), "unknown plot type; known: "
+                                       f"{', '.join(PLOT_TYPE_NAMES)}")
+            if name in seen:
+                raise SensorFieldError(w, name, "given twice")
+            seen.add(name)
+            if self.kind != "polar":
+                raise SensorFieldError(w, name, "per-plot-type errors and P_D apply to a "
+                                       f"polar radar's plots, not to a {self.kind} sensor")
+            limits = {"pd": (0.0, 1.0, ""), "sigma_range": (MIN_SIGMA_M, MAX_SIGMA, " m"),
+                      "sigma_bearing_deg": (MIN_SIGMA_BEARING_DEG, MAX_SIGMA_BEARING_DEG,
+                                            " degrees")}
+            clean = []
+            for key, v in zip(PLOT_TYPE_KEYS, values, strict=True):
+                if v is not None:
+                    v = float(v)
+                    lo, hi, unit = limits[key]
+                    bad = not (lo < v <= hi) if key == "pd" else not (lo <= v <= hi)
+                    if not np.isfinite(v) or bad:
+                        span = "(0, 1]" if key == "pd" else \
+                            f"[{short_number(lo)}, {short_number(hi)}]"
+                        raise SensorFieldError(w, f"{name}.{key}", f"must be in {span}{unit},"
+                                               f" got {v:g}")
+                clean.append(v)
+            out.append((name, *clean))
+        object.__setattr__(self, "plot_types", tuple(out))
+
+    def _by_type(self, key: str) -> dict[int, float]:
+        """Plot type code → the value of ``key`` its table gives (types without it left
+        out)."""
+        k = PLOT_TYPE_KEYS.index(key) + 1
+        return {PLOT_TYPE_NAMES[e[0]]: e[k] for e in self.plot_types if e[k] is not None}
+
+    def _per_plot(self, key: str, own: float | None, plot_type: np.ndarray | None
+                  ) -> float | np.ndarray | None:
+        by = self._by_type(key)
+        if not by or plot_type is None:
+            return own
+        codes = np.asarray(plot_type)
+        out = np.full(codes.shape, np.nan if own is None else float(own))
+        for code, v in by.items():
+            out[codes == code] = v
+        return out
+
+    def sigmas(self, plot_type: np.ndarray | None = None
+               ) -> tuple[float | np.ndarray | None, float | np.ndarray | None]:
+        """``(σr, σθ)`` of plots of types ``plot_type`` (codes of
+        :data:`mhtrack.attributes.PLOT_TYPES`): the type's own where its table gives one,
+        else the sensor's. Without type tables, or without ``plot_type``, the sensor's
+        two scalars (today's values, unchanged)."""
+        return (self._per_plot("sigma_range", self.sigma_range, plot_type),
+                self._per_plot("sigma_bearing_deg", self.sigma_bearing_deg, plot_type))
+
+    def pds(self, plot_type: np.ndarray | None = None) -> float | np.ndarray:
+        """``P_D`` of plots of types ``plot_type``, as :meth:`sigmas` (the sensor's
+        ``pd`` as a float when no type table gives one)."""
+        return self._per_plot("pd", self.pd, plot_type)  # type: ignore[return-value]
 
     def _check_errors(self) -> None:
         """The error keys of the sensor's kind are present and in range; the other kind's

@@ -42,7 +42,7 @@ import numpy as np
 from mhtrack.errors import InputError
 from mhtrack.frames import frame_lengths
 from mhtrack.io.asterix.api import ground_ranges
-from mhtrack.io.asterix.decode import MARKS, PLOT_COLUMNS, Decoder, plot_columns, sweep_periods
+from mhtrack.io.asterix.decode import MARKS, Decoder, plot_columns, sweep_periods
 from mhtrack.io.asterix.duplicates import stream_filter
 from mhtrack.io.asterix.problems import Problems
 from mhtrack.io.asterix.sites import sensors_with_sites, skipped_line
@@ -167,17 +167,12 @@ class DatagramSource(Source):
 
     def _chunk(self, rows: list[tuple[Any, ...]], times: list[float], at: list[int],
                n0: int, convert: bool, in_sector: list[int]) -> dict[str, np.ndarray]:
-        k = len(PLOT_COLUMNS)
-        p = plot_columns([r[:k] for r in rows])
+        p = plot_columns(rows)  # ADS-B reports add lat, lon, sigma; I048/130 its columns
         p["time"] = np.array(times, float)
         p["offset"] = np.asarray(at, np.int64)
         p["file_row"] = np.arange(n0, n0 + len(rows), dtype=np.int64)
         if self.sectors:
             p["sector"] = np.asarray(in_sector, np.int64)
-        if any(len(r) > k for r in rows):  # ADS-B reports: lat, lon, sigma
-            extra = np.array([r[k:k + 3] if len(r) > k else (np.nan,) * 3 for r in rows],
-                             float)
-            p["lat"], p["lon"], p["sigma"] = extra.T
         return self._convert(p) if convert else p
 
     def _convert(self, p: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
@@ -220,13 +215,15 @@ class DatagramSource(Source):
             x[adsb], y[adsb] = self.sensors.frame().to_local(p["lat"][adsb], p["lon"][adsb])
             R[adsb, 0, 0] = R[adsb, 1, 1] = p["sigma"][adsb] ** 2
         polar = ~adsb
+        types = p.get("plot_type")
         rng = ground_ranges(self.sensors, sensor[polar], p["slant_range"][polar],
                             p["bearing"][polar], p["flight_level"][polar])
         for sid in np.unique(sensor[polar]).tolist():
             mine = sensor == sid
             x[mine], y[mine], R[mine] = polar_plots(self.sensors, sid,
                                                     rng[sensor[polar] == sid],
-                                                    p["bearing"][mine])
+                                                    p["bearing"][mine],
+                                                    types[mine] if types is not None else None)
         return {**out, "x": x, "y": y, "R": R}
 
     def _adopt(self, radars: Sequence[int], adsb: Sequence[int] = (),

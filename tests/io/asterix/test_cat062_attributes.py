@@ -22,7 +22,7 @@ FRAME = LocalFrame(51.47, -0.45)
 
 def _table(n=400):
     rng = np.random.default_rng(4)
-    some = rng.random((6, n)) < 0.8  # each attribute known on 80 % of the rows
+    some = rng.random((12, n)) < 0.8  # each attribute known on 80 % of the rows
     major = rng.uniform(5, 3000, n)
     a = TrackAttributes(
         flight_level=np.where(some[0], rng.uniform(-10, 450, n), np.nan),
@@ -34,7 +34,18 @@ def _table(n=400):
         sigma_major=np.where(some[5], major, np.nan),
         sigma_minor=np.where(some[5], major * rng.uniform(0.05, 1, n), np.nan),
         sigma_orient=np.where(some[5], rng.uniform(0, 180, n), np.nan),
-        sensors=np.full(n, "", object), sensor_ages=np.full(n, "", object))
+        sensors=np.full(n, "", object), sensor_ages=np.full(n, "", object),
+        # ages up to 90 s: beyond I062/290's 63.75 s some are saturated
+        age_psr=np.where(some[6], rng.uniform(0, 90, n), np.nan),
+        age_ssr=np.where(some[7], rng.uniform(0, 90, n), np.nan),
+        age_mds=np.where(some[8], rng.uniform(0, 30, n), np.nan),
+        # the row's plot: a sensor (SAC·256 + SIC), its type, code and level as received
+        meas_sensor=np.where(some[9], rng.integers(0, 1 << 16, n), -1),
+        meas_type=np.where(some[9], rng.integers(0, 5, n), 0),
+        meas_mode_3a=np.where(some[9] & some[10], rng.integers(0, 0o10000, n), -1),
+        meas_mode_3a_vg=np.where(some[9], rng.integers(0, 4, n), 0),
+        meas_flight_level=np.where(some[9] & some[11], rng.uniform(-10, 450, n), np.nan),
+        meas_flight_level_vg=np.where(some[9], rng.integers(0, 4, n), 0))
     return TrackTable(scan=np.arange(n), time=1000.0 + np.arange(n) * 0.25,
                       track_id=rng.integers(0, 5000, n), x=rng.uniform(-2e5, 2e5, n),
                       y=rng.uniform(-2e5, 2e5, n), vx=rng.uniform(-250, 250, n),
@@ -77,6 +88,17 @@ def _compare(tracks: TrackTable, items: list[dict]) -> None:
             bad.append("380 ADR")
         if adr.get("ID", {}).get("ACID") != (a.callsign[i] or None):
             bad.append("380 ID")
+        tid = m.get("I062/245")  # target identification: STI 0 (downlinked), CHR
+        if (tid is None) != (not a.callsign[i]) or (
+                tid is not None and (tid["STI"], tid["TId"]) != (0, a.callsign[i])):
+            bad.append("245")
+        ages = m.get("I062/290", {})
+        for k, v in (("PSR", a.age_psr[i]), ("SSR", a.age_ssr[i]), ("MDS", a.age_mds[i])):
+            got = ages.get(k, {}).get(k)
+            if (got is None) != np.isnan(v) or (
+                    got is not None and abs(got - min(v, 63.75)) > 0.25):
+                bad.append(f"290 {k}")
+        bad += _wrong_340(m.get("I062/340"), a, i)
         acc = m.get("I062/500")
         if (acc is None) != np.isnan(a.sigma_major[i]):
             bad.append("500 present")
@@ -94,6 +116,33 @@ def _compare(tracks: TrackTable, items: list[dict]) -> None:
         assert any(not p for p in problems), (m, problems)
 
 
+def _wrong_340(got: dict | None, a: TrackAttributes, i: int) -> list[str]:
+    """I062/340 against the row's plot: SID = SAC·256 + SIC, TYP (1 PSR, 2 SSR, 3 both,
+    5 Mode S), MDA code with V, G, MDC level within ¼ FL with V, G."""
+    if (got is None) != (a.meas_sensor[i] < 0):
+        return ["340 present"]
+    if got is None:
+        return []
+    bad = []
+    sid = got["SID"]["SAC"] * 256 + got["SID"]["SIC"]
+    if sid != a.meas_sensor[i]:
+        bad.append("340 SID")
+    typ = {1: 1, 2: 2, 3: 3, 4: 5}.get(int(a.meas_type[i]))
+    if got.get("TYP", {}).get("TYP") != typ:
+        bad.append("340 TYP")
+    mda, code = got.get("MDA"), a.meas_mode_3a[i]
+    vg = int(a.meas_mode_3a_vg[i])
+    if (mda is None) != (code < 0) or (mda is not None and (
+            mda["Mode3A"], mda["V"], mda["G"]) != (code_text(code), vg >> 1, vg & 1)):
+        bad.append("340 MDA")
+    mdc, fl = got.get("MDC"), a.meas_flight_level[i]
+    vg = int(a.meas_flight_level_vg[i])
+    if (mdc is None) != np.isnan(fl) or (mdc is not None and (
+            abs(mdc["ModeC"] - fl) > 0.25 or (mdc["CV"], mdc["CG"]) != (vg >> 1, vg & 1))):
+        bad.append("340 MDC")
+    return bad
+
+
 @pytest.mark.parametrize("suffix", [".csv", ".parquet"])
 def test_items_decoded_by_pyasteryx_equal_the_tracks_file(tmp_path, suffix):
     write_tracks(_table(), tmp_path / f"t{suffix}", FRAME)
@@ -109,7 +158,8 @@ def test_a_file_without_attributes_exports_none(tmp_path):
                                                             "y", "vx", "vy", "plot")}),
                  tmp_path / "t.csv", FRAME)
     export_tracks(tmp_path / "t.csv", None, tmp_path / "t.ast")
-    new = {"I062/060", "I062/136", "I062/220", "I062/380", "I062/500"}
+    new = {"I062/060", "I062/136", "I062/220", "I062/380", "I062/500", "I062/245",
+           "I062/290", "I062/340"}
     assert not any(new & set(m) for m in _decoded(tmp_path / "t.ast"))
 
 
@@ -143,6 +193,23 @@ def test_a_tracker_run_exports_its_attributes(tmp_path):
     export_tracks(tmp_path / "tracks.csv", None, tmp_path / "export.ast")
     assert (tmp_path / "sink.ast").read_bytes() == (tmp_path / "export.ast").read_bytes()
     tracks = read_tracks(tmp_path / "tracks.csv")
-    online = ~tracks.tentative  # the tentative past has no identity
+    online = ~tracks.tentative
+    # the tentative past carries the identity its branch had: the same address as the
+    # confirmed track wherever it had one
+    past = tracks.tentative & (tracks.attrs.address >= 0)
+    assert past.sum() > 0.5 * tracks.tentative.sum()
+    first = {int(t): int(a) for t, a in zip(tracks.track_id[online].tolist(),
+                                             tracks.attrs.address[online].tolist(),
+                                             strict=True)}
+    same = [first.get(int(t), a) == a for t, a in zip(tracks.track_id[past].tolist(),
+                                                       tracks.attrs.address[past].tolist(),
+                                                       strict=True)]
+    assert np.mean(same) > 0.99
     assert tracks.attrs is not None and (tracks.attrs.address[online] >= 0).mean() > 0.9
+    known = np.isfinite(np.column_stack((tracks.attrs.age_psr, tracks.attrs.age_ssr,
+                                         tracks.attrs.age_mds)))
+    assert known[online].any(axis=1).mean() > 0.9  # the technologies' ages are filled
+    upd = online & (tracks.plot >= 0)  # a row with a plot says what that plot measured
+    assert (tracks.attrs.meas_sensor[upd] >= 0).all()
+    assert (tracks.attrs.meas_sensor[tracks.plot < 0] < 0).all()
     _compare(tracks, _decoded(tmp_path / "export.ast"))

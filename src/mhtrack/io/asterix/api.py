@@ -16,6 +16,7 @@ from mhtrack.io._source import FORMATS
 from mhtrack.io._times import seconds
 from mhtrack.io.asterix.decode import (
     ADSB_EXTRA,
+    CHARACTERISTICS,
     FL_M,
     PLOT_COLUMNS,
     Recording,
@@ -117,11 +118,12 @@ def ground_ranges(sensors: SensorSet, sensor: np.ndarray, slant: np.ndarray,
 
 def plot_columns(rec: Recording, sensors: SensorSet | None = None) -> dict[str, pa.Array]:
     """The plots table of a recording, columns in output order: :data:`PLOT_COLUMNS`,
-    then ``lat, lon, sigma`` when it holds ADS-B reports, ``range`` last (with
+    then ``lat, lon, sigma`` when it holds ADS-B reports, the I048/130 columns
+    (:data:`~mhtrack.io.asterix.decode.CHARACTERISTICS`) when a plot has them, ``range`` last (with
     ``sensors``); empty text, ``-1`` ints and NaN become empty cells."""
     p = rec.plots
     cols: dict[str, pa.Array] = {}
-    for name in (*PLOT_COLUMNS, *(c for c in ADSB_EXTRA if c in p)):
+    for name in (*PLOT_COLUMNS, *(c for c in (*ADSB_EXTRA, *CHARACTERISTICS) if c in p)):
         v = p[name]
         if name.endswith("_vg"):  # 2·V + G → the V and G columns, where any is set
             base = name[:-3]

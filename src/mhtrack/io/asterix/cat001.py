@@ -96,8 +96,11 @@ def plot_row001(rec: Any, at: int, problems: Problems) -> tuple[Any, ...] | None
         track = _uint(i020, "TYP")
     ptype = typ if typ >= 0 else 0
     vg = [0 if i is None else 2 * _uint(i, "V") + _uint(i, "G") for i in (i070, i090)]
+    i131 = rec.get_item("131")  # received power (dBm): the plot's amplitude
+    power = () if i131 is None else \
+        (*(np.nan,) * 7, float(i131.variation.content.as_quantity("dBm")))
     return (float(i141.variation.content.as_quantity("s")), sac * 256 + sic, sac, sic,
-            rho, theta, fl, m3a, "", "", -1, typ, ptype, *vg, sim, rab, tst, track)
+            rho, theta, fl, m3a, "", "", -1, typ, ptype, *vg, sim, rab, tst, track, *power)
 
 
 def mark_row002(rec: Any) -> tuple[Any, ...] | None:

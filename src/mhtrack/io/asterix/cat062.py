@@ -6,7 +6,9 @@ tentative, CST coasting), by libasterix (edition 1.18); and read back
 recordings"). With the tracks' attributes (issue 29 item 5,
 :class:`~mhtrack.attributes.TrackAttributes`) also, where known: 060 Mode 3/A code, 136
 measured flight level, 220 rate of climb, 380 ADR (Mode S address) and ID (callsign),
-500 APC and COV (the position's σx, σy and ``sign(Pxy) √|Pxy|``, :mod:`.cat062_items`).
+500 APC and COV (the position's σx, σy and ``sign(Pxy) √|Pxy|``), 245 target
+identification and 290 update ages per technology (PSR, SSR, Mode S;
+:mod:`.cat062_items`).
 """
 
 from __future__ import annotations

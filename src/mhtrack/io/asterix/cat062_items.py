@@ -3,7 +3,14 @@ CAT062 edition 1.18, encoded by libasterix): I062/060 Mode 3/A code (V, G, CH 0:
 code kept is the last validated one), 136 measured flight level (1/4 FL), 220 rate of
 climb (6.25 ft/min), 380 subfields ADR (24-bit address) and ID (callsign, up to eight
 characters of the 6-bit ICAO set), 500 subfields APC (σ of x and y, 0.5 m) and COV
-(``sign(Pxy) √|Pxy|``, 0.5 m). Each item only where its value is known.
+(``sign(Pxy) √|Pxy|``, 0.5 m), 245 target identification (STI 0 "downlinked from the
+target": our callsigns come from Mode S replies, I048/240; CHR the callsign) and 290
+system track update ages PSR, SSR and MDS (¼ s, 8 bits: an age beyond 63.75 s is written
+as 63.75 s, saturated, as the item cannot hold more), and 340 measured information of
+the row's own plot: SID (the sensor id as SAC·256 + SIC), TYP (plot type: 1 PSR, 2 SSR,
+3 SSR + PSR, 5 Mode S — roll-call: all-call and roll-call replies are not told apart
+here), MDA (the code as received with its V, G; L 0) and MDC (its Mode C level, ¼ FL,
+with V, G). Each item only where its value is known.
 
 σx, σy and Pxy come from the tracks file's ellipse (σ major ``M``, minor ``m``, the
 major axis' bearing ``β`` from north): with the axis ``u = (sin β, cos β)``,
@@ -20,8 +27,10 @@ from typing import Any
 import numpy as np
 
 import mhtrack.io.asterix._lib as _lib
-from mhtrack.attributes import TrackAttributes, code_text
+from mhtrack.attributes import COMBINED, MODE_S, PRIMARY, SECONDARY, TrackAttributes, code_text
 
+#: I062/340 TYP of our plot types.
+TYP340 = {PRIMARY: 1, SECONDARY: 2, COMBINED: 3, MODE_S: 5}
 #: Characters of I062/380 ID (ICAO 6-bit: A–Z, 0–9, space).
 ID_CHARS = frozenset("ABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789 ")
 
@@ -33,7 +42,9 @@ def lsb_attributes() -> dict[str, float]:
     return {"fl": float(rec.spec("136").create(1).variation.content.as_quantity("FL")),
             "fpm": float(rec.spec("220").create(1).variation.content.as_quantity("ft/min")),
             "m": float(apc.create((("X", 1), ("Y", 1))).variation.get_item("X")
-                       .variation.content.as_quantity("m"))}
+                       .variation.content.as_quantity("m")),
+            "age": float(rec.spec("290").create({"PSR": 1}).variation.get_item("PSR")
+                         .variation.content.as_quantity("s"))}
 
 
 def cartesian(a: TrackAttributes) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -72,6 +83,14 @@ def attribute_items(a: TrackAttributes, check: Callable[..., None]
 
     ax, ay = raw(sx, 0, top), raw(sy, 0, top)
     cov = raw(np.sign(cxy) * np.sqrt(np.abs(cxy)), -0x8000, 0x7FFF)
+    mfl = np.round(np.nan_to_num(a.meas_flight_level) * 4).astype(np.int64)
+    check(np.isfinite(a.meas_flight_level) & (np.abs(mfl) >= 1 << 13), "meas_flight_level",
+          lambda r: f"measured flight level {a.meas_flight_level[r]:g} beyond I062/340 MDC")
+    check(a.meas_sensor > 0xFFFF, "meas_sensor", lambda r: f"sensor {a.meas_sensor[r]} "
+          "is not SAC·256 + SIC (I062/340 SID)")
+    ages = {k: (np.isfinite(v), np.clip(np.round(np.nan_to_num(v) / L["age"]), 0, 0xFF)
+                .astype(np.int64))
+            for k, v in (("PSR", a.age_psr), ("SSR", a.age_ssr), ("MDS", a.age_mds))}
 
     def items(i: int) -> dict[str, Any]:
         out: dict[str, Any] = {}
@@ -88,9 +107,33 @@ def attribute_items(a: TrackAttributes, check: Callable[..., None]
             adr["ID"] = names[i].ljust(8)
         if adr:
             out["380"] = adr
+        if names[i]:
+            out["245"] = (("STI", 0), 0, ("CHR", names[i].ljust(8)))
+        age = {k: int(raw_age[i]) for k, (has, raw_age) in ages.items() if has[i]}
+        if age:
+            out["290"] = age
+        if a.meas_sensor[i] >= 0:
+            out["340"] = measured_item(a, i, int(mfl[i]))
         if known[i]:
             out["500"] = {"APC": (("X", int(ax[i])), ("Y", int(ay[i]))),
                           "COV": int(cov[i])}
         return out
 
     return items
+
+
+def measured_item(a: TrackAttributes, i: int, mfl: int) -> dict[str, Any]:
+    """I062/340 of row ``i`` (module docstring), ``mfl`` its level in ¼ FL."""
+    sensor = int(a.meas_sensor[i])
+    out: dict[str, Any] = {"SID": (("SAC", sensor >> 8), ("SIC", sensor & 0xFF))}
+    if int(a.meas_type[i]) in TYP340:
+        out["TYP"] = (("TYP", TYP340[int(a.meas_type[i])]), ("SIM", 0), ("RAB", 0),
+                      ("TST", 0), 0)
+    if a.meas_mode_3a[i] >= 0:
+        vg = int(a.meas_mode_3a_vg[i])
+        out["MDA"] = (("V", vg >> 1), ("G", vg & 1), ("L", 0), 0,
+                      ("MODE3A", code_text(int(a.meas_mode_3a[i]))))
+    if np.isfinite(a.meas_flight_level[i]):
+        vg = int(a.meas_flight_level_vg[i])
+        out["MDC"] = (("V", vg >> 1), ("G", vg & 1), ("LMC", mfl))
+    return out

@@ -27,6 +27,7 @@ import mhtrack.io.asterix._lib as _lib
 from mhtrack.io.asterix._lib import quantity
 from mhtrack.io.asterix.cat001 import TimeRestorer, block001, block002
 from mhtrack.io.asterix.cat021 import block021
+from mhtrack.io.asterix.characteristics import CHARACTERISTICS, characteristics
 from mhtrack.io.asterix.columns import columns
 from mhtrack.io.asterix.container import blocks
 from mhtrack.io.asterix.duplicates import DuplicateFilter
@@ -198,18 +199,20 @@ def _plots_only(rows: list[tuple[Any, ...]], cat: int, at: int, problems: Proble
     """The rows that are plots of real targets (:func:`~mhtrack.io.asterix.notplots.
     reason`), the others counted (``not_plot``, the first one's reason in the detail).
     Rows hold from column 11 on: CAT048 ``typ`` and the I048/020 flags (the plot type
-    made here), then ``mode_3a_vg, flight_level_vg``; CAT001 ``typ, plot_type,
-    mode_3a_vg, flight_level_vg, sim, rab, tst, track``; CAT021 ``typ, plot_type``, the
+    made here), then ``mode_3a_vg, flight_level_vg``, then the
+    :data:`CHARACTERISTICS` when the record has I048/130; CAT001 ``typ, plot_type,
+    mode_3a_vg, flight_level_vg, sim, rab, tst, track``, then the characteristics (all
+    NaN but ``amplitude``) when it has I001/131; CAT021 ``typ, plot_type``, the
     validity bits (0), the flags, ``lat, lon, sigma``. The result has
     :data:`PLOT_COLUMNS` (CAT021: then ``lat, lon, sigma``)."""
     out, dropped, first = [], 0, ""
     for r in rows:
         if cat == 48:
             why = reason(r[11], r[12], r[13], r[14])
-            row = (*r[:12], plot_type048_of(r[11]), r[15], r[16])
+            row = (*r[:12], plot_type048_of(r[11]), r[15], r[16], *r[17:])
         elif cat == 1:
             why = reason(r[11], r[15], r[16], r[17], r[18])
-            row = r[:15]
+            row = (*r[:15], *r[19:])  # I001/131: the characteristics' amplitude
         else:
             why = reason(-1, r[15], r[16], r[17])
             row = (*r[:11], -1, *r[12:15], *r[18:])
@@ -269,8 +272,11 @@ def plot_row(rec: Any, at: int, problems: Problems) -> tuple[Any, ...] | None:
     address = f"{i220.variation.content.as_uint():06X}" if i220 is not None else ""
     callsign = i240.variation.content.as_string().strip() if i240 is not None else ""
     tn = _sub(i161, "TRN").variation.content.as_uint() if i161 is not None else -1
+    i130 = rec.get_item("130")
     return (quantity(i140, "s"), sac * 256 + sic, sac, sic, rho, theta, fl, m3a, address,
-            callsign, tn, *flags048(rec), vg(i070), vg(i090))
+            callsign, tn, *flags048(rec), vg(i070), vg(i090),
+            *(() if i130 is None else characteristics(i130)))
+
 
 
 def vg(item: Any) -> int:
@@ -329,11 +335,13 @@ def _columns(rows: list[tuple[Any, ...]], marks: list[tuple[Any, ...]],
 
 def plot_columns(rows: list[tuple[Any, ...]]) -> dict[str, np.ndarray]:
     """:data:`PLOT_COLUMNS` of plot rows (:meth:`Decoder.blocks`), then :data:`ADSB_EXTRA`
-    when a row is an ADS-B report (NaN on the radars' rows); ``time`` is the time of
-    day."""
+    when a row is an ADS-B report, and :data:`CHARACTERISTICS` when a row has radar
+    plot characteristics (NaN on the other rows); ``time`` is the time of day."""
     k = len(PLOT_COLUMNS)
     out = columns([r[:k] for r in rows], PLOT_COLUMNS)
-    if any(len(r) > k for r in rows):
-        extra = np.array([r[k:k + 3] if len(r) > k else (np.nan,) * 3 for r in rows], float)
-        out.update(zip(ADSB_EXTRA, extra.T, strict=True))
+    for names, width in ((ADSB_EXTRA, len(ADSB_EXTRA)), (CHARACTERISTICS, len(CHARACTERISTICS))):
+        if any(len(r) == k + width for r in rows):
+            extra = np.array([r[k:] if len(r) == k + width else (np.nan,) * width
+                              for r in rows], float)
+            out.update(zip(names, extra.T, strict=True))
     return out

@@ -21,7 +21,8 @@ libasterix, once:
 * a **needed fixed-size field** (I048/010 SAC, SIC; 140; 040 RHO, THETA; 090 FL; 161 TRN;
   220) is read as ``raw × LSB`` with its bit offset, size, signedness and LSB taken from
   libasterix's spec classes (:func:`field`); text items (070, 240) and 020's flags are
-  decoded by libasterix once per distinct encoding.
+  decoded by libasterix once per distinct encoding, as is I048/130 (radar plot
+  characteristics, a compound item).
 
 Each new layout is checked: its first record decoded this way must equal libasterix's
 own decoding, else that layout always goes through libasterix. The tests compare both
@@ -35,6 +36,7 @@ from dataclasses import dataclass
 from typing import Any
 
 import mhtrack.io.asterix._lib as _lib
+from mhtrack.io.asterix.characteristics import characteristics
 from mhtrack.io.asterix.notplots import flags048_item
 from mhtrack.io.asterix.problems import Problems
 
@@ -238,8 +240,10 @@ def cat048_row(self: FastRecords, raw: bytes, spans: dict[str, tuple[int, int]],
         if "020" in spans else (-1, -1, -1, -1)
     vg = [2 * f[f"{k}_v"].read(raw, spans[k][0]) + f[f"{k}_g"].read(raw, spans[k][0])
           if k in spans else 0 for k in ("070", "090")]
+    char = self._decoded("130", raw[slice(*_range(spans["130"]))], characteristics) \
+        if "130" in spans else ()
     return (f["tod"].read(raw, spans["140"][0]), sac * 256 + sic, sac, sic, rho, theta,
-            fl, m3a, address, callsign, tn, *flags, *vg)
+            fl, m3a, address, callsign, tn, *flags, *vg, *char)
 
 
 def cat034_row(self: FastRecords, raw: bytes, spans: dict[str, tuple[int, int]], at: int,

@@ -33,7 +33,12 @@ requirements §6.3, Recommendations in the document's terms, §6.3.1):
   and its PSR figures, §6.4.3.1: random σ 120 m in slant range and 0.15° in azimuth,
   systematic 100 m, 0.1°, 1 m/NM, 100 ms); they are kept, marked unverified, and a
   sensors file entry overrides them. Being bounds a compliant radar should meet, they
-  overstate the errors of a good monopulse SSR, never understate them.
+  overstate the errors of a good monopulse SSR, never understate them. A second search
+  of the stored pages and documentation (issue 29, SSR/PSR accuracy, ESASSP, the 1997
+  standard and its companion "Radar Sensor Performance Analysis",
+  SUR.ET1.ST03.1000-STD-01-01) again found the documents' front pages only: the two
+  values stay marked unverified. A radar's plot types may have their own σ and ``P_D``
+  in the sensors file (PSR, SSR, combined, Mode S; docs/file-formats.md).
 
 The successor in substance, the EUROCONTROL Specification for ATM Surveillance System
 Performance (ESASSP, EUROCONTROL-SPEC-0147, Edition 1.1 2015 / 1.2 2021), states

@@ -45,10 +45,14 @@ class _Logged:
     plot: np.ndarray
     score: np.ndarray
     t: np.ndarray  # each leaf's own time
+    #: each model's filtered state (kept for the smoother only: ``models``)
+    mu: np.ndarray | None = None
+    xm: np.ndarray | None = None
+    Pm: np.ndarray | None = None
 
     @classmethod
     def of(cls, scan: int, time: float, leaves: Leaves,
-           rows: np.ndarray | None = None) -> _Logged:
+           rows: np.ndarray | None = None, models: bool = False) -> _Logged:
         tentative = leaves.track < 0
         sel = (tentative if rows is None else tentative & rows).nonzero()[0]
         node = leaves.node[sel]
@@ -56,22 +60,26 @@ class _Logged:
             sel = sel[node.argsort(kind="stable")]
             node = leaves.node[sel]
         # 2-D and wider rows by take (a copy without fancy indexing's set-up)
+        m = (leaves.mu.take(sel, axis=0), leaves.xm.take(sel, axis=0),
+             leaves.Pm.take(sel, axis=0)) if models else (None, None, None)
         return cls(np.array([scan], np.int64), np.array([time], float), node,
                    leaves.parent[sel], leaves.x.take(sel, axis=0), leaves.P.take(sel, axis=0),
-                   leaves.window[:, -1][sel], leaves.score[sel], leaves.time[sel])
+                   leaves.window[:, -1][sel], leaves.score[sel], leaves.time[sel], *m)
 
 
 class TentativeHistory:
     """States of tentative leaves over the last ``depth`` scans (0: keep nothing).
 
     Call :meth:`record` once per scan after the track management, and :meth:`backfill`
-    before it for the leaves confirmed at that scan.
+    before it for the leaves confirmed at that scan. ``models``: keep each leaf's model
+    states too (an IMM's ``mu, xm, Pm``), for the rows' smoothing.
     """
 
-    def __init__(self, depth: int) -> None:
+    def __init__(self, depth: int, models: bool = False) -> None:
         if depth < 0:
             raise ValueError(f"history depth must be >= 0, got {depth}")
         self.depth = int(depth)
+        self.models = models
         self._log: deque[_Logged] = deque(maxlen=max(self.depth, 1))
         #: per logged scan, the sorted plot rows the output gives a track at that scan
         self._claimed: deque[np.ndarray] = deque(maxlen=max(self.depth, 1))
@@ -83,7 +91,7 @@ class TentativeHistory:
         not modified); ``rows`` (mask): of those leaves only (the leaves a frame
         stepped), as if given ``leaves.take(rows)``."""
         if self.depth:
-            self._log.append(_Logged.of(scan, time, leaves, rows))
+            self._log.append(_Logged.of(scan, time, leaves, rows, self.models))
             rep = leaves.reported() if rep is None else rep
             if rows is not None:
                 rep = rep & rows
@@ -130,7 +138,7 @@ class TentativeHistory:
                 scan=np.repeat(log.scan, n), time=log.t[j], track_id=tid,
                 x=x[:, 0].copy(), y=x[:, 2].copy(), vx=x[:, 1].copy(), vy=x[:, 3].copy(),
                 plot=plot, score=log.score[j], P=log.P.take(j, axis=0),
-                tentative=np.ones(n, bool)))
+                tentative=np.ones(n, bool), **_models(log, j)))
             cur = log.parent[j]
             live = cur >= 0
             cur, tid = cur[live], tid[live]
@@ -145,7 +153,8 @@ class TentativeHistory:
         out: dict[str, np.ndarray] = {"count": np.array([len(self._log)], np.int64)}
         for i, (log, claimed) in enumerate(zip(self._log, self._claimed, strict=True)):
             for f in fields(_Logged):
-                out[f"{i}__{f.name}"] = getattr(log, f.name)
+                if getattr(log, f.name) is not None:
+                    out[f"{i}__{f.name}"] = getattr(log, f.name)
             out[f"{i}__claimed"] = claimed
         return out
 
@@ -159,3 +168,12 @@ class TentativeHistory:
             got.setdefault("t", np.full(got["node"].size, float(got["time"][0])))
             self._log.append(_Logged(**got))
             self._claimed.append(np.asarray(arrays[f"{i}__claimed"], np.int64))
+
+
+def _models(log: _Logged, j: np.ndarray) -> dict[str, np.ndarray]:
+    """The model states of rows ``j`` of ``log`` as :class:`TrackTable` fields (none when
+    the log kept none: a log restored from a state saved without them)."""
+    if log.mu is None or log.xm is None or log.Pm is None:
+        return {}
+    return {"mu": log.mu.take(j, axis=0), "xm": log.xm.take(j, axis=0),
+            "Pm": log.Pm.take(j, axis=0)}

@@ -32,8 +32,9 @@ TRACKER_FUSIONS: tuple[str, ...] = ("none", "adaptive-kmeans")
 INITIATION_FUSIONS: tuple[str, ...] = ("adaptive-kmeans", "kmeans", "none")
 #: K-means seedings compared in P2's clustering study.
 CLUSTER_METHODS: tuple[str, ...] = ("adaptive", "random")
-#: Tracker output modes: ``history`` adds each confirmed track's tentative past.
-OUTPUTS: tuple[str, ...] = ("history", "online")
+#: Tracker output modes: ``history`` adds each confirmed track's tentative past;
+#: ``smoothed`` is that history smoothed over each whole track (:mod:`mhtrack.sinks.smoothed`).
+OUTPUTS: tuple[str, ...] = ("history", "online", "smoothed")
 #: The output mode when none is chosen.
 DEFAULT_OUTPUT = OUTPUTS[0]
 #: What ``mhtrack export`` writes: ASTERIX CAT048 plots (the default) or CAT062 tracks.

@@ -89,7 +89,9 @@ def output_option(f: Callable[..., Any]) -> Callable[..., Any]:
         help="history: each confirmed track also at the scans before its confirmation, back "
         "to its first plot (at most MHTConfig.history_scans back; from the seed scan with "
         "an initiator --birth), those rows marked tentative; online: only what the tracker "
-        "reported at each scan.")(f)
+        "reported at each scan; smoothed: the history with every track's positions and "
+        "velocities smoothed over the whole track (fixed-interval Rauch-Tung-Striebel, "
+        "IMM-aware), for analysis.")(f)
 
 
 def config_changes(tracker_pd: float | None, meas_sigma: float | None,

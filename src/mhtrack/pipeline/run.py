@@ -305,8 +305,13 @@ class Pipeline:
         keep every step's :class:`StepStats` in :attr:`RunResult.stats` (else only their
         :class:`StatsSummary`: memory flat in the run's length)."""
         summary = StatsSummary()
+        if self.output == "smoothed":  # the history, smoothed at the end (sinks/smoothed.py)
+            from mhtrack.sinks.smoothed import SmoothedHistory
+
+            self.tracker.keep_models = True
+            sinks = [SmoothedHistory(sinks, self.tracker.motion)]
         stats, n_tracks = feed(self.outputs(progress=progress), sinks, self.source,
-                               backfill_ids=self.output == "history", summary=summary,
+                               backfill_ids=self.output != "online", summary=summary,
                                keep_stats=keep_stats)
         return RunResult(self.options.tracker, tuple(stats), n_tracks, self.source.timed,
                          summary)

@@ -6,7 +6,9 @@ that frame (``online``) and, kept apart, the tentative past of the tracks confir
 it (``backfill``, :attr:`~mhtrack.mht.MHTTracker.last_backfill`). The output mode
 (:data:`mhtrack.names.OUTPUTS`) decides what a table keeps: ``history`` both, sorted by
 scan and track at the end; ``online`` only the online rows, in the order reported —
-the rows :meth:`~mhtrack.mht.MHTTracker.run` returns.
+the rows :meth:`~mhtrack.mht.MHTTracker.run` returns; ``smoothed`` the rows of
+``history``, which the pipeline smooths before the sinks see them
+(:class:`~mhtrack.sinks.smoothed.SmoothedHistory`): a sink keeps them as ``history``.
 """
 
 from __future__ import annotations
@@ -78,13 +80,13 @@ class TrackCollector(Sink):
         self._parts: list[TrackTable] = []
 
     def write(self, out: FrameOutput) -> None:
-        self._parts += [t for t in (out.online, out.backfill if self.output == "history"
+        self._parts += [t for t in (out.online, out.backfill if self.output != "online"
                                     else None) if t is not None and len(t)]
 
     def tracks(self) -> TrackTable:
-        """The rows so far (``history``: sorted by scan, then track id)."""
+        """The rows so far (``history``, ``smoothed``: sorted by scan, then track id)."""
         out = TrackTable.concat(self._parts)
-        return out.sorted() if self.output == "history" else out
+        return out if self.output == "online" else out.sorted()
 
     def clear(self) -> None:
         """Forget the rows so far (a rolling part was written)."""

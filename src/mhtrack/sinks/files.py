@@ -117,7 +117,7 @@ class TracksFileSink(_Rows):
         if self._writer is None:
             self.start(None)
         assert self._writer is not None
-        history = self.rows.output == "history"
+        history = self.rows.output != "online"
         rows = [t for t in (out.online, out.backfill if history else None)
                 if t is not None and len(t)]
         if not rows:

@@ -10,9 +10,11 @@ output, and closes them. Positions, velocities and ``P`` are the smoothed ones; 
 other column (scan, time, track id, plot, score, tentative, attributes) is the row's own.
 The online view is not smoothed: it is what the tracker reported, frame by frame.
 
-A row is final only when its track has ended, so this sink keeps the run's history rows
-in memory (each with ``r`` model states) until the end: about 0.35 kB a row with a
-two-model IMM.
+A row can be smoothed over the rest of its track only once the track has ended; to keep
+memory bounded on long recordings a row is final, and smoothed over the rows of its track
+that have arrived, once they reach :data:`SMOOTHING_LAG_S` past it (10 minutes: longer
+than the smoother's reach by far — the rows' difference from the whole-track answer is
+in ``docs/mht.md``). The rows held take about 0.55 kB each with a two-model IMM.
 """
 
 from __future__ import annotations
@@ -25,7 +27,7 @@ import numpy as np
 
 from mhtrack.models.smoother import Filtered, smooth
 from mhtrack.records import TrackTable
-from mhtrack.sinks.base import FrameOutput, Sink, TrackCollector
+from mhtrack.sinks.base import FrameOutput, Sink
 
 if TYPE_CHECKING:
     from mhtrack.models.motion import MotionModel
@@ -48,14 +50,33 @@ def smoothed_rows(rows: TrackTable, motion: MotionModel) -> TrackTable:
                                mu=None, xm=None, Pm=None)
 
 
-class SmoothedHistory(Sink):
-    """The history rows of a run, smoothed at its end, into ``sinks`` (module docstring);
-    ``motion``: the tracker's motion model (``MHTTracker.motion``). The tracker must keep
-    its rows' model states (``keep_models``) when ``motion`` is an IMM."""
+#: A history row is final, and smoothed, once the track's rows reach this much data time
+#: past it (s), or its track has ended: the smoothing lag (module docstring).
+SMOOTHING_LAG_S = 600.0
 
-    def __init__(self, sinks: Sequence[Sink], motion: MotionModel) -> None:
-        self.sinks, self.motion = list(sinks), motion
-        self._rows = TrackCollector("history")
+
+class SmoothedHistory(Sink):
+    """The history rows of a run, smoothed track by track, into ``sinks`` (module
+    docstring); ``motion``: the tracker's motion model (``MHTTracker.motion``; the
+    tracker must keep its rows' model states, ``keep_models``, when it is an IMM).
+
+    A row is held until it is final: no backfill can come before it (its scan below
+    :attr:`FrameOutput.settled`) and the rows seen reach ``lag_s`` of data time past it.
+    Every ``lag_s / 4`` of data time the tracks with final rows are smoothed over all
+    the rows held of them and their final rows handed on (with ``settled``: the oldest
+    scan still held), so memory holds about ``1.25 lag_s`` of rows. A row whose track
+    ends within ``lag_s`` after it is smoothed over the whole rest of its track (the
+    fixed-interval smoother, exactly); a longer track's row over the next ``lag_s`` to
+    ``1.25 lag_s`` of it (fixed-lag). ``lag_s = inf``: every row at the end."""
+
+    def __init__(self, sinks: Sequence[Sink], motion: MotionModel,
+                 lag_s: float = SMOOTHING_LAG_S) -> None:
+        if not lag_s > 0:
+            raise ValueError(f"the smoothing lag must be > 0 s, got {lag_s}")
+        self.sinks, self.motion, self.lag_s = list(sinks), motion, float(lag_s)
+        self._held: list[TrackTable] = []
+        self._t = -np.inf  # the latest row time seen
+        self._t_pass = -np.inf  # the data time of the last release
         self._last: FrameOutput | None = None
 
     def start(self, source: Source | None) -> None:
@@ -63,24 +84,45 @@ class SmoothedHistory(Sink):
             s.start(source)
 
     def write(self, out: FrameOutput) -> None:
-        self._rows.write(out)
         self._last = out
+        for rows in (out.online, out.backfill):
+            if rows is not None and len(rows):
+                self._held.append(rows)
+                self._t = max(self._t, float(rows.time.max()))
+        if out.settled is not None and self._t - self._t_pass >= self.lag_s / 4:
+            self._t_pass = self._t
+            self._release(out, self._t - self.lag_s, out.settled)
 
-    def smoothed(self) -> TrackTable:
-        """The rows so far, smoothed (sorted by scan, then track id)."""
-        return smoothed_rows(self._rows.tracks(), self.motion)
+    def _release(self, out: FrameOutput, before: float, settled: int | None) -> None:
+        """Smooth the tracks with final rows (time ≤ ``before``, scan below ``settled``;
+        ``settled`` None: every row) and hand those rows on."""
+        if not self._held:
+            return
+        held = TrackTable.concat(self._held)
+        final = held.time <= before
+        if settled is not None:
+            final &= held.scan < settled
+        if not final.any():
+            self._held = [held]
+            return
+        mine = np.isin(held.track_id, np.unique(held.track_id[final]))
+        rows = smoothed_rows(held.take(mine), self.motion).take(final[mine])
+        rest = held.take(~final)
+        self._held = [rest] if len(rest) else []
+        if settled is not None and len(rest):
+            settled = min(settled, int(rest.scan.min()))
+        done = FrameOutput(out.frame, rows, TrackTable.empty(), out.stats, settled)
+        for s in self.sinks:
+            s.write(done)
 
     def close(self) -> None:
-        rows = self.smoothed()
-        self._rows.clear()
         if self._last is not None:
-            last = self._last
-            out = FrameOutput(last.frame, rows, TrackTable.empty(), last.stats, None)
-            for s in self.sinks:
-                s.write(out)
+            self._release(self._last, np.inf, None)
+        self._held = []
         for s in self.sinks:
             s.close()
 
     def abort(self) -> None:
+        self._held = []
         for s in self.sinks:
             s.abort()

@@ -37,5 +37,8 @@ CLUSTER_METHODS: tuple[str, ...] = ("adaptive", "random")
 OUTPUTS: tuple[str, ...] = ("history", "online", "smoothed")
 #: The output mode when none is chosen.
 DEFAULT_OUTPUT = OUTPUTS[0]
+#: The output mode of timed plots of rotating radars when none is chosen (the run whose
+#: defaults come from the radars, ``build.radar_rule``): the history smoothed.
+RADAR_OUTPUT = OUTPUTS[2]
 #: What ``mhtrack export`` writes: ASTERIX CAT048 plots (the default) or CAT062 tracks.
 EXPORT_CATEGORIES: tuple[str, ...] = ("048", "062")

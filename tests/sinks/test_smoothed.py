@@ -111,3 +111,42 @@ def test_smoothing_needs_covariances() -> None:
         smoothed_rows(t, ConstantVelocity())
     empty = smoothed_rows(dataclasses.replace(TrackTable.empty()), ConstantVelocity())
     assert len(empty) == 0
+
+
+def test_default_output_of_rotating_radars_is_smoothed(scene) -> None:
+    """Timed plots of rotating radars (defaults from the radars): ``smoothed``; a
+    scenario's scans (``run``): ``history``; an output given is kept."""
+    sc, sim = scene
+    src = MemorySource(sim.plots, sensors=sc.sensor_set())
+    assert Pipeline(src, TrackOptions()).output == "smoothed"
+    assert Pipeline(src, TrackOptions()).output_note is not None
+    assert Pipeline(src, TrackOptions(output="history")).output == "history"
+    assert Pipeline(src, TrackOptions(output="history")).output_note is None
+    sc2 = apply_overrides(preset("crossing"), scans=3)
+    sim2 = simulate(sc2, seed=1)
+    assert Pipeline(MemorySource(sim2.plots, scenario=sc2), TrackOptions()).output == "history"
+
+
+def test_other_sinks_see_each_frame_and_a_failure_leaves_no_file(scene, tmp_path) -> None:
+    from mhtrack.sinks import CallbackSink, TracksFileSink
+
+    sc, sim = scene
+    pipe = Pipeline(MemorySource(sim.plots, sensors=sc.sensor_set()), TrackOptions())
+    seen: list[int] = []
+    rows = TrackCollector("smoothed")
+    pipe.run([rows, CallbackSink(lambda out: seen.append(len(out.online)))])
+    assert len(seen) > 100  # every frame, as reported
+    assert sum(seen) == len(rows.tracks().online())
+
+    pipe = Pipeline(MemorySource(sim.plots, sensors=sc.sensor_set()), TrackOptions())
+    n = [0]
+
+    def fail(_):
+        n[0] += 1
+        if n[0] == 50:
+            raise OSError(5, "the recording went away")
+
+    sink = TracksFileSink(tmp_path / "tracks.csv", frame=pipe.frame, output=pipe.output)
+    with pytest.raises(OSError, match="went away"):
+        pipe.run([sink, CallbackSink(fail)])
+    assert list(tmp_path.iterdir()) == []

@@ -16,7 +16,7 @@ from __future__ import annotations
 from abc import ABC, abstractmethod
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, ClassVar
 
 from mhtrack.names import DEFAULT_OUTPUT, OUTPUTS
 from mhtrack.records import Scan, TrackTable
@@ -47,6 +47,10 @@ class Sink(ABC):
     """Receives every frame's output; :meth:`start` before the first, :meth:`close`
     after the last (a file sink writes there)."""
 
+    #: The sink keeps a table of the rows (a tracks file, a collector): with the output
+    #: ``smoothed`` it gets the smoothed rows, other sinks each frame's output.
+    keeps_rows: ClassVar[bool] = False
+
     def start(self, source: Source | None) -> None:  # noqa: B027 - optional hook
         """Called once before the first frame with the source (its ``file_rows``,
         ``timed``); ``None`` when the frames come from no source (rows kept as they
@@ -74,6 +78,8 @@ def check_output(output: str | None) -> str:
 
 class TrackCollector(Sink):
     """The tracks of the whole run in memory, as :meth:`MHTTracker.run` returns them."""
+
+    keeps_rows = True
 
     def __init__(self, output: str | None = None) -> None:
         self.output = check_output(output)

@@ -26,6 +26,8 @@ class _Rows(Sink):
     ``part_frames = n`` writes them every ``n`` frames to ``STEM.part0000.SUFFIX``, … of
     ``path`` (:meth:`_write_part`, each part atomically), :attr:`paths` the files written."""
 
+    keeps_rows = True
+
     def __init__(self, output: str | None, path: str | Path,
                  part_frames: int | None) -> None:
         if part_frames is not None and part_frames < 1:

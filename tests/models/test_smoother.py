@@ -198,3 +198,61 @@ def test_first_row_of_zero_velocity_gets_the_tracks_velocity() -> None:
     assert x[0, 1] == 0.0
     xs, _ = smooth(Filtered(np.zeros(len(t), np.int64), t, x, P), cv)
     np.testing.assert_allclose(xs[0, [1, 3]], [150.0, -80.0], rtol=0.05)
+
+
+def test_rts_equals_stone_soups_kalman_smoother() -> None:
+    """Stone Soup's own filter (KalmanPredictor, KalmanUpdater) and KalmanSmoother on the
+    same plots, with mhtrack's F(dt) and Q(dt) as its transition model."""
+    pytest.importorskip("stonesoup")
+    import datetime
+
+    from stonesoup.base import Property
+    from stonesoup.models.measurement.linear import LinearGaussian
+    from stonesoup.models.transition.linear import LinearGaussianTransitionModel
+    from stonesoup.predictor.kalman import KalmanPredictor
+    from stonesoup.smoother.kalman import KalmanSmoother
+    from stonesoup.types.detection import Detection
+    from stonesoup.types.hypothesis import SingleHypothesis
+    from stonesoup.types.state import GaussianState
+    from stonesoup.types.track import Track
+    from stonesoup.updater.kalman import KalmanUpdater
+
+    class DiscreteCV(LinearGaussianTransitionModel):
+        sigma: float = Property(doc="acceleration noise std (m/s²)")
+
+        @property
+        def ndim_state(self) -> int:
+            return 4
+
+        def matrix(self, time_interval: datetime.timedelta, **kwargs) -> np.ndarray:
+            return ConstantVelocity.F(time_interval.total_seconds())
+
+        def covar(self, time_interval: datetime.timedelta, **kwargs) -> np.ndarray:
+            return ConstantVelocity(self.sigma).Q(time_interval.total_seconds())
+
+    rng = np.random.default_rng(5)
+    n, sigma = 15, 3.0
+    # whole microseconds: Stone Soup's times are datetimes
+    t = np.round(np.r_[0.0, np.cumsum(rng.uniform(0.5, 10.0, n - 1))], 6)
+    z = rng.normal(size=(n, 2)) * 150.0 + 80.0 * t[:, None]
+    t0 = datetime.datetime(2024, 1, 1)
+    model = DiscreteCV(sigma=sigma)
+    predictor = KalmanPredictor(model)
+    updater = KalmanUpdater(LinearGaussian(ndim_state=4, mapping=(0, 2), noise_covar=R))
+    prior = GaussianState(M0.reshape(4, 1), P0, timestamp=t0)
+    track = Track()
+    for k in range(n):
+        when = t0 + datetime.timedelta(seconds=float(t[k]))
+        pred = predictor.predict(prior, timestamp=when)
+        det = Detection(z[k].reshape(2, 1), timestamp=when,
+                        measurement_model=updater.measurement_model)
+        prior = updater.update(SingleHypothesis(pred, det))
+        track.append(prior)
+    want = KalmanSmoother(transition_model=model).smooth(track)
+    x = np.array([s.state_vector.ravel() for s in track], float)
+    P = np.array([s.covar for s in track], float)
+    xs, Ps = smooth(Filtered(np.zeros(n, np.int64), t, x, P), ConstantVelocity(sigma))
+    np.testing.assert_allclose(xs, np.array([s.state_vector.ravel() for s in want], float),
+                               rtol=1e-9, atol=1e-6)
+    np.testing.assert_allclose(Ps, np.array([s.covar for s in want], float),
+                               rtol=1e-7, atol=1e-6)

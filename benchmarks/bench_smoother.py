@@ -26,7 +26,8 @@ from mhtrack.sources.memory import MemorySource
 def measure(seed: int) -> dict[str, float]:
     sc = preset("opensky-radars")
     sim = simulate(sc, seed=seed)
-    pipe = Pipeline(MemorySource(sim.plots, sensors=sc.sensor_set()), TrackOptions())
+    pipe = Pipeline(MemorySource(sim.plots, sensors=sc.sensor_set()),
+                    TrackOptions(output="history"))
     pipe.tracker.keep_models = True
     rows = TrackCollector("history")
     result = pipe.run([rows], keep_stats=False)

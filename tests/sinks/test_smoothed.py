@@ -113,6 +113,27 @@ def test_smoothing_needs_covariances() -> None:
     assert len(empty) == 0
 
 
+def test_accuracy_follows_the_smoothed_covariance() -> None:
+    """A row's σ major/minor/orientation (tracks that carry attributes) are those of its
+    smoothed P; the other attributes are the row's own."""
+    from mhtrack.attributes import TrackAttributes, accuracy
+    from mhtrack.models.motion import ConstantVelocity
+    from mhtrack.sinks.smoothed import smoothed_rows
+
+    n = 5
+    P = np.repeat(np.diag([400.0, 900.0, 100.0, 900.0])[None], n, axis=0)
+    t = np.arange(n) * 4.0
+    attrs = dataclasses.replace(TrackAttributes.absent(n, P),
+                                callsign=np.array(["ABC"] * n, object))
+    rows = TrackTable(np.arange(n), t, np.zeros(n, np.int64), 100.0 * t, 5.0 * t,
+                      np.full(n, 100.0), np.full(n, 5.0), np.arange(n), P=P, attrs=attrs)
+    out = smoothed_rows(rows, ConstantVelocity(2.0))
+    assert out.attrs is not None and list(out.attrs.callsign) == ["ABC"] * n
+    for got, want in zip((out.attrs.sigma_major, out.attrs.sigma_minor,
+                          out.attrs.sigma_orient), accuracy(out.P), strict=True):
+        np.testing.assert_array_equal(got, want)
+
+
 def test_default_output_of_rotating_radars_is_smoothed(scene) -> None:
     """Timed plots of rotating radars (defaults from the radars): ``smoothed``; a
     scenario's scans (``run``): ``history``; an output given is kept."""

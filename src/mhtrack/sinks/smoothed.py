@@ -25,6 +25,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from mhtrack.attributes import accuracy
 from mhtrack.models.smoother import Filtered, smooth
 from mhtrack.records import TrackTable
 from mhtrack.sinks.base import FrameOutput, Sink
@@ -37,7 +38,9 @@ if TYPE_CHECKING:
 def smoothed_rows(rows: TrackTable, motion: MotionModel) -> TrackTable:
     """``rows`` (a run's history, any order) with ``x, y, vx, vy, P`` smoothed track by
     track (:func:`~mhtrack.models.smoother.smooth`; an IMM needs the rows' ``mu, xm,
-    Pm``), the model states dropped; the same order and every other column kept."""
+    Pm``) and the attributes' accuracy that of the smoothed ``P``
+    (:func:`~mhtrack.attributes.accuracy`), the model states dropped; the same order and
+    every other column kept."""
     if len(rows) == 0:
         return dataclasses.replace(rows, mu=None, xm=None, Pm=None)
     if rows.P is None:
@@ -45,8 +48,12 @@ def smoothed_rows(rows: TrackTable, motion: MotionModel) -> TrackTable:
     x = np.column_stack((rows.x, rows.vx, rows.y, rows.vy))  # the state [x, vx, y, vy]
     xs, Ps = smooth(Filtered(rows.track_id, rows.time, x, rows.P, rows.mu, rows.xm,
                              rows.Pm), motion)
+    attrs = rows.attrs
+    if attrs is not None:  # the position's accuracy is that of the smoothed covariance
+        attrs = dataclasses.replace(attrs, **dict(zip(
+            ("sigma_major", "sigma_minor", "sigma_orient"), accuracy(Ps), strict=True)))
     return dataclasses.replace(rows, x=xs[:, 0].copy(), vx=xs[:, 1].copy(),
-                               y=xs[:, 2].copy(), vy=xs[:, 3].copy(), P=Ps,
+                               y=xs[:, 2].copy(), vy=xs[:, 3].copy(), P=Ps, attrs=attrs,
                                mu=None, xm=None, Pm=None)
 
 

@@ -33,9 +33,13 @@ TRACKER_FUSIONS: tuple[str, ...] = ("none", "adaptive-kmeans")
 INITIATION_FUSIONS: tuple[str, ...] = ("adaptive-kmeans", "kmeans", "none")
 #: K-means seedings compared in P2's clustering study.
 CLUSTER_METHODS: tuple[str, ...] = ("adaptive", "random")
-#: Tracker output modes: ``history`` adds each confirmed track's tentative past.
-OUTPUTS: tuple[str, ...] = ("history", "online")
+#: Tracker output modes: ``history`` adds each confirmed track's tentative past;
+#: ``smoothed`` is that history smoothed over each whole track (:mod:`mhtrack.sinks.smoothed`).
+OUTPUTS: tuple[str, ...] = ("history", "online", "smoothed")
 #: The output mode when none is chosen.
 DEFAULT_OUTPUT = OUTPUTS[0]
+#: The output mode of timed plots of rotating radars when none is chosen (the run whose
+#: defaults come from the radars, ``build.radar_rule``): the history smoothed.
+RADAR_OUTPUT = OUTPUTS[2]
 #: What ``mhtrack export`` writes: ASTERIX CAT048 plots (the default) or CAT062 tracks.
 EXPORT_CATEGORIES: tuple[str, ...] = ("048", "062")

@@ -260,7 +260,11 @@ class TrackTable:
     the track ``score`` (log-likelihood ratio), state covariance ``P`` (n, 4, 4) and
     ``tentative`` (bool: the row was reported after the scan, when the track was confirmed
     later, see :mod:`mhtrack.mht.history`) and, when the plots had attributes, ``attrs``
-    (:class:`~mhtrack.attributes.TrackAttributes`: flight level, codes, accuracy)."""
+    (:class:`~mhtrack.attributes.TrackAttributes`: flight level, codes, accuracy); with
+    an IMM tracker asked for them (:attr:`MHTTracker.keep_models
+    <mhtrack.mht.MHTTracker.keep_models>`, for :mod:`mhtrack.models.smoother`), each
+    model's filtered state: probabilities ``mu`` (n, r), states ``xm`` (n, r, 4),
+    covariances ``Pm`` (n, r, 4, 4). Files never carry the model states."""
 
     scan: np.ndarray
     time: np.ndarray
@@ -274,6 +278,9 @@ class TrackTable:
     P: np.ndarray | None = None
     tentative: np.ndarray | None = None
     attrs: TrackAttributes | None = field(default=None, repr=False)
+    mu: np.ndarray | None = field(default=None, repr=False)
+    xm: np.ndarray | None = field(default=None, repr=False)
+    Pm: np.ndarray | None = field(default=None, repr=False)
 
     def __len__(self) -> int:
         return len(self.scan)

@@ -163,8 +163,10 @@ def test_track_passes_the_sensor_set_and_writes_geodetic_tracks(tmp_path, monkey
         yield FrameOutput(scans[0], tr, TrackTable.empty(), StepStats(0, 0, 0, 0, 0, 0, 1, 0.0))
 
     monkeypatch.setattr(pipeline_run, "step_frames", fake_steps)
+    # the history as reported: the fake rows carry no covariance to smooth with
     code, stdout, stderr = invoke("track", str(plots), "--sensors", str(sensors),
-                                  "--out", str(tmp_path / "t.csv"), "--no-progress")
+                                  "--out", str(tmp_path / "t.csv"), "--no-progress",
+                                  "--output", "history")
     assert code == 0, stderr
     from mhtrack.mht.coverage import RadarCoverage
 

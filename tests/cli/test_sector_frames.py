@@ -17,7 +17,7 @@ from sim_recording import simulated_recording
 from mhtrack.cli.main import cli
 from mhtrack.io import read_tracks
 from mhtrack.io.sensors import read_sensors
-from mhtrack.pipeline import Pipeline
+from mhtrack.pipeline import Pipeline, TrackOptions
 from mhtrack.sinks import TrackCollector
 from mhtrack.sources.recording import AsterixSource
 
@@ -43,14 +43,15 @@ def test_track_cuts_frames_at_the_sectors_as_the_source_does(rec: Path) -> None:
     assert r.exit_code == 0, r.output
     got = read_tracks(out)
     ref = TrackCollector("online")
-    Pipeline.open(str(rec / "radar.ast"), sensors_file=str(rec / "sensors.toml"),
-                  sectors=True).run([ref])
+    Pipeline.open(str(rec / "radar.ast"), TrackOptions(output="online"),
+                  sensors_file=str(rec / "sensors.toml"), sectors=True).run([ref])
     want = ref.tracks()
     assert got.track_id.tolist() == want.track_id.tolist()
     assert np.allclose(got.x, want.x, atol=1e-6) and np.allclose(got.y, want.y, atol=1e-6)
     # and the flag is what made them: without it, the eighths' rows
     plain = TrackCollector("online")
-    Pipeline.open(str(rec / "radar.ast"), sensors_file=str(rec / "sensors.toml")).run([plain])
+    Pipeline.open(str(rec / "radar.ast"), TrackOptions(output="online"),
+                  sensors_file=str(rec / "sensors.toml")).run([plain])
     other = plain.tracks()
     assert (len(other) != len(got) or other.scan.tolist() != got.scan.tolist()
             or not np.allclose(other.x, got.x))

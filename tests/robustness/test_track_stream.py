@@ -61,8 +61,11 @@ def _start(tmp_path: Path, plots: Path, frame: int, out: Path) -> tuple[subproce
                                                                           Path]:
     script = tmp_path / "cmd.py"
     script.write_text(_TRACKING.format(src=SRC))
+    # the history streams its rows as they become final (the smoothed default waits
+    # SMOOTHING_LAG_S of data time, longer than this scene)
     p = subprocess.Popen([sys.executable, str(script), str(frame), "track", str(plots),
-                          "--out", str(out), "--quiet"], stdout=subprocess.PIPE, text=True)
+                          "--out", str(out), "--quiet", "--output", "history"],
+                         stdout=subprocess.PIPE, text=True)
     name = p.stdout.readline().strip()  # type: ignore[union-attr]
     return p, out.parent / name
 

@@ -117,7 +117,7 @@ def _table(scan, tid, x):
 
 @pytest.mark.parametrize("suffix", [".csv", ".parquet"])
 def test_a_failed_run_leaves_no_file_and_no_temporary(plots_dir, tmp_path, suffix):
-    pipe = Pipeline.open(str(plots_dir / "plots.csv"), TrackOptions())
+    pipe = Pipeline.open(str(plots_dir / "plots.csv"), TrackOptions(output="history"))
     out = tmp_path / f"tracks{suffix}"
     sink = TracksFileSink(out, frame=pipe.frame, output=pipe.output, chunk_rows=CHUNK)
     n = [0]

@@ -19,7 +19,7 @@ from mhtrack.cli.common import (
     scenario_options,
 )
 from mhtrack.cli.terminal import resume_on_interrupt, say
-from mhtrack.cli.track_commands import config_changes, output_option, tracker_options
+from mhtrack.cli.track_commands import config_changes, study_output_option, tracker_options
 
 
 def _params_of(decorator: Callable[[Callable[..., Any]], Callable[..., Any]],
@@ -84,7 +84,7 @@ def _run_kwargs(ctx: click.Context, param: click.Parameter, value: tuple[str, ..
               show_default=True, help="OSPA/GOSPA cut-off c (m).")
 @click.option("--order", type=click.FloatRange(min=1), default=2.0, show_default=True,
               help="OSPA/GOSPA order p.")
-@output_option
+@study_output_option
 @click.option("--run-kwarg", "run_kwarg", multiple=True, callback=_run_kwargs,
               metavar="KEY=VALUE", help="Extra keyword of run_scenario (VALUE read as JSON, "
               "else as text); repeatable.")

@@ -87,15 +87,30 @@ def birth_options(f: Callable[..., Any]) -> Callable[..., Any]:
     return f
 
 
+_OUTPUT_HELP = (
+    "history: each confirmed track also at the scans before its confirmation, back to its "
+    "first plot (at most MHTConfig.history_scans back; from the seed scan with an "
+    "initiator --birth), those rows marked tentative; online: only what the tracker "
+    "reported at each scan; smoothed: the history with every track's positions and "
+    "velocities smoothed over the whole track (fixed-interval Rauch-Tung-Striebel, "
+    "IMM-aware), its rows not marked tentative the online rows, smoothed")
+
+
 def output_option(f: Callable[..., Any]) -> Callable[..., Any]:
-    """``--output history|online``: which rows a batch run reports (``docs/mht.md``)."""
+    """``--output history|online|smoothed``: which rows a batch run reports
+    (``docs/mht.md``); default chosen by the pipeline (``pipeline.options.choose``)."""
+    return click.option(
+        "--output", "output", type=click.Choice(OUTPUTS), default=None,
+        help=_OUTPUT_HELP + " [smoothed for timed plots or a recording of rotating radars "
+        "(the defaults from the radars), else history].")(f)
+
+
+def study_output_option(f: Callable[..., Any]) -> Callable[..., Any]:
+    """``--output`` of a study of simulated scenarios (``montecarlo``): history unless
+    given (a study's parameters name it)."""
     return click.option(
         "--output", "output", type=click.Choice(OUTPUTS), default=DEFAULT_OUTPUT,
-        show_default=True,
-        help="history: each confirmed track also at the scans before its confirmation, back "
-        "to its first plot (at most MHTConfig.history_scans back; from the seed scan with "
-        "an initiator --birth), those rows marked tentative; online: only what the tracker "
-        "reported at each scan.")(f)
+        show_default=True, help=_OUTPUT_HELP + ".")(f)
 
 
 def config_changes(tracker_pd: float | None, meas_sigma: float | None,
@@ -199,7 +214,7 @@ def track(plots: Path, tracker: str, tracker_pd: float | None, meas_sigma: float
     result = pipe.run([TracksFileSink(out, frame=pipe.frame, output=pipe.output)],
                       progress=bars, keep_stats=False)
     say(f"{result.describe()} -> {out}")
-    for note in (pipe.birth_note, pipe.reach_note):
+    for note in (pipe.birth_note, pipe.reach_note, pipe.output_note):
         if note is not None:
             say(note)
     if pipe.registration is not None:

@@ -30,7 +30,8 @@ from mhtrack.pipeline import (
     step_frames,
 )
 from mhtrack.records import PlotTable, Scan, TrackTable
-from mhtrack.sinks import TrackCollector
+from mhtrack.sinks import Sink, TrackCollector
+from mhtrack.sinks.smoothed import SmoothedHistory
 from mhtrack.sources.memory import MemorySource
 
 if TYPE_CHECKING:  # loaded by run_scenario only (fast start of `mhtrack track`)
@@ -96,8 +97,12 @@ def track(
         total = scans.n_scans
         scans = MemorySource(scans)
     rows = TrackCollector(output)
+    sinks: list[Sink] = [rows]
+    if output == "smoothed":
+        tracker.keep_models = True
+        sinks = [SmoothedHistory(sinks, tracker.motion)]
     stats, _ = feed(step_frames(tracker, scans, fusion=fusion, name=name, progress=progress,
-                                total=total), [rows])
+                                total=total), sinks)
     return TrackingRun(name, rows.tracks(), tuple(stats), output)
 
 

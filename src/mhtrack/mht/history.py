@@ -53,10 +53,14 @@ class _Logged:
     #: when some leaf has one (plots with attributes): ``None`` otherwise
     ident: np.ndarray | None = None
     level: np.ndarray | None = None
+    #: each model's filtered state (kept for the smoother only: ``models``)
+    mu: np.ndarray | None = None
+    xm: np.ndarray | None = None
+    Pm: np.ndarray | None = None
 
     @classmethod
     def of(cls, scan: int, time: float, leaves: Leaves,
-           rows: np.ndarray | None = None) -> _Logged:
+           rows: np.ndarray | None = None, models: bool = False) -> _Logged:
         tentative = leaves.track < 0
         sel = (tentative if rows is None else tentative & rows).nonzero()[0]
         node = leaves.node[sel]
@@ -67,10 +71,12 @@ class _Logged:
         ident = leaves.ident.take(sel, axis=0)
         level = leaves.level.take(sel, axis=0)
         known = bool((ident >= 0).any() or np.isfinite(level[:, 0]).any())
+        m = (leaves.mu.take(sel, axis=0), leaves.xm.take(sel, axis=0),
+             leaves.Pm.take(sel, axis=0)) if models else (None, None, None)
         return cls(np.array([scan], np.int64), np.array([time], float), node,
                    leaves.parent[sel], leaves.x.take(sel, axis=0), leaves.P.take(sel, axis=0),
                    leaves.window[:, -1][sel], leaves.score[sel], leaves.time[sel],
-                   ident if known else None, level if known else None)
+                   ident if known else None, level if known else None, *m)
 
     def attributes(self, j: np.ndarray) -> TrackAttributes | None:
         """The identity of logged leaves ``j`` at their own times (code, address, flight
@@ -90,13 +96,15 @@ class TentativeHistory:
     """States of tentative leaves over the last ``depth`` scans (0: keep nothing).
 
     Call :meth:`record` once per scan after the track management, and :meth:`backfill`
-    before it for the leaves confirmed at that scan.
+    before it for the leaves confirmed at that scan. ``models``: keep each leaf's model
+    states too (an IMM's ``mu, xm, Pm``), for the rows' smoothing.
     """
 
-    def __init__(self, depth: int) -> None:
+    def __init__(self, depth: int, models: bool = False) -> None:
         if depth < 0:
             raise ValueError(f"history depth must be >= 0, got {depth}")
         self.depth = int(depth)
+        self.models = models
         self._log: deque[_Logged] = deque(maxlen=max(self.depth, 1))
         #: per logged scan, the sorted plot rows the output gives a track at that scan
         self._claimed: deque[np.ndarray] = deque(maxlen=max(self.depth, 1))
@@ -108,7 +116,7 @@ class TentativeHistory:
         not modified); ``rows`` (mask): of those leaves only (the leaves a frame
         stepped), as if given ``leaves.take(rows)``."""
         if self.depth:
-            self._log.append(_Logged.of(scan, time, leaves, rows))
+            self._log.append(_Logged.of(scan, time, leaves, rows, self.models))
             rep = leaves.reported() if rep is None else rep
             if rows is not None:
                 rep = rep & rows
@@ -155,7 +163,8 @@ class TentativeHistory:
                 scan=np.repeat(log.scan, n), time=log.t[j], track_id=tid,
                 x=x[:, 0].copy(), y=x[:, 2].copy(), vx=x[:, 1].copy(), vy=x[:, 3].copy(),
                 plot=plot, score=log.score[j], P=log.P.take(j, axis=0),
-                tentative=np.ones(n, bool), attrs=log.attributes(j)))
+                tentative=np.ones(n, bool), attrs=log.attributes(j),
+                **_models(log, j)))
             cur = log.parent[j]
             live = cur >= 0
             cur, tid = cur[live], tid[live]
@@ -185,3 +194,12 @@ class TentativeHistory:
             got.setdefault("t", np.full(got["node"].size, float(got["time"][0])))
             self._log.append(_Logged(**got))
             self._claimed.append(np.asarray(arrays[f"{i}__claimed"], np.int64))
+
+
+def _models(log: _Logged, j: np.ndarray) -> dict[str, np.ndarray]:
+    """The model states of rows ``j`` of ``log`` as :class:`TrackTable` fields (none when
+    the log kept none: a log restored from a state saved without them)."""
+    if log.mu is None or log.xm is None or log.Pm is None:
+        return {}
+    return {"mu": log.mu.take(j, axis=0), "xm": log.xm.take(j, axis=0),
+            "Pm": log.Pm.take(j, axis=0)}

@@ -60,13 +60,15 @@ def confirmed_windows(leaves: Leaves, rep: np.ndarray | None = None) -> np.ndarr
 
 def report(scan: Scan, leaves: Leaves, stepped: np.ndarray | None = None,
            rep: np.ndarray | None = None, *,
-           identity: Callable[[np.ndarray], TrackAttributes] | None = None) -> TrackTable:
+           identity: Callable[[np.ndarray], TrackAttributes] | None = None,
+           models: bool = False) -> TrackTable:
     """Confirmed tracks of the best hypothesis at ``scan``, ordered by track id; each row
     at its state's own time (``Leaves.time``). ``stepped`` (mask): only the leaves this
     frame stepped (a frame of one radar's sector reports the tracks it looked at).
     ``rep``: :meth:`Leaves.reported`, when known (not modified). ``identity``: the
     attributes of the reported leaves (their rows, in order) when the plots have them
-    (:func:`~mhtrack.mht.track_attributes.track_attributes`)."""
+    (:func:`~mhtrack.mht.track_attributes.track_attributes`). ``models``: each row's
+    model states too (``mu, xm, Pm``, for :mod:`mhtrack.models.smoother`)."""
     rep = leaves.reported() if rep is None else rep
     if stepped is not None:
         rep = rep & stepped
@@ -88,4 +90,6 @@ def report(scan: Scan, leaves: Leaves, stepped: np.ndarray | None = None,
         P=leaves.P.take(sel, axis=0),
         tentative=np.zeros(n, bool),
         attrs=None if identity is None else identity(sel),
+        **({"mu": leaves.mu.take(sel, axis=0), "xm": leaves.xm.take(sel, axis=0),
+            "Pm": leaves.Pm.take(sel, axis=0)} if models else {}),
     )

@@ -153,6 +153,17 @@ class MHTTracker:
         self.last_backfill: TrackTable = TrackTable.empty()
 
     @property
+    def keep_models(self) -> bool:
+        """Whether every reported and backfilled row carries its leaf's model states
+        (``TrackTable.mu, xm, Pm``: what :mod:`mhtrack.models.smoother` needs of an IMM);
+        off by default (rows are as small as before)."""
+        return self._history.models
+
+    @keep_models.setter
+    def keep_models(self, on: bool) -> None:
+        self._history.models = bool(on)
+
+    @property
     def leaves(self) -> Leaves:
         """The current hypothesis store (read-only view for inspection and tests)."""
         return self._leaves
@@ -310,7 +321,8 @@ class MHTTracker:
             track_attributes(leaves, sel, attrs, frame.rows, self._callsigns, frame.time,
                              sensor=frame.scan.sensor, plot_t=frame.scan.plot_times(),
                              ages=self._ages)
-        return report(frame.scan, leaves, stepped, rep, identity=identity)
+        return report(frame.scan, leaves, stepped, rep, identity=identity,
+                      models=self._history.models)
 
     def _forget(self, leaves: Leaves, rows: np.ndarray, rep: np.ndarray) -> None:
         """The plots the confirmed tracks used (``rep``: the leaves that report them)

@@ -22,7 +22,7 @@ import sys
 import threading
 import time
 from collections.abc import Callable, Iterable, Iterator
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, BinaryIO, TextIO
 
@@ -196,7 +196,10 @@ class Live:
             # stopped with a checkpoint: the plots held go into it, tracked on resume
             hold=lambda: self.stop.is_set() and live.checkpoint is not None)
         try:
-            self.pipeline = Pipeline(self.source, options, survey=survey)
+            # a live run reports what it tracked as it goes: online unless told otherwise
+            online = options if options.output is not None else replace(options,
+                                                                        output="online")
+            self.pipeline = Pipeline(self.source, online, survey=survey)
         except BaseException:
             if isinstance(self.reader, UdpReader):
                 self.reader.close()

@@ -30,8 +30,10 @@ from mhtrack.names import (
     DEFAULT_CLUTTER_FRAME,
     DEFAULT_OUTPUT,
     DEFAULT_TRACKER,
+    RADAR_OUTPUT,
     TRACKER_FUSIONS,
 )
+from mhtrack.sinks.base import check_output
 
 if TYPE_CHECKING:
     from mhtrack.mht import MHTTracker
@@ -65,8 +67,8 @@ class TrackOptions:
     fusion: str | None = None
     #: Clutter frame of timed plots (:data:`mhtrack.names.CLUTTER_FRAMES`).
     clutter_frame: str = DEFAULT_CLUTTER_FRAME
-    #: Output mode (:data:`mhtrack.names.OUTPUTS`).
-    output: str = DEFAULT_OUTPUT
+    #: Output mode (:data:`mhtrack.names.OUTPUTS`); ``None``: chosen by :func:`choose`.
+    output: str | None = None
     #: The sensors' ``P_D`` the user set for a simulation (``run --pd``): the tracker
     #: assumes it (:func:`~mhtrack.build.capped_pd`) unless ``p_detection`` is given.
     sensor_pd: float | None = None
@@ -105,6 +107,8 @@ class Choices:
     area_text: str
     #: The defaults taken from rotating radars (timed plots without a scenario), or None.
     radars: RadarRule | None = None
+    #: The output mode (:data:`mhtrack.names.OUTPUTS`).
+    output: str = DEFAULT_OUTPUT
 
 
 def choose(source: Source, options: TrackOptions, survey: Survey | None,
@@ -119,7 +123,9 @@ def choose(source: Source, options: TrackOptions, survey: Survey | None,
       :func:`~mhtrack.build.default_fusion` of the scenario's or the plots' sensors;
     * the tracker (:func:`~mhtrack.build.make_tracker`) with the source's sensors
       (radar coverage, per-radar clutter in ``clutter_frame``);
-    * the output frame: the sensors' local frame when they have a geodetic reference.
+    * the output frame: the sensors' local frame when they have a geodetic reference;
+    * the output mode: :data:`~mhtrack.names.RADAR_OUTPUT` (the history smoothed) for
+      timed plots of rotating radars, else :data:`~mhtrack.names.DEFAULT_OUTPUT`.
     """
     scenario, area, radars = source.scenario, None, None
     if config is None and scenario is not None:
@@ -156,7 +162,10 @@ def choose(source: Source, options: TrackOptions, survey: Survey | None,
     text = ("the scenario's region" if scenario is not None
             else f"the plots' {area.width / 1e3:.3g} km × {area.height / 1e3:.3g} km "
             "bounding box" if area is not None else "P1's 8 km × 8 km region")
-    return Choices(config, fusion, tracker, frame, area, text, radars)
+    output = options.output
+    if output is None:
+        output = RADAR_OUTPUT if radars is not None else DEFAULT_OUTPUT
+    return Choices(config, fusion, tracker, frame, area, text, radars, check_output(output))
 
 
 def _n_sensors(source: Source, survey: Survey | None) -> int:

@@ -27,7 +27,7 @@ from mhtrack.pipeline.frame_log import log_frame
 from mhtrack.pipeline.options import TrackOptions, birth_density_note, choose
 from mhtrack.progress import Count
 from mhtrack.records import Scan
-from mhtrack.sinks.base import FrameOutput, Sink, check_output
+from mhtrack.sinks.base import FrameOutput, Sink
 
 if TYPE_CHECKING:
     from mhtrack.initiation.fusion import AdaptiveKMeansFusion
@@ -214,13 +214,13 @@ class Pipeline:
                  config: MHTConfig | None = None, survey: Survey | None = None) -> None:
         self.source = source
         self.options = TrackOptions() if options is None else options
-        self.output = check_output(self.options.output)
         if survey is not None:  # surveyed elsewhere (live: its first rotations)
             self.__dict__["survey"] = survey
         survey = self.survey if source.scenario is None else None
         self.choices = choose(source, self.options, survey, config)
         self.config, self.tracker = self.choices.config, self.choices.tracker
         self.fusion, self.frame = self.choices.fusion, self.choices.frame
+        self.output = self.choices.output
         self.registration = self._registration()
 
     def _registration(self) -> Registration | None:
@@ -287,6 +287,16 @@ class Pipeline:
         return (f"reach learned from the plots (no max_range in the sensors file; min/"
                 f"median/max over {reach.sectors} sectors): {parts}")
 
+    @property
+    def output_note(self) -> str | None:
+        """The line saying the history is smoothed when that was chosen by default
+        (timed plots of rotating radars), else ``None``."""
+        if self.options.output is not None or self.output != "smoothed":
+            return None
+        return ("output: the history with each track smoothed over its rows (fixed-interval "
+                "Rauch-Tung-Striebel, IMM-aware); --output history for the filtered rows, "
+                "online for the rows as reported")
+
     def outputs(self, *, progress: bool = False) -> Iterator[FrameOutput]:
         """The tracker's output frame by frame (the iterator form of a sink)."""
         survey = self.survey if progress else None
@@ -303,10 +313,20 @@ class Pipeline:
         """Step the tracker over every frame of the source into ``sinks`` (each
         started before the first frame and closed after the last). ``keep_stats``:
         keep every step's :class:`StepStats` in :attr:`RunResult.stats` (else only their
-        :class:`StatsSummary`: memory flat in the run's length)."""
+        :class:`StatsSummary`: memory flat in the run's length). With the output
+        ``smoothed`` the sinks that keep rows (:attr:`Sink.keeps_rows`) get the history
+        smoothed (:class:`~mhtrack.sinks.smoothed.SmoothedHistory`), the others each
+        frame's output as the tracker reported it."""
         summary = StatsSummary()
+        if self.output == "smoothed":  # tables get the history smoothed (sinks/smoothed.py)
+            from mhtrack.sinks.smoothed import SmoothedHistory
+
+            self.tracker.keep_models = True
+            tables = [s for s in sinks if s.keeps_rows]
+            sinks = [SmoothedHistory(tables, self.tracker.motion),
+                     *(s for s in sinks if not s.keeps_rows)]
         stats, n_tracks = feed(self.outputs(progress=progress), sinks, self.source,
-                               backfill_ids=self.output == "history", summary=summary,
+                               backfill_ids=self.output != "online", summary=summary,
                                keep_stats=keep_stats)
         return RunResult(self.options.tracker, tuple(stats), n_tracks, self.source.timed,
                          summary)

@@ -14,7 +14,8 @@ if TYPE_CHECKING:
 
 #: What each output mode (:data:`mhtrack.names.OUTPUTS`) reports, in words.
 OUTPUT_TEXT = {"history": "history (each track also before its confirmation, rows marked "
-               "tentative)", "online": "online (what the tracker reported at each scan)"}
+               "tentative)", "online": "online (what the tracker reported at each scan)",
+               "smoothed": "smoothed (the history, each track smoothed over all its rows)"}
 
 
 def run_dir(scenario: Scenario, tracker: str, birth: str | None, seed: int) -> Path:

@@ -6,7 +6,9 @@ that frame (``online``) and, kept apart, the tentative past of the tracks confir
 it (``backfill``, :attr:`~mhtrack.mht.MHTTracker.last_backfill`). The output mode
 (:data:`mhtrack.names.OUTPUTS`) decides what a table keeps: ``history`` both, sorted by
 scan and track at the end; ``online`` only the online rows, in the order reported —
-the rows :meth:`~mhtrack.mht.MHTTracker.run` returns.
+the rows :meth:`~mhtrack.mht.MHTTracker.run` returns; ``smoothed`` the rows of
+``history``, which the pipeline smooths before the sinks see them
+(:class:`~mhtrack.sinks.smoothed.SmoothedHistory`): a sink keeps them as ``history``.
 """
 
 from __future__ import annotations
@@ -14,7 +16,7 @@ from __future__ import annotations
 from abc import ABC, abstractmethod
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, ClassVar
 
 from mhtrack.names import DEFAULT_OUTPUT, OUTPUTS
 from mhtrack.records import Scan, TrackTable
@@ -45,6 +47,10 @@ class Sink(ABC):
     """Receives every frame's output; :meth:`start` before the first, :meth:`close`
     after the last (a file sink writes there)."""
 
+    #: The sink keeps a table of the rows (a tracks file, a collector): with the output
+    #: ``smoothed`` it gets the smoothed rows, other sinks each frame's output.
+    keeps_rows: ClassVar[bool] = False
+
     def start(self, source: Source | None) -> None:  # noqa: B027 - optional hook
         """Called once before the first frame with the source (its ``file_rows``,
         ``timed``); ``None`` when the frames come from no source (rows kept as they
@@ -73,18 +79,20 @@ def check_output(output: str | None) -> str:
 class TrackCollector(Sink):
     """The tracks of the whole run in memory, as :meth:`MHTTracker.run` returns them."""
 
+    keeps_rows = True
+
     def __init__(self, output: str | None = None) -> None:
         self.output = check_output(output)
         self._parts: list[TrackTable] = []
 
     def write(self, out: FrameOutput) -> None:
-        self._parts += [t for t in (out.online, out.backfill if self.output == "history"
+        self._parts += [t for t in (out.online, out.backfill if self.output != "online"
                                     else None) if t is not None and len(t)]
 
     def tracks(self) -> TrackTable:
-        """The rows so far (``history``: sorted by scan, then track id)."""
+        """The rows so far (``history``, ``smoothed``: sorted by scan, then track id)."""
         out = TrackTable.concat(self._parts)
-        return out.sorted() if self.output == "history" else out
+        return out if self.output == "online" else out.sorted()
 
     def clear(self) -> None:
         """Forget the rows so far (a rolling part was written)."""

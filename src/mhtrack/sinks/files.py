@@ -26,6 +26,8 @@ class _Rows(Sink):
     ``part_frames = n`` writes them every ``n`` frames to ``STEM.part0000.SUFFIX``, … of
     ``path`` (:meth:`_write_part`, each part atomically), :attr:`paths` the files written."""
 
+    keeps_rows = True
+
     def __init__(self, output: str | None, path: str | Path,
                  part_frames: int | None) -> None:
         if part_frames is not None and part_frames < 1:
@@ -117,7 +119,7 @@ class TracksFileSink(_Rows):
         if self._writer is None:
             self.start(None)
         assert self._writer is not None
-        history = self.rows.output == "history"
+        history = self.rows.output != "online"
         rows = [t for t in (out.online, out.backfill if history else None)
                 if t is not None and len(t)]
         if not rows:

@@ -98,13 +98,14 @@ def test_periods_and_density_from_the_first_rotations(rec: Path, tmp_path: Path)
 
 def test_status_line_by_hand() -> None:
     counts = {"datagrams": 10, "queue_drops": 1, "plots": 40, "duplicates": 3,
-              "late_drops": 2}
+              "late_drops": 2, "kernel_drops": None}
     clock = iter([100.0, 104.0, 104.2, 104.5])  # line, frame out, frame out, line
     st = Health(lambda: counts, lambda: 3, lambda out: np.array([0]), {1: 4.0, 2: 12.0},
                 lambda: next(clock))
     assert st.line() == ("live: 10 datagrams, 40 plots, 3 duplicates, 2 late drops, "
-                         "1 queue drops, 0 frames, 0 tracks, 0 radars silent")
-    counts.update(datagrams=30, plots=140)
+                         "1 queue drops, kernel drops n/a, 0 frames, 0 tracks, "
+                         "0 radars silent")
+    counts.update(datagrams=30, plots=140, kernel_drops=7)
     st.arrivals.add(0, 103.9)  # plot 0 came at 103.9 s: latencies 0.1 s and 0.3 s
     frame = SimpleNamespace(time=50.0, sensor=np.array([2]), rows=np.array([0]))
     st.write(SimpleNamespace(frame=frame))
@@ -113,7 +114,8 @@ def test_status_line_by_hand() -> None:
     # radar 1 never sent a frame in 13 s > 3 x 4 s: silent; radar 2 sent one at 63 s
     # 20 datagrams and 100 plots in 4.5 s; p50 of (0.1, 0.3) 0.2 s, p99 0.1 + 0.99 x 0.2
     assert st.line() == ("live: 4.4 datagrams/s, 22.2 plots/s, 30 datagrams, 140 plots, "
-                         "3 duplicates, 2 late drops, 1 queue drops, 2 frames, 3 tracks, "
+                         "3 duplicates, 2 late drops, 1 queue drops, 7 kernel drops, "
+                         "2 frames, 3 tracks, "
                          "1 radars silent (1), latency p50 200 ms p99 298 ms")
 
 

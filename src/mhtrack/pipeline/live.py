@@ -49,6 +49,9 @@ if TYPE_CHECKING:
     from mhtrack.sources.udp import ReaderStats
 
 DAY_FROM = ("receive", "stream")
+#: Plots whose decoding-order number the source remembers (2 MB, at least the largest
+#: frame: a burst of 10^5 plots in one sector fits).
+KEEP_ROWS = 1 << 18
 #: Status period (s) when a status file or endpoint is asked for without one.
 DEFAULT_STATUS_EVERY_S = 10.0
 #: Period output: a track is extrapolated at most this many of the longest radar
@@ -197,6 +200,8 @@ class Live:
             first_row=0 if st is None else st.next_row,
             not_before=None if st is None else st.last_time,
             pending=None if st is None else decode_pending(st.pending),
+            recent=None if st is None else st.duplicates,
+            keep_rows=KEEP_ROWS,  # the health looks up the frame just made
             # stopped with a checkpoint: the plots held go into it, tracked on resume
             hold=lambda: self.stop.is_set() and live.checkpoint is not None)
         try:
@@ -289,11 +294,12 @@ class Live:
             yield data if stream else (data, when)
         self.health.input_ended = True
 
-    def _counts(self) -> dict[str, int]:
+    def _counts(self) -> dict[str, int | None]:
         s, r = self.source.stats, self.reader.stats
         return {"datagrams": r.datagrams, "queue_drops": r.queue_dropped,
-                "plots": s.plots_in, "duplicates": self.source.problems.counts.get(
-                    "duplicate", 0), "late_drops": s.late_dropped}
+                "kernel_drops": r.kernel_dropped, "plots": s.plots_in,
+                "duplicates": self.source.problems.counts.get("duplicate", 0),
+                "late_drops": s.late_dropped}
 
     def _tracks(self) -> int:
         return int(np.count_nonzero(self.pipeline.tracker.leaves.reported()))
@@ -315,7 +321,8 @@ class Live:
         return LiveState(self.source.next_frame, axis.day0, axis.latest,
                          self.pipeline.tracker.last_time,
                          None if self.periodic is None else self.periodic.next_tick,
-                         encode_pending(self.source.pending()), self.source.next_row)
+                         encode_pending(self.source.pending()), self.source.next_row,
+                         self.source.recent_blocks() or None)
 
     # -- running ----------------------------------------------------------------------
     @property

@@ -32,6 +32,9 @@ _PLAIN = (
     ("datagrams", "datagrams_total", "counter", "Datagrams received."),
     ("queue_drops", "queue_drops_total", "counter",
      "Datagrams dropped because the queue to the tracker was full."),
+    ("kernel_drops", "kernel_drops_total", "counter",
+     "Datagrams the kernel dropped for a full socket buffer (SO_RXQ_OVFL; NaN: not "
+     "available on this system or input)."),
     ("plots", "plots_total", "counter", "Plots decoded and passed to the re-order window."),
     ("duplicates", "duplicates_total", "counter",
      "Data blocks received twice (redundant LANs) and dropped."),
@@ -60,7 +63,8 @@ def prometheus_text(snap: Mapping[str, Any]) -> str:
         out.extend(f"{PREFIX}{name}{suffix} {_number(v)}" for suffix, v in samples)
 
     for key, name, kind, text in _PLAIN:
-        metric(name, kind, text, [("", float(snap[key]))])
+        v = snap.get(key)
+        metric(name, kind, text, [("", math.nan if v is None else float(v))])
     metric("radars_silent", "gauge", "Radars silent for 3 rotation periods of data time.",
            [("", float(len(snap["radars_silent"])))])
     lat = snap["latency_s"]

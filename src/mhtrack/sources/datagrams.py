@@ -77,7 +77,8 @@ class DatagramSource(Source):
                  axis: TimeAxis | None = None, first_frame: int = 0, first_row: int = 0,
                  not_before: float | None = None,
                  pending: Mapping[str, Any] | None = None,
-                 hold: Callable[[], bool] | None = None) -> None:
+                 hold: Callable[[], bool] | None = None,
+                 recent: str | None = None, keep_rows: int | None = None) -> None:
         super().__init__()
         if chunk < 1:
             raise ValueError(f"chunk must be >= 1 plot, got {chunk!r}")
@@ -107,6 +108,13 @@ class DatagramSource(Source):
         #: ``hold()`` true at the end of the input: keep the plots held (:attr:`held`)
         #: instead of making frames of them (a live run stopped to be resumed).
         self.restore, self.hold = pending, hold
+        #: The duplicate filter's blocks of an earlier run
+        #: (:meth:`~mhtrack.io.asterix.duplicates.DuplicateFilter.recent`), remembered
+        #: first: a copy received before the stop and again after is taken once.
+        self.recent_start = recent
+        #: :meth:`file_rows` knows the last ``keep_rows`` plots only (``None``: all; a
+        #: live stream without end keeps its memory flat).
+        self.keep_rows = keep_rows
         self.held: dict[str, Any] | None = None
         #: Plots decoded so far: the next plot's decoding-order number (its ``file_row``).
         self.decoded = 0
@@ -133,6 +141,8 @@ class DatagramSource(Source):
         on the axis, ``offset``); sweep marks (time on the axis) go to ``sweeps``."""
         self._decoder = decoder = Decoder(fast=self.fast,
                                           duplicates=stream_filter())
+        if self.recent_start is not None:
+            decoder.duplicates.restore(self.recent_start)  # type: ignore[union-attr]
         self.axis = axis = TimeAxis()
         axis.day0, axis.latest = self.axis_start
         self.decoded = 0
@@ -273,7 +283,7 @@ class DatagramSource(Source):
             self.name, self.stats, self._frame_lengths(), self.window_s,
             lambda first: f"byte {first['offset']} (plot {first['file_row']})",
             first_frame=self.first_frame, first_row=self.first_row,
-            not_before=self.not_before)
+            not_before=self.not_before, keep_rows=self.keep_rows)
         if self.restore is not None:
             yield from stream.restore(self.restore)
         for cols in self._decoded(problems):
@@ -292,6 +302,12 @@ class DatagramSource(Source):
         if self.held is not None:
             return self.held
         return None if self._stream is None else self._stream.pending()
+
+    def recent_blocks(self) -> str | None:
+        """The duplicate filter's recent blocks now (``DuplicateFilter.recent``: what a
+        checkpoint keeps; before reading, those given)."""
+        f = None if self._decoder is None else self._decoder.duplicates
+        return self.recent_start if f is None else f.recent()
 
     @property
     def next_frame(self) -> int:

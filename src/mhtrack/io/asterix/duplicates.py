@@ -28,6 +28,8 @@ from collections import OrderedDict
 WINDOW_S = 0.5
 #: Default number of recent blocks remembered.
 SPAN = 4096
+#: Octets of a block's digest (BLAKE2b).
+DIGEST = 16
 
 
 class DuplicateFilter:
@@ -47,7 +49,7 @@ class DuplicateFilter:
         """Whether this data block (its whole octets, header included) is new: not seen
         within ``window`` s (with capture times) or within the last ``span`` blocks."""
         self.count += 1
-        key = hashlib.blake2b(block, digest_size=16).digest()
+        key = hashlib.blake2b(block, digest_size=DIGEST).digest()
         prev = self.seen.get(key)
         if prev is not None:
             if abs(time - prev[0]) <= self.window if time is not None and prev[0] is not None \
@@ -66,6 +68,37 @@ class DuplicateFilter:
                 self.seen.popitem(last=False)
         return True
 
+
+    def recent(self) -> str:
+        """The digests remembered, oldest first, as one hex string (32 digits each): with
+        :meth:`restore`, a filter of a later run (a live run resumed from a checkpoint)
+        takes a copy of a block this one received as a copy."""
+        return b"".join(self.seen).hex()
+
+    def restore(self, recent: str) -> None:
+        """Remember the digests of :meth:`recent` (oldest first) as the last blocks
+        received, before any of this filter's own; a :class:`ValueError` naming what is
+        wrong when ``recent`` is not such a string (it may come from a hostile file)."""
+        if not isinstance(recent, str):
+            raise ValueError(f"recent blocks: expected a hex string, got "
+                             f"{type(recent).__name__}")
+        if len(recent) % (2 * DIGEST) or len(recent) > 2 * DIGEST * self.span:
+            raise ValueError(f"recent blocks: {len(recent)} hex digits, expected a multiple "
+                             f"of {2 * DIGEST} and at most {2 * DIGEST * self.span}")
+        try:
+            raw = bytes.fromhex(recent)
+        except ValueError:
+            raise ValueError("recent blocks: not a hex string") from None
+        keys = [raw[i:i + DIGEST] for i in range(0, len(raw), DIGEST)]
+        if len(set(keys)) != len(keys):
+            raise ValueError("recent blocks: a digest appears twice")
+        old = list(self.seen.items())
+        self.seen = OrderedDict((k, (None, i + 1 - len(keys))) for i, k in enumerate(keys))
+        for k, v in old:
+            self.seen.pop(k, None)
+            self.seen[k] = v
+        while len(self.seen) > self.span:
+            self.seen.popitem(last=False)
 
 
 def stream_filter(span: int = SPAN) -> DuplicateFilter:

@@ -155,3 +155,49 @@ def test_stopped_before_any_datagram(rec: Path, tmp_path: Path) -> None:
     result = live.run()
     assert (result.reader.datagrams, len(result.run.stats), result.sent_rows) == (0, 0, 0)
     assert (tmp_path / "e.ast").read_bytes() == b""  # an empty recording, written
+
+
+def test_a_quiet_feed_closes_its_frames_on_the_idle_clock(rec: Path) -> None:
+    """Half the recording written, the pipe left open (the feed gone quiet): on the idle
+    clock (the test's own: one second a reading, ``idle_close_s`` 5 s) live closes the
+    frames it holds and sends their rows — those of a run whose input ended there —
+    before any more input; the default wait is the re-order window plus the longest
+    rotation; ``0`` never closes."""
+    import time
+
+    from mhtrack.pipeline.live import idle_wait
+
+    sensors = read_sensors(rec / "sensors.toml")
+    blocks = [d for d, _ in recording_datagrams(rec / "radar.ast")]
+    k = len(blocks) // 2
+    head = b"".join(blocks[:k])
+    rf, writer = _pipe(head)
+    writer.start()
+    ended = io.StringIO()
+    with rf:
+        Live(sensors, OPTIONS, LiveOptions(stdin="raw", day_from="stream", json=True),
+             stdin=rf, stdout=ended).run()
+    writer.join()
+    want = ended.getvalue().splitlines()
+    assert want
+    ticks = iter(range(10**9))
+    r, w = os.pipe()
+    out = io.StringIO()
+    with os.fdopen(r, "rb", buffering=0) as rf:
+        live = Live(sensors, OPTIONS, LiveOptions(stdin="raw", day_from="stream", json=True,
+                                                  idle_close_s=5.0),
+                    stdin=rf, stdout=out, idle_clock=lambda: float(next(ticks)))
+        runner = threading.Thread(target=live.run)
+        runner.start()
+        os.write(w, head)
+        for _ in range(3000):  # bounded; ends when the rows are out
+            if len(out.getvalue().splitlines()) >= len(want) and live.source.idles:
+                break
+            time.sleep(0.01)
+        got = out.getvalue().splitlines()  # before any more input
+        os.close(w)
+        runner.join()
+    assert got == want and live.source.idles >= 1
+    assert idle_wait(sensors, LiveOptions(stdin="raw")) == 2.0 + max(
+        s.period for s in sensors.sensors)
+    assert idle_wait(sensors, LiveOptions(stdin="raw", idle_close_s=0.0)) is None

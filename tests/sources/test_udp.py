@@ -139,6 +139,38 @@ def test_kernel_drops_not_available_say_so(monkeypatch: pytest.MonkeyPatch) -> N
     assert StdinReader(io.BytesIO(b"")).stats.kernel_dropped is None
 
 
+def test_a_quiet_input_yields_idle_once_per_quiet_spell() -> None:
+    """With ``idle_s`` the reader yields ``IDLE`` once the clock (the test's own, one
+    second a reading) has run ``idle_s`` past the last datagram, once per quiet spell,
+    in its place between the datagrams; without it, never."""
+    from mhtrack.sources.base import IDLE
+
+    ticks = iter(range(10**6))
+    r, w = os.pipe()
+    with os.fdopen(r, "rb", buffering=0) as rf:
+        reader = StdinReader(rf, framing="len32", idle_s=3.0,
+                             clock=lambda: float(next(ticks)))
+        it = iter(reader)
+        os.write(w, b"\0\0\0\1a")
+        assert next(it)[0] == b"a"
+        assert next(it) is IDLE and reader.idles == 1  # quiet: the clock ran on
+        os.write(w, b"\0\0\0\1b")
+        assert next(it)[0] == b"b"  # quiet again after it, one more IDLE
+        assert next(it) is IDLE and reader.idles == 2
+        os.write(w, b"\0\0\0\1c")
+        os.close(w)
+        rest = list(it)
+    assert [x[0] for x in rest if x is not IDLE] == [b"c"]
+    r, w = os.pipe()
+    os.write(w, b"\0\0\0\1a")
+    os.close(w)
+    with os.fdopen(r, "rb", buffering=0) as rf:
+        plain = StdinReader(rf, framing="len32")
+        assert [d for d, _ in plain] == [b"a"] and plain.idles == 0
+    with pytest.raises(ValueError, match="idle_s"):
+        StdinReader(io.BytesIO(b""), idle_s=0.0)
+
+
 def _blocks() -> list[bytes]:
     """Three ASTERIX-framed blocks (category, 2-octet length, bytes)."""
     return [bytes([48, 0, 5, 1, 2]), bytes([34, 0, 3]), bytes([62, 0, 9]) + b"abcdef"]

@@ -41,6 +41,8 @@ _PLAIN = (
     ("late_drops", "late_drops_total", "counter",
      "Plots dropped for arriving after the re-order window."),
     ("frames", "frames_total", "counter", "Frames (sectors) tracked."),
+    ("idle_closes", "idle_closes_total", "counter",
+     "Times the feed was quiet for the idle wait and the frames held were closed."),
     ("tracks", "tracks", "gauge", "Confirmed tracks now."),
 )
 

@@ -49,6 +49,8 @@ class TimedStream:
         self._rows = np.zeros(1024, np.int64) if keep_rows is None else \
             np.full(int(keep_rows), -1, np.int64)
         self._n_out = 0
+        #: Times the input went quiet (:meth:`idle`).
+        self.idles = 0
         #: The first running row number (a resumed run numbers on: the tracker's plot
         #: windows hold the earlier run's rows, and a plot is known by its row).
         self.first_row = int(first_row)
@@ -72,6 +74,18 @@ class TimedStream:
         if late.n:
             logging.getLogger("mhtrack").warning("%s", late.line(self.name,
                                                                  self.where(late.first)))
+
+    def idle(self) -> Iterator[Scan]:
+        """The input went quiet (a live feed: :data:`~mhtrack.sources.base.IDLE`): the
+        re-order window is released and every open frame closed, as at the end of the
+        input, but the stream goes on — a later plot older than the plots released is a
+        late drop, a later plot of a radar starts its next frame."""
+        self.idles += 1
+        released = self.buffer.flush()
+        if released and len(released["time"]):
+            yield from map(self._scan, self.framer.push(released))
+        yield from map(self._scan, self.framer.flush())
+        self._count()
 
     def pending(self) -> dict[str, object]:
         """The plots held — in the framer (``framed``) and in the re-order buffer

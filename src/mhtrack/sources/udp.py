@@ -25,6 +25,13 @@ the next one. Setting the ``stop`` event (:func:`stop_on_signals`: SIGTERM, Ctrl
 iteration cleanly: the sockets are drained once more without waiting, every datagram
 already received is yielded, then the iteration ends — the source then finishes the
 frames it holds.
+
+With ``idle_s`` the iteration also yields :data:`~mhtrack.sources.base.IDLE` (once)
+when no datagram has come for ``idle_s`` seconds of ``clock`` (injectable: tests pass
+their own): the feed has gone quiet, and the source closes the frames it holds instead
+of waiting for plots that may never come (``docs/live.md``, *A silent feed*). Only a
+live run asks for it: a recording read from a file has no wall clock, and gives the
+same frames every time.
 """
 
 from __future__ import annotations
@@ -41,10 +48,12 @@ import sys
 import threading
 import time
 from abc import ABC, abstractmethod
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from typing import Any, BinaryIO
 from urllib.parse import urlsplit
+
+from mhtrack.sources.base import IDLE
 
 #: Receive buffer asked of the kernel per socket (bytes; Linux caps it at
 #: ``net.core.rmem_max`` unless run as root).
@@ -170,8 +179,16 @@ class _Threaded(ABC):
     """A receiving thread filling a bounded queue; iteration yields from the queue until
     the thread has ended (stop set, or end of input) and the queue is empty."""
 
-    def __init__(self, stop: threading.Event | None, max_queued: int) -> None:
+    def __init__(self, stop: threading.Event | None, max_queued: int,
+                 idle_s: float | None = None,
+                 clock: Callable[[], float] = time.monotonic) -> None:
+        if idle_s is not None and not idle_s > 0:
+            raise ValueError(f"idle_s must be > 0 s, got {idle_s!r}")
         self.stop = threading.Event() if stop is None else stop
+        #: Yield :data:`IDLE` after this long without a datagram (``None``: never).
+        self.idle_s, self.clock = idle_s, clock
+        #: Times :data:`IDLE` was yielded.
+        self.idles = 0
         self.stats = ReaderStats()
         self._queue: queue.Queue[tuple[bytes, float]] = queue.Queue(max_queued)
         self._thread: threading.Thread | None = None
@@ -205,17 +222,27 @@ class _Threaded(ABC):
                                             daemon=True)
             self._thread.start()
 
-    def __iter__(self) -> Iterator[tuple[bytes, float]]:
+    def __iter__(self) -> Iterator[Any]:
+        """``(datagram, receive time)`` as they come; :data:`IDLE` once after each quiet
+        spell of ``idle_s`` (module docstring)."""
         self.start()
         assert self._thread is not None
+        last, told = self.clock(), False
         while True:
             try:
-                yield self._queue.get(timeout=POLL_S)
-                continue
+                item = self._queue.get(timeout=POLL_S)
             except queue.Empty:
                 pass
+            else:
+                last, told = self.clock(), False
+                yield item
+                continue
             if not self._thread.is_alive() and self._queue.empty():
                 break
+            if self.idle_s is not None and not told and self.clock() - last >= self.idle_s:
+                told = True
+                self.idles += 1
+                yield IDLE
         self._thread.join()
         if self.error is not None:
             raise self.error
@@ -228,8 +255,10 @@ class UdpReader(_Threaded):
     bound ``host, port`` of each, so port 0 picks a free port)."""
 
     def __init__(self, endpoints: list[str | Endpoint], *, stop: threading.Event | None = None,
-                 rcvbuf: int = DEFAULT_RCVBUF, max_queued: int = DEFAULT_MAX_QUEUED) -> None:
-        super().__init__(stop, max_queued)
+                 rcvbuf: int = DEFAULT_RCVBUF, max_queued: int = DEFAULT_MAX_QUEUED,
+                 idle_s: float | None = None,
+                 clock: Callable[[], float] = time.monotonic) -> None:
+        super().__init__(stop, max_queued, idle_s, clock)
         if not endpoints:
             raise ValueError("no endpoint to listen on")
         self.endpoints = [e if isinstance(e, Endpoint) else parse_endpoint(e)
@@ -296,8 +325,10 @@ class StdinReader(_Threaded):
 
     def __init__(self, stream: BinaryIO, *, framing: str = "raw",
                  stop: threading.Event | None = None,
-                 max_queued: int = DEFAULT_MAX_QUEUED, name: str = "stdin") -> None:
-        super().__init__(stop, max_queued)
+                 max_queued: int = DEFAULT_MAX_QUEUED, name: str = "stdin",
+                 idle_s: float | None = None,
+                 clock: Callable[[], float] = time.monotonic) -> None:
+        super().__init__(stop, max_queued, idle_s, clock)
         if framing not in STDIN_FRAMINGS:
             raise ValueError(f"unknown stdin framing {framing!r} (expected "
                              f"{', '.join(STDIN_FRAMINGS)})")

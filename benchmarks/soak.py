@@ -109,7 +109,7 @@ def wait_taken(status: Path, before: int, live: subprocess.Popen) -> dict:
     t0, last, still = time.monotonic(), None, 0
     while time.monotonic() - t0 < PASS_TIMEOUT_S:
         if live.poll() is not None:
-            raise RuntimeError(f"live ended: {live.stderr.read()}")
+            raise RuntimeError(f"live ended (exit {live.returncode})")
         time.sleep(1.0)
         s = _status(status)
         key = (s["datagrams"], s["plots"], s["frames"])
@@ -141,14 +141,21 @@ def main() -> None:
                  "--status-every", "1", "--checkpoint", str(d / "state.npz"),
                  "--checkpoint-every", "10", "-q"]
     print("$ mhtrack " + " ".join(live_args), flush=True)
-    live = subprocess.Popen([*CLI, *live_args], stderr=subprocess.PIPE,
-                            stdout=subprocess.DEVNULL, text=True, env=_env())
+    err_path = d / "live.err"  # a file, not a pipe: a status line a second would fill one
+    with err_path.open("w") as err_file:
+        live = subprocess.Popen([*CLI, *live_args], stderr=err_file,
+                                stdout=subprocess.DEVNULL, text=True, env=_env())
     rows = []
     try:
-        first = live.stderr.readline().strip()
-        m = re.match(r"listening on (udp://127\.0\.0\.1:\d+)$", first)
+        m = None
+        for _ in range(600):  # bounded: the first line names the port
+            first = err_path.read_text().split("\n", 1)[0].strip()
+            m = re.match(r"listening on (udp://127\.0\.0\.1:\d+)$", first)
+            if m is not None or live.poll() is not None:
+                break
+            time.sleep(0.5)
         if m is None:
-            raise RuntimeError(f"live did not start: {first!r}")
+            raise RuntimeError(f"live did not start: {err_path.read_text()!r}")
         to, sent, t0, got = m.group(1), 0, time.monotonic(), 0
         print("$ mhtrack replay PASS.pcap --to " + to + " --speed max  (each pass)")
         print("| data hour | wall s | datagrams sent | received | kernel drops | plots | "
@@ -168,8 +175,9 @@ def main() -> None:
                 print("| {} | {:.0f} | {} | {} | {} | {} | {} | {} | {:.1f} | {:.1f} |"
                       .format(*row), flush=True)
         live.send_signal(signal.SIGTERM)
-        _, err = live.communicate(timeout=600)
-        print(err.strip().splitlines()[-1] if err.strip() else "", flush=True)
+        live.wait(timeout=600)
+        err = err_path.read_text().strip().splitlines()
+        print(err[-1] if err else "", flush=True)
     finally:
         if live.poll() is None:
             live.kill()

@@ -17,6 +17,7 @@ under its id, and new tracks get new ids."""
 
 from __future__ import annotations
 
+import contextlib
 import io
 import json
 import os
@@ -80,13 +81,13 @@ def _live(rec: Path, ck: Path, *extra: str) -> subprocess.Popen:
         stderr=subprocess.PIPE, env=_env())
 
 
-def _write(proc: subprocess.Popen, data: bytes, close: bool) -> threading.Thread:
+def _write(proc: subprocess.Popen, data: bytes) -> threading.Thread:
+    """Write ``data`` to ``proc``'s stdin from a thread, leaving it open (the feed goes
+    on: no end of input)."""
     def feed() -> None:
         try:
             proc.stdin.write(data)
             proc.stdin.flush()
-            if close:
-                proc.stdin.close()
         except (BrokenPipeError, ValueError):  # killed while writing
             pass
 
@@ -109,7 +110,7 @@ def test_kill_9_then_resume_keeps_the_track_ids(rec: Path, tmp_path: Path, seed:
     kill_frame = int(rng.choice(late[:int(0.7 * len(late))]))
     ck = tmp_path / "state.npz"
     a = _live(rec, ck, "--checkpoint-every", EVERY_MIN)
-    feeder = _write(a, b"".join(blocks), close=False)  # the feed goes on: no end of input
+    feeder = _write(a, b"".join(blocks))
     first = []
     try:
         for line in a.stdout:  # bounded: the process ends at the latest with its input
@@ -122,6 +123,10 @@ def test_kill_9_then_resume_keeps_the_track_ids(rec: Path, tmp_path: Path, seed:
             a.kill()
         a.wait()
         feeder.join()
+        with contextlib.suppress(OSError):
+            a.stdin.close()
+        a.stdout.close()
+        a.stderr.close()
     assert a.returncode == -signal.SIGKILL
     assert first == ref[:len(first)]  # the killed run was the reference until then
     kept = tmp_path / "kept.npz"
@@ -134,9 +139,7 @@ def test_kill_9_then_resume_keeps_the_track_ids(rec: Path, tmp_path: Path, seed:
     rest = [d for d, t in items if t > t_kill]
     assert 0 < len(rest) < len(blocks)
     b = _live(rec, ck, "--resume")
-    feeder = _write(b, b"".join(rest), close=True)
-    out, err = b.communicate()
-    feeder.join()
+    out, err = b.communicate(b"".join(rest))  # writes, closes and reads: to the end
     assert b.returncode == 0, err.decode()
     second = [json.loads(x) for x in out.splitlines()]
     assert second and min(r["frame"] for r in second) >= state.next_frame

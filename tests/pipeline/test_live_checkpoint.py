@@ -103,7 +103,7 @@ def test_a_copy_late_across_the_restart_is_a_copy(rec: Path, tmp_path: Path) -> 
     ck = tmp_path / "state.npz"
     first, cut = _run(rec, blocks[:k], stop_after=k, checkpoint=ck)
     tracker, state = read_checkpoint(ck)
-    assert state.duplicates is not None and len(state.duplicates) == 32 * k  # k < 4 096
+    assert state.duplicates is not None and len(state.duplicates) == 40 * k  # k < 4 096
     # the same checkpoint without the filter's blocks (as before they were kept)
     blind = tmp_path / "blind.npz"
     CheckpointSink(blind, lambda: tracker, lambda: replace(state, duplicates=None)).save()

@@ -179,11 +179,14 @@ def test_restore_refuses_what_is_no_list_of_digests() -> None:
 
     good = stream_filter()
     good.keep(bytes([48, 0, 4, 1]))
+    good.keep(bytes([48, 0, 4, 2]))
     text = good.recent()
-    assert len(text) == 32
-    for bad, match in ((3, "hex string"), (text[:-1], "multiple of 32"),
-                       ("zz" * 16, "not a hex"), (text * 2, "twice"),
-                       ("00" * 16 * 5, "at most")):
+    assert len(text) == 80 and text[32:40] == "00000001" and text[72:80] == "00000000"
+    swapped = text[40:] + text[:40]  # the newer block first: ages must fall
+    for bad, match in ((3, "hex string"), (text[:-1], "multiple of 40"),
+                       ("zz" * 20, "not a hex"), (text[:40] * 2, "twice"),
+                       ("00" * 20 * 5, "at most"), (swapped, "ages must fall"),
+                       (text[:32] + "ffffffff", "ages must fall")):
         f = stream_filter(span=4)
         with pytest.raises(ValueError, match=match):
             f.restore(bad)

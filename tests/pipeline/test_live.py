@@ -98,13 +98,14 @@ def test_periods_and_density_from_the_first_rotations(rec: Path, tmp_path: Path)
 
 def test_status_line_by_hand() -> None:
     counts = {"datagrams": 10, "queue_drops": 1, "plots": 40, "duplicates": 3,
-              "late_drops": 2}
+              "late_drops": 2, "kernel_drops": None}
     clock = iter([100.0, 104.0, 104.2, 104.5])  # line, frame out, frame out, line
     st = Health(lambda: counts, lambda: 3, lambda out: np.array([0]), {1: 4.0, 2: 12.0},
                 lambda: next(clock))
     assert st.line() == ("live: 10 datagrams, 40 plots, 3 duplicates, 2 late drops, "
-                         "1 queue drops, 0 frames, 0 tracks, 0 radars silent")
-    counts.update(datagrams=30, plots=140)
+                         "1 queue drops, kernel drops n/a, 0 frames, 0 tracks, "
+                         "0 radars silent")
+    counts.update(datagrams=30, plots=140, kernel_drops=7)
     st.arrivals.add(0, 103.9)  # plot 0 came at 103.9 s: latencies 0.1 s and 0.3 s
     frame = SimpleNamespace(time=50.0, sensor=np.array([2]), rows=np.array([0]))
     st.write(SimpleNamespace(frame=frame))
@@ -113,7 +114,8 @@ def test_status_line_by_hand() -> None:
     # radar 1 never sent a frame in 13 s > 3 x 4 s: silent; radar 2 sent one at 63 s
     # 20 datagrams and 100 plots in 4.5 s; p50 of (0.1, 0.3) 0.2 s, p99 0.1 + 0.99 x 0.2
     assert st.line() == ("live: 4.4 datagrams/s, 22.2 plots/s, 30 datagrams, 140 plots, "
-                         "3 duplicates, 2 late drops, 1 queue drops, 2 frames, 3 tracks, "
+                         "3 duplicates, 2 late drops, 1 queue drops, 7 kernel drops, "
+                         "2 frames, 3 tracks, "
                          "1 radars silent (1), latency p50 200 ms p99 298 ms")
 
 
@@ -153,3 +155,49 @@ def test_stopped_before_any_datagram(rec: Path, tmp_path: Path) -> None:
     result = live.run()
     assert (result.reader.datagrams, len(result.run.stats), result.sent_rows) == (0, 0, 0)
     assert (tmp_path / "e.ast").read_bytes() == b""  # an empty recording, written
+
+
+def test_a_quiet_feed_closes_its_frames_on_the_idle_clock(rec: Path) -> None:
+    """Half the recording written, the pipe left open (the feed gone quiet): on the idle
+    clock (the test's own: one second a reading, ``idle_close_s`` 5 s) live closes the
+    frames it holds and sends their rows — those of a run whose input ended there —
+    before any more input; the default wait is the re-order window plus the longest
+    rotation; ``0`` never closes."""
+    import time
+
+    from mhtrack.pipeline.live import idle_wait
+
+    sensors = read_sensors(rec / "sensors.toml")
+    blocks = [d for d, _ in recording_datagrams(rec / "radar.ast")]
+    k = len(blocks) // 2
+    head = b"".join(blocks[:k])
+    rf, writer = _pipe(head)
+    writer.start()
+    ended = io.StringIO()
+    with rf:
+        Live(sensors, OPTIONS, LiveOptions(stdin="raw", day_from="stream", json=True),
+             stdin=rf, stdout=ended).run()
+    writer.join()
+    want = ended.getvalue().splitlines()
+    assert want
+    ticks = iter(range(10**9))
+    r, w = os.pipe()
+    out = io.StringIO()
+    with os.fdopen(r, "rb", buffering=0) as rf:
+        live = Live(sensors, OPTIONS, LiveOptions(stdin="raw", day_from="stream", json=True,
+                                                  idle_close_s=5.0),
+                    stdin=rf, stdout=out, idle_clock=lambda: float(next(ticks)))
+        runner = threading.Thread(target=live.run)
+        runner.start()
+        os.write(w, head)
+        for _ in range(3000):  # bounded; ends when the rows are out
+            if len(out.getvalue().splitlines()) >= len(want) and live.source.idles:
+                break
+            time.sleep(0.01)
+        got = out.getvalue().splitlines()  # before any more input
+        os.close(w)
+        runner.join()
+    assert got == want and live.source.idles >= 1
+    assert idle_wait(sensors, LiveOptions(stdin="raw")) == 2.0 + max(
+        s.period for s in sensors.sensors)
+    assert idle_wait(sensors, LiveOptions(stdin="raw", idle_close_s=0.0)) is None

@@ -3,6 +3,9 @@ statistics, and its summary gives the printout of the run that keeps them all.""
 
 from __future__ import annotations
 
+from hypothesis import given
+from hypothesis import strategies as st
+
 from mhtrack.io import write_plots
 from mhtrack.io.sensors import write_sensors
 from mhtrack.pipeline import Pipeline, TrackOptions, caps_acted
@@ -24,3 +27,18 @@ def test_summary_equals_the_kept_statistics(tmp_path):
     assert lean.describe().split(" ms/scan")[0].rsplit(",", 1)[0] == \
         kept.describe().split(" ms/scan")[0].rsplit(",", 1)[0]
     assert lean.t_avg > 0
+
+
+@given(st.lists(st.lists(st.integers(0, 5000), max_size=30), max_size=30))
+def test_id_bitmap_counts_as_a_set(batches: list[list[int]]) -> None:
+    """The run's count of distinct track ids (a bitmap: flat memory over days) equals
+    the size of a Python set of the same ids, batch after batch."""
+    import numpy as np
+
+    from mhtrack.pipeline.run import IdSet
+
+    ids, ref = IdSet(), set()
+    for b in batches:
+        ids.update(np.array(b, np.int64))
+        ref.update(b)
+        assert len(ids) == len(ref)

@@ -159,3 +159,34 @@ def test_pending_plots_continue_in_a_fresh_framer(stream, stop) -> None:
     got += [f.cols["pos"].tolist() for f in second.flush()]
     want = [g[3] for g in _frames(t, s, lengths, cuts)]
     assert got == want
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.lists(st.tuples(st.floats(0, 3), st.integers(1, 3)), min_size=1, max_size=80),
+       st.integers(1, 30), st.integers(1, 10))
+def test_a_ring_of_rows_knows_the_last_rows_as_the_whole_map(plots, keep, batch) -> None:
+    """``TimedStream(keep_rows=K)`` (a live stream: memory flat) gives the same frames,
+    and for the last ``K`` rows out the same file rows as the stream keeping them all;
+    older rows are ``-1`` (forgotten), never another plot's row."""
+    from mhtrack.sources.base import SourceStats
+    from mhtrack.sources.timed import TimedStream
+
+    rng = np.random.default_rng(len(plots))
+    t = np.cumsum([dt for dt, _ in plots])
+    cols = {"time": t, "sensor": np.array([s for _, s in plots]), "x": t, "y": t,
+            "file_row": rng.permutation(t.size) + 100}
+
+    def run(keep_rows):
+        ts = TimedStream("s", SourceStats(), 1.0, 0.5, str, keep_rows=keep_rows)
+        out = []
+        for a in range(0, t.size, batch):
+            out += list(ts.push({k: v[a:a + batch] for k, v in cols.items()}))
+        return out + list(ts.finish()), ts
+
+    whole, full = run(None)
+    ring, kept = run(keep)
+    assert [f.rows.tolist() for f in ring] == [f.rows.tolist() for f in whole]
+    rows = np.arange(-2, t.size)  # (-1: no plot)
+    want = full.file_rows(rows)
+    want[rows < t.size - keep] = -1
+    assert kept.file_rows(rows).tolist() == want.tolist()

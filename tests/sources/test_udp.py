@@ -5,6 +5,7 @@ written; a stop signal ends the reading cleanly."""
 
 from __future__ import annotations
 
+import io
 import os
 import signal
 import socket
@@ -102,6 +103,72 @@ def test_a_full_queue_counts_its_drops() -> None:
     got = [d for d, _ in reader]
     assert got == [bytes([i]) for i in range(10)]
     assert (reader.stats.datagrams, reader.stats.queue_dropped) == (10, 15)
+
+
+def test_kernel_drops_counted_from_the_socket() -> None:
+    """A socket with a small receive buffer, sent 300 datagrams of 1 000 octets over
+    loopback before it is read (loopback delivers at ``sendto``: what the buffer cannot
+    hold the kernel drops), then one more once it is read: every datagram sent is either
+    received or in the kernel's drop count (``SO_RXQ_OVFL``), and some were dropped."""
+    reader = UdpReader(["udp://127.0.0.1:0"], rcvbuf=4096)
+    if reader.stats.kernel_dropped is None:
+        reader.close()
+        pytest.skip("SO_RXQ_OVFL not available (Linux only)")
+    port = reader.addresses[0][1]
+    _send(port, [b"%04d" % i + bytes(996) for i in range(300)])
+    reader._drain()  # what the buffer held (read in this thread: no timing involved)
+    _send(port, [b"last"])  # into an empty buffer; carries the count of every drop
+    reader._drain()
+    reader.stop.set()
+    got = [d for d, _ in reader]
+    assert got[-1] == b"last"
+    assert 0 < reader.stats.kernel_dropped < 300
+    assert len(got) + reader.stats.kernel_dropped == 301
+    assert [int(d[:4]) for d in got[:-1]] == sorted(int(d[:4]) for d in got[:-1])
+
+
+def test_kernel_drops_not_available_say_so(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Where the option does not exist the count is ``None`` (the status says n/a), not
+    a zero that would claim no drops."""
+    import mhtrack.sources.udp as udp
+
+    monkeypatch.setattr(udp.sys, "platform", "darwin")
+    reader = UdpReader(["udp://127.0.0.1:0"])
+    reader.close()
+    assert reader.stats.kernel_dropped is None
+    assert StdinReader(io.BytesIO(b"")).stats.kernel_dropped is None
+
+
+def test_a_quiet_input_yields_idle_once_per_quiet_spell() -> None:
+    """With ``idle_s`` the reader yields ``IDLE`` once the clock (the test's own, one
+    second a reading) has run ``idle_s`` past the last datagram, once per quiet spell,
+    in its place between the datagrams; without it, never."""
+    from mhtrack.sources.base import IDLE
+
+    ticks = iter(range(10**6))
+    r, w = os.pipe()
+    with os.fdopen(r, "rb", buffering=0) as rf:
+        reader = StdinReader(rf, framing="len32", idle_s=3.0,
+                             clock=lambda: float(next(ticks)))
+        it = iter(reader)
+        os.write(w, b"\0\0\0\1a")
+        assert next(it)[0] == b"a"
+        assert next(it) is IDLE and reader.idles == 1  # quiet: the clock ran on
+        os.write(w, b"\0\0\0\1b")
+        assert next(it)[0] == b"b"  # quiet again after it, one more IDLE
+        assert next(it) is IDLE and reader.idles == 2
+        os.write(w, b"\0\0\0\1c")
+        os.close(w)
+        rest = list(it)
+    assert [x[0] for x in rest if x is not IDLE] == [b"c"]
+    r, w = os.pipe()
+    os.write(w, b"\0\0\0\1a")
+    os.close(w)
+    with os.fdopen(r, "rb", buffering=0) as rf:
+        plain = StdinReader(rf, framing="len32")
+        assert [d for d, _ in plain] == [b"a"] and plain.idles == 0
+    with pytest.raises(ValueError, match="idle_s"):
+        StdinReader(io.BytesIO(b""), idle_s=0.0)
 
 
 def _blocks() -> list[bytes]:

@@ -142,6 +142,10 @@ def replay(recording: Path, to: tuple[str, ...], speed: float | None, loop: bool
 @click.option("--reorder-window", "reorder_window_s", type=click.FloatRange(min=0),
               default=None, help="Plots may be out of time order by at most this many "
               "seconds [2].")
+@click.option("--idle-close", "idle_close_s", type=click.FloatRange(min=0), default=None,
+              help="Close the frames held after this many wall-clock seconds without a "
+              "datagram (a feed gone quiet); 0: never [the re-order window plus the "
+              "longest rotation period].")
 @tracker_options("--pd")
 @click.option("--clutter-frame", type=click.Choice(CLUTTER_FRAMES),
               default=DEFAULT_CLUTTER_FRAME, show_default=True,
@@ -154,7 +158,7 @@ def live(listen: tuple[str, ...], stdin: str | None, sensors_file: Path,
          status_every: float | None, status_json: Path | None, prometheus: Path | None,
          metrics_http: str | None, view: str | None, checkpoint: Path | None,
          checkpoint_every: float | None, resume: bool, reorder_window_s: float | None,
-         tracker: str, tracker_pd: float | None,
+         idle_close_s: float | None, tracker: str, tracker_pd: float | None,
          meas_sigma: float | None, accel_sigma: float | None,
          imm_accel_sigma: float | None, clutter_density: float | None,
          birth_density: float | None, nscan: int | None, clutter_frame: str, birth: str,
@@ -175,6 +179,7 @@ def live(listen: tuple[str, ...], stdin: str | None, sensors_file: Path,
                            checkpoint_every_s=(None if checkpoint_every is None
                                                else 60.0 * checkpoint_every),
                            resume=resume, reorder_window_s=reorder_window_s,
+                           idle_close_s=idle_close_s,
                            **({} if day_from is None else {"day_from": day_from}))
     with stop_on_signals(threading.Event()) as stop:
         run = Live(read_sensors(sensors_file), options, settings, stop=stop,

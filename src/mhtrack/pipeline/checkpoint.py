@@ -3,7 +3,9 @@ full state (:meth:`~mhtrack.mht.MHTTracker.save`, one ``.npz`` written atomicall
 what the live run needs to continue — the next frame's number, the time axis (``day0``,
 ``latest``: the day of later times of day), the latest time tracked, the next tick of
 the period output, the next plot's row number (the tracker's plot windows name plots
-by row: numbers must not repeat) and the plots received but not yet tracked (in the
+by row: numbers must not repeat), the duplicate filter's last data blocks (their
+digests: a redundant-LAN copy late across the restart is still a copy) and the plots
+received but not yet tracked (in the
 re-order window and in open frames) — under ``meta["extra"]``. A run resumed from it
 therefore makes the same frames as a run never stopped, given the same datagrams after
 the checkpoint.
@@ -53,6 +55,10 @@ class LiveState:
     pending: dict[str, Any] | None = None
     #: The running row number of the next plot (the tracker knows plots by row).
     next_row: int = 0
+    #: The duplicate filter's last blocks (``DuplicateFilter.recent``: hex digests,
+    #: oldest first; ``None``: none): a redundant-LAN copy arriving after the restart
+    #: of a block received before it is still a copy.
+    duplicates: str | None = None
     format: int = LIVE_FORMAT
 
 
@@ -146,6 +152,7 @@ def read_checkpoint(path: str | Path) -> tuple[MHTTracker, LiveState]:
     """The tracker and the live bookkeeping of a checkpoint written by
     :class:`CheckpointSink`; an :class:`InputError` naming the file otherwise."""
     from mhtrack.build import load_tracker
+    from mhtrack.io.asterix.duplicates import stream_filter
     from mhtrack.mht.state import saved_meta
 
     meta: dict[str, Any] = saved_meta(path)
@@ -156,6 +163,8 @@ def read_checkpoint(path: str | Path) -> tuple[MHTTracker, LiveState]:
     try:
         state = LiveState(**extra)
         decode_pending(state.pending)  # the plots held must read back
+        if state.duplicates is not None:  # and the duplicate filter's blocks
+            stream_filter().restore(state.duplicates)
     except (TypeError, ValueError, KeyError, AttributeError) as e:
         raise InputError(f"{path}: member 'meta': field 'extra': {e}", file=str(path)) from None
     return load_tracker(path), state

@@ -29,7 +29,6 @@ from __future__ import annotations
 import bisect
 import math
 import threading
-from collections import deque
 from collections.abc import Callable, Mapping
 from typing import Any
 
@@ -39,8 +38,10 @@ from mhtrack.sinks.base import FrameOutput, Sink
 
 #: Latencies kept for the snapshot's percentiles (the last frames).
 WINDOW = 100_000
-#: Datagrams remembered by :class:`Arrivals` at most.
-MAX_ARRIVALS = 1_000_000
+#: Datagrams remembered by :class:`Arrivals` at most (4 MB; at the national load's
+#: 1 400 datagrams/s, the last 187 s: a frame's plots are decoded within the re-order
+#: window and a frame's length of it going out).
+MAX_ARRIVALS = 1 << 18
 #: A radar is silent after this many rotation periods without a frame.
 SILENT_PERIODS = 3.0
 
@@ -49,28 +50,31 @@ class Arrivals:
     """Receive time of the datagram of each plot, by the plot's decoding-order number:
     :meth:`add` ``(first plot number of the datagram, receive time)`` as each datagram
     is taken (plots of earlier datagrams all numbered below it); :meth:`time_of` a
-    plot. The last ``keep`` datagrams are remembered; older plots have no time."""
+    plot. The last ``keep`` datagrams are remembered, in two NumPy rings allocated (and
+    written) whole at the start — memory flat from the first datagram; older plots have
+    no time."""
 
     def __init__(self, keep: int = MAX_ARRIVALS) -> None:
+        if keep < 1:
+            raise ValueError(f"keep must be >= 1 datagram, got {keep!r}")
         self.keep = int(keep)
-        self._first: list[int] = []
-        self._time: list[float] = []
-        self._drop = 0  # entries forgotten at the front
+        self._first = np.full(self.keep, -1, np.int64)
+        self._time = np.full(self.keep, np.nan)
+        self.n = 0  # datagrams added
 
     def add(self, first_plot: int, when: float) -> None:
-        self._first.append(int(first_plot))
-        self._time.append(float(when))
-        if len(self._first) - self._drop > self.keep:
-            self._drop += 1
-            if self._drop >= self.keep:  # compact now and then: amortised O(1)
-                del self._first[:self._drop], self._time[:self._drop]
-                self._drop = 0
+        i = self.n % self.keep
+        self._first[i] = first_plot
+        self._time[i] = when
+        self.n += 1
 
     def time_of(self, plot: int) -> float | None:
         """The receive time of the datagram holding plot ``plot`` (the last datagram
         taken whose first plot number is at most ``plot``); ``None`` if forgotten."""
-        i = bisect.bisect_right(self._first, int(plot), lo=self._drop) - 1
-        return None if i < self._drop else self._time[i]
+        lo, keep, first = max(0, self.n - self.keep), self.keep, self._first
+        i = bisect.bisect_right(range(lo, self.n), int(plot),
+                                key=lambda j: int(first[j % keep])) - 1
+        return None if i < 0 else float(self._time[(lo + i) % keep])
 
 
 def percentiles(values: list[float] | np.ndarray, qs: tuple[float, ...] = (50, 99)
@@ -86,13 +90,15 @@ class Health(Sink):
     """Counts what a live run did and times each frame (module docstring). Put it
     *after* the output sinks, so its ``write`` comes once the frame has gone out.
 
-    ``counts()`` → the running totals ``datagrams, queue_drops, plots, duplicates,
-    late_drops`` (callables of the reader and source); ``tracks()`` → confirmed tracks
+    ``counts()`` → the running totals ``datagrams, queue_drops, kernel_drops, plots,
+    duplicates, late_drops`` (``kernel_drops`` ``None`` where not counted; callables of
+    the reader and source); ``tracks()`` → confirmed tracks
     after a frame (called in :meth:`write`, the stepping thread); ``plot_numbers(out)``
     → the frame's plots' decoding-order numbers; ``periods``
     — each radar's rotation period (s); ``clock`` → now (s, the receive times' clock)."""
 
-    def __init__(self, counts: Callable[[], Mapping[str, int]], tracks: Callable[[], int],
+    def __init__(self, counts: Callable[[], Mapping[str, int | None]],
+                 tracks: Callable[[], int],
                  plot_numbers: Callable[[FrameOutput], np.ndarray],
                  periods: Mapping[int, float], clock: Callable[[], float], *,
                  arrivals: Arrivals | None = None, window: int = WINDOW) -> None:
@@ -110,7 +116,10 @@ class Health(Sink):
         self.untimed = 0  # frames whose last datagram was forgotten
         self.latency_sum = 0.0
         self.latency_count = 0
-        self.recent: deque[float] = deque(maxlen=int(window))
+        #: The last ``window`` latencies: a ring allocated (and written) whole at the
+        #: start, so the memory does not grow with the frames.
+        self.recent = np.full(int(window), np.nan)
+        self._n_recent = 0
         self._interval: list[float] = []
         self._last_frame: dict[int, float] = {}  # radar -> time of its last frame
         self._first_time: float | None = None
@@ -151,7 +160,8 @@ class Health(Sink):
     def _observe(self, latency_s: float) -> None:
         self.latency_sum += latency_s
         self.latency_count += 1
-        self.recent.append(latency_s)
+        self.recent[self._n_recent % self.recent.size] = latency_s
+        self._n_recent += 1
         self._interval.append(latency_s)
 
     def silent(self) -> list[int]:
@@ -167,7 +177,7 @@ class Health(Sink):
         (ids), ``latency_s`` — ``p50, p99`` of the last :data:`WINDOW` frames, ``sum``
         and ``count`` of all — and ``time`` (the clock)."""
         with self._lock:
-            p50, p99 = percentiles(np.fromiter(self.recent, float, len(self.recent)))
+            p50, p99 = percentiles(self.recent[:min(self._n_recent, self.recent.size)])
             return {"time": self.clock() if now is None else now, **dict(self.counts()),
                     "frames": self.frames, "tracks": self.n_tracks,
                     "radars_silent": self.silent(),
@@ -192,7 +202,10 @@ class Health(Sink):
         lat = ("" if math.isnan(p50) else
                f", latency p50 {1e3 * p50:.0f} ms p99 {1e3 * p99:.0f} ms")
         silent = s["radars_silent"]
+        kernel = s.get("kernel_drops")  # None: not counted (SO_RXQ_OVFL is Linux's)
+        kernel = "kernel drops n/a" if kernel is None else f"{kernel} kernel drops"
         return (f"live: {rates}{d} datagrams, {p} plots, {s['duplicates']} duplicates, "
                 f"{s['late_drops']} late drops, {s['queue_drops']} queue drops, "
+                f"{kernel}, "
                 f"{s['frames']} frames, {s['tracks']} tracks, {len(silent)} radars silent"
                 f"{' (' + ', '.join(map(str, silent)) + ')' if silent else ''}{lat}")

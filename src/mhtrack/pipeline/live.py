@@ -36,66 +36,27 @@ from mhtrack.pipeline.checkpoint import (
     read_checkpoint,
 )
 from mhtrack.pipeline.health import Health
+from mhtrack.pipeline.live_options import (
+    DAY_FROM,
+    DEFAULT_STATUS_EVERY_S,
+    EXTRAPOLATION_PERIODS,
+    KEEP_ROWS,
+    LiveOptions,
+    idle_wait,
+)
 from mhtrack.pipeline.monitor import MetricsServer, host_port, prometheus_text, write_status
 from mhtrack.pipeline.options import TrackOptions
 from mhtrack.pipeline.run import Pipeline, RunResult
 from mhtrack.pipeline.view import ViewServer, ViewSink, radar_list
 from mhtrack.pipeline.warmup import Warmup, warm_up
 from mhtrack.sinks.base import FrameOutput, Sink
+from mhtrack.sources.base import IDLE
 
 if TYPE_CHECKING:
     from mhtrack.models.radars import SensorSet
     from mhtrack.records import TrackTable
     from mhtrack.sources.base import Survey
     from mhtrack.sources.udp import ReaderStats
-
-DAY_FROM = ("receive", "stream")
-#: Status period (s) when a status file or endpoint is asked for without one.
-DEFAULT_STATUS_EVERY_S = 10.0
-#: Period output: a track is extrapolated at most this many of the longest radar
-#: rotation periods past its own time (``LiveOptions.max_extrapolation_s``).
-EXTRAPOLATION_PERIODS = 2.0
-
-
-@dataclass(frozen=True)
-class LiveOptions:
-    """Where a live run reads and writes (``None``/empty: not used)."""
-
-    #: ``udp://HOST:PORT`` endpoints to listen on (several LANs: merged).
-    listen: tuple[str, ...] = ()
-    #: Read stdin instead, with this framing (``raw`` or ``len32``).
-    stdin: str | None = None
-    #: How the day of a time of day is found (module docstring).
-    day_from: str = "receive"
-    #: ``udp://HOST:PORT`` destinations of the CAT062 system tracks.
-    out_udp: tuple[str, ...] = ()
-    #: CAT062 recording (``.ast`` or ``.pcap``), in parts of ``part_frames`` frames.
-    out_file: Path | None = None
-    part_frames: int | None = None
-    #: JSON lines of the online rows on stdout.
-    json: bool = False
-    #: Send every output on this period of data time (s) instead of on update.
-    period_out_s: float | None = None
-    #: Period output: longest extrapolation of a track (s; ``None``: 2 rotations).
-    max_extrapolation_s: float | None = None
-    #: Seconds between status lines (``None``: none).
-    status_every_s: float | None = None
-    #: The status as a JSON file and as Prometheus text (file; HTTP ``HOST:PORT``).
-    status_json: Path | None = None
-    prometheus: Path | None = None
-    metrics_http: str | None = None
-    #: The live view's page and JSON at ``http://HOST:PORT/`` (``:PORT``: 127.0.0.1;
-    #: :mod:`~mhtrack.pipeline.view`).
-    view: str | None = None
-    #: Tracker checkpoints: the file, every this many seconds of data time (``None``:
-    #: only at the end); ``resume``: start from it when it exists.
-    checkpoint: Path | None = None
-    checkpoint_every_s: float | None = None
-    resume: bool = False
-    #: CAT062 data source (I062/010).
-    sac: int | None = None
-    sic: int | None = None
-    reorder_window_s: float | None = None
 
 
 @dataclass(frozen=True)
@@ -132,12 +93,14 @@ class LiveResult:
 class Live:
     """The assembled live run (module docstring); :meth:`run` until ``stop`` is set or
     the input ends. ``stdin``/``stdout``: the streams of ``LiveOptions.stdin`` and
-    ``json``; ``emit``: where status lines go; ``clock``: the receive times' clock."""
+    ``json``; ``emit``: where status lines go; ``clock``: the receive times' clock;
+    ``idle_clock``: the clock of ``LiveOptions.idle_close_s`` (tests pass their own)."""
 
     def __init__(self, sensors: SensorSet, options: TrackOptions, live: LiveOptions, *,
                  stop: threading.Event | None = None, stdin: BinaryIO | None = None,
                  stdout: TextIO | None = None, emit: Callable[[str], None] | None = None,
-                 clock: Callable[[], float] = time.time) -> None:
+                 clock: Callable[[], float] = time.time,
+                 idle_clock: Callable[[], float] = time.monotonic) -> None:
         from mhtrack.io.asterix.timeaxis import TimeAxis
         from mhtrack.sources.datagrams import DatagramSource
         from mhtrack.sources.udp import StdinReader, UdpReader
@@ -161,10 +124,10 @@ class Live:
         if live.stdin is not None:
             self.reader: UdpReader | StdinReader = StdinReader(
                 stdin if stdin is not None else sys.stdin.buffer, framing=live.stdin,
-                stop=self.stop)
+                stop=self.stop, clock=idle_clock)
             name = "stdin"
         else:
-            self.reader = UdpReader(list(live.listen), stop=self.stop)
+            self.reader = UdpReader(list(live.listen), stop=self.stop, clock=idle_clock)
             name = ",".join(self.reader.names)
         if emit is not None:  # before any warm-up: a sender may wait for this line
             if self.resumed is not None:
@@ -178,6 +141,8 @@ class Live:
         if self.live_density_needed or any(
                 s.period is None for s in sensors.sensors if s.kind == "polar"):
             sensors, survey, incoming = self._warm_up(sensors, incoming, name)
+        # a quiet feed closes the frames held after a bounded wall-clock wait
+        self.reader.idle_s = idle_wait(sensors, live)
         axis = None
         st = self.resumed
         if st is not None:
@@ -193,6 +158,8 @@ class Live:
             first_row=0 if st is None else st.next_row,
             not_before=None if st is None else st.last_time,
             pending=None if st is None else decode_pending(st.pending),
+            recent=None if st is None else st.duplicates,
+            keep_rows=KEEP_ROWS,  # the health looks up the frame just made
             # stopped with a checkpoint: the plots held go into it, tracked on resume
             hold=lambda: self.stop.is_set() and live.checkpoint is not None)
         try:
@@ -291,16 +258,21 @@ class Live:
     def _arrived(self, reader: Iterable[tuple[bytes, float]]) -> Iterator[Any]:
         """The reader's datagrams, each receive time noted for the latency first."""
         stream = self.live.day_from == "stream"
-        for data, when in reader:
+        for item in reader:
+            if item is IDLE:
+                yield item
+                continue
+            data, when = item
             self.health.arrivals.add(self.source.decoded, when)
             yield data if stream else (data, when)
         self.health.input_ended = True
 
-    def _counts(self) -> dict[str, int]:
+    def _counts(self) -> dict[str, int | None]:
         s, r = self.source.stats, self.reader.stats
         return {"datagrams": r.datagrams, "queue_drops": r.queue_dropped,
-                "plots": s.plots_in, "duplicates": self.source.problems.counts.get(
-                    "duplicate", 0), "late_drops": s.late_dropped}
+                "kernel_drops": r.kernel_dropped, "plots": s.plots_in,
+                "duplicates": self.source.problems.counts.get("duplicate", 0),
+                "late_drops": s.late_dropped, "idle_closes": self.source.idles}
 
     def _tracks(self) -> int:
         return int(np.count_nonzero(self.pipeline.tracker.leaves.reported()))
@@ -330,7 +302,8 @@ class Live:
         return LiveState(self.source.next_frame, axis.day0, axis.latest,
                          self.pipeline.tracker.last_time,
                          None if self.periodic is None else self.periodic.next_tick,
-                         encode_pending(self.source.pending()), self.source.next_row)
+                         encode_pending(self.source.pending()), self.source.next_row,
+                         self.source.recent_blocks() or None)
 
     # -- running ----------------------------------------------------------------------
     @property

@@ -32,12 +32,17 @@ _PLAIN = (
     ("datagrams", "datagrams_total", "counter", "Datagrams received."),
     ("queue_drops", "queue_drops_total", "counter",
      "Datagrams dropped because the queue to the tracker was full."),
+    ("kernel_drops", "kernel_drops_total", "counter",
+     "Datagrams the kernel dropped for a full socket buffer (SO_RXQ_OVFL; NaN: not "
+     "available on this system or input)."),
     ("plots", "plots_total", "counter", "Plots decoded and passed to the re-order window."),
     ("duplicates", "duplicates_total", "counter",
      "Data blocks received twice (redundant LANs) and dropped."),
     ("late_drops", "late_drops_total", "counter",
      "Plots dropped for arriving after the re-order window."),
     ("frames", "frames_total", "counter", "Frames (sectors) tracked."),
+    ("idle_closes", "idle_closes_total", "counter",
+     "Times the feed was quiet for the idle wait and the frames held were closed."),
     ("tracks", "tracks", "gauge", "Confirmed tracks now."),
 )
 
@@ -60,7 +65,8 @@ def prometheus_text(snap: Mapping[str, Any]) -> str:
         out.extend(f"{PREFIX}{name}{suffix} {_number(v)}" for suffix, v in samples)
 
     for key, name, kind, text in _PLAIN:
-        metric(name, kind, text, [("", float(snap[key]))])
+        v = snap.get(key)
+        metric(name, kind, text, [("", math.nan if v is None else float(v))])
     metric("radars_silent", "gauge", "Radars silent for 3 rotation periods of data time.",
            [("", float(len(snap["radars_silent"])))])
     lat = snap["latency_s"]

@@ -332,6 +332,37 @@ class Pipeline:
                          summary)
 
 
+class IdSet:
+    """The distinct non-negative track ids seen, one bit each (a bitmap grown to the
+    largest id): a live run reports ids for days, and a ``set`` of Python ints would cost
+    some 60 octets an id for ever."""
+
+    def __init__(self) -> None:
+        self._bits = np.zeros(0, np.uint8)
+        self._n = 0
+
+    def update(self, ids: np.ndarray) -> None:
+        """Add ``ids`` (integers ≥ 0)."""
+        ids = np.asarray(ids, np.int64)
+        if ids.size == 0:
+            return
+        if ids.min() < 0:
+            raise ValueError(f"track ids must be >= 0, got {int(ids.min())}")
+        need = int(ids.max()) // 8 + 1
+        if need > self._bits.size:
+            grown = np.zeros(max(need, 2 * self._bits.size), np.uint8)
+            grown[:self._bits.size] = self._bits
+            self._bits = grown
+        ids = np.unique(ids)
+        byte, bit = ids >> 3, (1 << (ids & 7)).astype(np.uint8)
+        new = (self._bits[byte] & bit) == 0
+        self._n += int(new.sum())
+        np.bitwise_or.at(self._bits, byte[new], bit[new])
+
+    def __len__(self) -> int:
+        return self._n
+
+
 def feed(outputs: Iterable[FrameOutput], sinks: Sequence[Sink], source: Source | None = None,
          *, backfill_ids: bool = True, summary: StatsSummary | None = None,
          keep_stats: bool = True) -> tuple[list[StepStats], int]:
@@ -342,16 +373,16 @@ def feed(outputs: Iterable[FrameOutput], sinks: Sequence[Sink], source: Source |
     for sink in sinks:
         sink.start(source)
     stats: list[StepStats] = []
-    ids: set[int] = set()
+    ids = IdSet()
     try:
         for out in outputs:
             if keep_stats:
                 stats.append(out.stats)
             if summary is not None:
                 summary.add(out.stats)
-            ids.update(out.online.track_id.tolist())
+            ids.update(out.online.track_id)
             if backfill_ids:
-                ids.update(out.backfill.track_id.tolist())
+                ids.update(out.backfill.track_id)
             for sink in sinks:
                 sink.write(out)
         for sink in sinks:

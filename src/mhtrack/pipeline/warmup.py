@@ -58,6 +58,7 @@ def warm_up(datagrams: Iterator[tuple[bytes, float]], sensors: SensorSet, *, nam
             max_s: float = MAX_WARMUP_S) -> Warmup:
     """Hold ``datagrams`` until the warm-up ends (module docstring); the survey of what
     was held. ``use_receive_time``: the receive times give the day (``day_from``)."""
+    from mhtrack.sources.base import IDLE
     from mhtrack.sources.datagrams import DatagramSource
 
     given = {s.id: float(s.period) for s in sensors.sensors if s.period is not None}
@@ -70,7 +71,10 @@ def warm_up(datagrams: Iterator[tuple[bytes, float]], sensors: SensorSet, *, nam
     periods = dict(given)
     first = last = None
     offset = 0
-    for data, when in datagrams:
+    for item in datagrams:
+        if item is IDLE:  # a quiet feed: nothing is framed yet
+            continue
+        data, when = item
         held.append((data, when))
         new_marks = False
         for _, what, found in decoder.blocks(data, offset, problems,

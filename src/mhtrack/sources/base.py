@@ -32,6 +32,19 @@ if TYPE_CHECKING:
     from mhtrack.scenario import Scenario
 
 
+class _Idle:
+    """The type of :data:`IDLE`."""
+
+    def __repr__(self) -> str:
+        return "IDLE"
+
+
+#: In a live stream of datagrams, in place of one: the input has been quiet for a
+#: bounded wall-clock wait (a reader's ``idle_s``, :mod:`~mhtrack.sources.udp`); a
+#: :class:`~mhtrack.sources.datagrams.DatagramSource` then closes the frames it holds.
+IDLE = _Idle()
+
+
 @dataclass
 class SourceStats:
     """What a source did to its input so far (counters only grow while it is read)."""

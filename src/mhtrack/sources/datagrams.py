@@ -53,7 +53,7 @@ from mhtrack.io.reorder import kept as kept_by_buffer
 from mhtrack.io.timed_plots import polar_plots
 from mhtrack.models.radars import SensorSet
 from mhtrack.records import Scan
-from mhtrack.sources.base import Source, SourceStats, Survey
+from mhtrack.sources.base import IDLE, Source, SourceStats, Survey
 from mhtrack.sources.timed import TimedStream
 
 #: Plots decoded before they are converted and pushed on (memory: a few hundred kB).
@@ -77,7 +77,8 @@ class DatagramSource(Source):
                  axis: TimeAxis | None = None, first_frame: int = 0, first_row: int = 0,
                  not_before: float | None = None,
                  pending: Mapping[str, Any] | None = None,
-                 hold: Callable[[], bool] | None = None) -> None:
+                 hold: Callable[[], bool] | None = None,
+                 recent: str | None = None, keep_rows: int | None = None) -> None:
         super().__init__()
         if chunk < 1:
             raise ValueError(f"chunk must be >= 1 plot, got {chunk!r}")
@@ -107,6 +108,13 @@ class DatagramSource(Source):
         #: ``hold()`` true at the end of the input: keep the plots held (:attr:`held`)
         #: instead of making frames of them (a live run stopped to be resumed).
         self.restore, self.hold = pending, hold
+        #: The duplicate filter's blocks of an earlier run
+        #: (:meth:`~mhtrack.io.asterix.duplicates.DuplicateFilter.recent`), remembered
+        #: first: a copy received before the stop and again after is taken once.
+        self.recent_start = recent
+        #: :meth:`file_rows` knows the last ``keep_rows`` plots only (``None``: all; a
+        #: live stream without end keeps its memory flat).
+        self.keep_rows = keep_rows
         self.held: dict[str, Any] | None = None
         #: Plots decoded so far: the next plot's decoding-order number (its ``file_row``).
         self.decoded = 0
@@ -121,18 +129,26 @@ class DatagramSource(Source):
         """``(byte offset, payload, capture time)`` of each datagram."""
         offset = 0
         for d in self._input:
+            if d is IDLE:
+                yield offset, IDLE, None
+                continue
             payload, when = (d, None) if isinstance(d, bytes | bytearray | memoryview) else d
             yield offset, payload, when
             offset += len(payload)
 
     def _decoded(self, problems: Problems, sweeps: list[tuple[Any, ...]] | None = None,
-                 convert: bool = True) -> Iterator[dict[str, np.ndarray]]:
+                 convert: bool = True, idle: bool = False
+                 ) -> Iterator[dict[str, np.ndarray]]:
         """Chunks of decoded plots in decoding order: converted (columns ``time, sensor,
         x, y, R, file_row, offset``; radars without a site left out) or, with ``convert``
         false, as decoded (:data:`~mhtrack.io.asterix.decode.PLOT_COLUMNS` with the time
-        on the axis, ``offset``); sweep marks (time on the axis) go to ``sweeps``."""
+        on the axis, ``offset``); sweep marks (time on the axis) go to ``sweeps``; with
+        ``idle``, :data:`~mhtrack.sources.base.IDLE` where the input had one (after the
+        chunk decoded before it)."""
         self._decoder = decoder = Decoder(fast=self.fast,
                                           duplicates=stream_filter())
+        if self.recent_start is not None:
+            decoder.duplicates.restore(self.recent_start)  # type: ignore[union-attr]
         self.axis = axis = TimeAxis()
         axis.day0, axis.latest = self.axis_start
         self.decoded = 0
@@ -143,6 +159,15 @@ class DatagramSource(Source):
         in_sector: list[int] = []
         n = 0
         for offset, payload, when in self._datagrams(problems):
+            if payload is IDLE:  # the feed went quiet: what is decoded, then the marker
+                if rows:
+                    yield self._chunk(rows, times, at_rows, n, convert, in_sector)
+                    n += len(rows)
+                    self.decoded = n
+                    rows, times, at_rows, in_sector = [], [], [], []
+                if idle:
+                    yield IDLE  # type: ignore[misc]
+                continue
             for at, what, found in decoder.blocks(payload, offset, problems, when):
                 t = axis.times_list([r[0] for r in found], when)
                 if what == MARKS:
@@ -270,11 +295,14 @@ class DatagramSource(Source):
             self.name, self.stats, self._frame_lengths(), self.window_s,
             lambda first: f"byte {first['offset']} (plot {first['file_row']})",
             first_frame=self.first_frame, first_row=self.first_row,
-            not_before=self.not_before)
+            not_before=self.not_before, keep_rows=self.keep_rows)
         if self.restore is not None:
             yield from stream.restore(self.restore)
-        for cols in self._decoded(problems):
-            yield from stream.push(cols)
+        for cols in self._decoded(problems, idle=True):
+            if cols is IDLE:  # a live feed went quiet: close what is held
+                yield from stream.idle()
+            else:
+                yield from stream.push(cols)
         if self.hold is not None and self.hold():
             self.held = stream.pending()
         else:
@@ -289,6 +317,18 @@ class DatagramSource(Source):
         if self.held is not None:
             return self.held
         return None if self._stream is None else self._stream.pending()
+
+    def recent_blocks(self) -> str | None:
+        """The duplicate filter's recent blocks now (``DuplicateFilter.recent``: what a
+        checkpoint keeps; before reading, those given)."""
+        f = None if self._decoder is None else self._decoder.duplicates
+        return self.recent_start if f is None else f.recent()
+
+    @property
+    def idles(self) -> int:
+        """Times the input went quiet and the frames held were closed
+        (:meth:`TimedStream.idle`)."""
+        return 0 if self._stream is None else self._stream.idles
 
     @property
     def next_frame(self) -> int:

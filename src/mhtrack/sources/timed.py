@@ -30,7 +30,7 @@ class TimedStream:
     def __init__(self, name: str, stats: SourceStats, frame_s: Mapping[int, float] | float,
                  window_s: float, where: Callable[[dict[str, object]], str], *,
                  first_frame: int = 0, first_row: int = 0,
-                 not_before: float | None = None) -> None:
+                 not_before: float | None = None, keep_rows: int | None = None) -> None:
         self.name = name
         self.stats = stats
         self.where = where
@@ -40,9 +40,17 @@ class TimedStream:
         if not_before is not None:  # as if plots up to it had gone: earlier ones are late
             self.buffer.latest = self.buffer.released = float(not_before)
         # file row of each running row: one int64 array grown by doubling (8 bytes a
-        # plot, no object per frame), the first ``_n_out`` entries valid
-        self._rows = np.zeros(1024, np.int64)
+        # plot, no object per frame), the first ``_n_out`` entries valid; with
+        # ``keep_rows`` (a stream without end: live) a ring of the last ``keep_rows``
+        # rows, allocated and written whole at the start (memory flat)
+        if keep_rows is not None and keep_rows < 1:
+            raise ValueError(f"keep_rows must be >= 1, got {keep_rows!r}")
+        self.keep_rows = keep_rows
+        self._rows = np.zeros(1024, np.int64) if keep_rows is None else \
+            np.full(int(keep_rows), -1, np.int64)
         self._n_out = 0
+        #: Times the input went quiet (:meth:`idle`).
+        self.idles = 0
         #: The first running row number (a resumed run numbers on: the tracker's plot
         #: windows hold the earlier run's rows, and a plot is known by its row).
         self.first_row = int(first_row)
@@ -66,6 +74,18 @@ class TimedStream:
         if late.n:
             logging.getLogger("mhtrack").warning("%s", late.line(self.name,
                                                                  self.where(late.first)))
+
+    def idle(self) -> Iterator[Scan]:
+        """The input went quiet (a live feed: :data:`~mhtrack.sources.base.IDLE`): the
+        re-order window is released and every open frame closed, as at the end of the
+        input, but the stream goes on — a later plot older than the plots released is a
+        late drop, a later plot of a radar starts its next frame."""
+        self.idles += 1
+        released = self.buffer.flush()
+        if released and len(released["time"]):
+            yield from map(self._scan, self.framer.push(released))
+        yield from map(self._scan, self.framer.flush())
+        self._count()
 
     def pending(self) -> dict[str, object]:
         """The plots held — in the framer (``framed``) and in the re-order buffer
@@ -101,11 +121,16 @@ class TimedStream:
         c = fr.cols
         n = len(c["time"])
         rows = np.arange(self._n_out, self._n_out + n, dtype=np.int64) + self.first_row
-        if self._n_out + n > self._rows.size:
+        if self.keep_rows is not None:  # the last keep_rows of the frame's rows
+            last = np.arange(max(0, n - self.keep_rows), n)
+            self._rows[(self._n_out + last) % self.keep_rows] = \
+                np.asarray(c["file_row"], np.int64)[last]
+        elif self._n_out + n > self._rows.size:
             grown = np.zeros(max(2 * self._rows.size, self._n_out + n), np.int64)
             grown[:self._n_out] = self._rows[:self._n_out]
             self._rows = grown
-        self._rows[self._n_out:self._n_out + n] = c["file_row"]
+        if self.keep_rows is None:
+            self._rows[self._n_out:self._n_out + n] = c["file_row"]
         self._n_out += n
         self.stats.plots_out += n
         self.stats.frames += 1
@@ -121,9 +146,14 @@ class TimedStream:
 
     def file_rows(self, rows: np.ndarray) -> np.ndarray:
         """The ``file_row`` of each running row number (``-1`` stays ``-1``, and so
-        does a row before :attr:`first_row`)."""
+        does a row before :attr:`first_row` or, with ``keep_rows``, one older than the
+        last ``keep_rows``)."""
         rows = np.asarray(rows, np.int64) - self.first_row
         out = np.full(rows.shape, -1, np.int64)
-        ok = rows >= 0
-        out[ok] = self._rows[:self._n_out][rows[ok]]
+        if self.keep_rows is None:
+            ok = rows >= 0
+            out[ok] = self._rows[:self._n_out][rows[ok]]
+        else:
+            ok = (rows >= max(0, self._n_out - self.keep_rows)) & (rows < self._n_out)
+            out[ok] = self._rows[rows[ok] % self.keep_rows]
         return out

@@ -16,10 +16,22 @@ the bytes were read) for :class:`~mhtrack.sources.datagrams.DatagramSource`. A t
 drains the sockets into a queue as soon as datagrams arrive, so a slow tracker step does
 not overflow the kernel's socket buffer; the queue is bounded (``max_queued``), and a
 datagram that does not fit is dropped and counted (``stats.queue_dropped``), never
-silently. Setting the ``stop`` event (:func:`stop_on_signals`: SIGTERM, Ctrl-C) ends the
+silently. The kernel's own drops — datagrams that found a socket's receive buffer full
+— are read from the socket on Linux (``SO_RXQ_OVFL``: each datagram carries the
+socket's running count of drops before it, as ancillary data of ``recvmsg``) and summed
+over the sockets in ``stats.kernel_dropped``; ``None`` where the option is not available
+(other systems; stdin, a pipe, never drops). Drops after the last datagram read show with
+the next one. Setting the ``stop`` event (:func:`stop_on_signals`: SIGTERM, Ctrl-C) ends the
 iteration cleanly: the sockets are drained once more without waiting, every datagram
 already received is yielded, then the iteration ends — the source then finishes the
 frames it holds.
+
+With ``idle_s`` the iteration also yields :data:`~mhtrack.sources.base.IDLE` (once)
+when no datagram has come for ``idle_s`` seconds of ``clock`` (injectable: tests pass
+their own): the feed has gone quiet, and the source closes the frames it holds instead
+of waiting for plots that may never come (``docs/live.md``, *A silent feed*). Only a
+live run asks for it: a recording read from a file has no wall clock, and gives the
+same frames every time.
 """
 
 from __future__ import annotations
@@ -31,13 +43,17 @@ import queue
 import selectors
 import signal
 import socket
+import struct
+import sys
 import threading
 import time
 from abc import ABC, abstractmethod
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from typing import Any, BinaryIO
 from urllib.parse import urlsplit
+
+from mhtrack.sources.base import IDLE
 
 #: Receive buffer asked of the kernel per socket (bytes; Linux caps it at
 #: ``net.core.rmem_max`` unless run as root).
@@ -49,6 +65,11 @@ POLL_S = 0.05
 #: Largest UDP payload.
 MAX_DATAGRAM = 65535
 STDIN_FRAMINGS = ("raw", "len32")
+#: Linux's ``SO_RXQ_OVFL`` (``asm-generic/socket.h``; not in Python's socket module):
+#: a socket option asking for the drop count as ancillary data of each datagram.
+SO_RXQ_OVFL = 40
+#: The drop count is an unsigned 32-bit counter (it wraps).
+_U32 = 1 << 32
 
 
 @dataclass(frozen=True)
@@ -127,14 +148,47 @@ class ReaderStats:
     queue_dropped: int = 0
     #: Datagrams received per endpoint (``str(endpoint)``, or ``"stdin"``).
     per_input: dict[str, int] = field(default_factory=dict)
+    #: Datagrams the kernel dropped for a full socket buffer (all sockets; ``None``:
+    #: not available, module docstring).
+    kernel_dropped: int | None = None
+
+
+def drop_counting(sock: socket.socket) -> bool:
+    """Ask the kernel for ``sock``'s drop count with every datagram (``SO_RXQ_OVFL``,
+    Linux); whether it was granted."""
+    if not sys.platform.startswith("linux"):
+        return False
+    try:
+        sock.setsockopt(socket.SOL_SOCKET, SO_RXQ_OVFL, 1)
+    except OSError:
+        return False
+    return True
+
+
+def drop_count(ancdata: list[tuple[int, int, bytes]]) -> int | None:
+    """The socket's running drop count carried by one datagram's ancillary data
+    (``SO_RXQ_OVFL``: a native unsigned 32-bit integer); ``None`` without one (the
+    kernel sends it only once a drop has happened)."""
+    for level, kind, data in ancdata:
+        if level == socket.SOL_SOCKET and kind == SO_RXQ_OVFL and len(data) >= 4:
+            return int(struct.unpack("=I", data[:4])[0])
+    return None
 
 
 class _Threaded(ABC):
     """A receiving thread filling a bounded queue; iteration yields from the queue until
     the thread has ended (stop set, or end of input) and the queue is empty."""
 
-    def __init__(self, stop: threading.Event | None, max_queued: int) -> None:
+    def __init__(self, stop: threading.Event | None, max_queued: int,
+                 idle_s: float | None = None,
+                 clock: Callable[[], float] = time.monotonic) -> None:
+        if idle_s is not None and not idle_s > 0:
+            raise ValueError(f"idle_s must be > 0 s, got {idle_s!r}")
         self.stop = threading.Event() if stop is None else stop
+        #: Yield :data:`IDLE` after this long without a datagram (``None``: never).
+        self.idle_s, self.clock = idle_s, clock
+        #: Times :data:`IDLE` was yielded.
+        self.idles = 0
         self.stats = ReaderStats()
         self._queue: queue.Queue[tuple[bytes, float]] = queue.Queue(max_queued)
         self._thread: threading.Thread | None = None
@@ -168,17 +222,27 @@ class _Threaded(ABC):
                                             daemon=True)
             self._thread.start()
 
-    def __iter__(self) -> Iterator[tuple[bytes, float]]:
+    def __iter__(self) -> Iterator[Any]:
+        """``(datagram, receive time)`` as they come; :data:`IDLE` once after each quiet
+        spell of ``idle_s`` (module docstring)."""
         self.start()
         assert self._thread is not None
+        last, told = self.clock(), False
         while True:
             try:
-                yield self._queue.get(timeout=POLL_S)
-                continue
+                item = self._queue.get(timeout=POLL_S)
             except queue.Empty:
                 pass
+            else:
+                last, told = self.clock(), False
+                yield item
+                continue
             if not self._thread.is_alive() and self._queue.empty():
                 break
+            if self.idle_s is not None and not told and self.clock() - last >= self.idle_s:
+                told = True
+                self.idles += 1
+                yield IDLE
         self._thread.join()
         if self.error is not None:
             raise self.error
@@ -191,8 +255,10 @@ class UdpReader(_Threaded):
     bound ``host, port`` of each, so port 0 picks a free port)."""
 
     def __init__(self, endpoints: list[str | Endpoint], *, stop: threading.Event | None = None,
-                 rcvbuf: int = DEFAULT_RCVBUF, max_queued: int = DEFAULT_MAX_QUEUED) -> None:
-        super().__init__(stop, max_queued)
+                 rcvbuf: int = DEFAULT_RCVBUF, max_queued: int = DEFAULT_MAX_QUEUED,
+                 idle_s: float | None = None,
+                 clock: Callable[[], float] = time.monotonic) -> None:
+        super().__init__(stop, max_queued, idle_s, clock)
         if not endpoints:
             raise ValueError("no endpoint to listen on")
         self.endpoints = [e if isinstance(e, Endpoint) else parse_endpoint(e)
@@ -205,6 +271,11 @@ class UdpReader(_Threaded):
             self.close()
             raise
         self.addresses = [s.getsockname()[:2] for s in self.sockets]
+        #: Each socket's drop count as last seen (``None``: not counted, module
+        #: docstring); the total in ``stats.kernel_dropped``.
+        self._drops: list[int] | None = [0] * len(self.sockets) if all(
+            drop_counting(s) for s in self.sockets) else None
+        self.stats.kernel_dropped = None if self._drops is None else 0
         self.names = [str(Endpoint(ep.host, a[1])) for ep, a in
                       zip(self.endpoints, self.addresses, strict=True)]
 
@@ -212,12 +283,20 @@ class UdpReader(_Threaded):
         """Read every socket in turn, one datagram each a round, until a round finds
         none (module docstring)."""
         pairs = list(zip(self.sockets, self.names, strict=True))
+        drops, space = self._drops, socket.CMSG_SPACE(4)
         got = True
         while got:
             got = False
-            for sock, name in pairs:
+            for i, (sock, name) in enumerate(pairs):
                 try:
-                    data = sock.recv(MAX_DATAGRAM)
+                    if drops is None:
+                        data = sock.recv(MAX_DATAGRAM)
+                    else:
+                        data, anc, _, _ = sock.recvmsg(MAX_DATAGRAM, space)
+                        seen = drop_count(anc)
+                        if seen is not None and seen != drops[i] % _U32:
+                            drops[i] += (seen - drops[i]) % _U32  # a running count
+                            self.stats.kernel_dropped = sum(drops)
                 except (BlockingIOError, InterruptedError):
                     continue
                 self._put(data, time.time(), name)
@@ -246,8 +325,10 @@ class StdinReader(_Threaded):
 
     def __init__(self, stream: BinaryIO, *, framing: str = "raw",
                  stop: threading.Event | None = None,
-                 max_queued: int = DEFAULT_MAX_QUEUED, name: str = "stdin") -> None:
-        super().__init__(stop, max_queued)
+                 max_queued: int = DEFAULT_MAX_QUEUED, name: str = "stdin",
+                 idle_s: float | None = None,
+                 clock: Callable[[], float] = time.monotonic) -> None:
+        super().__init__(stop, max_queued, idle_s, clock)
         if framing not in STDIN_FRAMINGS:
             raise ValueError(f"unknown stdin framing {framing!r} (expected "
                              f"{', '.join(STDIN_FRAMINGS)})")

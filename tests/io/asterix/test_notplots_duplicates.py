@@ -149,3 +149,44 @@ def test_memory_is_bounded_by_the_span(blocks_: list[int], span: int) -> None:
     for i, b in enumerate(blocks_):
         f.keep(bytes([48, 0, 4, b]), float(i))
         assert len(f.seen) <= span
+
+
+@given(st.lists(st.integers(0, 30), max_size=120), st.integers(0, 120),
+       st.integers(1, 16), st.booleans())
+def test_a_restored_filter_decides_as_the_filter_never_stopped(
+        blocks_: list[int], cut: int, span: int, with_times: bool) -> None:
+    """A stream filter's :meth:`recent` digests, restored into a fresh filter (a live run
+    resumed from its checkpoint), make the same keep/drop decisions on the rest of the
+    stream as the filter that saw it all — a copy late across the restart is a copy."""
+    from mhtrack.io.asterix.duplicates import stream_filter
+
+    seq = [bytes([48, 0, 4, b]) for b in blocks_]
+    cut = min(cut, len(seq))
+    whole = stream_filter(span)
+    want = [whole.keep(b, float(i) if with_times else None) for i, b in enumerate(seq)]
+    first = stream_filter(span)
+    got = [first.keep(b, float(i) if with_times else None) for i, b in enumerate(seq[:cut])]
+    second = stream_filter(span)
+    second.restore(first.recent())
+    got += [second.keep(b, float(i) if with_times else None)
+            for i, b in enumerate(seq[cut:], cut)]
+    assert got == want
+    assert len(second.seen) <= span
+
+
+def test_restore_refuses_what_is_no_list_of_digests() -> None:
+    from mhtrack.io.asterix.duplicates import stream_filter
+
+    good = stream_filter()
+    good.keep(bytes([48, 0, 4, 1]))
+    good.keep(bytes([48, 0, 4, 2]))
+    text = good.recent()
+    assert len(text) == 80 and text[32:40] == "00000001" and text[72:80] == "00000000"
+    swapped = text[40:] + text[:40]  # the newer block first: ages must fall
+    for bad, match in ((3, "hex string"), (text[:-1], "multiple of 40"),
+                       ("zz" * 20, "not a hex"), (text[:40] * 2, "twice"),
+                       ("00" * 20 * 5, "at most"), (swapped, "ages must fall"),
+                       (text[:32] + "ffffffff", "ages must fall")):
+        f = stream_filter(span=4)
+        with pytest.raises(ValueError, match=match):
+            f.restore(bad)

@@ -12,6 +12,9 @@ whatever its delay within the last ``span`` blocks: a copy later than the window
 decoded again and its plots — not dropped as late when within the re-order window, or at
 the time of the last plot already released — tracked twice (a second LAN 1 s behind
 doubled every plot). The octets hold the block's time of day: only a copy can equal them.
+Its window is infinite, so the count alone decides (receive times, when given, play no
+part), and its state — the blocks remembered and their ages in blocks received — can be
+kept in a live run's checkpoint and restored (:meth:`DuplicateFilter.recent`).
 
 Streaming: one :meth:`DuplicateFilter.keep` call per data block, in file order; memory
 is bounded by ``span`` digests (16-octet BLAKE2b of each block) whatever the window.
@@ -28,6 +31,9 @@ from collections import OrderedDict
 WINDOW_S = 0.5
 #: Default number of recent blocks remembered.
 SPAN = 4096
+#: Octets of a block's digest (BLAKE2b), and of its age in :meth:`DuplicateFilter.recent`.
+DIGEST = 16
+AGE = 4
 
 
 class DuplicateFilter:
@@ -47,10 +53,11 @@ class DuplicateFilter:
         """Whether this data block (its whole octets, header included) is new: not seen
         within ``window`` s (with capture times) or within the last ``span`` blocks."""
         self.count += 1
-        key = hashlib.blake2b(block, digest_size=16).digest()
+        key = hashlib.blake2b(block, digest_size=DIGEST).digest()
         prev = self.seen.get(key)
         if prev is not None:
-            if abs(time - prev[0]) <= self.window if time is not None and prev[0] is not None \
+            timed = time is not None and prev[0] is not None and math.isfinite(self.window)
+            if abs(time - prev[0]) <= self.window if timed \
                     else self.count - prev[1] <= self.span:
                 self.dropped += 1
                 return False
@@ -66,6 +73,50 @@ class DuplicateFilter:
                 self.seen.popitem(last=False)
         return True
 
+
+    def recent(self) -> str:
+        """The blocks remembered, oldest first, as one hex string — per block its digest
+        (32 digits) and its age in blocks received since (8 digits, at most ``span + 1``:
+        older is as good as forgotten): with :meth:`restore`, the filter of a later run
+        (a live run resumed from a checkpoint) decides on the blocks that follow as this
+        one would — a copy late across the restart is a copy. For a stream filter (the
+        count rule: :func:`stream_filter`)."""
+        cap = self.span + 1
+        return b"".join(k + min(self.count - c, cap).to_bytes(AGE, "big")
+                        for k, (_, c) in self.seen.items()).hex()
+
+    def restore(self, recent: str) -> None:
+        """Remember the blocks of :meth:`recent` as received before any of this
+        filter's own; a :class:`ValueError` naming what is wrong when ``recent`` is not
+        such a string (it may come from a hostile file)."""
+        if not isinstance(recent, str):
+            raise ValueError(f"recent blocks: expected a hex string, got "
+                             f"{type(recent).__name__}")
+        size = DIGEST + AGE
+        if len(recent) % (2 * size) or len(recent) > 2 * size * self.span:
+            raise ValueError(f"recent blocks: {len(recent)} hex digits, expected a multiple "
+                             f"of {2 * size} and at most {2 * size * self.span}")
+        try:
+            raw = bytes.fromhex(recent)
+        except ValueError:
+            raise ValueError("recent blocks: not a hex string") from None
+        entries = [(raw[i:i + DIGEST], int.from_bytes(raw[i + DIGEST:i + size], "big"))
+                   for i in range(0, len(raw), size)]
+        keys = [k for k, _ in entries]
+        if len(set(keys)) != len(keys):
+            raise ValueError("recent blocks: a digest appears twice")
+        ages = [a for _, a in entries]
+        if any(a > self.span + 1 for a in ages) or ages != sorted(ages, reverse=True):
+            raise ValueError(f"recent blocks: ages must fall from oldest to newest and be "
+                             f"at most {self.span + 1}")
+        old = list(self.seen.items())
+        # received ``age`` blocks before this filter's count 0
+        self.seen = OrderedDict((k, (None, self.count - a)) for k, a in entries)
+        for k, v in old:
+            self.seen.pop(k, None)
+            self.seen[k] = v
+        while len(self.seen) > self.span:
+            self.seen.popitem(last=False)
 
 
 def stream_filter(span: int = SPAN) -> DuplicateFilter:

@@ -6,7 +6,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from mhtrack.build import make_tracker
 from mhtrack.build.radar_defaults import radar_rule
 from mhtrack.mht import MHTConfig
 from mhtrack.models.clutter import Region, UniformClutter
@@ -47,7 +46,7 @@ def run_regions(sim, partition: Partition, batch: int = 8
     rule = radar_rule(sim.scenario.sensor_set(), p.sensor, p.time, p.x, p.y,
                       v_max=MHTConfig().v_max)
     cfg = MHTConfig(new_target_density=rule.new_target_density)
-    regions = [RegionTracker(make_tracker("mht-agmm", cfg, sensors=sim.scenario.sensor_set()))
+    regions = [RegionTracker("mht-agmm", cfg, sim.scenario.sensor_set())
                for _ in partition.cores]
     hand = HandOver(partition)
     own: list[list[TrackTable]] = [[] for _ in regions]

@@ -39,7 +39,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from mhtrack.mht import MHTConfig
 from mhtrack.models.clutter import Region
+from mhtrack.models.radars import SensorSet
 from mhtrack.records import Scan, TrackTable
 
 #: Defaults of :class:`HandOver` (ours): en-route separation is 5 NM (9.3 km), so a 2 km
@@ -100,16 +102,21 @@ class Partition:
 
 class RegionTracker:
     """One region's tracker (what one machine runs; a Dask actor in
-    ``benchmarks/regions.py``): steps its frames and returns their reports."""
+    ``benchmarks/regions.py``): built there from its name, configuration and sensors
+    (:func:`~mhtrack.build.make_tracker`: plain data travel, a tracker is made where it
+    runs), steps its frames and returns their reports."""
 
-    def __init__(self, tracker: object) -> None:
-        self.tracker = tracker
+    def __init__(self, name: str, config: MHTConfig, sensors: SensorSet | None = None
+                 ) -> None:
+        from mhtrack.build import make_tracker
+
+        self.tracker = make_tracker(name, config, sensors=sensors)
 
     def step(self, frames: list[Scan]) -> TrackTable:
         """Step every frame in order; the confirmed tracks reported at each (online
         rows), concatenated. A frame without plots is skipped, as a source makes no frame
         without plots (the radar's look is known from its plots)."""
-        parts = [self.tracker.step(f) for f in frames if len(f.rows)]  # type: ignore[attr-defined]
+        parts = [self.tracker.step(f) for f in frames if len(f.rows)]
         parts = [p for p in parts if len(p)]
         return TrackTable.concat(parts) if parts else TrackTable.empty()
 

@@ -17,9 +17,10 @@ Stages (each prints its command or what it does, and how long it took):
    ``mhtrack replay radar.pcap --speed 1`` (real time). ``live``'s RSS is sampled from
    ``/proc`` every second. Once ``replay`` is done, ``live`` gets SIGTERM after 3 s; a
    ``live`` still busy ``--stop-timeout`` seconds later is killed (it fell behind; its
-   last status file gives its figures). Printed: plots/s sustained (plots decoded over the replay's wall time, and frames
-   tracked), the latency p50/p99 of the whole run and of each 10 s status line (a latency
-   that grows line after line is a tracker falling behind), RSS (peak and last).
+   last status file gives its figures). Printed: plots/s sustained (plots decoded over
+   the replay's wall time, and frames tracked), the latency p50/p99 of the whole run and
+   of each 10 s status line (a latency that grows line after line is a tracker falling
+   behind), RSS (peak and last).
 3. **Profile** — ``cProfile`` of the same pipeline (``Pipeline.open(radar.pcap)``, the
    same options) on the recording's first ``--profile-s`` seconds at full speed: the
    capacity of one core (plots/s) and where the time goes, per stage.

@@ -172,6 +172,15 @@ def rss_mb(pid: int) -> tuple[float, float]:
     return get.get("VmRSS", 0.0), get.get("VmHWM", 0.0)
 
 
+def cpu_s(pid: int) -> float:
+    """User + system CPU seconds of process ``pid`` (``/proc/PID/stat``; 0 when gone)."""
+    try:
+        f = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+    except OSError:
+        return 0.0
+    return (int(f[11]) + int(f[12])) / os.sysconf("SC_CLK_TCK")
+
+
 def live_run(d: Path, meta: dict, a: argparse.Namespace) -> dict:
     """Replay ``d/radar.pcap`` at real time into ``live`` (module docstring, stage 2)."""
     drain = Drain()
@@ -205,6 +214,9 @@ def live_run(d: Path, meta: dict, a: argparse.Namespace) -> dict:
         t_replay = time.time() - t0
         time.sleep(3.0)
         hwm = rss_mb(live.pid)[1]
+        cpu = cpu_s(live.pid)
+        with (d / "status.json").open() as fh:
+            at_end = json.load(fh)  # the last status before the stop
         t_stop = time.time()
         live.send_signal(signal.SIGTERM)
         killed = False
@@ -225,7 +237,7 @@ def live_run(d: Path, meta: dict, a: argparse.Namespace) -> dict:
                 if (m := re.search(r"latency p50 (\d+) ms p99 (\d+) ms", ln))]
     return {"command": "mhtrack " + " ".join(args) + " | mhtrack " + " ".join(rep),
             "replay": said.strip(), "replay_s": t_replay, "stop_s": t_exit, "status": st,
-            "killed": killed,
+            "killed": killed, "cpu_s": cpu, "at_end": at_end,
             "lines": per_line, "rss_peak_mb": max(hwm, max((r for _, r in rss), default=0)),
             "rss": rss, "cat062_datagrams": drain.count, "last_lines": [ln for _, ln in
                                                                        lines[-3:]]}
@@ -258,15 +270,15 @@ def profile(d: Path, meta: dict, a: argparse.Namespace) -> dict:
                          reorder_window_s=a.reorder_window)
     sink = Stop()
     prof = cProfile.Profile()
-    t0 = time.perf_counter()
+    c0, t0 = time.process_time(), time.perf_counter()
     prof.enable()
     with contextlib.suppress(_Enough):
         pipe.run([sink])
     prof.disable()
-    wall = time.perf_counter() - t0
+    wall, cpu = time.perf_counter() - t0, time.process_time() - c0
     prof.dump_stats(str(d / "profile.prof"))
     stats = pstats.Stats(prof)
-    return {"wall": wall, "frames": sink.frames, "plots": sink.plots,
+    return {"wall": wall, "cpu": cpu, "frames": sink.frames, "plots": sink.plots,
             "stages": stages(stats)}
 
 
@@ -399,6 +411,10 @@ def main() -> None:
               f"median {_pct([x[2] for x in lines], 50):.0f} ms, last "
               f"{lines[-1][2] if lines else 0:.0f} ms, max "
               f"{max((x[2] for x in lines), default=0):.0f} ms")
+        e = r["at_end"]
+        print(f"  at the replay's end (+3 s): {e['plots']} plots decoded, {e['frames']} frames "
+              f"tracked; live's CPU {r['cpu_s']:.0f} s = {e['plots'] / max(r['cpu_s'], 1e-9):.0f}"
+              f" plots decoded per CPU-second (the replay needs {meta['plots_per_s']:.0f}/s)")
         print(f"  RSS peak {r['rss_peak_mb']:.0f} MB, at 60 s "
               f"{next((m for t, m in r['rss'] if t >= 60), 0):.0f} MB, last "
               f"{r['rss'][-1][1] if r['rss'] else 0:.0f} MB")
@@ -410,7 +426,8 @@ def main() -> None:
         p = profile(d, meta, a)
         print(f"\nprofile (cProfile, {d / 'profile.prof'}): first {a.profile_s:g} s of data, "
               f"{p['frames']} frames, {p['plots']} plots in {p['wall']:.1f} s = "
-              f"{p['plots'] / p['wall']:.0f} plots/s on one core under the profiler")
+              f"{p['plots'] / p['wall']:.0f} plots/s under the profiler; CPU {p['cpu']:.1f} s "
+              f"= {p['plots'] / p['cpu']:.0f} plots per CPU-second")
         for label, sec in p["stages"]:
             print(f"  {label:70s} {sec:8.2f} s {100 * sec / p['wall']:5.1f} %")
     s = stonesoup(d, a)

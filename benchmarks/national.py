@@ -21,7 +21,7 @@ Stages (each prints its command or what it does, and how long it took):
    the replay's wall time, and frames tracked), the latency p50/p99 of the whole run and
    of each 10 s status line (a latency that grows line after line is a tracker falling
    behind), RSS (peak and last).
-3. **Profile** — ``cProfile`` of the same pipeline (``Pipeline.open(radar.pcap)``, the
+3. **Profile** (``national_profile.py``) — ``cProfile`` of the same pipeline (``Pipeline.open(radar.pcap)``,
    same options) on the recording's first ``--profile-s`` seconds at full speed: the
    capacity of one core (plots/s) and where the time goes, per stage.
 4. **Stone Soup** — its GNN (``benchmarks/stonesoup_timed.py``, as in ``bench_async.py``)
@@ -34,13 +34,10 @@ Loopback only (127.0.0.1); every wait is bounded.
 from __future__ import annotations
 
 import argparse
-import contextlib
-import cProfile
 import json
 import math
 import os
 import pickle
-import pstats
 import re
 import signal
 import socket
@@ -243,90 +240,6 @@ def live_run(d: Path, meta: dict, a: argparse.Namespace) -> dict:
                                                                        lines[-3:]]}
 
 
-# ------------------------------------------------------------------ 3. profile
-class _Enough(Exception):
-    pass
-
-
-def profile(d: Path, meta: dict, a: argparse.Namespace) -> dict:
-    """cProfile of the pipeline on the recording's first ``--profile-s`` seconds."""
-    from mhtrack.pipeline import Pipeline, TrackOptions
-    from mhtrack.sinks.base import Sink
-
-    class Stop(Sink):
-        def __init__(self) -> None:
-            self.t0, self.frames, self.plots = None, 0, 0
-
-        def write(self, out) -> None:
-            t = out.frame.time
-            self.t0 = t if self.t0 is None else self.t0
-            self.frames += 1
-            self.plots += out.stats.n_plots
-            if t - self.t0 > a.profile_s:
-                raise _Enough
-
-    opts = TrackOptions(new_target_density=meta["birth_density"], output="online")
-    pipe = Pipeline.open(d / "radar.pcap", opts, sensors_file=str(d / "sensors.toml"),
-                         reorder_window_s=a.reorder_window)
-    sink = Stop()
-    prof = cProfile.Profile()
-    c0, t0 = time.process_time(), time.perf_counter()
-    prof.enable()
-    with contextlib.suppress(_Enough):
-        pipe.run([sink])
-    prof.disable()
-    wall, cpu = time.perf_counter() - t0, time.process_time() - c0
-    prof.dump_stats(str(d / "profile.prof"))
-    stats = pstats.Stats(prof)
-    return {"wall": wall, "cpu": cpu, "frames": sink.frames, "plots": sink.plots,
-            "stages": stages(stats)}
-
-
-#: Where the time goes: (label, function name, file fragment); a stage's time is the
-#: cumulative time of that function in the profile.
-STAGE_FUNCS = (
-    ("whole run (feed)", "feed", "pipeline/run.py"),
-    ("tracker step", "step", "mht/tracker.py"),
-    ("  frame context, look", "_frame", "mht/tracker.py"),
-    ("  look (coverage)", "_look", "mht/tracker.py"),
-    ("  predict", "predict_leaves", "mht/predict.py"),
-    ("  gate", "gate_looked", "mht/timed.py"),
-    ("  clutter", "clutter_intensity", "mht/"),
-    ("  score (update increment)", "update_increment", "mht/"),
-    ("  propose children", "propose_children", "mht/extend.py"),
-    ("  births: propose", "propose", "mht/births/"),
-    ("  prune children", "prune_children", "mht/pruning.py"),
-    ("  grow (Kalman update)", "grow_children", "mht/extend.py"),
-    ("  births: seed", "seed", "mht/births/"),
-    ("  number and merge", "_number", "mht/tracker.py"),
-    ("  global hypothesis", "_hypothesis", "mht/tracker.py"),
-    ("  N-scan pruning", "prune_after_solve", "mht/pruning.py"),
-    ("  confirm", "_confirm", "mht/tracker.py"),
-    ("  report", "_report", "mht/tracker.py"),
-    ("  statistics", "of", "mht/"),
-)
-
-
-def stages(stats: pstats.Stats) -> list[tuple[str, float]]:
-    """Cumulative seconds of each stage of :data:`STAGE_FUNCS` found in ``stats`` (a
-    function the profile does not hold is left out), the source (the run less the
-    tracker's steps and the sink), and the 12 heaviest functions by own time."""
-    out, cum = [], {}
-    for label, fn, frag in STAGE_FUNCS:
-        hits = [v[3] for (f, _, name), v in stats.stats.items()  # type: ignore[attr-defined]
-                if name == fn and frag in f.replace(os.sep, "/") and "mhtrack" in f]
-        if hits:
-            cum[fn] = max(hits)
-            out.append((label, cum[fn]))
-    if "feed" in cum and "step" in cum:
-        out.insert(1, ("source: read, decode, re-order, frame (run − steps)",
-                       cum["feed"] - cum["step"]))
-    own = sorted(stats.stats.items(), key=lambda kv: -kv[1][2])[:12]  # type: ignore[attr-defined]
-    for (f, line, name), v in own:
-        out.append((f"own time: {'/'.join(Path(f).parts[-2:])}:{line} {name}", v[2]))
-    return out
-
-
 # ------------------------------------------------------------------ 4. Stone Soup
 def stonesoup(d: Path, a: argparse.Namespace) -> dict:
     """Stone Soup's GNN and mhtrack on the slice (module docstring, stage 4)."""
@@ -380,6 +293,8 @@ def main() -> None:
     ap.add_argument("--box-km", type=float, default=150.0)
     ap.add_argument("--skip-live", action="store_true")
     ap.add_argument("--skip-profile", action="store_true")
+    ap.add_argument("--no-cprofile", action="store_true",
+                    help="time the pipeline on --profile-s seconds without the profiler")
     ap.add_argument("--skip-stonesoup", action="store_true")
     a = ap.parse_args()
     d = a.out or Path(tempfile.mkdtemp(prefix="national_"))
@@ -423,8 +338,11 @@ def main() -> None:
         print(f"  $ {r['command']}")
         (d / "live_result.json").write_text(json.dumps(r, indent=1))
     if not a.skip_profile:
+        from national_profile import profile
+
         p = profile(d, meta, a)
-        print(f"\nprofile (cProfile, {d / 'profile.prof'}): first {a.profile_s:g} s of data, "
+        how = "no profiler" if a.no_cprofile else f"cProfile, {d / 'profile.prof'}"
+        print(f"\nprofile ({how}): first {a.profile_s:g} s of data, "
               f"{p['frames']} frames, {p['plots']} plots in {p['wall']:.1f} s = "
               f"{p['plots'] / p['wall']:.0f} plots/s under the profiler; CPU {p['cpu']:.1f} s "
               f"= {p['plots'] / p['cpu']:.0f} plots per CPU-second")

@@ -21,9 +21,10 @@ Stages (each prints its command or what it does, and how long it took):
    the replay's wall time, and frames tracked), the latency p50/p99 of the whole run and
    of each 10 s status line (a latency that grows line after line is a tracker falling
    behind), RSS (peak and last).
-3. **Profile** (``national_profile.py``) — ``cProfile`` of the same pipeline (``Pipeline.open(radar.pcap)``,
-   same options) on the recording's first ``--profile-s`` seconds at full speed: the
-   capacity of one core (plots/s) and where the time goes, per stage.
+3. **Profile** (``national_profile.py``) — ``cProfile`` of the same pipeline
+   (``Pipeline.open(radar.pcap)``, same options) on the recording's first ``--profile-s``
+   seconds at full speed: plots per wall- and CPU-second (the capacity of one core) and
+   where the time goes, per stage (``--no-cprofile``: timed without the profiler).
 4. **Stone Soup** — its GNN (``benchmarks/stonesoup_timed.py``, as in ``bench_async.py``)
    and mhtrack on a slice of the same scene: the plots within a ``--box-km`` square about
    the centre over the first ``--stonesoup-s`` seconds; plots/s of each.
@@ -344,7 +345,7 @@ def main() -> None:
         how = "no profiler" if a.no_cprofile else f"cProfile, {d / 'profile.prof'}"
         print(f"\nprofile ({how}): first {a.profile_s:g} s of data, "
               f"{p['frames']} frames, {p['plots']} plots in {p['wall']:.1f} s = "
-              f"{p['plots'] / p['wall']:.0f} plots/s under the profiler; CPU {p['cpu']:.1f} s "
+              f"{p['plots'] / p['wall']:.0f} plots/s of wall time; CPU {p['cpu']:.1f} s "
               f"= {p['plots'] / p['cpu']:.0f} plots per CPU-second")
         for label, sec in p["stages"]:
             print(f"  {label:70s} {sec:8.2f} s {100 * sec / p['wall']:5.1f} %")

@@ -121,6 +121,36 @@ def _rotation_starts(radar: RotatingRadar, start: float, end: float) -> np.ndarr
     return t0 + radar.period * np.arange(n)
 
 
+#: Earth radius (m) for the reach pre-filter's scale bound: the WGS-84 semi-minor axis (the
+#: smaller radius gives the larger bound).
+_EARTH_R = 6_356_752.0
+#: Largest distance from the frame's origin (rad of arc) up to which the pre-filter acts.
+_FILTER_MAX_ARC = 1.0
+
+
+def may_reach(radar: RotatingRadar, site_xy: np.ndarray, seg: Segment) -> bool:
+    """False only when the target of ``seg`` is out of ``radar``'s ``max_range`` all
+    along: a bound in the local (azimuthal-equidistant) frame, where the planar distance
+    of two points is at most ``k`` times their geodesic distance, ``k = a/sin a`` the
+    frame's largest scale at ``a`` (the arc from the origin, ≤ 1 rad) of the farther
+    point; with 1 % and 10 km to spare, plus the longest distance the target flies
+    between two truth samples (it is only checked at them).
+    Skipping such a target leaves every other plot unchanged (each target has its own
+    random stream)."""
+    if radar.max_range is None or len(seg.t) == 0:
+        return True
+    arc = (max(float(np.hypot(*site_xy)), float(np.hypot(seg.p[:, 0], seg.p[:, 1]).max()))
+           + radar.max_range) / _EARTH_R
+    if arc >= _FILTER_MAX_ARC:
+        return True
+    k = arc / np.sin(arc) if arc > 0 else 1.0
+    d = np.hypot(seg.p[:, 0] - site_xy[0], seg.p[:, 1] - site_xy[1]).min()
+    hop = 0.0
+    if len(seg.t) > 1:
+        hop = float(np.hypot(seg.v[:, 0], seg.v[:, 1]).max() * np.diff(seg.t).max())
+    return bool(d <= 1.01 * k * radar.max_range + 10_000.0 + hop)
+
+
 def radar_plots(
     radar: RotatingRadar,
     pd: float,
@@ -136,7 +166,10 @@ def radar_plots(
     origin`` (unsorted: targets in ``segs`` order, then clutter by rotation, then the
     ``scene``'s clutter by rotation about the site's plane position ``site_xy``)."""
     cols: dict[str, list[np.ndarray]] = {k: [] for k in ("time", "range", "bearing", "origin")}
+    site_xy = np.array(frame.to_local(*site), float).ravel()
     for seg in segs:
+        if not may_reach(radar, site_xy, seg):
+            continue
         t = crossings(radar, frame, site, seg)
         if t.size == 0:
             continue

@@ -98,6 +98,13 @@ class Birth(ABC):
         return new_trees(self.motion.new_states(cand.x, cand.P), cand.score, cand.peak,
                          first + group, int(scan.index), cand.n_updates, cand.window, time)
 
+    def scan_density(self, frame: FrameContext, kappa: np.ndarray) -> float | None:
+        """Optional hook, called once a frame after the clutter intensity ``kappa`` (n,):
+        the frame's new-target density (per m²) that scores its plots and births in place
+        of ``MHTConfig.new_target_density`` (e.g. :class:`~mhtrack.mht.undetected.
+        UndetectedDensity`'s). Default ``None``: the configuration's."""
+        return None
+
     def limit(self, max_per_scan: int) -> None:  # noqa: B027 (optional hook)
         """Optional hook: the most new trees this scan may start (the scan's
         ``max_births_per_scan``, scaled with the scene by :mod:`mhtrack.mht.caps`).

@@ -6,6 +6,8 @@ estimator. Every scan the tracker calls, with the frame's context
 the scan, the frame's limits, and :meth:`~mhtrack.mht.context.FrameContext.cut` to count
 what a cap removed),
 
+0. :meth:`Birth.scan_density` once the clutter intensity is known (optional hook): the
+   frame's new-target density, if the process keeps its own (``None``: the configuration's);
 1. :meth:`Birth.propose` after the clutter intensity is known: the candidate new trees'
    first leaves (:class:`BirthCandidates`); their count is reserved in ``max_leaves``;
 2. :meth:`Birth.seed` once the existing leaves have grown: the new trees' leaves

@@ -20,7 +20,12 @@ Each library runs in its own subprocess with ``PYTHONPATH`` on its ``src``: ours
 checkout) and the reference (``--reference``, a git revision extracted by ``git archive``;
 default the main branch this work started from), in turn ``--repeat`` times; medians.
 
-Run: ``python benchmarks/bench_dense.py [--repeat 3] [--reference REV] [--scans 20]``.
+``--ours-config JSON``: ``MHTConfig`` fields changed on our side only (the reference keeps
+its defaults), e.g. ``'{"startup_density": true}'`` (issue 30's start-up density); several
+``--ours-config`` run as several sides of ours.
+
+Run: ``python benchmarks/bench_dense.py [--repeat 3] [--reference REV] [--scans 20]
+[--ours-config JSON ...]``.
 """
 
 from __future__ import annotations
@@ -42,7 +47,7 @@ ROOT = HERE.parent
 sys.path.insert(0, str(HERE))
 
 #: The main branch this work started from ("today's code path").
-REFERENCE = "61194a3"
+REFERENCE = "e1d9348"
 
 #: Stage group → the tracker functions (``bench_stages.STAGES`` and wrapped methods) in it.
 GROUPS = {
@@ -90,7 +95,8 @@ def held(tracks: object, truth: object, scans: list[int], gate: float) -> tuple[
     return int(ok.sum()), int(one_id.sum())
 
 
-def run_one(n_scans: int, seed: int, held_scans: int, gate: float) -> dict:
+def run_one(n_scans: int, seed: int, held_scans: int, gate: float,
+            config: dict | None = None) -> dict:
     """The scene on the library on ``sys.path``, in this process: the figures."""
     import dataclasses
     import logging
@@ -105,7 +111,7 @@ def run_one(n_scans: int, seed: int, held_scans: int, gate: float) -> dict:
     n_targets, rate, name = SCENES["big"]
     sc = scene(n_targets, rate, n_scans)
     sim = simulate(sc, seed=seed)
-    cfg = dataclasses.replace(default_config(sc), scale_caps=True)
+    cfg = dataclasses.replace(default_config(sc), scale_caps=True, **(config or {}))
     trk = make_tracker(name, cfg, clutter_density=rate / sc.region.area)
     warm = warm_up(trk.motion)
     bench_stages.install()
@@ -195,11 +201,13 @@ def reference_src(rev: str) -> Path:
     return d / "src"
 
 
-def on_library(src: Path, a: argparse.Namespace) -> dict:
-    """:func:`run_one` in a subprocess on the library in ``src``."""
+def on_library(src: Path, a: argparse.Namespace, config: str = "{}") -> dict:
+    """:func:`run_one` in a subprocess on the library in ``src`` (``config``: JSON of the
+    ``MHTConfig`` fields to change)."""
     env = {**os.environ, "PYTHONPATH": str(src)}
     cmd = [sys.executable, __file__, "--one", "--scans", str(a.scans), "--seed",
-           str(a.seed), "--held-scans", str(a.held_scans), "--gate", str(a.gate)]
+           str(a.seed), "--held-scans", str(a.held_scans), "--gate", str(a.gate),
+           "--config", config]
     out = subprocess.run(cmd, env=env, capture_output=True, text=True, check=True)
     return json.loads(out.stdout.strip().splitlines()[-1])
 
@@ -212,18 +220,23 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--gate", type=float, default=300.0, help="m")
     ap.add_argument("--repeat", type=int, default=3, help="runs of each side, in turn")
     ap.add_argument("--reference", default=REFERENCE, help="git revision (or 'none')")
+    ap.add_argument("--ours-config", action="append", default=None, metavar="JSON",
+                    help="MHTConfig fields changed on our side (repeatable: one side each)")
+    ap.add_argument("--config", default="{}", help=argparse.SUPPRESS)  # --one's
     ap.add_argument("--one", action="store_true", help="this process, JSON out")
     a = ap.parse_args(argv)
     if a.one:
-        print(json.dumps(run_one(a.scans, a.seed, a.held_scans, a.gate)))
+        print(json.dumps(run_one(a.scans, a.seed, a.held_scans, a.gate,
+                                 json.loads(a.config))))
         return 0
-    sides = {"ours": ROOT / "src"}
+    sides = {("ours" if c == "{}" else f"ours {c}"): (ROOT / "src", c)
+             for c in (a.ours_config or ["{}"])}
     if a.reference != "none":
-        sides[f"reference {a.reference}"] = reference_src(a.reference)
+        sides[f"reference {a.reference}"] = (reference_src(a.reference), "{}")
     runs: dict[str, list[dict]] = {k: [] for k in sides}
     for _ in range(a.repeat):
-        for k, src in sides.items():
-            runs[k].append(on_library(src, a))
+        for k, (src, config) in sides.items():
+            runs[k].append(on_library(src, a, config))
     print(f"dense scene: 1 000 aircraft x 5 000 clutter/scan, P_D 0.9, {a.scans} scans, "
           f"seed {a.seed}; held over the last {a.held_scans} scans within {a.gate:g} m; "
           f"median of {a.repeat} runs each, in turn")
@@ -235,7 +248,7 @@ def main(argv: list[str] | None = None) -> int:
         m["stages"] = {g: statistics.median(r["stages"][g] for r in rs)
                        for g in rs[0]["stages"]}
         each = ", ".join(f"{r['s_per_scan_median']:.3f}" for r in rs)
-        print(f"  {k:20s} held {m['held']:.3f} (one id {m['held_one_id']:.3f}), "
+        print(f"  {k}\n  {'':20s} held {m['held']:.3f} (one id {m['held_one_id']:.3f}), "
               f"{m['s_per_scan_median']:.3f} s/scan median (last {a.held_scans}: "
               f"{m['s_per_scan_last']:.3f}; all runs "
               f"{each}), "

@@ -14,7 +14,7 @@ from typing import Any
 from mhtrack.bounds import float_problem, int_problem
 from mhtrack.models.imm import CVModelSet
 from mhtrack.models.motion import ConstantVelocity, MotionModel
-from mhtrack.names import BIRTHS
+from mhtrack.names import BIRTHS, EVERY_PLOT
 
 #: Largest N-scan depth: every leaf keeps ``N + 1`` plot ids and the trees grow with ``N``;
 #: deeper than this only costs memory (P1 uses 3).
@@ -43,6 +43,13 @@ class MHTConfig:
         (P1 §3).
     new_target_density : ``λ_v``, density of new targets (per m² per scan) in the score
         denominator ``κ̂ + λ_v`` (P1 eq. 5) and the birth score. Default 1e−7 (P1 §3).
+    startup_density : score each scan's plots and births with the density of targets not
+        yet detected instead of the constant ``new_target_density`` ``λ_v``: estimated
+        at the first scan from the plots in excess of the clutter, then decayed by
+        ``1 − P_D`` a scan with ``λ_v`` added (the PMBM filter's undetected-target
+        intensity, :mod:`mhtrack.mht.undetected`), so that a tracker started on a busy sky
+        knows that every target present is new. Only with ``birth = "every-plot"``.
+        Default False (P1's constant ``λ_v``).
     sigma_w : Cartesian measurement noise std (m), ``R = σw² I`` for plots without their
         own covariance. Default 100 (P1 §3, ``σw² = 10⁴``).
     sigma_v : process (acceleration) noise std of the constant-velocity model (m/s²).
@@ -147,6 +154,7 @@ class MHTConfig:
 
     p_detection: float = 0.9
     new_target_density: float = 1e-7
+    startup_density: bool = False
     sigma_w: float = 100.0
     sigma_v: float = 10.0
     imm_sigma_v: float = 1.0
@@ -208,7 +216,7 @@ class MHTConfig:
             and self.imm_sigma_v >= 0,
             "finite >= 0",
         )
-        for name in ("miss_uses_gate_probability", "scale_caps"):
+        for name in ("miss_uses_gate_probability", "scale_caps", "startup_density"):
             check(name, isinstance(getattr(self, name), bool), "a bool")
         check("n_scan", _is_int(self.n_scan) and 1 <= self.n_scan <= MAX_N_SCAN,
               f"an integer in [1, {MAX_N_SCAN}]")
@@ -226,6 +234,8 @@ class MHTConfig:
               and 0 <= self.history_scans <= MAX_HISTORY_SCANS,
               f"an integer in [0, {MAX_HISTORY_SCANS}]")
         check("birth", self.birth in BIRTHS, f"one of {', '.join(BIRTHS)}")
+        check("startup_density", not self.startup_density or self.birth == EVERY_PLOT,
+              "False unless birth is 'every-plot'")
         check("birth_theta_deg", isinstance(self.birth_theta_deg, int | float)
               and 0 <= self.birth_theta_deg <= 180, "in [0, 180]")
         check("max_leaves", self.max_leaves > self.max_births_per_scan,

@@ -186,12 +186,13 @@ class MHTTracker:
         in_gates = plots_in_confirmed_gates(leaves, gated, f.n_plots)
         kappa = clutter_intensity(self.clutter, f, in_gates, self.config.min_clutter_density)
         self.last_kappa = kappa
-        update_dl = update_increment(gated.loglik, kappa, self.coverage.plot_pds(scan),
-                                     self.config.new_target_density, gated.plot)
+        lam = self.birth.scan_density(f, kappa)
+        lam = self.config.new_target_density if lam is None else lam
+        update_dl = update_increment(gated.loglik, kappa, self.coverage.plot_pds(scan), lam,
+                                     gated.plot)
         attrs = scan.attrs if scan.attrs is not None and scan.attrs.any() else None
         if attrs is not None:
-            reply = reply_terms(self.attributes, attrs, kappa,
-                                self.config.new_target_density)
+            reply = reply_terms(self.attributes, attrs, kappa, lam)
             update_dl = update_dl + reply[gated.plot] + pair_increments(
                 self.attributes, leaves.level, leaves.ident, attrs, scan.plot_times(),
                 gated.track, gated.plot)

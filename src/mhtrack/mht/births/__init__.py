@@ -19,6 +19,7 @@ from mhtrack.mht.births.initiator import InitiatorBirth
 from mhtrack.mht.births.timed_initiator import TimedInitiatorBirth
 from mhtrack.mht.config import MHTConfig
 from mhtrack.mht.sprt import sprt_thresholds
+from mhtrack.mht.undetected import UndetectedDensity
 from mhtrack.models.motion import MotionModel
 from mhtrack.names import EVERY_PLOT
 from mhtrack.records import Scan
@@ -38,7 +39,9 @@ def default_birth(cfg: MHTConfig, motion: MotionModel,
                           new_target_density=cfg.new_target_density,
                           floor=sprt_thresholds(cfg.alpha, cfg.beta)[1], v_max=cfg.v_max,
                           width=cfg.n_scan + 1, max_per_scan=cfg.max_births_per_scan,
-                          plot_pd=plot_pd)
+                          plot_pd=plot_pd,
+                          undetected=UndetectedDensity(cfg.new_target_density)
+                          if cfg.startup_density else None)
 
 
 __all__ = ["Birth", "BirthCandidates", "EveryPlotBirth", "InitiatorBirth",

@@ -6,6 +6,8 @@ estimator. Every scan the tracker calls, with the frame's context
 the scan, the frame's limits, and :meth:`~mhtrack.mht.context.FrameContext.cut` to count
 what a cap removed),
 
+0. :meth:`Birth.scan_density` once the clutter intensity is known (optional hook): the
+   frame's new-target density, if the process keeps its own (``None``: the configuration's);
 1. :meth:`Birth.propose` after the clutter intensity is known: the candidate new trees'
    first leaves (:class:`BirthCandidates`); their count is reserved in ``max_leaves``;
 2. :meth:`Birth.seed` once the existing leaves have grown: the new trees' leaves
@@ -97,6 +99,13 @@ class Birth(ABC):
         time = np.full(len(cand), float(scan.time), float) if cand.time is None else cand.time
         return new_trees(self.motion.new_states(cand.x, cand.P), cand.score, cand.peak,
                          first + group, int(scan.index), cand.n_updates, cand.window, time)
+
+    def scan_density(self, frame: FrameContext, kappa: np.ndarray) -> float | None:
+        """Optional hook, called once a frame after the clutter intensity ``kappa`` (n,):
+        the frame's new-target density (per m²) that scores its plots and births in place
+        of ``MHTConfig.new_target_density`` (e.g. :class:`~mhtrack.mht.undetected.
+        UndetectedDensity`'s). Default ``None``: the configuration's."""
+        return None
 
     def limit(self, max_per_scan: int) -> None:  # noqa: B027 (optional hook)
         """Optional hook: the most new trees this scan may start (the scan's

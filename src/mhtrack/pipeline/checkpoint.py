@@ -4,7 +4,8 @@ what the live run needs to continue — the next frame's number, the time axis (
 ``latest``: the day of later times of day), the latest time tracked, the next tick of
 the period output, the next plot's row number (the tracker's plot windows name plots
 by row: numbers must not repeat) and the plots received but not yet tracked (in the
-re-order window and in open frames) — under ``meta["extra"]``. A run resumed from it
+re-order window and in open frames) and, with bias estimation, its state
+(:mod:`~mhtrack.pipeline.registration_state`) — under ``meta["extra"]``. A run resumed from it
 therefore makes the same frames as a run never stopped, given the same datagrams after
 the checkpoint.
 
@@ -53,6 +54,9 @@ class LiveState:
     pending: dict[str, Any] | None = None
     #: The running row number of the next plot (the tracker knows plots by row).
     next_row: int = 0
+    #: The bias estimation's state (``--estimate-bias``;
+    #: :func:`~mhtrack.pipeline.registration_state.encode_state`), else ``None``.
+    bias: dict[str, Any] | None = None
     format: int = LIVE_FORMAT
 
 

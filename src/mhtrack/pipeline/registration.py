@@ -38,9 +38,10 @@ SNAPSHOT_S = 10.0
 #: estimate by 0.4° (opensky-radars seed 3, first 20 s), and plots moved by such a swing
 #: break tracks. Until then its plots go to the tracker as measured.
 APPLY_SIGMA = (20.0, 2e-4, 0.02)
-#: Before that, a plot is corrected where the correction is known: the σ of its position
-#: (:meth:`Registration._position_sigma`) below this (m, ours).
-APPLY_POS_SIGMA = 50.0
+#: Before that, a plot is corrected where the correction is known: the σ of the
+#: correction's position (:meth:`Registration._position_sigma`) below this fraction of
+#: the plot's own σ (the larger axis of its covariance; ours).
+APPLY_POS_SIGMA = 1.0
 
 
 @dataclass
@@ -147,7 +148,8 @@ class Registration:
             zc, Rc, _ = self._place(sid, r, b, self.applied(sid))
             if sid not in self.settled and APPLY_POS_SIGMA > 0:
                 ze, Re, He = self._place(sid, r, b)
-                known = self._position_sigma(sid, He) < APPLY_POS_SIGMA
+                own = np.sqrt(np.linalg.eigvalsh(Re)[:, -1])
+                known = self._position_sigma(sid, He) < APPLY_POS_SIGMA * own
                 zc[known], Rc[known] = ze[known], Re[known]
             z[idx] = zc
             if R is None:

@@ -8,8 +8,12 @@ by :func:`~mhtrack.models.geodesy.polar_to_local`). After the step, every confir
 track updated by a plot of one sensor is paired with the last plot another sensor gave
 that track within :attr:`Registration.max_dt` seconds; the pair's difference, the times
 bridged by the track's velocity, updates the estimator
-(:class:`~mhtrack.models.registration.BiasEstimator`). A radar's estimate corrects its
-plots only once it has settled (:data:`APPLY_SIGMA`).
+(:class:`~mhtrack.models.registration.BiasEstimator`). A radar's estimate corrects all
+its plots once it has settled (:data:`APPLY_SIGMA`); before that, only the plots where
+the correction is already known better than the plot itself (:data:`APPLY_POS_SIGMA`:
+where the first pairs were, the correction's σ is small even while the components trade
+against each other elsewhere). Each pair updates the estimator in the cluster of its
+track (the cluster-robust σ).
 """
 
 from __future__ import annotations

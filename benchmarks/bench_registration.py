@@ -10,7 +10,10 @@ reference, cycling 3, 1, 2. Draw ``k`` simulates with seed ``k``. Each run is th
 (``mhtrack simulate … --bias``, ``mhtrack track … [--estimate-bias --bias-reference
 REF]``, ``mhtrack evaluate … --json``); the estimate at 600 s is read from the run's
 :attr:`~mhtrack.pipeline.registration.Registration.history` (the same pipeline, in
-process). Run: ``PYTHONPATH=src python benchmarks/bench_registration.py [draws...]``.
+process). Each estimate's error is also given in its reported σ, and the fraction of
+them within 2σ and 3σ over all draws (the coverage of the cluster-robust σ). Run:
+``PYTHONPATH=src python benchmarks/bench_registration.py [--quick] [draws...]``
+(``--quick``: without the unbiased run with estimation).
 """
 
 from __future__ import annotations

@@ -55,3 +55,42 @@ def test_bias_options_need_estimate_bias(tmp_path) -> None:
     code, _, err = invoke("simulate", "opensky-radars", "--scans", "2", "--out",
                           tmp_path / "x", "--bias", "7:range=1")
     assert code != 0 and "sensor 7" in err
+
+
+def test_run_simulates_biases_and_estimates_them(tmp_path) -> None:
+    """``run --bias … --estimate-bias`` as ``simulate --bias`` then ``track
+    --estimate-bias``: the same estimates written by --bias-out, to a tenth of their σ
+    (``track`` reads the plots back from CSV, ``run`` tracks them in memory)."""
+    bias = ("--bias", "1:range=200,azimuth=-0.12")
+    est = ("--estimate-bias", "--bias-reference", "3")
+    code, _, err = invoke("run", "opensky-radars", "--seed", "1", "--scans", "20",
+                          *bias, *est, "--bias-out", tmp_path / "run.json",
+                          "--out", tmp_path / "r", "--json")
+    assert code == 0, err
+    assert "registration bias (reference sensors: 3;" in err
+    d = tmp_path / "sim"
+    assert invoke("simulate", "opensky-radars", "--seed", "1", "--scans", "20", "--out",
+                  d, *bias)[0] == 0
+    code, _, err = invoke("track", d / "plots.csv", "--sensors", d / "sensors.toml",
+                          "--out", tmp_path / "t.csv", *est, "--bias-out",
+                          tmp_path / "track.json")
+    assert code == 0, err
+    by_run = json.loads((tmp_path / "run.json").read_text())["radars"]
+    by_track = json.loads((tmp_path / "track.json").read_text())["radars"]
+    assert by_run.keys() == by_track.keys() == {"1", "2"}
+    for sid, est in by_run.items():
+        for key in ("range_offset", "range_gain", "azimuth_deg"):
+            assert abs(est[key] - by_track[sid][key]) < 0.1 * est[f"sigma_{key}"], (sid, key)
+    assert abs(by_run["1"]["range_offset"] - 200.0) < 40.0
+
+
+def test_run_and_live_bias_options_need_estimate_bias(tmp_path) -> None:
+    code, _, err = invoke("run", "opensky-radars", "--scans", "2", "--out", tmp_path / "r",
+                          "--bias-out", tmp_path / "b.json")
+    assert code != 0 and "--estimate-bias" in err
+    sensors = tmp_path / "s.toml"
+    sensors.write_text('[[sensors]]\nid = 1\nkind = "polar"\npd = 0.9\nlat = 52.0\n'
+                       'lon = 0.0\nsigma_range = 30.0\nsigma_bearing_deg = 0.1\nperiod = 4.0\n')
+    code, _, err = invoke("live", "--stdin", "raw", "--sensors", sensors, "--bias-reference",
+                          "1")
+    assert code != 0 and "--estimate-bias" in err

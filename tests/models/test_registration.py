@@ -157,3 +157,51 @@ def test_reference_pairs_change_nothing() -> None:
     est = BiasEstimator([2])
     assert not est.update(1, np.ones((2, 3)), 3, np.ones((2, 3)), np.ones(2), np.eye(2))
     assert np.array_equal(est.b, np.zeros(3))
+
+
+def _clustered_run(seed: int, true: RadarBias) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """30 aircraft, 6 pairs each; each aircraft's pairs share an error (radar 2 sees it
+    60 m off, as a velocity error bridging its pairs would) that ``C`` leaves out. The
+    error of (range offset, gain, azimuth) and its σ from the model ``P`` and the
+    reported (cluster-robust) covariance."""
+    rng = np.random.default_rng(seed)
+    p = targets(30, seed)
+    est = BiasEstimator([2])
+    for g in range(len(p)):
+        shared = rng.normal(0.0, 60.0, 2)
+        for _ in range(6):
+            r1, b1 = measure(1, p[g:g + 1], RadarBias(), rng)
+            r2, b2 = measure(2, p[g:g + 1] + shared, true, rng)
+            z2, R2, H2 = place(2, r2, b2, est.bias(2, model=True))
+            z1, R1, H1 = place(1, r1, b1, est.bias(1))
+            est.update(2, H2[0], 1, H1[0], z2[0] - z1[0], R1[0] + R2[0], cluster=g)
+    b = est.bias(2)
+    err = np.array([b.range_offset - true.range_offset, b.range_gain - true.range_gain,
+                    b.azimuth_deg - true.azimuth_deg])
+    return err, np.array(est.bias(2, model=True).sigma), np.array(b.sigma)
+
+
+def test_cluster_robust_sigma_covers_shared_errors() -> None:
+    """Errors shared within an aircraft's pairs: over 40 draws the model σ is optimistic
+    (far fewer than 95 % of the errors within 2σ), the reported σ covers about 95 % of
+    them (binomial: 40 draws × 3 components, expected 114 of 120)."""
+    true = RadarBias(150.0, 0.9985, 0.09)
+    runs = [_clustered_run(seed, true) for seed in range(40)]
+    err = np.array([r[0] for r in runs])
+    model = np.mean(np.abs(err) < 2 * np.array([r[1] for r in runs]))
+    robust = np.mean(np.abs(err) < 2 * np.array([r[2] for r in runs]))
+    assert model < 0.75
+    assert 0.88 <= robust <= 1.0
+
+
+def test_independent_pairs_robust_equals_model_on_average() -> None:
+    """Independent pairs (each its own cluster) with the right ``C``: the reported
+    variance is the model's on average (E[P_r] = P), within the sandwich's noise."""
+    rng = np.random.default_rng(5)
+    p = targets(200, 5)
+    true = RadarBias(-80.0, 1.001, -0.05)
+    meas = {1: measure(1, p, RadarBias(), rng), 2: measure(2, p, true, rng)}
+    est = BiasEstimator([2])
+    one_pass(est, meas)
+    ratio = np.array(est.bias(2).sigma) / np.array(est.bias(2, model=True).sigma)
+    assert np.all((ratio > 0.8) & (ratio < 1.25))

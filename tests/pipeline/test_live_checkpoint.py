@@ -41,14 +41,14 @@ def _blocks(rec: Path) -> list[bytes]:
 
 
 def _run(rec: Path, blocks: list[bytes], stop_after: int | None = None,
-         **options: object) -> tuple[list[dict], Live]:
+         track: TrackOptions = OPTIONS, **options: object) -> tuple[list[dict], Live]:
     """A live run over stdin on ``blocks`` (JSON lines): to the end of the input, or
     stopped (as by SIGTERM) once ``stop_after`` datagrams were received."""
     r, w = os.pipe()
     stop = threading.Event()
     out = io.StringIO()
     with os.fdopen(r, "rb", buffering=0) as rf:
-        live = Live(read_sensors(rec / "sensors.toml"), OPTIONS,
+        live = Live(read_sensors(rec / "sensors.toml"), track,
                     LiveOptions(stdin="raw", day_from="stream", json=True, **options),
                     stdin=rf, stdout=out, stop=stop)
 
@@ -181,3 +181,56 @@ def test_held_plots_keep_their_columns_types_through_json() -> None:
     saved["held"]["callsign"]["values"] = [{"a": 1}, ""]
     with pytest.raises(ValueError, match="numbers or text only"):
         decode_pending(saved)
+
+
+BIAS = TrackOptions(output="online", new_target_density=1e-10, estimate_bias=True,
+                    bias_reference=3)
+
+
+@pytest.fixture(scope="module")
+def biased(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    return simulated_recording(tmp_path_factory.mktemp("bias"), seed=2, scans=12,
+                               simulate=("--bias", "1:range=200,azimuth=-0.12",
+                                         "--bias", "2:gain=1.002,azimuth=0.08"))
+
+
+def test_bias_state_goes_through_the_checkpoint(biased: Path, tmp_path: Path) -> None:
+    """With --estimate-bias, a run stopped midway and resumed from its checkpoint gives
+    the rows and the final bias estimate (every float) of a run never stopped: the
+    checkpoint holds the estimator's state, its robust sums and the tracks' last plots."""
+    blocks = _blocks(biased)
+    k = len(blocks) // 2
+    whole, w = _run(biased, blocks, track=BIAS)
+    ck = tmp_path / "state.npz"
+    first, _ = _run(biased, blocks[:k], stop_after=k, track=BIAS, checkpoint=ck)
+    _, state = read_checkpoint(ck)
+    assert state.bias is not None and state.bias["pairs"] > 0  # pairs learnt before
+    second, two = _run(biased, blocks[k:], track=BIAS, checkpoint=ck, resume=True)
+    assert first + second == whole
+    reg_w, reg_2 = w.pipeline.registration, two.pipeline.registration
+    assert reg_w is not None and reg_2 is not None and reg_w.pairs > state.bias["pairs"]
+    assert reg_2.pairs == reg_w.pairs
+    assert reg_2.biases() == reg_w.biases()  # the same floats, σ included
+
+
+@pytest.mark.parametrize(("field", "value", "match"), [
+    ("b", [float("nan")] * 6, "'b'"), ("P", [[1.0, 2.0], [3.0, 4.0]], "'P'"),
+    ("ids", [7], "'ids'"), ("meat", "x", "'meat'"), ("last", [[1, [[0, 1, None, None,
+                                                                    None, None]]]], "last")])
+def test_a_hostile_bias_state_is_refused(biased: Path, field: str, value: object,
+                                         match: str) -> None:
+    """A checkpoint's bias state is input: each bad field is named, nothing is set."""
+    from mhtrack.pipeline.registration import Registration
+    from mhtrack.pipeline.registration_state import encode_state, restore_state
+
+    sensors = read_sensors(biased / "sensors.toml")
+    good = json.loads(json.dumps(encode_state(Registration(sensors, reference=3))))
+    reg = Registration(sensors, reference=3)
+    before = encode_state(reg)
+    with pytest.raises(ValueError, match=match):
+        restore_state(reg, {**good, field: value})
+    assert encode_state(reg) == before
+    bad_p = json.loads(json.dumps(good))
+    bad_p["P"][0][0] = -1.0
+    with pytest.raises(ValueError, match="not a covariance"):
+        restore_state(reg, bad_p)

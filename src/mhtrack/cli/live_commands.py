@@ -11,7 +11,14 @@ import click
 
 from mhtrack.cli.asterix_commands import needs_libasterix
 from mhtrack.cli.terminal import say
-from mhtrack.cli.track_commands import birth_options, track_options, tracker_options
+from mhtrack.cli.track_commands import (
+    bias_fields,
+    bias_options,
+    birth_options,
+    report_biases,
+    track_options,
+    tracker_options,
+)
 from mhtrack.names import CLUTTER_FRAMES, DEFAULT_CLUTTER_FRAME
 
 
@@ -151,6 +158,7 @@ def replay(recording: Path, to: tuple[str, ...], speed: float | None, loop: bool
               default=DEFAULT_CLUTTER_FRAME, show_default=True,
               help="Estimate each radar's clutter in the local plane or in range and bearing.")
 @birth_options
+@bias_options
 @needs_libasterix
 def live(listen: tuple[str, ...], stdin: str | None, sensors_file: Path,
          day_from: str | None, out_udp: tuple[str, ...], out: Path | None,
@@ -162,7 +170,9 @@ def live(listen: tuple[str, ...], stdin: str | None, sensors_file: Path,
          meas_sigma: float | None, accel_sigma: float | None,
          imm_accel_sigma: float | None, clutter_density: float | None,
          birth_density: float | None, nscan: int | None, clutter_frame: str, birth: str,
-         birth_theta: float | None, fusion: str | None) -> None:
+         birth_theta: float | None, fusion: str | None, estimate_bias: bool = False,
+         bias_reference: int | None = None, bias_init: Path | None = None,
+         bias_out: Path | None = None) -> None:
     """Track ASTERIX plots arriving over UDP (or stdin) until Ctrl-C or SIGTERM."""
     from mhtrack.io.sensors import read_sensors
     from mhtrack.pipeline.live import Live, LiveOptions
@@ -170,7 +180,8 @@ def live(listen: tuple[str, ...], stdin: str | None, sensors_file: Path,
 
     options = track_options(tracker, tracker_pd, meas_sigma, accel_sigma, imm_accel_sigma,
                             clutter_density, birth_density, nscan, birth, birth_theta,
-                            fusion, "online", clutter_frame=clutter_frame)
+                            fusion, "online", clutter_frame=clutter_frame,
+                            **bias_fields(estimate_bias, bias_reference, bias_init, bias_out))
     settings = LiveOptions(listen=listen, stdin=stdin, out_udp=out_udp, out_file=out,
                            part_frames=part_frames, json=as_json,
                            period_out_s=period_out, status_every_s=status_every,
@@ -186,6 +197,7 @@ def live(listen: tuple[str, ...], stdin: str | None, sensors_file: Path,
                    emit=lambda line: click.echo(line, err=True))
         result = run.run()
     say(result.describe(), err=True)
+    report_biases(run.pipeline.registration, bias_out, err=True)
 
 
 COMMANDS = [live, replay]

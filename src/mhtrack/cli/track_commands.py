@@ -96,6 +96,59 @@ _OUTPUT_HELP = (
     "IMM-aware), its rows not marked tentative the online rows, smoothed")
 
 
+def bias_options(f: Callable[..., Any]) -> Callable[..., Any]:
+    """``--estimate-bias``, ``--bias-reference``, ``--bias-init``, ``--bias-out``
+    (registration bias, ``docs/registration.md``): the same on ``track``, ``run`` and
+    ``live``."""
+    opts = [
+        click.option("--estimate-bias", is_flag=True, help="Estimate each radar's "
+                     "registration bias (range offset, range gain, azimuth offset) online "
+                     "from aircraft that several sensors see, and correct its plots "
+                     "(docs/registration.md)."),
+        click.option("--bias-reference", type=int, default=None, metavar="ID",
+                     help="With --estimate-bias: the radar whose bias is held at zero "
+                     "[ADS-B if any, else the lowest radar id]."),
+        click.option("--bias-init", type=click.Path(exists=True, dir_okay=False,
+                     path_type=Path), default=None, help="With --estimate-bias: start from "
+                     "the biases of an earlier run (a --bias-out file)."),
+        click.option("--bias-out", type=click.Path(dir_okay=False, path_type=Path),
+                     default=None, help="With --estimate-bias: write the final biases "
+                     "(JSON) for --bias-init."),
+    ]
+    for opt in reversed(opts):
+        f = opt(f)
+    return f
+
+
+def bias_fields(estimate_bias: bool, bias_reference: int | None, bias_init: Path | None,
+                bias_out: Path | None) -> dict[str, Any]:
+    """The :class:`~mhtrack.pipeline.TrackOptions` fields of :func:`bias_options` (the
+    prior read from ``--bias-init``); the other options without ``--estimate-bias`` are
+    a usage error."""
+    if not estimate_bias and (bias_reference, bias_init, bias_out) != (None, None, None):
+        raise click.UsageError("--bias-reference, --bias-init and --bias-out go with "
+                               "--estimate-bias")
+    prior = None
+    if bias_init is not None:
+        from mhtrack.io.biasfile import read_biases
+
+        prior = read_biases(bias_init)
+    return {"estimate_bias": estimate_bias, "bias_reference": bias_reference,
+            "bias_prior": prior}
+
+
+def report_biases(registration: Any, bias_out: Path | None, *, err: bool = False) -> None:
+    """Print the estimated biases (:meth:`Registration.describe`) and write ``bias_out``."""
+    if registration is None:
+        return
+    say("\n".join(registration.describe()), err=err)
+    if bias_out is not None:
+        from mhtrack.io.biasfile import write_biases
+
+        write_biases(bias_out, registration.biases(), registration.references)
+        say(f"biases -> {bias_out}", err=err)
+
+
 def output_option(f: Callable[..., Any]) -> Callable[..., Any]:
     """``--output history|online|smoothed``: which rows a batch run reports
     (``docs/mht.md``); default chosen by the pipeline (``pipeline.options.choose``)."""
@@ -164,17 +217,7 @@ def track_options(tracker: str, tracker_pd: float | None, meas_sigma: float | No
 @click.option("--sector-frames", is_flag=True, help="A recording: cut frames at each "
               "radar's own CAT034 sector crossings instead of eighths of its rotation "
               "(docs/real-radar.md: measured, and why it is not the default).")
-@click.option("--estimate-bias", is_flag=True, help="Estimate each radar's registration "
-              "bias (range offset, range gain, azimuth offset) online from aircraft that "
-              "several sensors see, and correct its plots (docs/registration.md).")
-@click.option("--bias-reference", type=int, default=None, metavar="ID",
-              help="With --estimate-bias: the radar whose bias is held at zero [ADS-B if "
-              "any, else the lowest radar id].")
-@click.option("--bias-init", type=click.Path(exists=True, dir_okay=False, path_type=Path),
-              default=None, help="With --estimate-bias: start from the biases of an earlier "
-              "run (a --bias-out file).")
-@click.option("--bias-out", type=click.Path(dir_okay=False, path_type=Path), default=None,
-              help="With --estimate-bias: write the final biases (JSON) for --bias-init.")
+@bias_options
 @birth_options
 @output_option
 @needs_libasterix
@@ -194,19 +237,10 @@ def track(plots: Path, tracker: str, tracker_pd: float | None, meas_sigma: float
     from mhtrack.sinks.files import TracksFileSink
 
     check_output_file(out, inputs=(plots, scenario_file, sensors_file), what="tracks file")
-    if not estimate_bias and (bias_reference, bias_init, bias_out) != (None, None, None):
-        raise click.UsageError("--bias-reference, --bias-init and --bias-out go with "
-                               "--estimate-bias")
-    prior = None
-    if bias_init is not None:
-        from mhtrack.io.biasfile import read_biases
-
-        prior = read_biases(bias_init)
     options = track_options(tracker, tracker_pd, meas_sigma, accel_sigma, imm_accel_sigma,
                             clutter_density, birth_density, nscan, birth, birth_theta,
                             fusion, output, clutter_frame=clutter_frame,
-                            estimate_bias=estimate_bias, bias_reference=bias_reference,
-                            bias_prior=prior)
+                            **bias_fields(estimate_bias, bias_reference, bias_init, bias_out))
     bars = show_progress()
     pipe = Pipeline.open(plots, options, scenario_file=scenario_file,
                          sensors_file=sensors_file, reorder_window_s=reorder_window_s,
@@ -217,13 +251,7 @@ def track(plots: Path, tracker: str, tracker_pd: float | None, meas_sigma: float
     for note in (pipe.birth_note, pipe.reach_note, pipe.output_note):
         if note is not None:
             say(note)
-    if pipe.registration is not None:
-        say("\n".join(pipe.registration.describe()))
-        if bias_out is not None:
-            from mhtrack.io.biasfile import write_biases
-
-            write_biases(bias_out, pipe.registration.biases(), pipe.registration.references)
-            say(f"biases -> {bias_out}")
+    report_biases(pipe.registration, bias_out)
 
 
 @click.command()
@@ -244,6 +272,9 @@ def track(plots: Path, tracker: str, tracker_pd: float | None, meas_sigma: float
 @birth_options
 @output_option
 @clutter_scene_option
+@click.option("--bias", "biases", multiple=True, metavar="ID:range=M,gain=G,azimuth=DEG",
+              help="Give rotating radar ID a registration bias (as simulate --bias).")
+@bias_options
 def run(scenario: str, seed: int, clutter: str | None, clutter_rate: float | None,
         pd: float | None, scans: int | None, tracker: str, tracker_pd: float | None,
         meas_sigma: float | None, accel_sigma: float | None, imm_accel_sigma: float | None,
@@ -251,7 +282,9 @@ def run(scenario: str, seed: int, clutter: str | None, clutter_rate: float | Non
         birth_density: float | None, nscan: int | None, out: Path | None,
         cutoff: float | None, order: float | None, as_json: bool, html_report: bool,
         birth: str, birth_theta: float | None, fusion: str | None, output: str | None,
-        clutter_scene: str | None = None) -> None:
+        clutter_scene: str | None = None, biases: tuple[str, ...] = (),
+        estimate_bias: bool = False, bias_reference: int | None = None,
+        bias_init: Path | None = None, bias_out: Path | None = None) -> None:
     """Simulate SCENARIO, track, evaluate and plot, in one go.
 
     Writes plots, truth, tracks, scenario.toml, metrics.json, scene.png (truth, plots,
@@ -268,9 +301,17 @@ def run(scenario: str, seed: int, clutter: str | None, clutter_rate: float | Non
                          what="run's files")
     sc = with_scene_arg(load_scenario_arg(scenario, clutter, clutter_rate, pd, scans),
                         clutter_scene)
+    if biases:
+        from mhtrack.scenario.biases import parse_bias, with_biases
+
+        try:
+            sc = with_biases(sc, [parse_bias(b) for b in biases])
+        except ValueError as e:
+            raise click.BadParameter(str(e), param_hint="--bias") from None
     options = track_options(tracker, tracker_pd, meas_sigma, accel_sigma, imm_accel_sigma,
                             clutter_density, birth_density, nscan, birth, birth_theta,
-                            fusion, output, sensor_pd=pd)
+                            fusion, output, sensor_pd=pd,
+                            **bias_fields(estimate_bias, bias_reference, bias_init, bias_out))
     warn_known_kappa(sc, options)
     result = run_scenario(sc, seed, options=options, cutoff=cutoff, order=order,
                           progress=show_progress())
@@ -285,11 +326,13 @@ def run(scenario: str, seed: int, clutter: str | None, clutter_rate: float | Non
         echo_json(summary)
         if page is not None:
             say(f"wrote {page}", err=True)
+        report_biases(result.registration, bias_out, err=True)
         return
     for line in run_text(result, out):
         say(line)
     if page is not None:
         say(f"wrote {page}")
+    report_biases(result.registration, bias_out)
 
 
 COMMANDS = [track, run]

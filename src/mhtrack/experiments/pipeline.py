@@ -115,6 +115,9 @@ class ScenarioRun:
     evaluation: Evaluation
     #: The line naming the new-target density chosen (None when the user set it).
     birth_note: str | None = None
+    #: The bias estimation (``TrackOptions.estimate_bias``;
+    #: :class:`~mhtrack.pipeline.registration.Registration`), else None.
+    registration: Any = None
 
     def summary(self) -> dict[str, Any]:
         """The ``evaluate`` JSON object plus ``t_avg`` (s/scan), ``tracker``, ``caps`` (the
@@ -180,4 +183,4 @@ def run_scenario(
     run = TrackingRun(options.tracker, rows.tracks(), result.stats, pipe.output)
     metric = {k: v for k, v in (("cutoff", cutoff), ("order", order)) if v is not None}
     ev = evaluate(run.tracks, sim.truth, plots=sim.plots, **metric)
-    return ScenarioRun(sim, run, ev, pipe.birth_note)
+    return ScenarioRun(sim, run, ev, pipe.birth_note, pipe.registration)

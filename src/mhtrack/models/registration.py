@@ -28,6 +28,19 @@ squares; Bar-Shalom, Li & Kirubarajan 2001, §5.2, the "information" of each pai
 ``Gᵀ C⁻¹ G``). A pair whose normalised innovation exceeds the χ² gate (2 degrees of
 freedom) is not used (a wrong association).
 
+**Honest uncertainty.** The pairs of one aircraft are not independent: one plot enters
+several pairs, and the track velocity that bridges their times has an error correlated
+from scan to scan. The Kalman ``P`` treats every pair as independent and is optimistic
+(errors of 3.5 σ on opensky-radars). The σ reported is therefore the cluster-robust
+("sandwich") covariance of the least-squares estimate with one cluster per aircraft
+track (Liang & Zeger, Biometrika 73, 1986; White, Econometrica 48, 1980)::
+
+    P_r = P (P0⁻¹ + Σ_g s_g s_gᵀ) P,    s_g = Σ_{k ∈ g} G_kᵀ C_k⁻¹ r_k(b̂)
+
+with ``r_k(b̂) = y_k − G_k b̂_k + G_k b̂`` the pair's residual at the current estimate
+(linearised). Errors shared within an aircraft's pairs count once per aircraft, not once
+per pair; with independent pairs and the right ``C``, ``E[P_r] = P``.
+
 **Gauge.** Differences only see the biases relative to each other: the biases of the
 *reference* sensors are held at zero (ADS-B, Cartesian sensors and one chosen radar), so
 the estimates are those of every other radar against them.
@@ -47,6 +60,13 @@ from scipy.stats import chi2
 PRIOR_SIGMA = (500.0, 0.01, 0.5)
 #: The χ² gate on a pair's normalised innovation (2 degrees of freedom, P = 0.999).
 GATE_P = 0.999
+#: The cluster-robust covariance (:meth:`BiasEstimator.covariance`) is reported once this
+#: many clusters (aircraft tracks) gave pairs (ours: the sandwich is biased low and noisy
+#: with few clusters; until then the model covariance ``P``).
+MIN_CLUSTERS = 20
+#: A cluster with no pair for this long (s of plot time) is closed: its score is fixed at
+#: the estimate then (ours; bounds the memory of a long run).
+CLUSTER_CLOSE_S = 60.0
 
 
 @dataclass(frozen=True)
@@ -116,6 +136,12 @@ class BiasEstimator:
                 if all(s > 0 for s in pb.sigma):
                     sig[k:k + 3] = (pb.sigma[0], pb.sigma[1], np.radians(pb.sigma[2]))
         self.P = np.diag(sig**2)
+        #: Prior information ``P0⁻¹`` and the sandwich's meat of closed clusters.
+        self.P0_inv = np.diag(1.0 / sig**2)
+        self.meat = np.zeros((n, n))
+        #: Open clusters: key → [Σ GᵀC⁻¹(y − G b̂_k), Σ GᵀC⁻¹G, last time].
+        self.clusters: dict[int, list[Any]] = {}
+        self.n_clusters = 0
         self._q = np.tile([process_sigma[0], process_sigma[1], np.radians(process_sigma[2])],
                           len(self.ids)) ** 2
         self.gate = float(chi2.ppf(gate_p, 2))
@@ -127,19 +153,49 @@ class BiasEstimator:
         """Radar ``sid``'s bias is estimated (not a reference)."""
         return sid in self._slot
 
-    def bias(self, sid: int) -> RadarBias:
-        """The current estimate of radar ``sid`` (zero for a reference sensor)."""
+    def covariance(self) -> np.ndarray:
+        """The reported covariance: the cluster-robust ``P_r`` (module docstring) once
+        :data:`MIN_CLUSTERS` clusters gave pairs, else the model's ``P``."""
+        if self.n_clusters < MIN_CLUSTERS:
+            return self.P
+        meat = self.meat + self.P0_inv
+        for alpha, A, _ in self.clusters.values():
+            sg = alpha + A @ self.b
+            meat = meat + np.outer(sg, sg)
+        Pr = self.P @ meat @ self.P
+        return (Pr + Pr.T) / 2
+
+    def close_clusters(self, t: float) -> None:
+        """Close the clusters with no pair since ``t −`` :data:`CLUSTER_CLOSE_S`: their
+        scores at the current estimate go into the meat."""
+        for key in [k for k, c in self.clusters.items() if c[2] < t - CLUSTER_CLOSE_S]:
+            alpha, A, _ = self.clusters.pop(key)
+            sg = alpha + A @ self.b
+            self.meat += np.outer(sg, sg)
+
+    def bias(self, sid: int, *, model: bool = False) -> RadarBias:
+        """The current estimate of radar ``sid`` (zero for a reference sensor), its σ from
+        :meth:`covariance` (``model``: from the model's ``P``)."""
         k = self._slot.get(sid)
         if k is None:
             return RadarBias()
-        s = np.sqrt(np.diag(self.P)[k:k + 3])
+        cov = self.P if model else self.covariance()
+        s = np.sqrt(np.diag(cov)[k:k + 3])
         return RadarBias(float(self.b[k]), float(1.0 + self.b[k + 1]),
                          float(np.degrees(self.b[k + 2])),
                          (float(s[0]), float(s[1]), float(np.degrees(s[2]))))
 
     def biases(self) -> dict[int, RadarBias]:
         """Every estimated radar's :meth:`bias`."""
-        return {sid: self.bias(sid) for sid in self.ids}
+        cov = self.covariance()
+        out = {}
+        for sid in self.ids:
+            k = self._slot[sid]
+            s = np.sqrt(np.diag(cov)[k:k + 3])
+            out[sid] = RadarBias(float(self.b[k]), float(1.0 + self.b[k + 1]),
+                                 float(np.degrees(self.b[k + 2])),
+                                 (float(s[0]), float(s[1]), float(np.degrees(s[2]))))
+        return out
 
     def _advance(self, t: float) -> None:
         """Random walk of the biases up to time ``t`` (nothing with no process noise)."""
@@ -148,10 +204,12 @@ class BiasEstimator:
         self.t = t if self.t is None else max(self.t, t)
 
     def update(self, sid_i: int, H_i: np.ndarray, sid_j: int, H_j: np.ndarray,
-               y: np.ndarray, C: np.ndarray, t: float | None = None) -> bool:
+               y: np.ndarray, C: np.ndarray, t: float | None = None,
+               cluster: int | None = None) -> bool:
         """One pair's difference ``y`` (2,) with its noise ``C`` (2, 2) and the radars'
-        correction Jacobians ``H_i``, ``H_j`` (2, 3) (module docstring). Returns whether
-        it passed the gate and was used."""
+        correction Jacobians ``H_i``, ``H_j`` (2, 3) (module docstring); ``cluster``: the
+        aircraft (track) whose errors it shares (none: a cluster of its own). Returns
+        whether it passed the gate and was used."""
         if t is not None:
             self._advance(float(t))
         G = np.zeros((2, len(self.b)))
@@ -167,6 +225,17 @@ class BiasEstimator:
         if float(y @ Si @ y) > self.gate:
             self.rejected += 1
             return False
+        Ci = np.linalg.inv(C)
+        score = (G.T @ Ci @ (y - G @ self.b), G.T @ Ci @ G)
+        key = -1 - self.n_clusters if cluster is None else int(cluster)
+        c = self.clusters.get(key)
+        if c is None:
+            self.clusters[key] = [*score, -np.inf if self.t is None else self.t]
+            self.n_clusters += 1
+        else:
+            c[0] = c[0] + score[0]
+            c[1] = c[1] + score[1]
+            c[2] = -np.inf if self.t is None else self.t
         K = -self.P @ G.T @ Si
         self.b += K @ y
         IKH = np.eye(len(self.b)) + K @ G

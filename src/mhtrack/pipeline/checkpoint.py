@@ -4,9 +4,10 @@ what the live run needs to continue — the next frame's number, the time axis (
 ``latest``: the day of later times of day), the latest time tracked, the next tick of
 the period output, the next plot's row number (the tracker's plot windows name plots
 by row: numbers must not repeat), the duplicate filter's last data blocks (their
-digests: a redundant-LAN copy late across the restart is still a copy) and the plots
-received but not yet tracked (in the
-re-order window and in open frames) — under ``meta["extra"]``. A run resumed from it
+digests: a redundant-LAN copy late across the restart is still a copy), the plots
+received but not yet tracked (in the re-order window and in open frames) and, with
+bias estimation, its state (:mod:`~mhtrack.pipeline.registration_state`) — under
+``meta["extra"]``. A run resumed from it
 therefore makes the same frames as a run never stopped, given the same datagrams after
 the checkpoint.
 
@@ -59,6 +60,9 @@ class LiveState:
     #: oldest first; ``None``: none): a redundant-LAN copy arriving after the restart
     #: of a block received before it is still a copy.
     duplicates: str | None = None
+    #: The bias estimation's state (``--estimate-bias``;
+    #: :func:`~mhtrack.pipeline.registration_state.encode_state`), else ``None``.
+    bias: dict[str, Any] | None = None
     format: int = LIVE_FORMAT
 
 

@@ -46,6 +46,7 @@ from mhtrack.pipeline.live_options import (
 )
 from mhtrack.pipeline.monitor import MetricsServer, host_port, prometheus_text, write_status
 from mhtrack.pipeline.options import TrackOptions
+from mhtrack.pipeline.registration_state import encode_state
 from mhtrack.pipeline.run import Pipeline, RunResult
 from mhtrack.pipeline.view import ViewServer, ViewSink, radar_list
 from mhtrack.pipeline.warmup import Warmup, warm_up
@@ -174,12 +175,28 @@ class Live:
         if resumed is not None:  # the same track ids, hypotheses and clutter go on
             self.pipeline.tracker = resumed[0]
             self.pipeline.config = resumed[0].config
+            self._resume_bias(resumed[1])
         elif survey is not None and self.emit is not None:
             note = self.pipeline.birth_note
             if note is not None:
                 span = 0.0 if self.warmup is None else self.warmup.span_s
                 self.emit(f"live, from the first {span:.0f} s: {note}")
         self._make_sinks(sensors, stdout)
+
+    def _resume_bias(self, state: LiveState) -> None:
+        """The bias estimate of the checkpoint (with ``--estimate-bias``), checked."""
+        from mhtrack.errors import InputError
+        from mhtrack.pipeline.registration_state import restore_state
+
+        reg = self.pipeline.registration
+        if reg is None or state.bias is None:
+            return
+        try:
+            restore_state(reg, state.bias)
+        except ValueError as e:
+            path = self.live.checkpoint
+            raise InputError(f"{path}: member 'meta': field 'extra.bias': {e}",
+                             file=str(path)) from None
 
     def _warm_up(self, sensors: SensorSet, incoming: Iterator[tuple[bytes, float]],
                  name: str) -> tuple[SensorSet, Survey | None, Iterator[Any]]:
@@ -303,7 +320,9 @@ class Live:
                          self.pipeline.tracker.last_time,
                          None if self.periodic is None else self.periodic.next_tick,
                          encode_pending(self.source.pending()), self.source.next_row,
-                         self.source.recent_blocks() or None)
+                         self.source.recent_blocks() or None,
+                         None if self.pipeline.registration is None
+                         else encode_state(self.pipeline.registration))
 
     # -- running ----------------------------------------------------------------------
     @property

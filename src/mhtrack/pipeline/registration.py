@@ -8,8 +8,12 @@ by :func:`~mhtrack.models.geodesy.polar_to_local`). After the step, every confir
 track updated by a plot of one sensor is paired with the last plot another sensor gave
 that track within :attr:`Registration.max_dt` seconds; the pair's difference, the times
 bridged by the track's velocity, updates the estimator
-(:class:`~mhtrack.models.registration.BiasEstimator`). A radar's estimate corrects its
-plots only once it has settled (:data:`APPLY_SIGMA`).
+(:class:`~mhtrack.models.registration.BiasEstimator`). A radar's estimate corrects all
+its plots once it has settled (:data:`APPLY_SIGMA`); before that, only the plots where
+the correction is already known better than the plot itself (:data:`APPLY_POS_SIGMA`:
+where the first pairs were, the correction's σ is small even while the components trade
+against each other elsewhere). Each pair updates the estimator in the cluster of its
+track (the cluster-robust σ).
 """
 
 from __future__ import annotations
@@ -38,6 +42,10 @@ SNAPSHOT_S = 10.0
 #: estimate by 0.4° (opensky-radars seed 3, first 20 s), and plots moved by such a swing
 #: break tracks. Until then its plots go to the tracker as measured.
 APPLY_SIGMA = (20.0, 2e-4, 0.02)
+#: Before that, a plot is corrected where the correction is known: the σ of the
+#: correction's position (:meth:`Registration._position_sigma`) below this fraction of
+#: the plot's own σ (the larger axis of its covariance; ours).
+APPLY_POS_SIGMA = 1.0
 
 
 @dataclass
@@ -97,14 +105,22 @@ class Registration:
         """The bias that corrects radar ``sid``'s plots for the tracker: the estimate once
         its σ are all below :data:`APPLY_SIGMA` (and from then on), else none."""
         self._settle(sid, None)
-        return self.estimator.bias(sid) if sid in self.settled else RadarBias()
+        return self.estimator.bias(sid, model=True) if sid in self.settled else RadarBias()
 
     def _settle(self, sid: int, t: float | None) -> None:
         """Mark radar ``sid`` settled (at time ``t``) once its σ are below the bounds."""
         if sid not in self.settled and all(
-                s < a for s, a in zip(self.estimator.bias(sid).sigma, APPLY_SIGMA,
+                s < a for s, a in zip(self.estimator.bias(sid, model=True).sigma, APPLY_SIGMA,
                                       strict=True)):
             self.settled[sid] = t
+
+    def _position_sigma(self, sid: int, H: np.ndarray) -> np.ndarray:
+        """σ (m, the larger axis) of the correction's position at each plot of radar
+        ``sid`` (``H`` (n, 2, 3)): ``√λmax(H P_ii Hᵀ)``, ``P_ii`` the model covariance of
+        its bias."""
+        k = self.estimator._slot[sid]
+        S = H @ self.estimator.P[k:k + 3, k:k + 3] @ np.swapaxes(H, 1, 2)
+        return np.sqrt(np.linalg.eigvalsh(S)[:, -1])
 
     def _place(self, sid: int, r: np.ndarray, b: np.ndarray, bias: RadarBias | None = None
                ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -112,7 +128,7 @@ class Registration:
         current estimate): ``z`` (n, 2), ``R`` (n, 2, 2) and the correction Jacobian
         ``H`` (n, 2, 3)."""
         s = self.sensors.sensor(sid)
-        bias = self.estimator.bias(sid) if bias is None else bias
+        bias = self.estimator.bias(sid, model=True) if bias is None else bias
         rc, bc = bias.correct(r, b)
         z, R = polar_to_local(self.frame, *self._site[sid], rc, bc, s.sigma_range,
                               s.sigma_bearing_deg)
@@ -134,6 +150,11 @@ class Registration:
             r, b = local_to_polar(self.frame, *self._site[sid], z[idx, 0], z[idx, 1])
             r, b = np.atleast_1d(r), np.atleast_1d(b)
             zc, Rc, _ = self._place(sid, r, b, self.applied(sid))
+            if sid not in self.settled and APPLY_POS_SIGMA > 0:
+                ze, Re, He = self._place(sid, r, b)
+                own = np.sqrt(np.linalg.eigvalsh(Re)[:, -1])
+                known = self._position_sigma(sid, He) < APPLY_POS_SIGMA * own
+                zc[known], Rc[known] = ze[known], Re[known]
             z[idx] = zc
             if R is None:
                 R = np.zeros((len(scan), 2, 2))
@@ -164,13 +185,14 @@ class Registration:
             v = np.array((online.vx[k], online.vy[k]), float)
             for other in last.values():
                 if other.sensor != sid and abs(t - other.t) <= self.max_dt:
-                    pairs.append((new, other, v))
+                    pairs.append((new, other, v, int(online.track_id[k])))
             last[sid] = new
         used = self._update(pairs)
         if len(times):
             now = float(times.max())
             for sid in self.estimator.ids:
                 self._settle(sid, now)
+            self.estimator.close_clusters(now)
             if not self.history or now >= self.history[-1][0] + SNAPSHOT_S:
                 self.history.append((now, self.biases()))
         if len(self._last) > 4096:  # forget tracks with no recent plot
@@ -187,15 +209,16 @@ class Registration:
         z, R, H = self._place(p.sensor, np.array([p.r]), np.array([p.b]))
         return z[0], R[0], H[0]
 
-    def _update(self, pairs: list[tuple[_Plot, _Plot, np.ndarray]]) -> int:
+    def _update(self, pairs: list[tuple[_Plot, _Plot, np.ndarray, int]]) -> int:
         used = 0
-        for new, other, v in pairs:
+        for new, other, v, tid in pairs:
             zi, Ri, Hi = self._state(new)
             zj, Rj, Hj = self._state(other)
             dt = new.t - other.t
             y = zi - zj - v * dt
             C = Ri + Rj + np.eye(2) * (dt**2 * SIGMA_V**2 + (SIGMA_A * dt**2 / 2) ** 2)
-            used += self.estimator.update(new.sensor, Hi, other.sensor, Hj, y, C, new.t)
+            used += self.estimator.update(new.sensor, Hi, other.sensor, Hj, y, C, new.t,
+                                          cluster=tid)
         self.pairs += used
         return used
 

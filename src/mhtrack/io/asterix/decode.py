@@ -25,8 +25,8 @@ import numpy as np
 
 import mhtrack.io.asterix._lib as _lib
 from mhtrack.io.asterix._lib import quantity
-from mhtrack.io.asterix.cat001 import TimeRestorer, block001, block002
-from mhtrack.io.asterix.cat021 import block021
+from mhtrack.io.asterix.cat001 import TimeRestorer, block001, block002, records001, records002
+from mhtrack.io.asterix.cat021 import block021, records021
 from mhtrack.io.asterix.characteristics import CHARACTERISTICS, characteristics
 from mhtrack.io.asterix.columns import columns
 from mhtrack.io.asterix.container import blocks
@@ -106,7 +106,8 @@ def read_recording(path: str | Path, *, fast: bool = True, progress: bool = Fals
     times: list[float] = []
     axis = TimeAxis()
     bar = Count(len(data), "decode", "B", progress, scale=True)
-    for offset, when, payload in units(data, kind, name, decoder.categories, problems):
+    for offset, when, payload in units(data, kind, name, decoder.categories, problems,
+                                      decoder.fills):
         bar.to(offset)
         for _, what, found in decoder.blocks(payload, offset, problems, when):
             into = marks if what == MARKS else rows  # ADS-B reports beside the plots
@@ -170,6 +171,21 @@ class Decoder:
                 yield at, ADSB, _plots_only(found, cat, at, problems)
             else:
                 yield at, PLOTS, _plots_only(found, cat, at, problems)
+
+    def fills(self, block: bytes) -> bool:
+        """Whether the records of data block ``block`` (header included) decode to
+        exactly fill it, by the UAP this decoder reads its category with; a category it
+        does not decode is not judged (``True``)."""
+        cat, raw = block[0], block[3:]
+        if cat in self.readers:
+            return self.readers[cat].fills(raw)
+        if cat in self.specs:
+            found = self.specs[cat].cv_uap.parse(self.bits(raw))
+        elif cat in (1, 2, 21):
+            found = (records001 if cat == 1 else records002 if cat == 2 else records021)(raw)
+        else:
+            return True
+        return not isinstance(found, ValueError)
 
     def _records(self, cat: int, raw: bytes, at: int, when: float | None,
                  problems: Problems) -> list[tuple[Any, ...]] | None:

@@ -118,17 +118,11 @@ def report_row(rec: Any, at: int, problems: Problems) -> tuple[Any, ...] | None:
             -1, ADSB, 0, 0, *flags, lat, lon, sigma_m(nacp, nucp, version))
 
 
-def records021(raw: bytes) -> list[Any] | ValueError:
-    """The records of a CAT021 data block (the octets after its header), or a
-    ``ValueError`` when they do not fill it."""
-    base = _lib.modules()[0]
-    return spec().cv_uap.parse(base.Bits.from_bytes(raw))
-
-
 def block021(raw: bytes, at: int, problems: Problems) -> list[tuple[Any, ...]] | None:
     """The ADS-B rows of one CAT021 data block, or ``None`` when its records do not fill
     it (the caller counts ``undecodable``)."""
-    recs = records021(raw)
+    base = _lib.modules()[0]
+    recs = spec().cv_uap.parse(base.Bits.from_bytes(raw))
     if isinstance(recs, ValueError):
         return None
     return [r for r in (report_row(rec, at, problems) for rec in recs) if r is not None]

@@ -25,13 +25,14 @@ import numpy as np
 
 import mhtrack.io.asterix._lib as _lib
 from mhtrack.io.asterix._lib import quantity
-from mhtrack.io.asterix.cat001 import TimeRestorer, block001, block002, records001, records002
-from mhtrack.io.asterix.cat021 import block021, records021
+from mhtrack.io.asterix.cat001 import TimeRestorer, block001, block002
+from mhtrack.io.asterix.cat021 import block021
 from mhtrack.io.asterix.characteristics import CHARACTERISTICS, characteristics
 from mhtrack.io.asterix.columns import columns
 from mhtrack.io.asterix.container import blocks
 from mhtrack.io.asterix.duplicates import DuplicateFilter
 from mhtrack.io.asterix.fast import reader034, reader048
+from mhtrack.io.asterix.fill import fills_any_edition
 from mhtrack.io.asterix.framings import recognise, units
 from mhtrack.io.asterix.notplots import flags048, plot_type048_of, reason
 from mhtrack.io.asterix.problems import Problems
@@ -173,19 +174,13 @@ class Decoder:
                 yield at, PLOTS, _plots_only(found, cat, at, problems)
 
     def fills(self, block: bytes) -> bool:
-        """Whether the records of data block ``block`` (header included) decode to
-        exactly fill it, by the UAP this decoder reads its category with; a category it
-        does not decode is not judged (``True``)."""
+        """Whether the records of data block ``block`` (header included) fill it
+        exactly: by this decoder's fast layouts (CAT048, CAT034), else by any edition
+        libasterix carries (:func:`~mhtrack.io.asterix.fill.fills_any_edition`)."""
         cat, raw = block[0], block[3:]
-        if cat in self.readers:
-            return self.readers[cat].fills(raw)
-        if cat in self.specs:
-            found = self.specs[cat].cv_uap.parse(self.bits(raw))
-        elif cat in (1, 2, 21):
-            found = (records001 if cat == 1 else records002 if cat == 2 else records021)(raw)
-        else:
+        if cat in self.readers and self.readers[cat].fills(raw):
             return True
-        return not isinstance(found, ValueError)
+        return fills_any_edition(cat, raw)
 
     def _records(self, cat: int, raw: bytes, at: int, when: float | None,
                  problems: Problems) -> list[tuple[Any, ...]] | None:

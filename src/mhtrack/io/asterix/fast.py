@@ -37,6 +37,7 @@ from typing import Any
 
 import mhtrack.io.asterix._lib as _lib
 from mhtrack.io.asterix.characteristics import characteristics
+from mhtrack.io.asterix.fill import announces
 from mhtrack.io.asterix.notplots import flags048_item
 from mhtrack.io.asterix.problems import Problems
 
@@ -173,9 +174,12 @@ class FastRecords:
     def fills(self, raw: bytes) -> bool:
         """The records of ``raw`` (a block's octets after its header) follow one another
         to exactly its end: each record's length from a learnt layout, else from
-        libasterix's strict parsing (nothing learnt, no row read)."""
+        libasterix's strict parsing (nothing learnt, no row read); each record's FSPEC
+        announces an item (:func:`~mhtrack.io.asterix.fill.announces`)."""
         p, n = 0, len(raw)
         while p < n:
+            if not announces(raw, p):
+                return False
             found = self._spans(raw, p, n)
             if found is None:
                 bits = self.base.Bits.from_bytes(raw[p:])

@@ -7,6 +7,8 @@ markers / sector crossings (``mhtrack export``), then times, best of ``--repeat`
 
 * ``convert`` — read, decode, ground range (with the sensors file), write the CSV, as
   ``mhtrack convert REC OUT --sensors FILE`` does (target ≥ 20 000 plots/s);
+* ``convert`` of the same data blocks written back to back as a raw stream (``.ast``:
+  blocks judged by their content too, :mod:`mhtrack.io.asterix.resync`);
 * decoding alone through :mod:`mhtrack.io.asterix.fast` (layouts learnt from libasterix);
 * decoding alone through libasterix record by record (``read_recording(fast=False)``),
   the reference path, once.
@@ -45,6 +47,8 @@ def main() -> int:
 
     from mhtrack.cli.main import cli
     from mhtrack.io.asterix import _lib, convert, export, read_recording
+    from mhtrack.io.asterix.framings import units
+    from mhtrack.io.asterix.problems import Problems
     from mhtrack.io.sensors import read_sensors
 
     _lib.modules()
@@ -64,10 +68,15 @@ def main() -> int:
               f"{blocks} data blocks ({rec.stat().st_size / 1e6:.1f} MB pcap) in "
               f"{t_export:.1f} s ({n / t_export:.0f} plots/s)")
         t_conv = best_of(lambda: convert(rec, d / "out.csv", sensors), args.repeat)
+        raw = d / "hour.ast"  # the same data blocks back to back, no framing of their own
+        raw.write_bytes(b"".join(p for _, _, p in units(
+            rec.read_bytes(), "pcap", "hour.pcap", {34, 48}, Problems())))
+        t_raw = best_of(lambda: convert(raw, d / "out.csv", sensors), args.repeat)
         t_fast = best_of(lambda: read_recording(rec), args.repeat)
         t_slow = best_of(lambda: read_recording(rec, fast=False), 1)
         print(f"{'what':44s} {'s':>7s} {'plots/s':>9s}")
         for what, t in (("convert (decode, ground range, write CSV)", t_conv),
+                        ("convert, raw data blocks (.ast)", t_raw),
                         ("decode, fast path", t_fast),
                         ("decode, libasterix record by record", t_slow)):
             print(f"{what:44s} {t:7.2f} {n / t:9.0f}")

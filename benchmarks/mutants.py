@@ -1,6 +1,7 @@
 """Damaged recordings through ``convert`` and ``track`` (issue 33, acceptance run 1).
 
-Usage: ``python benchmarks/mutants.py [--mutants 2000] [--seed 0] [--work DIR]``.
+Usage: ``python benchmarks/mutants.py [--mutants 2000] [--seed 0] [--work DIR]
+[--shard K/N] [--formats raw]``.
 
 A small but rich recording (the ``opensky-radars`` preset, seed 1, its first 45 s: three
 rotating radars, 1 129 plots, 190 CAT034 sweep marks) is exported as pcap, then written
@@ -294,6 +295,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--only", help="replay one mutant: FORMAT-KIND-SEED")
     ap.add_argument("--work", type=Path, default=None)
     ap.add_argument("--shard", default="0/1", help="K/N: run the mutants K, K + N, ...")
+    ap.add_argument("--formats", default=",".join(FORMATS),
+                    help="only these formats' mutants (the same seeds as in the full run)")
     args = ap.parse_args(argv)
     work = args.work or Path(tempfile.mkdtemp(prefix="mutants-"))
     work.mkdir(parents=True, exist_ok=True)
@@ -309,7 +312,7 @@ def main(argv: list[str] | None = None) -> int:
         jobs = [(rng.choice(FORMATS), rng.choice(KINDS), rng.randrange(2**31))
                 for _ in range(args.mutants)]
         k, n = map(int, args.shard.split("/"))
-        jobs = jobs[k::n]
+        jobs = [j for j in jobs[k::n] if j[0] in args.formats.split(",")]
     counts: dict[tuple[str, str], list[int]] = collections.defaultdict(lambda: [0, 0, 0])
     failures: list[str] = []
     for i, (fmt, kind, seed) in enumerate(jobs, 1):

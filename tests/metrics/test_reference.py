@@ -173,3 +173,33 @@ def test_adsb_reports_as_the_reference(tmp_path: Path) -> None:
     assert m.n_misses == 0 and m.n_false == 0 and m.id_switches == 0
     assert ev.n_targets == 2
     assert m.motp <= 180.0 / 2**30 * 111_320.0 * 2  # I021/131: 180/2³⁰ ° a step
+
+
+def test_adsb_reference_is_walked_once(tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+                                       ) -> None:
+    """A recording with no CAT062 is read as CAT021 from the same walk of the file (the
+    framing reader runs once), with the same updates and problems as a walk of its own
+    for CAT021 (the former path)."""
+    import mhtrack.io.asterix.category_file as cf
+    from mhtrack.io.asterix import encode_other
+    from mhtrack.io.reference import _adsb_reports, read_reference
+    from mhtrack.models.geodesy import LocalFrame
+
+    frame = LocalFrame(*ORIGIN)
+    lat, lon = frame.to_geodetic(np.linspace(0, 9e3, 10), np.zeros(10))
+    reports = [(t, encode_other.report021(t, 0x0709, float(lat[i]), float(lon[i]),
+                                          address="A00001"))
+               for i, t in enumerate(np.arange(10) * 4.0)]
+    ast = tmp_path / "adsb.ast"
+    ast.write_bytes(b"".join(b for t, r in reports
+                             for _, _, b in encode_other.blocks([(t, 0x0709, 21, r)]))
+                    + b"\x15\x00")  # two octets of damage at the end
+    walks = []
+    real = cf.units
+    monkeypatch.setattr(cf, "units", lambda *a, **k: walks.append(1) or real(*a, **k))
+    ref = read_reference(ast, frame)
+    assert len(walks) == 1 and len(ref) == 10
+    cols, key, problems = _adsb_reports(ast)
+    assert np.array_equal(ref.time, cols["time"]) and np.array_equal(ref.key, key)
+    assert ref.problems == problems and problems.counts == {"resync": 1,
+                                                            "skipped_octets": 2}

@@ -39,6 +39,7 @@ from mhtrack.io.asterix.problems import Problems
 from mhtrack.io.asterix.timeaxis import DAY_S
 
 if TYPE_CHECKING:
+    from mhtrack.io.asterix.category_file import Walked
     from mhtrack.models.geodesy import LocalFrame
 
 
@@ -74,16 +75,17 @@ def read_reference(path: str | Path, frame: LocalFrame | None = None) -> Referen
     reports (module docstring); the records skipped are in ``problems`` (the caller
     warns: one line per kind, naming ``path`` and the byte offset of the first)."""
     from mhtrack.io.asterix.cat062 import block062, track_columns
-    from mhtrack.io.asterix.category_file import category_rows
+    from mhtrack.io.asterix.category_file import category_blocks, category_rows
 
-    rows, problems = category_rows(path, 62, block062)
+    walked = category_blocks(path, (62, 21))  # one walk serves both categories
+    rows, problems = category_rows(path, 62, block062, walked)
     if rows:
         cols = track_columns(rows)
         source = cols["sac"].astype(np.int64) * 256 + cols["sic"].astype(np.int64)
         key = source * 65536 + cols["track_number"].astype(np.int64)
         velocity = tuple(np.nan_to_num(np.asarray(cols[k], float)) for k in ("vx", "vy"))
     else:
-        cols, key, problems = _adsb_reports(path)
+        cols, key, problems = _adsb_reports(path, walked)
         velocity = (np.zeros(key.size), np.zeros(key.size))
     if frame is None:
         from mhtrack.models.geodesy import LocalFrame
@@ -95,9 +97,12 @@ def read_reference(path: str | Path, frame: LocalFrame | None = None) -> Referen
     return ReferenceUpdates(np.asarray(cols["time"], float), key, state, frame, problems)
 
 
-def _adsb_reports(path: str | Path) -> tuple[dict[str, np.ndarray], np.ndarray, Problems]:
-    """The CAT021 reports of ``path`` as reference updates: columns ``time`` (continued
-    across midnight), ``lat``, ``lon``; their keys; the parts skipped."""
+def _adsb_reports(path: str | Path, walked: Walked | None = None
+                  ) -> tuple[dict[str, np.ndarray], np.ndarray, Problems]:
+    """The CAT021 reports of ``path`` (``walked``: already walked by
+    :func:`~mhtrack.io.asterix.category_file.category_blocks`) as reference updates:
+    columns ``time`` (continued across midnight), ``lat``, ``lon``; their keys; the
+    parts skipped."""
     from mhtrack.errors import InputError
     from mhtrack.io.asterix.cat021 import COLUMNS, block021
     from mhtrack.io.asterix.category_file import category_rows
@@ -111,7 +116,7 @@ def _adsb_reports(path: str | Path) -> tuple[dict[str, np.ndarray], np.ndarray, 
             at.extend([offset] * len(found))
         return found
 
-    rows, problems = category_rows(path, 21, rows_of)
+    rows, problems = category_rows(path, 21, rows_of, walked)
     if not rows:
         raise InputError(f"{path}: no CAT062 track nor CAT021 ADS-B report with a position "
                          "and a time: not a reference", file=str(path))

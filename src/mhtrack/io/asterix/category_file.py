@@ -2,11 +2,13 @@
 :mod:`~mhtrack.io.asterix.framings`, recognised by content): what a reference read for
 ``evaluate --reference`` walks — CAT062 system tracks or CAT021 ADS-B reports. Blocks of
 other categories and blocks whose records do not fill them are counted in the
-:class:`~mhtrack.io.asterix.problems.Problems`, never passed on."""
+:class:`~mhtrack.io.asterix.problems.Problems`, never passed on. One walk of the file
+can serve several categories (:func:`category_blocks`): a reference without CAT062 is
+read as CAT021 without reading the file again."""
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -18,28 +20,41 @@ from mhtrack.io.asterix.problems import Problems
 #: One block's rows (``raw`` records, the block's file offset, the problems), or
 #: ``None`` when its records do not fill it.
 BlockRows = Callable[[bytes, int, Problems], "list[tuple[Any, ...]] | None"]
+#: A recording walked once: ``(file offset, category, records)`` of every data block,
+#: and the problems of its framing.
+Walked = tuple[list[tuple[int, int, bytes]], Problems]
 
 
-def category_rows(path: str | Path, cat: int, rows_of: BlockRows
-                  ) -> tuple[list[tuple[Any, ...]], Problems]:
-    """The rows ``rows_of`` gives for every category-``cat`` block of recording ``path``
-    (in file order), and the parts skipped."""
+def category_blocks(path: str | Path, cats: Sequence[int]) -> Walked:
+    """Every data block of recording ``path`` in file order, recognised with ``cats``
+    among its categories, and the framing's problems."""
     gen = _lib.modules()[1]
     name = str(path)
     data = Path(path).read_bytes()
-    cats = {int(c) for c in gen.manifest["CATS"]} | {cat}
-    kind = recognise(data, name, cats)
+    known = {int(c) for c in gen.manifest["CATS"]} | set(cats)
+    kind = recognise(data, name, known)
     problems = Problems()
+    found = [block for offset, _, payload in units(data, kind, name, known, problems)
+             for block in blocks(payload, offset, problems)]
+    return found, problems
+
+
+def category_rows(path: str | Path, cat: int, rows_of: BlockRows,
+                  walked: Walked | None = None) -> tuple[list[tuple[Any, ...]], Problems]:
+    """The rows ``rows_of`` gives for every category-``cat`` block of recording ``path``
+    (in file order), and the parts skipped; ``walked``: the file already walked by
+    :func:`category_blocks` (else it is walked now)."""
+    found, framing = walked if walked is not None else category_blocks(path, (cat,))
+    problems = Problems(dict(framing.counts), dict(framing.first), dict(framing.detail))
     rows: list[tuple[Any, ...]] = []
-    for offset, _, payload in units(data, kind, name, cats, problems):
-        for at, found_cat, raw in blocks(payload, offset, problems):
-            if found_cat != cat:
-                problems.add("unknown_category", at, detail=f"category {found_cat}")
-                continue
-            found = rows_of(raw, at, problems)
-            if found is None:
-                problems.add("undecodable", at, detail=f"category {cat}: records do not "
-                             "fill the block")
-                continue
-            rows += found
+    for at, found_cat, raw in found:
+        if found_cat != cat:
+            problems.add("unknown_category", at, detail=f"category {found_cat}")
+            continue
+        got = rows_of(raw, at, problems)
+        if got is None:
+            problems.add("undecodable", at, detail=f"category {cat}: records do not "
+                         "fill the block")
+            continue
+        rows += got
     return rows, problems

@@ -32,6 +32,7 @@ from mhtrack.io.asterix.columns import columns
 from mhtrack.io.asterix.container import blocks
 from mhtrack.io.asterix.duplicates import DuplicateFilter
 from mhtrack.io.asterix.fast import reader034, reader048
+from mhtrack.io.asterix.fill import fills_any_edition
 from mhtrack.io.asterix.framings import recognise, units
 from mhtrack.io.asterix.notplots import flags048, plot_type048_of, reason
 from mhtrack.io.asterix.problems import Problems
@@ -106,7 +107,8 @@ def read_recording(path: str | Path, *, fast: bool = True, progress: bool = Fals
     times: list[float] = []
     axis = TimeAxis()
     bar = Count(len(data), "decode", "B", progress, scale=True)
-    for offset, when, payload in units(data, kind, name, decoder.categories, problems):
+    for offset, when, payload in units(data, kind, name, decoder.categories, problems,
+                                      decoder.fills):
         bar.to(offset)
         for _, what, found in decoder.blocks(payload, offset, problems, when):
             into = marks if what == MARKS else rows  # ADS-B reports beside the plots
@@ -170,6 +172,15 @@ class Decoder:
                 yield at, ADSB, _plots_only(found, cat, at, problems)
             else:
                 yield at, PLOTS, _plots_only(found, cat, at, problems)
+
+    def fills(self, block: bytes) -> bool:
+        """Whether the records of data block ``block`` (header included) fill it
+        exactly: by this decoder's fast layouts (CAT048, CAT034), else by any edition
+        libasterix carries (:func:`~mhtrack.io.asterix.fill.fills_any_edition`)."""
+        cat, raw = block[0], block[3:]
+        if cat in self.readers and self.readers[cat].fills(raw):
+            return True
+        return fills_any_edition(cat, raw)
 
     def _records(self, cat: int, raw: bytes, at: int, when: float | None,
                  problems: Problems) -> list[tuple[Any, ...]] | None:

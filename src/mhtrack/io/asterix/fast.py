@@ -37,6 +37,7 @@ from typing import Any
 
 import mhtrack.io.asterix._lib as _lib
 from mhtrack.io.asterix.characteristics import characteristics
+from mhtrack.io.asterix.fill import announces
 from mhtrack.io.asterix.notplots import flags048_item
 from mhtrack.io.asterix.problems import Problems
 
@@ -170,9 +171,30 @@ class FastRecords:
         check = self._fast(raw, p, len(raw), 0, Problems(), only=layout)
         layout.ok = check is not None and check[1] == end and _same(check[0], row)
 
-    def _fast(self, raw: bytes, p: int, n: int, at: int, problems: Problems,
-              only: _Layout | None = None) -> tuple[tuple[Any, ...] | None, int] | None:
-        """One record through a learnt layout, or ``None`` if none applies."""
+    def fills(self, raw: bytes) -> bool:
+        """The records of ``raw`` (a block's octets after its header) follow one another
+        to exactly its end: each record's length from a learnt layout, else from
+        libasterix's strict parsing (nothing learnt, no row read); each record's FSPEC
+        announces an item (:func:`~mhtrack.io.asterix.fill.announces`)."""
+        p, n = 0, len(raw)
+        while p < n:
+            if not announces(raw, p):
+                return False
+            found = self._spans(raw, p, n)
+            if found is None:
+                bits = self.base.Bits.from_bytes(raw[p:])
+                result = self.record.parse(self.base.ParsingMode.StrictParsing, bits)
+                if isinstance(result, ValueError):
+                    return False
+                p = n - len(result[1]) // 8
+            else:
+                p = found[1]
+        return True
+
+    def _spans(self, raw: bytes, p: int, n: int, only: _Layout | None = None
+               ) -> tuple[dict[str, tuple[int, int]], int] | None:
+        """The items (name -> (offset, length)) and end of the record at ``p`` by a
+        learnt layout, or ``None`` if none applies."""
         for layout in [only] if only is not None else self.layouts.get(raw[p:p + 1], ()):
             if (not layout.ok and only is None) or not raw.startswith(layout.fspec, p):
                 continue
@@ -185,10 +207,16 @@ class FastRecords:
                         return None
                 spans[name] = (q, size)
                 q += size
-            if q > n:
-                return None
-            return self.fast_row(self, raw, spans, at, problems), q
+            return None if q > n else (spans, q)
         return None
+
+    def _fast(self, raw: bytes, p: int, n: int, at: int, problems: Problems,
+              only: _Layout | None = None) -> tuple[tuple[Any, ...] | None, int] | None:
+        """One record through a learnt layout, or ``None`` if none applies."""
+        found = self._spans(raw, p, n, only)
+        if found is None:
+            return None
+        return self.fast_row(self, raw, found[0], at, problems), found[1]
 
     def _variable(self, name: str, raw: bytes, q: int) -> int | None:
         """Length of the variable-size item ``name`` at ``q``: a known encoding, or one

@@ -29,12 +29,16 @@ Layouts of ORADIS, GPS and Final as the Croatia Control ``asterix`` decoder read
 Damage (a length beyond the data, a missing trailer, a time beyond a day; a pcap packet
 empty, more than a day from the one before, or whose captured length is neither its
 length nor the snap length) is skipped at the level of one record: the reader moves on to
-the next offset where :data:`CONFIRM` records in a row are valid (or valid ones end the
-file), counts one ``resync`` and the octets skipped (:func:`_walk`). It raises only on the
-file's own headers: a file that is no recording, a capture link type not read
-(:class:`InputError`, naming the byte). A raw stream has no framing of its own: a damaged
-block length that still fits takes the blocks it covers with it (the decoder then finds
-that block undecodable).
+the next offset where :data:`~mhtrack.io.asterix.resync.CONFIRM` records in a row are
+valid (or valid ones end the file), counts one ``resync`` and the octets skipped
+(:mod:`mhtrack.io.asterix.resync`). It raises only on the file's own headers: a file that
+is no recording, a capture link type not read (:class:`InputError`, naming the byte). A
+raw stream has no framing of its own beyond category and length, so its blocks are
+judged by their content too when the reader is given a ``fits`` check
+(:func:`~mhtrack.io.asterix.resync.judged`): a block is valid only when its records, item
+lengths read from its FSPEC by the category's UAP, end exactly at its end. A damaged
+block length that lands on octets framed like a block is then found out, and reading
+resumes at the good blocks it would have covered.
 """
 
 from __future__ import annotations
@@ -45,6 +49,7 @@ from collections.abc import Callable, Iterator
 from mhtrack.errors import InputError
 from mhtrack.io.asterix.link import LINKS, payload
 from mhtrack.io.asterix.problems import Problems
+from mhtrack.io.asterix.resync import judged, walk
 from mhtrack.io.asterix.timeaxis import DAY_S
 
 #: ``(offset of the payload in the file, time s or None, ASTERIX octets)``.
@@ -58,8 +63,6 @@ FINAL_PAD = b"\xa5\xa5\xa5\xa5"
 STREAMS = ("final", "oradis", "gps", "raw")
 #: Records checked from the start to recognise a stream framing.
 PROBE = 16
-#: Records in a row that confirm where reading resumes after damage.
-CONFIRM = 3
 #: Octets searched for the first valid record of a file whose first records are damaged.
 SEARCH = 4096
 #: pcap packets longer than this are damage (the largest snap length tcpdump uses).
@@ -178,16 +181,18 @@ def recognise(data: bytes, name: str, cats: set[int]) -> str:
                      file=name)
 
 
-def units(data: bytes, kind: str, name: str, cats: set[int], problems: Problems
-          ) -> Iterator[Unit]:
+def units(data: bytes, kind: str, name: str, cats: set[int], problems: Problems,
+          fits: Callable[[bytes], bool] | None = None) -> Iterator[Unit]:
     """Every unit of a recording of framing ``kind`` (:func:`recognise`); ORADIS inside
-    UDP is unwrapped too (:func:`unwrap`). Damage is counted in ``problems``."""
+    UDP is unwrapped too (:func:`unwrap`). Damage is counted in ``problems``. ``fits``
+    (a data block, header included -> whether its records fill it) judges the blocks of
+    a raw stream by their content too (:func:`~mhtrack.io.asterix.resync.judged`)."""
     if kind == "pcap":
         inner = _pcap(data, name, problems)
     elif kind == "pcapng":
         inner = _pcapng(data, name, problems)
     else:
-        inner = _stream(data, kind, cats, problems)
+        inner = _stream(data, kind, cats, problems, fits)
     for offset, time, octets in inner:
         yield from unwrap(offset, time, octets, cats)
 
@@ -206,54 +211,16 @@ def unwrap(offset: int, time: float | None, octets: bytes, cats: set[int]
     return out if out and p == len(octets) else [(offset, time, octets)]
 
 
-def _confirmed(data: bytes, q: int, at: Callable[[int], int]) -> bool:
-    """:data:`CONFIRM` valid records in a row from ``q``, or valid ones to the end."""
-    for _ in range(CONFIRM):
-        if q == len(data):
-            return True
-        s = at(q)
-        if not s:
-            return False
-        q += s
-    return True
-
-
-def _walk(data: bytes, start: int, at: Callable[[int], int], problems: Problems
-          ) -> Iterator[tuple[int, int]]:
-    """``(offset, length)`` of each valid record from ``start``. A record is taken when the
-    one after it is valid too (or the file ends there), or else when no record confirmed
-    by :data:`CONFIRM` valid records in a row (or by the end of the file) starts inside it
-    (it is the last good record before damage, not a false length swallowing good
-    records). After damage, reading resumes at the next confirmed record, searched octet
-    by octet (damage may add or remove octets, so no alignment is assumed)."""
-    n = len(data)
-
-    def confirmed(q: int) -> bool:
-        return _confirmed(data, q, at)
-
-    p = start
-    while p < n:
-        step = at(p)
-        if step and (p + step == n or at(p + step)
-                     or not any(confirmed(q) for q in range(p + 1, p + step))):
-            yield p, step
-            p += step
-            continue
-        q = p + 1
-        while q < n and not confirmed(q):
-            q += 1
-        problems.add("resync", p)
-        problems.add("skipped_octets", p, q - p)
-        p = q
-
-
-def _stream(data: bytes, kind: str, cats: set[int], problems: Problems) -> Iterator[Unit]:
+def _stream(data: bytes, kind: str, cats: set[int], problems: Problems,
+            fits: Callable[[bytes], bool] | None = None) -> Iterator[Unit]:
     if kind == "gps" and len(data) < GPS_HEADER:
         problems.add("skipped_octets", 0, len(data))
         return
     check = _AT[kind]
+    at = judged(data, lambda q: _raw_at(data, q, cats), fits) \
+        if kind == "raw" and fits is not None else lambda q: check(data, q, cats)
     day, last = 0, None  # GPS: days counted where its time of day steps back over 12 h
-    for p, step in _walk(data, _START[kind], lambda q: check(data, q, cats), problems):
+    for p, step in walk(data, _START[kind], at, problems):
         if kind == "final":
             tod = int.from_bytes(data[p + 5:p + 8], "big") * 0.01
             yield p + FINAL_HEADER, data[p + 4] * DAY_S + tod, \
@@ -306,7 +273,7 @@ def _pcap(data: bytes, name: str, problems: Problems) -> Iterator[Unit]:
         q += step
     if secs:
         last[0] = sorted(secs)[len(secs) // 2]
-    for p, step in _walk(data, 24, at, problems):
+    for p, step in walk(data, 24, at, problems):
         sec, frac, _, _ = rec.unpack_from(data, p)
         nxt = p + step
         if nxt + 16 > len(data) or abs(rec.unpack_from(data, nxt)[0] - sec) <= DAY_S:
@@ -356,7 +323,7 @@ def _pcapng(data: bytes, name: str, problems: Problems) -> Iterator[Unit]:
             return 0
         return total
 
-    for p, total in _walk(data, 0, at, problems):
+    for p, total in walk(data, 0, at, problems):
         if data[p:p + 4] == PCAPNG_MAGIC:
             state["e"] = "<" if data[p + 8] == 0x4D else ">"
             links = []

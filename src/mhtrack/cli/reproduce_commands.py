@@ -140,7 +140,7 @@ def clutter_shift(runs: int, out: Path, seed: int, ablation_runs: int,
     try:
         from mhtrack.scenario import preset as load_preset
 
-        scenario = load_preset(preset)
+        scenario = cs.default_scenario() if preset == cs.PRESET else load_preset(preset)
         with resume_on_interrupt("reproduce clutter-shift", out):
             study = cs.clutter_shift(out, runs, seed, scenario=scenario,
                                      methods=methods or tuple(cs.METHODS), **run_on)

@@ -8,8 +8,9 @@ every method, so the methods pair run by run. Each job (one scene, one method, o
 builds the tracker ``mhtrack run`` would build for the scene (:class:`~mhtrack.pipeline.
 Pipeline`, every default chosen by the pipeline): for a registered estimator or variant the
 tracker ``mht-<estimator>`` with its ``clutter_params``
-(:func:`~mhtrack.experiments.scene_methods.method_tracker`), for ``known`` and ``uniform``
-tracker :data:`TRACKER` given the method's per-radar estimator; it tracks frame by frame
+(:func:`~mhtrack.experiments.scene_methods.method_tracker`), for ``known``, ``uniform`` (and
+an estimator no tracker name uses) tracker :data:`TRACKER` given the method's per-radar
+estimator; it tracks frame by frame
 and scores:
 
 * the **clutter error** after every frame, of the frame's radar ``s``:
@@ -141,7 +142,7 @@ def _view(tracks: Any, sim: Any, cutoff: float, order: float) -> dict[str, float
 def run_job(job: Mapping[str, Any]) -> dict[str, Any]:
     """One method on one run of one scene (module docstring)."""
     from mhtrack.experiments.pipeline import scenario_source
-    from mhtrack.experiments.scene_methods import make_method, method_tracker
+    from mhtrack.experiments.scene_methods import has_tracker, make_method, method_tracker
     from mhtrack.pipeline import Pipeline, TrackOptions, feed, step_frames
     from mhtrack.scenario import Scenario, simulate
     from mhtrack.scenario.scene_truth import RadarTruth
@@ -151,7 +152,7 @@ def run_job(job: Mapping[str, Any]) -> dict[str, Any]:
     scenario = Scenario.from_dict(job["scenario"])
     sim = simulate(scenario, seed=job["seed"])
     method = job["method"]
-    if method in (ORACLE, UNIFORM):
+    if not has_tracker(method):  # known, uniform, an estimator without a tracker name
         pipe = Pipeline(scenario_source(scenario, sim.plots), TrackOptions(tracker=TRACKER))
         est = make_method(method, scenario, job.get("params"))
     else:

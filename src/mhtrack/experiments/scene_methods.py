@@ -18,7 +18,8 @@ holds it: one estimate per radar, ``κ̂_s(x)`` per m² per rotation.
 Every registered estimator and variant is run by the tracker built the normal way
 (:func:`method_tracker`: ``mht-<estimator>`` with the variant's ``clutter_params``, through
 :func:`mhtrack.build.make_tracker`), so what only the build does (``birth_scaling``'s birth
-wrapper) acts as it does in ``mhtrack run``.
+wrapper) acts as it does in ``mhtrack run``; an estimator registered without a tracker name
+is given to ``mht-gmm``'s tracker in place of its own (:func:`make_method`).
 """
 
 from __future__ import annotations
@@ -84,7 +85,19 @@ def method_tracker(method: str, params: Mapping[str, Any] | None = None
     if est not in estimator_methods():
         raise ValueError(f"{method!r} is not a registered clutter estimator or variant")
     by_estimator = {e: t for t, e in TRACKER_ESTIMATORS.items()}
+    if est not in by_estimator:
+        raise ValueError(f"{method!r}: no tracker uses estimator {est!r}")
     return by_estimator[est], {**kw, **dict(params or {})}
+
+
+def has_tracker(method: str) -> bool:
+    """Whether a tracker of :data:`mhtrack.build.TRACKER_ESTIMATORS` uses ``method``'s
+    estimator (an estimator registered without one is given to ``mht-gmm``'s tracker)."""
+    from mhtrack.build import TRACKER_ESTIMATORS
+
+    if method in (ORACLE, UNIFORM):
+        return False
+    return VARIANTS.get(method, (method, {}))[0] in TRACKER_ESTIMATORS.values()
 
 
 def describe(method: str) -> str:

@@ -68,3 +68,23 @@ def test_variants_build_their_estimators_tracker():
                                           "seed": 3}
     with pytest.raises(ValueError, match="not a registered"):
         method_tracker("uniform")
+
+
+@pytest.mark.parametrize("forget_used", [True, False])
+def test_per_radar_rotation_keeps_track_plots_only_when_told(forget_used):
+    """On a rotating radar the tracks' plots leave the rotation being gathered, unless the
+    map keeps them: after the rotation the map holds 3 or 2 plots."""
+    from mhtrack.clutter.per_sensor import PerSensorClutter
+
+    per = PerSensorClutter(lambda: ClutterMap(max_range=5_000.0, forget_used=forget_used),
+                           {1: 4.0})
+
+    def frame(t, z):
+        z = np.asarray(z, float)
+        return Scan(index=0, time=t, z=z, sensor=np.ones(len(z), np.int64),
+                    rows=np.arange(len(z)), t=np.full(len(z), t))
+
+    per.update(frame(0.5, [[100.0, 100.0], [900.0, -200.0], [-50.0, 2000.0]]))
+    per.forget(np.array([False, True, False]))
+    per.update(frame(4.5, [[10.0, 10.0]]))  # the next rotation: the first one is fed
+    assert per.estimator(1).sums_.sum() == (3.0 if not forget_used else 2.0)

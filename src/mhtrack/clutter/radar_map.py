@@ -103,7 +103,9 @@ class ClutterMap(ClutterEstimator):
     birth_scaling : ``β`` of the birth density this map drives
         (:func:`birth_scale`; 0: none). Default 0.
     forget_used : take the plots confirmed tracks used out of their cells (:meth:`forget`;
-        ``False``: keep them, the ablation of ``reproduce clutter-scenes``). Default True.
+        on rotating radars :class:`~mhtrack.clutter.per_sensor.PerSensorClutter` takes them
+        out of the rotation it gathers, unless this is ``False``; ``False``: keep them,
+        the ablation of ``reproduce clutter-scenes``). Default True.
     """
 
     name = "map"

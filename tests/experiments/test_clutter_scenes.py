@@ -93,7 +93,9 @@ def test_an_estimator_registered_by_name_joins_the_study(monkeypatch, tmp_path):
     from mhtrack.build import CLUTTER_ESTIMATOR_CLASSES
 
     monkeypatch.setitem(CLUTTER_ESTIMATOR_CLASSES, "flat", Flat)
-    assert all_methods() == ("known", "uniform", "gmm", "agmm", "flat")
+    registered = tuple(n for n in CLUTTER_ESTIMATOR_CLASSES if n != "known")
+    assert registered[-1] == "flat"
+    assert all_methods() == ("known", "uniform", *registered, "map-birth")
     assert ("flat", "gmm") in study_pairs(all_methods())
     assert ("flat", "uniform") in study_pairs(all_methods())
     st = clutter_scenes(tmp_path, runs=1, base=preset("radars-clutter", scans=10),
@@ -116,3 +118,31 @@ def test_cli_writes_the_report(tmp_path):
     bad = CliRunner().invoke(reproduce, ["clutter-scenes", "--scene", "fog",
                                     "--out", str(tmp_path / "x")])
     assert bad.exit_code != 0 and "unknown scene(s) fog" in bad.output
+
+
+def test_a_variant_runs_the_tracker_its_build_gives(tmp_path, monkeypatch):
+    """``map-birth`` is built by ``make_tracker`` (its birth wrapper scales the births),
+    and ``gmm``'s record is the one of the former path (``mht-gmm``'s tracker given
+    ``make_method``'s estimator)."""
+    import mhtrack.experiments.scene_methods as sm
+    from mhtrack.mht.births.clutter_scaled import ClutterScaledBirth
+
+    calls = []
+    real = ClutterScaledBirth.propose
+
+    def propose(self, *a, **k):
+        calls.append(1)
+        return real(self, *a, **k)
+
+    monkeypatch.setattr(ClutterScaledBirth, "propose", propose)
+    base = preset("radars-clutter", scans=10)
+    st = clutter_scenes(tmp_path / "new", runs=1, base=base, scenes=("burst",),
+                        methods=("gmm", "map-birth"), resolution=16, workers=1)
+    assert calls, "map-birth's tracker never used the clutter-scaled birth"
+    assert ("map-birth", "map") not in study_pairs(("gmm", "map-birth"))
+    assert ("map-birth", "map") in study_pairs(("gmm", "map", "map-birth"))
+    monkeypatch.setattr(sm, "has_tracker", lambda m: False)  # the former path
+    old = clutter_scenes(tmp_path / "old", runs=1, base=base, scenes=("burst",),
+                         methods=("gmm",), resolution=16, workers=1)
+    (a,), (b,) = st.records["burst"]["gmm"], old.records["burst"]["gmm"]
+    assert _strip(a) == _strip(b)

@@ -136,3 +136,24 @@ def test_two_workers_and_dask_give_the_same_study(study, tmp_path):
     assert dk.computed == 12 and not dk.errors
     assert _timeless(dk.records) == _timeless(study.records)
     assert [c.to_dict() for c in dk.paired] == [c.to_dict() for c in study.paired]
+
+
+def test_any_registered_estimator_joins_and_is_paired_with_gmm(tmp_path):
+    from mhtrack.clutter.forgetting import ForgettingGMMClutter
+
+    sc = preset("crossing", scans=6)
+    assert isinstance(cs.make_estimator("fgmm", sc), ForgettingGMMClutter)
+    with pytest.raises(ValueError, match="unknown method 'nope'"):
+        cs.make_estimator("nope", sc)
+    r = CliRunner().invoke(reproduce, ["clutter-shift", "--runs", "2", "--workers", "1",
+                                       "--preset", "crossing", "--method", "gmm",
+                                       "--method", "fgmm", "--out", str(tmp_path),
+                                       "--no-progress"])
+    assert r.exit_code == 0, r.output
+    assert "fgmm vs gmm" in r.stdout
+    res = json.loads((tmp_path / "results.json").read_text())
+    assert res["params"]["scenario"] == "crossing"
+    assert set(res["params"]["methods"]) == {"gmm", "fgmm"}
+    bad = CliRunner().invoke(reproduce, ["clutter-shift", "--method", "nope",
+                                         "--out", str(tmp_path / "x")])
+    assert bad.exit_code == 2 and "nope" in bad.output

@@ -9,6 +9,7 @@ from typing import Any
 import click
 
 from mhtrack.cli.asterix_commands import needs_libasterix
+from mhtrack.cli.clutter_options import clutter_estimator_options, clutter_params
 from mhtrack.cli.common import (
     clutter_scene_option,
     echo_json,
@@ -220,6 +221,7 @@ def track_options(tracker: str, tracker_pd: float | None, meas_sigma: float | No
 @bias_options
 @birth_options
 @output_option
+@clutter_estimator_options
 @needs_libasterix
 def track(plots: Path, tracker: str, tracker_pd: float | None, meas_sigma: float | None,
           accel_sigma: float | None, imm_accel_sigma: float | None,
@@ -230,7 +232,8 @@ def track(plots: Path, tracker: str, tracker_pd: float | None, meas_sigma: float
           birth: str,
           birth_theta: float | None, fusion: str | None, output: str | None,
           estimate_bias: bool = False, bias_reference: int | None = None,
-          bias_init: Path | None = None, bias_out: Path | None = None) -> None:
+          bias_init: Path | None = None, bias_out: Path | None = None,
+          **estimator_opts: Any) -> None:
     """Run a tracker on a PLOTS file and write its tracks."""
     from mhtrack.io.paths import check_output_file
     from mhtrack.pipeline.run import Pipeline
@@ -240,7 +243,8 @@ def track(plots: Path, tracker: str, tracker_pd: float | None, meas_sigma: float
     options = track_options(tracker, tracker_pd, meas_sigma, accel_sigma, imm_accel_sigma,
                             clutter_density, birth_density, nscan, birth, birth_theta,
                             fusion, output, clutter_frame=clutter_frame,
-                            **bias_fields(estimate_bias, bias_reference, bias_init, bias_out))
+                            **bias_fields(estimate_bias, bias_reference, bias_init, bias_out),
+                            clutter_params=clutter_params(tracker, **estimator_opts))
     bars = show_progress()
     pipe = Pipeline.open(plots, options, scenario_file=scenario_file,
                          sensors_file=sensors_file, reorder_window_s=reorder_window_s,
@@ -275,6 +279,7 @@ def track(plots: Path, tracker: str, tracker_pd: float | None, meas_sigma: float
 @click.option("--bias", "biases", multiple=True, metavar="ID:range=M,gain=G,azimuth=DEG",
               help="Give rotating radar ID a registration bias (as simulate --bias).")
 @bias_options
+@clutter_estimator_options
 def run(scenario: str, seed: int, clutter: str | None, clutter_rate: float | None,
         pd: float | None, scans: int | None, tracker: str, tracker_pd: float | None,
         meas_sigma: float | None, accel_sigma: float | None, imm_accel_sigma: float | None,
@@ -284,7 +289,8 @@ def run(scenario: str, seed: int, clutter: str | None, clutter_rate: float | Non
         birth: str, birth_theta: float | None, fusion: str | None, output: str | None,
         clutter_scene: str | None = None, biases: tuple[str, ...] = (),
         estimate_bias: bool = False, bias_reference: int | None = None,
-        bias_init: Path | None = None, bias_out: Path | None = None) -> None:
+        bias_init: Path | None = None, bias_out: Path | None = None,
+        **estimator_opts: Any) -> None:
     """Simulate SCENARIO, track, evaluate and plot, in one go.
 
     Writes plots, truth, tracks, scenario.toml, metrics.json, scene.png (truth, plots,
@@ -311,7 +317,8 @@ def run(scenario: str, seed: int, clutter: str | None, clutter_rate: float | Non
     options = track_options(tracker, tracker_pd, meas_sigma, accel_sigma, imm_accel_sigma,
                             clutter_density, birth_density, nscan, birth, birth_theta,
                             fusion, output, sensor_pd=pd,
-                            **bias_fields(estimate_bias, bias_reference, bias_init, bias_out))
+                            **bias_fields(estimate_bias, bias_reference, bias_init, bias_out),
+                            clutter_params=clutter_params(tracker, **estimator_opts))
     warn_known_kappa(sc, options)
     result = run_scenario(sc, seed, options=options, cutoff=cutoff, order=order,
                           progress=show_progress())

@@ -121,6 +121,8 @@ class PerSensorClutter(ClutterEstimator):
             self.estimator(sid).forget(used)
             return
         pending = self._pending.get(sid)
+        if not getattr(self.estimator(sid), "forget_used", True):
+            return  # an estimator that keeps the tracks' plots (ClutterMap(forget_used=False))
         if pending and np.any(used):
             last = pending[-1]
             keep = ~np.asarray(used, bool)

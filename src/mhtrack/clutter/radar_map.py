@@ -36,6 +36,13 @@ Musicki & Evans ("Clutter map information for data association and track
 initialization", IEEE TAES 40(2), 2004) estimate the clutter density from the plots no
 track claims.
 
+*Cell size.* Unless given, the cells follow the radar's reach ``R`` (``max_range``):
+:data:`REACH_RINGS` rings of ``Δr = R / 12`` and :data:`REACH_SECTORS` sectors (11.25°;
+cells square at ``r = Δr/Δθ ≈ 0.42 R``), so a map holds the same 384 cells whatever the
+radar's reach and a cell collects, over the memory, a count a forgetting average can
+estimate. Measured on ``reproduce clutter-scenes`` (``docs/clutter.md``). Without a reach
+(a scan path) the cells are 500 m × 64 sectors.
+
 The rings grow as far plots arrive (up to ``max_rings``; plots beyond are counted in
 ``n_outside_``): memory ``n_r × n_θ`` floats, time per rotation linear in its plots plus
 one pass over the cells.
@@ -50,6 +57,14 @@ import numpy as np
 
 from mhtrack.clutter.base import ClutterEstimator
 from mhtrack.records import Scan
+
+#: Rings over the reach and sectors of a map placed with a ``max_range`` and no
+#: ``range_cell`` / ``n_azimuth`` given (module docstring, *Cell size*).
+REACH_RINGS = 12
+REACH_SECTORS = 32
+#: Cells of a map without a reach.
+DEFAULT_RANGE_CELL = 500.0
+DEFAULT_SECTORS = 64
 
 Source = Literal["all", "outside-gates"]
 SOURCES: tuple[str, ...] = ("all", "outside-gates")
@@ -75,8 +90,10 @@ class ClutterMap(ClutterEstimator):
     ----------
     site : the radar's site (x, y) in the local frame (m). Default ``(0, 0)``, the
         frame's origin (a scan path with one sensor and no site).
-    range_cell : ``Δr`` (m). Default 500.
-    n_azimuth : ``n_θ``, sectors of bearing. Default 64 (5.6°).
+    range_cell : ``Δr`` (m). Default ``max_range / REACH_RINGS`` with a ``max_range``,
+        else 500.
+    n_azimuth : ``n_θ``, sectors of bearing. Default :data:`REACH_SECTORS` (11.25°) with
+        a ``max_range``, else 64 (5.6°).
     forgetting : ``γ`` in (0, 1]; the memory is ``1/(1 − γ)`` rotations. Default 0.9.
     prior_weight : ``b₀`` (rotations) of the shrinkage toward the map's mean. Default 1.
     max_range : rings made at once to reach this range (m); ``None``: as plots arrive.
@@ -85,17 +102,30 @@ class ClutterMap(ClutterEstimator):
         gates). Default ``"all"``.
     birth_scaling : ``β`` of the birth density this map drives
         (:func:`birth_scale`; 0: none). Default 0.
+    forget_used : take the plots confirmed tracks used out of their cells (:meth:`forget`;
+        on rotating radars :class:`~mhtrack.clutter.per_sensor.PerSensorClutter` takes them
+        out of the rotation it gathers, unless this is ``False``; ``False``: keep them,
+        the ablation of ``reproduce clutter-scenes``). Default True.
     """
 
     name = "map"
 
-    def __init__(self, *, site: tuple[float, float] = (0.0, 0.0), range_cell: float = 500.0,
-                 n_azimuth: int = 64, forgetting: float = 0.9, prior_weight: float = 1.0,
+    def __init__(self, *, site: tuple[float, float] = (0.0, 0.0),
+                 range_cell: float | None = None, n_azimuth: int | None = None,
+                 forgetting: float = 0.9, prior_weight: float = 1.0,
                  max_range: float | None = None, max_rings: int = 4096,
-                 source: Source = "all", birth_scaling: float = 0.0) -> None:
+                 source: Source = "all", birth_scaling: float = 0.0,
+                 forget_used: bool = True) -> None:
         site_t = tuple(float(v) for v in site)
         if len(site_t) != 2 or not all(np.isfinite(site_t)):
             raise ValueError(f"site must be two finite coordinates, got {site!r}")
+        if max_range is not None and not (np.isfinite(max_range) and max_range > 0):
+            raise ValueError(f"max_range must be finite and > 0 m, got {max_range!r}")
+        self.cell_args = (range_cell, n_azimuth)  # as given: placed() re-derives the rest
+        if range_cell is None:
+            range_cell = DEFAULT_RANGE_CELL if max_range is None else max_range / REACH_RINGS
+        if n_azimuth is None:
+            n_azimuth = DEFAULT_SECTORS if max_range is None else REACH_SECTORS
         if not (np.isfinite(range_cell) and range_cell > 0):
             raise ValueError(f"range_cell must be finite and > 0 m, got {range_cell!r}")
         if not (isinstance(n_azimuth, int | np.integer) and 1 <= n_azimuth <= 65536):
@@ -106,8 +136,6 @@ class ClutterMap(ClutterEstimator):
             raise ValueError(f"prior_weight must be finite and >= 0, got {prior_weight!r}")
         if not (isinstance(max_rings, int | np.integer) and 1 <= max_rings <= 1_000_000):
             raise ValueError(f"max_rings must be an integer in [1, 1e6], got {max_rings!r}")
-        if max_range is not None and not (np.isfinite(max_range) and max_range > 0):
-            raise ValueError(f"max_range must be finite and > 0 m, got {max_range!r}")
         if source not in SOURCES:
             raise ValueError(f"source must be one of {SOURCES}, got {source!r}")
         if not (np.isfinite(birth_scaling) and 0.0 <= birth_scaling <= 10.0):
@@ -121,7 +149,8 @@ class ClutterMap(ClutterEstimator):
         self.max_rings = int(max_rings)
         self.source = source
         self.birth_scaling = float(birth_scaling)
-        n0 = 0 if max_range is None else min(int(np.ceil(max_range / range_cell)), max_rings)
+        self.forget_used = bool(forget_used)
+        n0 = 0 if max_range is None else min(int(np.ceil(max_range / range_cell - 1e-9)), max_rings)
         self.sums_ = np.zeros((n0, self.n_azimuth))
         self.looks_ = 0.0
         self.n_updates_ = 0
@@ -132,11 +161,11 @@ class ClutterMap(ClutterEstimator):
                ) -> ClutterMap:
         """A fresh map with this one's parameters about ``site`` (rings made out to
         ``max_range`` when given, else this map's)."""
-        return ClutterMap(site=site, range_cell=self.range_cell, n_azimuth=self.n_azimuth,
+        return ClutterMap(site=site, range_cell=self.cell_args[0], n_azimuth=self.cell_args[1],
                           forgetting=self.forgetting, prior_weight=self.prior_weight,
                           max_range=self.max_range if max_range is None else max_range,
                           max_rings=self.max_rings, source=self.source,
-                          birth_scaling=self.birth_scaling)
+                          birth_scaling=self.birth_scaling, forget_used=self.forget_used)
 
     # ------------------------------------------------------------------ geometry
     @property
@@ -191,7 +220,7 @@ class ClutterMap(ClutterEstimator):
     def forget(self, used: np.ndarray) -> None:
         """Take the last rotation's plots that confirmed tracks used out of their cells."""
         used = np.asarray(used, bool).reshape(-1)
-        if used.shape != self._last.shape or not used.any():
+        if not self.forget_used or used.shape != self._last.shape or not used.any():
             return
         cells = self._last[used & (self._last >= 0)]
         if cells.size:

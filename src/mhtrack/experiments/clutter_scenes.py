@@ -6,8 +6,12 @@ clutter, a sea band whose sea state rises, a burst), over paired runs.
 Run ``i`` of a scene simulates with ``run_seed(seed, i, "spawn")``, the same plots for
 every method, so the methods pair run by run. Each job (one scene, one method, one run)
 builds the tracker ``mhtrack run`` would build for the scene (:class:`~mhtrack.pipeline.
-Pipeline`, tracker :data:`TRACKER`, every default chosen by the pipeline), gives it the
-method's per-radar clutter estimator, tracks frame by frame and scores:
+Pipeline`, every default chosen by the pipeline): for a registered estimator or variant the
+tracker ``mht-<estimator>`` with its ``clutter_params``
+(:func:`~mhtrack.experiments.scene_methods.method_tracker`), for ``known``, ``uniform`` (and
+an estimator no tracker name uses) tracker :data:`TRACKER` given the method's per-radar
+estimator; it tracks frame by frame
+and scores:
 
 * the **clutter error** after every frame, of the frame's radar ``s``:
   ``IAE = ∫_{C_s} |κ̂_s(x) − κ_s(x, t)| dx`` over the radar's coverage ``C_s`` (geodesic
@@ -41,13 +45,21 @@ import numpy as np
 
 from mhtrack.clutter.base import ClutterEstimator
 from mhtrack.experiments.jobs import SPACED, Job, JobStore, JsonRecords, run_jobs, run_seed
-from mhtrack.experiments.scene_methods import ORACLE, UNIFORM, all_methods, describe
+from mhtrack.experiments.scene_methods import (
+    ORACLE,
+    UNIFORM,
+    VARIANTS,
+    all_methods,
+    describe,
+    known_methods,
+)
 from mhtrack.metrics.paired import PairedComparison, compare_paired, paired_by_run
 from mhtrack.records import Scan
 
 PRESET = "radars-clutter"
 DEFAULT_RUNS = 50
-#: The tracker whose defaults every method shares (its estimator is replaced).
+#: The tracker of ``known`` and ``uniform`` (its estimator is replaced); every other
+#: method's tracker is built with its own estimator (module docstring).
 TRACKER = "mht-gmm"
 #: IAE grid: 100² cells (1.35 × 1.08 km on ``radars-clutter``; its narrowest clutter, the
 #: ground clutter, has L = 4 km).
@@ -130,7 +142,7 @@ def _view(tracks: Any, sim: Any, cutoff: float, order: float) -> dict[str, float
 def run_job(job: Mapping[str, Any]) -> dict[str, Any]:
     """One method on one run of one scene (module docstring)."""
     from mhtrack.experiments.pipeline import scenario_source
-    from mhtrack.experiments.scene_methods import make_method
+    from mhtrack.experiments.scene_methods import has_tracker, make_method, method_tracker
     from mhtrack.pipeline import Pipeline, TrackOptions, feed, step_frames
     from mhtrack.scenario import Scenario, simulate
     from mhtrack.scenario.scene_truth import RadarTruth
@@ -139,8 +151,15 @@ def run_job(job: Mapping[str, Any]) -> dict[str, Any]:
     t_start = time.perf_counter()
     scenario = Scenario.from_dict(job["scenario"])
     sim = simulate(scenario, seed=job["seed"])
-    pipe = Pipeline(scenario_source(scenario, sim.plots), TrackOptions(tracker=TRACKER))
-    est = make_method(job["method"], scenario, job.get("params"))
+    method = job["method"]
+    if not has_tracker(method):  # known, uniform, an estimator without a tracker name
+        pipe = Pipeline(scenario_source(scenario, sim.plots), TrackOptions(tracker=TRACKER))
+        est = make_method(method, scenario, job.get("params"))
+    else:
+        name, kw = method_tracker(method, job.get("params"))
+        pipe = Pipeline(scenario_source(scenario, sim.plots),
+                        TrackOptions(tracker=name, clutter_params=kw or None))
+        est = pipe.tracker.clutter
     timed = TimedClutter(est)
     pipe.tracker.clutter = timed
     grid, cell = scenario.region.grid(int(job["resolution"]))
@@ -186,11 +205,12 @@ class ClutterScenesStudy:
 
 def study_pairs(methods: Sequence[str]) -> list[tuple[str, str]]:
     """The comparisons ``(A, B)``: every estimator against ``gmm`` (P1's) and against
-    ``uniform``, ``gmm`` against ``uniform``, and the oracle's headroom over ``gmm``
-    (only pairs whose two methods are run)."""
+    ``uniform``, ``gmm`` against ``uniform``, the oracle's headroom over ``gmm`` and each
+    variant against its estimator (only pairs whose two methods are run)."""
     est = [m for m in methods if m not in (ORACLE, UNIFORM, "gmm")]
     pairs = [(m, "gmm") for m in est] + [(m, UNIFORM) for m in est]
     pairs += [("gmm", UNIFORM), (UNIFORM, "gmm"), (ORACLE, "gmm")]
+    pairs += [(v, VARIANTS[v][0]) for v in methods if v in VARIANTS]  # each ablation
     seen, out = set(), []
     for a, b in pairs:
         if a in methods and b in methods and (b, a) not in seen and (a, b) not in seen:
@@ -247,10 +267,10 @@ def clutter_scenes(out_dir: str | os.PathLike[str], runs: int = DEFAULT_RUNS, se
 
     methods = tuple(all_methods() if methods is None else methods)
     scenes = tuple(SCENES if scenes is None else scenes)
-    bad = [m for m in methods if m not in all_methods()]
+    bad = [m for m in methods if m not in known_methods()]
     if bad:
         raise ValueError(f"unknown method(s) {', '.join(bad)} "
-                         f"(expected {', '.join(all_methods())})")
+                         f"(expected {', '.join(known_methods())})")
     bad = [s for s in scenes if s not in SCENES]
     if bad:
         raise ValueError(f"unknown scene(s) {', '.join(bad)} (expected {', '.join(SCENES)})")

@@ -8,7 +8,11 @@ of knowing the clutter intensity, over paired runs:
   evenly over the region (:class:`UniformCountClutter`);
 * ``gmm`` — P1's MHT-GMM estimator (fixed deletion threshold; :mod:`mhtrack.clutter.gmm`);
 * ``agmm`` — P1's MHT-AGMM estimator (adaptive number of components, eq. 12;
-  :mod:`mhtrack.clutter.agmm`).
+  :mod:`mhtrack.clutter.agmm`);
+* any other name of :data:`mhtrack.build.CLUTTER_ESTIMATOR_CLASSES` on request (``fgmm``,
+  ``map``, ...; :func:`study_methods`), built by
+  :func:`~mhtrack.build.make_clutter_estimator` with its defaults and compared with ``gmm``
+  and ``uniform``.
 
 Run ``i`` simulates with ``run_seed(seed, i, "spawn")``, the same plots for every method,
 so the methods pair run by run. Each job (one method, one run) tracks with the tracker's
@@ -116,18 +120,42 @@ class UniformCountClutter(ClutterEstimator):
         self.counts = [int(c) for c in state["counts"]]
 
 
+def study_methods() -> tuple[str, ...]:
+    """Every method the study can run: :data:`METHODS` (its default set) and every other
+    registered estimator but the constant ``known`` (here ``known`` is the oracle)."""
+    from mhtrack.build import CLUTTER_ESTIMATOR_CLASSES
+
+    return (*METHODS, *(n for n in CLUTTER_ESTIMATOR_CLASSES if n not in METHODS))
+
+
+def describe(method: str) -> str:
+    """One line on ``method`` (:data:`METHODS`, else the estimator class's docstring)."""
+    if method in METHODS:
+        return METHODS[method]
+    from mhtrack.build import CLUTTER_ESTIMATOR_CLASSES
+
+    doc = (CLUTTER_ESTIMATOR_CLASSES[method].__doc__ or method).strip().split("\n\n")[0]
+    return " ".join(doc.split())
+
+
+def study_pairs(methods: Sequence[str]) -> tuple[tuple[str, str], ...]:
+    """:data:`PAIRS`, then every further estimator against ``gmm`` and ``uniform``."""
+    extra = [m for m in methods if m not in METHODS]
+    return (*PAIRS, *((m, b) for m in extra for b in ("gmm", "uniform")))
+
+
 def make_estimator(method: str, scenario: Any,
                    clutter_params: Mapping[str, Any] | None = None) -> ClutterEstimator:
-    """A fresh estimator of ``method`` (:data:`METHODS`) for ``scenario``."""
+    """A fresh estimator of ``method`` (:func:`study_methods`) for ``scenario``."""
     from mhtrack.build import make_clutter_estimator
 
     if method == "known":
         return TrueClutter(scenario.clutter, len(scenario.sensors))
     if method == "uniform":
         return UniformCountClutter(scenario.region.area)
-    if method in ("gmm", "agmm"):
+    if method in study_methods():
         return make_clutter_estimator(method, **dict(clutter_params or {}))
-    raise ValueError(f"unknown method {method!r} (expected {', '.join(METHODS)})")
+    raise ValueError(f"unknown method {method!r} (expected {', '.join(study_methods())})")
 
 
 def _probe(scans: Iterable[Scan], tracker: Any, sim: Any, grid: np.ndarray, cell: float,
@@ -238,9 +266,10 @@ def clutter_shift(out_dir: str | os.PathLike[str], runs: int = DEFAULT_RUNS, see
                   progress: bool = False) -> ClutterShiftStudy:
     """Run (or resume) the study into ``out_dir/jobs/`` (module docstring). ``scenario``
     replaces the ``crossing-changing`` preset (tests use a shortened one)."""
-    bad = [m for m in methods if m not in METHODS]
+    bad = [m for m in methods if m not in study_methods()]
     if bad:
-        raise ValueError(f"unknown method(s) {', '.join(bad)} (expected {', '.join(METHODS)})")
+        raise ValueError(f"unknown method(s) {', '.join(bad)} "
+                         f"(expected {', '.join(study_methods())})")
     sc = default_scenario() if scenario is None else scenario
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
@@ -260,8 +289,9 @@ def clutter_shift(out_dir: str | os.PathLike[str], runs: int = DEFAULT_RUNS, see
     for recs in records.values():
         recs.sort(key=lambda r: r["run"])
     params = {"scenario": sc.name, "runs": runs, "seed": seed, "methods": list(methods),
-              **base, "method_descriptions": {m: METHODS[m] for m in methods}}
-    return ClutterShiftStudy(out_dir, params, records, errors, paired_comparisons(records),
+              **base, "method_descriptions": {m: describe(m) for m in methods}}
+    return ClutterShiftStudy(out_dir, params, records, errors,
+                             paired_comparisons(records, study_pairs(methods)),
                              done.computed, done.skipped)
 
 

@@ -10,7 +10,16 @@ holds it: one estimate per radar, ``κ̂_s(x)`` per m² per rotation.
 * every other name of :data:`mhtrack.build.CLUTTER_ESTIMATOR_CLASSES` (today ``gmm``,
   ``agmm``; an estimator registered there joins the study by its name) — the tracker's own
   per-radar assembly (:func:`mhtrack.build.radar_clutter`: one estimator per radar, fed a
-  rotation at a time, in the radar's range and bearing).
+  rotation at a time, in the radar's range and bearing);
+* the variants of :data:`VARIANTS` — a registered estimator with keywords: the clutter map
+  driving the birth density (``map-birth``, β = 1) and the ablations of the new estimators'
+  components (no shrinkage, no forgetting of tracks' plots; no forgetting, no split/merge).
+
+Every registered estimator and variant is run by the tracker built the normal way
+(:func:`method_tracker`: ``mht-<estimator>`` with the variant's ``clutter_params``, through
+:func:`mhtrack.build.make_tracker`), so what only the build does (``birth_scaling``'s birth
+wrapper) acts as it does in ``mhtrack run``; an estimator registered without a tracker name
+is given to ``mht-gmm``'s tracker in place of its own (:func:`make_method`).
 """
 
 from __future__ import annotations
@@ -25,10 +34,26 @@ from mhtrack.records import Scan
 
 ORACLE, UNIFORM = "known", "uniform"
 UNIFORM_WINDOW = 5
+#: Variant name → (registered estimator, its keywords): ``map-birth`` the clutter map
+#: driving the birth density; the others switch one component off (the ablation).
+VARIANTS: dict[str, tuple[str, dict[str, Any]]] = {
+    "map-birth": ("map", {"birth_scaling": 1.0}),
+    "map-no-shrinkage": ("map", {"prior_weight": 0.0}),
+    "map-keeps-track-plots": ("map", {"forget_used": False}),
+    "fgmm-no-forgetting": ("fgmm", {"forgetting": 1.0}),
+    "fgmm-no-split-merge": ("fgmm", {"merge_distance": 0.0, "split_kurtosis": 0.0}),
+}
+#: The variants run by default (the ablations only when asked for by name).
+DEFAULT_VARIANTS = ("map-birth",)
 #: What each fixed method is; the registered estimators are described by their class.
 DESCRIPTIONS = {
     ORACLE: "true κ_s(x, t) of the scene at every frame (oracle)",
     UNIFORM: "κ̂ = mean plot count of the radar's last 5 rotations / (π R²), inside its reach",
+    "map-birth": "clutter map driving the birth density, s(z) = min(1, ρ̄/κ̂(z))^β, β = 1",
+    "map-no-shrinkage": "clutter map without the shrinkage toward its mean (b₀ = 0)",
+    "map-keeps-track-plots": "clutter map that keeps the plots confirmed tracks used",
+    "fgmm-no-forgetting": "forgetting mixture with γ = 1 (no forgetting)",
+    "fgmm-no-split-merge": "forgetting mixture without split and merge",
 }
 
 
@@ -40,8 +65,39 @@ def estimator_methods() -> tuple[str, ...]:
 
 
 def all_methods() -> tuple[str, ...]:
-    """``known``, ``uniform`` and :func:`estimator_methods`, in report order."""
-    return (ORACLE, UNIFORM, *estimator_methods())
+    """The default methods: ``known``, ``uniform``, :func:`estimator_methods` and
+    :data:`DEFAULT_VARIANTS`, in report order."""
+    return (ORACLE, UNIFORM, *estimator_methods(), *DEFAULT_VARIANTS)
+
+
+def known_methods() -> tuple[str, ...]:
+    """Every method the study can run: :func:`all_methods` and every variant."""
+    return (*all_methods(), *(v for v in VARIANTS if v not in DEFAULT_VARIANTS))
+
+
+def method_tracker(method: str, params: Mapping[str, Any] | None = None
+                   ) -> tuple[str, dict[str, Any]]:
+    """The tracker name (``mht-<estimator>``, :data:`mhtrack.build.TRACKER_ESTIMATORS`) and
+    clutter keywords (the variant's, then ``params``) of a registered estimator or variant."""
+    from mhtrack.build import TRACKER_ESTIMATORS
+
+    est, kw = VARIANTS.get(method, (method, {}))
+    if est not in estimator_methods():
+        raise ValueError(f"{method!r} is not a registered clutter estimator or variant")
+    by_estimator = {e: t for t, e in TRACKER_ESTIMATORS.items()}
+    if est not in by_estimator:
+        raise ValueError(f"{method!r}: no tracker uses estimator {est!r}")
+    return by_estimator[est], {**kw, **dict(params or {})}
+
+
+def has_tracker(method: str) -> bool:
+    """Whether a tracker of :data:`mhtrack.build.TRACKER_ESTIMATORS` uses ``method``'s
+    estimator (an estimator registered without one is given to ``mht-gmm``'s tracker)."""
+    from mhtrack.build import TRACKER_ESTIMATORS
+
+    if method in (ORACLE, UNIFORM):
+        return False
+    return VARIANTS.get(method, (method, {}))[0] in TRACKER_ESTIMATORS.values()
 
 
 def describe(method: str) -> str:

@@ -56,3 +56,30 @@ def test_pcapng_resolutions_and_offset() -> None:
     assert _times(_pcapng(binary, [_epb(1024 * 5)]), "pcapng") == [3605.0]
     spb = _block(3, struct.pack("<I", len(FRAME)) + FRAME + bytes(-len(FRAME) % 4))
     assert _times(_pcapng(b"", [spb]), "pcapng") == [None]
+
+
+def test_pcapng_time_a_day_off_its_neighbours_is_not_used() -> None:
+    """A timestamp with its bit 62 flipped (4.6e12 s in µs units) among packets a second
+    apart: that packet's capture time is dropped and counted (``bad_time``, at its block's
+    byte), the others are kept. Two packets in a row agreeing with each other but not
+    with the last time taken (the clock set) are taken from the second on."""
+    t0 = 1_700_000_000_000_000
+    stamps = [t0, t0 + 1_000_000, (t0 + 2_000_000) | (1 << 62), t0 + 3_000_000]
+    data = _pcapng(b"", [_epb(ts) for ts in stamps])
+    problems = Problems()
+    got = [when for _, when, _ in units(data, "pcapng", "x", {48}, problems)]
+    assert got == [pytest.approx(1_700_000_000.0), pytest.approx(1_700_000_001.0), None,
+                   pytest.approx(1_700_000_003.0)]
+    assert problems.counts == {"bad_time": 1}
+    head = len(_pcapng(b"", []))
+    assert problems.first["bad_time"] == head + 2 * len(_epb(t0))
+    # the clock set forward by two days: the first packet after the jump is refused,
+    # the next one, agreeing with it, is taken and the check goes on from it
+    jump = 2 * 86_400_000_000
+    stamps = [t0, t0 + 1_000_000 + jump, t0 + 2_000_000 + jump, t0 + 3_000_000 + jump]
+    problems = Problems()
+    got = [when for _, when, _ in units(_pcapng(b"", [_epb(ts) for ts in stamps]),
+                                        "pcapng", "x", {48}, problems)]
+    assert got[1] is None
+    assert got[2:] == [pytest.approx(1_700_172_802.0), pytest.approx(1_700_172_803.0)]
+    assert problems.counts == {"bad_time": 1}

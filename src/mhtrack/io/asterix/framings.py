@@ -303,8 +303,36 @@ def _clock(data: bytes, e: str, start: int, end: int) -> tuple[float, float]:
     return unit, offset
 
 
+class _Clock:
+    """Capture times checked against the packets around them: a time more than a day
+    from the last one taken is damage (a flipped high bit of a 64-bit timestamp), counted
+    as ``bad_time`` and not used (``None``: the time axis then goes by the times of day
+    alone); the next packet that agrees with the refused time rather than the last one
+    taken is taken, and the check goes on from it (the clock was set). A damaged FIRST
+    time is not caught (pcap's reader starts from the median of its first packets;
+    this one from the first)."""
+
+    def __init__(self, problems: Problems) -> None:
+        self.problems = problems
+        self.last: float | None = None  # the last time taken
+        self.odd: float | None = None  # the last time refused
+
+    def take(self, t: float | None, offset: int) -> float | None:
+        """``t`` if it is plausible, else ``None`` (counted at byte ``offset``)."""
+        if t is None:
+            return None
+        if self.last is None or abs(t - self.last) <= DAY_S \
+                or (self.odd is not None and abs(t - self.odd) <= DAY_S):
+            self.last, self.odd = t, None
+            return t
+        self.odd = t
+        self.problems.add("bad_time", offset)
+        return None
+
+
 def _pcapng(data: bytes, name: str, problems: Problems) -> Iterator[Unit]:
     state = {"e": "<"}
+    clock = _Clock(problems)
     links: list[tuple[int, tuple[float, float]]] = []
 
     def at(p: int) -> int:
@@ -350,4 +378,5 @@ def _pcapng(data: bytes, name: str, problems: Problems) -> Iterator[Unit]:
             if found is None:
                 problems.add("non_udp", p)
             else:
-                yield found[0], None if ts is None else ts * unit + offset, found[1]
+                yield found[0], clock.take(None if ts is None else ts * unit + offset, p), \
+                    found[1]

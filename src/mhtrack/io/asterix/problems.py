@@ -22,6 +22,8 @@ KINDS = {
     "resync": "{n} damaged framing record(s) or packet(s): reading went on at the next "
               "valid one",
     "skipped_octets": "{n} octet(s) of damaged framing skipped",
+    "bad_time": "{n} packet(s) whose capture time is more than a day from the packets "
+                "around it: their capture time not used",
     "duplicate": "{n} data block(s) received twice within the duplicate window (redundant "
                  "LANs, re-sent packets) dropped",
     "impossible": "{n} report(s) with a physically impossible value (latitude beyond "

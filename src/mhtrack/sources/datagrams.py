@@ -39,9 +39,7 @@ from typing import Any
 
 import numpy as np
 
-from mhtrack.errors import InputError
 from mhtrack.frames import frame_lengths
-from mhtrack.io.asterix.api import ground_ranges
 from mhtrack.io.asterix.decode import MARKS, Decoder, plot_columns, sweep_periods
 from mhtrack.io.asterix.duplicates import stream_filter
 from mhtrack.io.asterix.problems import Problems
@@ -50,10 +48,10 @@ from mhtrack.io.asterix.timeaxis import TimeAxis
 from mhtrack.io.plot_attributes import decoded_attributes
 from mhtrack.io.reorder import DEFAULT_REORDER_WINDOW_S
 from mhtrack.io.reorder import kept as kept_by_buffer
-from mhtrack.io.timed_plots import polar_plots
 from mhtrack.models.radars import SensorSet
 from mhtrack.records import Scan
 from mhtrack.sources.base import IDLE, Source, SourceStats, Survey
+from mhtrack.sources.positions import local_positions
 from mhtrack.sources.timed import TimedStream
 
 #: Plots decoded before they are converted and pushed on (memory: a few hundred kB).
@@ -234,21 +232,7 @@ class DatagramSource(Source):
         if not sensor.size:
             return {**out, "x": np.zeros(0), "y": np.zeros(0), "R": np.zeros((0, 2, 2))}
         assert self.sensors is not None
-        self._check_radars(sensor, p["offset"], adsb)
-        x, y, R = np.empty(sensor.size), np.empty(sensor.size), np.zeros((sensor.size, 2, 2))
-        if adsb.any():  # WGS-84 positions, σ per axis from NACp/NUCp
-            x[adsb], y[adsb] = self.sensors.frame().to_local(p["lat"][adsb], p["lon"][adsb])
-            R[adsb, 0, 0] = R[adsb, 1, 1] = p["sigma"][adsb] ** 2
-        polar = ~adsb
-        types = p.get("plot_type")
-        rng = ground_ranges(self.sensors, sensor[polar], p["slant_range"][polar],
-                            p["bearing"][polar], p["flight_level"][polar])
-        for sid in np.unique(sensor[polar]).tolist():
-            mine = sensor == sid
-            x[mine], y[mine], R[mine] = polar_plots(self.sensors, sid,
-                                                    rng[sensor[polar] == sid],
-                                                    p["bearing"][mine],
-                                                    types[mine] if types is not None else None)
+        x, y, R = local_positions(self.sensors, p, adsb, self.name)
         return {**out, "x": x, "y": y, "R": R}
 
     def _adopt(self, radars: Sequence[int], adsb: Sequence[int] = (),
@@ -264,24 +248,6 @@ class DatagramSource(Source):
         self.sensors, skipped = sensors_with_sites(self.sensors, sites, new, self.name,
                                                    adsb=new_adsb, first_position=first)
         self._seen.update(r for r in (*new, *new_adsb) if r not in skipped)
-
-    def _check_radars(self, sensor: np.ndarray, offset: np.ndarray, adsb: np.ndarray
-                      ) -> None:
-        """Every radar kept is a polar sensor with a lat/lon site, every ADS-B station a
-        sensor of kind ``adsb``."""
-        assert self.sensors is not None
-        for sid in np.unique(sensor).tolist():
-            s = self.sensors.sensor(sid)
-            mine = sensor == sid
-            at = int(offset[mine][0])
-            if adsb[mine].any() and s.kind != "adsb":
-                raise InputError(f"{self.name}, byte {at}: sensor {sid} sends ADS-B "
-                                 f"reports (CAT021) but the sensors file makes it "
-                                 f"{s.kind!r}: give it kind = \"adsb\"", file=self.name)
-            if not adsb[mine].all() and (s.kind != "polar" or s.lat is None):
-                raise InputError(f"{self.name}, byte {at}: sensor {sid} of the sensors file "
-                                 "is not a polar radar with a lat/lon site (its ASTERIX "
-                                 "plots are range and bearing)", file=self.name)
 
     def _frame_lengths(self) -> dict[int, float]:
         sensors = self.sensors.sensors if self.sensors is not None else ()

@@ -83,3 +83,16 @@ def test_pcapng_time_a_day_off_its_neighbours_is_not_used() -> None:
     assert got[1] is None
     assert got[2:] == [pytest.approx(1_700_172_802.0), pytest.approx(1_700_172_803.0)]
     assert problems.counts == {"bad_time": 1}
+
+
+def test_pcapng_first_time_beyond_any_clock_is_not_used() -> None:
+    """A damaged FIRST timestamp (bit 62: 4.6e12 s, after the year 2106) is not used and
+    the packets after it keep theirs; before, it set the day of the whole axis and every
+    later plot fell 4.6e12 s back."""
+    t0 = 1_700_000_000_000_000
+    stamps = [t0 | (1 << 62), t0 + 1_000_000, t0 + 2_000_000]
+    problems = Problems()
+    got = [when for _, when, _ in units(_pcapng(b"", [_epb(ts) for ts in stamps]),
+                                        "pcapng", "x", {48}, problems)]
+    assert got == [None, pytest.approx(1_700_000_001.0), pytest.approx(1_700_000_002.0)]
+    assert problems.counts == {"bad_time": 1}

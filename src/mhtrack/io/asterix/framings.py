@@ -65,6 +65,8 @@ STREAMS = ("final", "oradis", "gps", "raw")
 PROBE = 16
 #: Octets searched for the first valid record of a file whose first records are damaged.
 SEARCH = 4096
+#: Capture times at or beyond this (s, 2³²: pcap's 32-bit seconds, the year 2106) are damage.
+MAX_CAPTURE_S = 2.0 ** 32
 #: pcap packets longer than this are damage (the largest snap length tcpdump uses).
 MAX_PACKET = 262144
 
@@ -308,9 +310,11 @@ class _Clock:
     from the last one taken is damage (a flipped high bit of a 64-bit timestamp), counted
     as ``bad_time`` and not used (``None``: the time axis then goes by the times of day
     alone); the next packet that agrees with the refused time rather than the last one
-    taken is taken, and the check goes on from it (the clock was set). A damaged FIRST
-    time is not caught (pcap's reader starts from the median of its first packets;
-    this one from the first)."""
+    taken is taken, and the check goes on from it (the clock was set). A time outside
+    ``[0, 2³²)`` s (before 1970 or after 2106, pcap's own range) is damage wherever it
+    comes, the first packet included; a first time damaged within that range is not
+    caught (pcap's reader starts from the median of its first packets; this one from the
+    first)."""
 
     def __init__(self, problems: Problems) -> None:
         self.problems = problems
@@ -320,6 +324,9 @@ class _Clock:
     def take(self, t: float | None, offset: int) -> float | None:
         """``t`` if it is plausible, else ``None`` (counted at byte ``offset``)."""
         if t is None:
+            return None
+        if not 0.0 <= t < MAX_CAPTURE_S:  # before 1970 or after 2106: no clock's time
+            self.problems.add("bad_time", offset)
             return None
         if self.last is None or abs(t - self.last) <= DAY_S \
                 or (self.odd is not None and abs(t - self.odd) <= DAY_S):

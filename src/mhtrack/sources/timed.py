@@ -63,13 +63,17 @@ class TimedStream:
         if released and len(released["time"]):
             yield from map(self._scan, self.framer.push(released))
 
-    def finish(self) -> Iterator[Scan]:
-        """The remaining frames (end of input); warns about dropped plots."""
+    def _release_all(self) -> Iterator[Scan]:
+        """Every plot held: the re-order window released, every open frame closed."""
         released = self.buffer.flush()
         if released and len(released["time"]):
             yield from map(self._scan, self.framer.push(released))
         yield from map(self._scan, self.framer.flush())
         self._count()
+
+    def finish(self) -> Iterator[Scan]:
+        """The remaining frames (end of input); warns about dropped plots."""
+        yield from self._release_all()
         late = self.buffer.late
         if late.n:
             logging.getLogger("mhtrack").warning("%s", late.line(self.name,
@@ -81,11 +85,7 @@ class TimedStream:
         input, but the stream goes on — a later plot older than the plots released is a
         late drop, a later plot of a radar starts its next frame."""
         self.idles += 1
-        released = self.buffer.flush()
-        if released and len(released["time"]):
-            yield from map(self._scan, self.framer.push(released))
-        yield from map(self._scan, self.framer.flush())
-        self._count()
+        yield from self._release_all()
 
     def pending(self) -> dict[str, object]:
         """The plots held — in the framer (``framed``) and in the re-order buffer

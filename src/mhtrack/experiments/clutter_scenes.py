@@ -53,6 +53,7 @@ from mhtrack.experiments.scene_methods import (
     describe,
     known_methods,
 )
+from mhtrack.metrics.clutter import integrated_absolute_error
 from mhtrack.metrics.paired import PairedComparison, compare_paired, paired_by_run
 from mhtrack.records import Scan
 
@@ -113,20 +114,20 @@ class TimedClutter(ClutterEstimator):
 def _probe(frames: Any, est: ClutterEstimator, truth: Any, cell: float,
            iae: list[float]) -> Iterator[Scan]:
     """Yield the frames to the tracker; once it has stepped one, append the clutter error
-    of the frame's radar (module docstring). The truth is computed once per rotation."""
-    cache: dict[tuple[int, float], np.ndarray] = {}
+    of the frame's radar (module docstring). The truth is computed once per rotation of
+    each radar (the radars' frames interleave)."""
+    cache: dict[int, tuple[float, np.ndarray]] = {}  # radar → (rotation, its truth)
     for f in frames:
         yield f
         if not len(f):
             continue
         sid = int(f.sensor[0])
-        key = (sid, truth.rotation_time(sid, float(f.time)))
-        if key not in cache:
-            cache.clear()  # the rotations of one radar follow each other
-            cache[key] = truth.intensity(sid, float(f.time))
+        rotation = truth.rotation_time(sid, float(f.time))
+        if sid not in cache or cache[sid][0] != rotation:
+            cache[sid] = (rotation, truth.intensity(sid, float(f.time)))
         cover = truth.coverage(sid)
         kappa_hat = np.asarray(est.intensity(truth.xy), float)
-        iae.append(float(np.abs(kappa_hat - cache[key])[cover].sum() * cell))
+        iae.append(integrated_absolute_error(kappa_hat[cover], cache[sid][1][cover], cell))
 
 
 def _view(tracks: Any, sim: Any, cutoff: float, order: float) -> dict[str, float]:

@@ -179,23 +179,19 @@ class BiasEstimator:
         k = self._slot.get(sid)
         if k is None:
             return RadarBias()
-        cov = self.P if model else self.covariance()
+        return self._bias_at(k, self.P if model else self.covariance())
+
+    def biases(self) -> dict[int, RadarBias]:
+        """Every estimated radar's :meth:`bias` (the covariance computed once)."""
+        cov = self.covariance()
+        return {sid: self._bias_at(self._slot[sid], cov) for sid in self.ids}
+
+    def _bias_at(self, k: int, cov: np.ndarray) -> RadarBias:
+        """The estimate in slots ``k … k+2`` of the state, its σ from ``cov``."""
         s = np.sqrt(np.diag(cov)[k:k + 3])
         return RadarBias(float(self.b[k]), float(1.0 + self.b[k + 1]),
                          float(np.degrees(self.b[k + 2])),
                          (float(s[0]), float(s[1]), float(np.degrees(s[2]))))
-
-    def biases(self) -> dict[int, RadarBias]:
-        """Every estimated radar's :meth:`bias`."""
-        cov = self.covariance()
-        out = {}
-        for sid in self.ids:
-            k = self._slot[sid]
-            s = np.sqrt(np.diag(cov)[k:k + 3])
-            out[sid] = RadarBias(float(self.b[k]), float(1.0 + self.b[k + 1]),
-                                 float(np.degrees(self.b[k + 2])),
-                                 (float(s[0]), float(s[1]), float(np.degrees(s[2]))))
-        return out
 
     def _advance(self, t: float) -> None:
         """Random walk of the biases up to time ``t`` (nothing with no process noise)."""

@@ -11,6 +11,8 @@ import click
 from mhtrack.cli.asterix_commands import needs_libasterix
 from mhtrack.cli.clutter_options import clutter_estimator_options, clutter_params
 from mhtrack.cli.common import (
+    attributes_arg,
+    attributes_options,
     clutter_scene_option,
     echo_json,
     load_scenario_arg,
@@ -279,6 +281,7 @@ def track(plots: Path, tracker: str, tracker_pd: float | None, meas_sigma: float
 @click.option("--bias", "biases", multiple=True, metavar="ID:range=M,gain=G,azimuth=DEG",
               help="Give rotating radar ID a registration bias (as simulate --bias).")
 @bias_options
+@attributes_options
 @clutter_estimator_options
 def run(scenario: str, seed: int, clutter: str | None, clutter_rate: float | None,
         pd: float | None, scans: int | None, tracker: str, tracker_pd: float | None,
@@ -290,6 +293,8 @@ def run(scenario: str, seed: int, clutter: str | None, clutter_rate: float | Non
         clutter_scene: str | None = None, biases: tuple[str, ...] = (),
         estimate_bias: bool = False, bias_reference: int | None = None,
         bias_init: Path | None = None, bias_out: Path | None = None,
+        attributes: bool | None = None, psr_only: float | None = None,
+        ssr_only: float | None = None, garble: float | None = None,
         **estimator_opts: Any) -> None:
     """Simulate SCENARIO, track, evaluate and plot, in one go.
 
@@ -321,7 +326,9 @@ def run(scenario: str, seed: int, clutter: str | None, clutter_rate: float | Non
                             clutter_params=clutter_params(tracker, **estimator_opts))
     warn_known_kappa(sc, options)
     result = run_scenario(sc, seed, options=options, cutoff=cutoff, order=order,
-                          progress=show_progress())
+                          progress=show_progress(),
+                          attributes=attributes_arg(sc, attributes, psr_only, ssr_only,
+                                                    garble))
     out = out if out is not None else run_dir(sc, tracker, birth, seed)
     summary = write_run(out, result, seed)
     page = None

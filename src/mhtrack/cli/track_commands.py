@@ -19,6 +19,7 @@ from mhtrack.cli.common import (
     scenario_options,
     with_scene_arg,
 )
+from mhtrack.cli.report_commands import page_options
 from mhtrack.cli.terminal import say, show_progress
 from mhtrack.names import (
     BIRTHS,
@@ -274,7 +275,9 @@ def track(plots: Path, tracker: str, tracker_pd: float | None, meas_sigma: float
 @click.option("--json", "as_json", is_flag=True, help="Print one JSON object.")
 @click.option("--report", "html_report", is_flag=True,
               help="Also write report.html: one self-contained page (scene, metrics, "
-              "parameters; needs mhtrack[report]).")
+              "parameters; needs mhtrack[report]); with the page options of `report` "
+              "(--plotlyjs, --coastlines).")
+@page_options
 @birth_options
 @output_option
 @clutter_scene_option
@@ -295,6 +298,7 @@ def run(scenario: str, seed: int, clutter: str | None, clutter_rate: float | Non
         bias_init: Path | None = None, bias_out: Path | None = None,
         attributes: bool | None = None, psr_only: float | None = None,
         ssr_only: float | None = None, garble: float | None = None,
+        plotlyjs: str | None = None, coastlines: bool = False,
         **estimator_opts: Any) -> None:
     """Simulate SCENARIO, track, evaluate and plot, in one go.
 
@@ -305,6 +309,9 @@ def run(scenario: str, seed: int, clutter: str | None, clutter_rate: float | Non
     from mhtrack.pipeline.options import warn_known_kappa
     from mhtrack.reports.run_files import run_dir, run_text, write_run
 
+    if not html_report and (plotlyjs is not None or coastlines):
+        raise click.UsageError("--plotlyjs and --coastlines are options of the page: "
+                               "they need --report")
     if out is not None:
         from mhtrack.io.paths import check_output_dir
 
@@ -335,7 +342,7 @@ def run(scenario: str, seed: int, clutter: str | None, clutter_rate: float | Non
     if html_report:
         from mhtrack.cli.report_commands import write_report_or_fail
 
-        page = write_report_or_fail(out)
+        page = write_report_or_fail(out, plotlyjs=plotlyjs, coastlines=coastlines)
     if as_json:
         echo_json(summary)
         if page is not None:

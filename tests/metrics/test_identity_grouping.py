@@ -17,6 +17,14 @@ from mhtrack.records import PlotTable, TrackTable, TruthTable
 
 
 # --- the former code path (mhtrack/metrics/identity.py before the change) --------------
+def _mode(v):
+    v = v[v >= 0]
+    if not v.size:
+        return -1
+    values, counts = np.unique(v, return_counts=True)
+    return int(values[np.argmax(counts)])
+
+
 def _former_target_identities(plots):
     a, origin = plots.attrs, plots.origin
     if a is None or origin is None:
@@ -24,8 +32,7 @@ def _former_target_identities(plots):
     out = {}
     for tid in np.unique(origin[origin >= 0]).tolist():
         mine = origin == tid
-        out[int(tid)] = (identity_module._mode(a.mode_3a[mine & (a.mode_3a_g == 0)]),
-                         identity_module._mode(a.address[mine]))
+        out[int(tid)] = (_mode(a.mode_3a[mine & (a.mode_3a_g == 0)]), _mode(a.address[mine]))
     return out
 
 
@@ -162,3 +169,22 @@ def test_grouped_figures_equal_the_former_masks(seed, monkeypatch):
     assert i.ids_per_aircraft > 1.0 and 0.0 < i.wrong_code_rate < 1.0 and i.n_code_rows > 0
     assert 0.5 < i.p_update < 1.0 and i.update_interval > 0
     assert i.false_track_rate > 0 and i.dubious_track_rate >= 0
+
+
+def test_target_identities_ties_keep_the_smaller_value():
+    """Per target the most frequent code and address, ties to the smaller, garbled codes
+    and absent values not counted (hand-worked), as the former per-target masks said."""
+    rows = [(4, 0o5, 0, 9), (4, 0o3, 0, 9), (4, 0o5, 0, 7), (4, 0o3, 0, 7), (4, 0o3, 1, -1),
+            (2, 0o7, 1, -1), (2, -1, 0, 8), (-1, 0o1, 0, 1)]
+    plots = PlotTable(
+        scan=np.zeros(8, np.int64), time=np.zeros(8), sensor=np.zeros(8, np.int64),
+        x=np.zeros(8), y=np.zeros(8), origin=np.array([r[0] for r in rows]),
+        attrs=PlotAttributes.from_columns({
+            "mode_3a": np.array([r[1] for r in rows]),
+            "mode_3a_g": np.array([r[2] for r in rows]),
+            "address": np.array([r[3] for r in rows])}))
+    # target 4: codes 5, 3, 5, 3 (the garbled 3 not counted) -> 3; addresses 9, 9, 7, 7
+    # -> 7; target 2: its only code garbled -> none, address 8
+    want = {4: (0o3, 7), 2: (-1, 8)}
+    assert identity_module.target_identities(plots) == want
+    assert _former_target_identities(plots) == want

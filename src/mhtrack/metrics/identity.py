@@ -81,12 +81,25 @@ def target_identities(plots: PlotTable) -> dict[int, tuple[int, int]]:
     a, origin = plots.attrs, plots.origin
     if a is None or origin is None:
         return {}
-    rows = np.flatnonzero(np.asarray(origin) >= 0)
-    code = np.where(a.mode_3a_g[rows] == 0, a.mode_3a[rows], -1)  # -1: not counted
-    out = {}
-    for tid, g in _groups(np.asarray(origin)[rows]):
-        out[tid] = (_mode(code[g]), _mode(a.address[rows][g]))
-    return out
+    o = np.asarray(origin)
+    rows = o >= 0
+    code = np.where(a.mode_3a_g == 0, a.mode_3a, -1)  # a garbled code is not counted
+    codes, addresses = _modes(o[rows], code[rows]), _modes(o[rows], a.address[rows])
+    return {int(t): (codes.get(int(t), -1), addresses.get(int(t), -1))
+            for t in np.unique(o[rows]).tolist()}
+
+
+def _modes(key: np.ndarray, v: np.ndarray) -> dict[int, int]:
+    """Key → the most frequent of its values ``>= 0`` (ties: the smaller value; keys
+    without one left out), for all keys at once."""
+    ok = v >= 0
+    if not ok.any():
+        return {}
+    pairs, counts = np.unique(np.column_stack((key[ok], v[ok])), axis=0,
+                              return_counts=True)
+    order = np.lexsort((pairs[:, 1], -counts, pairs[:, 0]))  # per key: most, then smallest
+    first = order[np.r_[True, np.diff(pairs[order, 0]) != 0]]
+    return dict(zip(pairs[first, 0].tolist(), pairs[first, 1].tolist(), strict=True))
 
 
 def _groups(keys: np.ndarray) -> list[tuple[int, np.ndarray]]:
@@ -97,14 +110,6 @@ def _groups(keys: np.ndarray) -> list[tuple[int, np.ndarray]]:
     order = np.argsort(keys, kind="stable")
     cuts = np.flatnonzero(np.diff(keys[order])) + 1
     return [(int(keys[g[0]]), g) for g in np.split(order, cuts)] if keys.size else []
-
-
-def _mode(v: np.ndarray) -> int:
-    v = v[v >= 0]
-    if not v.size:
-        return -1
-    values, counts = np.unique(v, return_counts=True)
-    return int(values[np.argmax(counts)])
 
 
 def identity_figures(tracks: TrackTable, truth: TruthTable, aligned: TrackTable,

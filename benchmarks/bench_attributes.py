@@ -1,9 +1,9 @@
 """Plot attributes on ``opensky-radars`` (issue 29, acceptance): the same seeds with
 secondary-radar attributes off and on, paired.
 
-Per seed ``S``: ``mhtrack simulate opensky-radars --seed S [--attributes] --out D`` (the
-attributes come from their own random streams: the plots' positions, times and origins
-are the same with and without), ``mhtrack track D/plots.csv --sensors D/sensors.toml
+Per seed ``S``: ``mhtrack simulate opensky-radars --seed S --no-attributes|--attributes
+--out D`` (the attributes come from their own random streams: the plots' positions, times
+and origins are the same with and without), ``mhtrack track D/plots.csv --sensors D/sensors.toml
 --out D/tracks-history.csv --output history`` (each confirmed track also at the scans
 before its confirmation); the ``online`` view (what a display saw, ``--output online``)
 is its rows with ``tentative`` 0 (:func:`online_rows`); and ``mhtrack evaluate
@@ -61,7 +61,7 @@ def online_rows(history: Path, out: Path) -> None:
 def run_seed(seed: int, tmp: Path) -> dict[str, dict[str, dict[str, float]]]:
     """``{attributes: {view: figures}}`` of one seed."""
     out: dict[str, dict[str, dict[str, float]]] = {}
-    for label, extra in (("off", []), ("on", ["--attributes"])):
+    for label, extra in (("off", ["--no-attributes"]), ("on", ["--attributes"])):
         d = tmp / f"{seed}-{label}"
         _cli(["simulate", "opensky-radars", "--seed", str(seed), "--out", str(d), "-q",
               *extra])

@@ -1,7 +1,7 @@
 """Time per frame of each ``--birth`` on ``opensky-radars`` (timed plots of three rotating
 radars), every birth beside ``every-plot`` measured in the same run::
 
-    mhtrack simulate opensky-radars --seed S --out D
+    mhtrack simulate opensky-radars --seed S --no-attributes --out D
     mhtrack track D/plots.csv --sensors D/sensors.toml --birth B --out D/t.csv
 
 Each track runs in a fresh subprocess (the births in turn, ``--repeat`` rounds; medians
@@ -83,7 +83,8 @@ def main(argv: list[str] | None = None) -> int:
     with tempfile.TemporaryDirectory() as tmp:
         d = Path(tmp)
         subprocess.run([sys.executable, "-c", "from mhtrack.cli.main import main; main()",
-                        "simulate", "opensky-radars", "--seed", str(a.seed), "--out", str(d)],
+                        "simulate", "opensky-radars", "--seed", str(a.seed), "--no-attributes",
+                        "--out", str(d)],
                        capture_output=True, check=True,
                        env={**os.environ, "PYTHONPATH": str(Path(a.src).resolve())})
         for _ in range(a.repeat):

@@ -2,7 +2,7 @@
 item 7): per seed and ``--birth``, coverage, track ids per aircraft, false tracks and OSPA,
 each run through the CLI::
 
-    mhtrack simulate opensky-radars --seed S --out D
+    mhtrack simulate opensky-radars --seed S --no-attributes --out D
     mhtrack track D/plots.csv --sensors D/sensors.toml --birth B --out D/tracks_B.csv
     mhtrack evaluate D/tracks_B.csv D/truth.csv --json
 
@@ -50,7 +50,8 @@ def main(seeds: list[int], births: list[str]) -> None:
     for seed in seeds:
         with tempfile.TemporaryDirectory() as tmp:
             d = Path(tmp)
-            _cli("simulate", "opensky-radars", "--seed", str(seed), "--out", str(d))
+            _cli("simulate", "opensky-radars", "--seed", str(seed), "--no-attributes",
+                 "--out", str(d))
             for birth in births:
                 out = d / f"tracks_{birth}.csv"
                 t0 = time.perf_counter()

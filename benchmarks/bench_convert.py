@@ -55,7 +55,7 @@ def main() -> int:
     with tempfile.TemporaryDirectory() as tmp:
         d = Path(tmp)
         r = CliRunner().invoke(cli, ["simulate", "opensky-radars", "--seed", str(args.seed),
-                                     "--scans", "360", "--out", str(d)])
+                                     "--scans", "360", "--no-attributes", "--out", str(d)])
         if r.exit_code != 0:
             print(r.output, file=sys.stderr)
             return 1

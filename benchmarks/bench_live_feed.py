@@ -127,7 +127,7 @@ def main() -> None:
     a = ap.parse_args()
     d = a.out or Path(tempfile.mkdtemp(prefix="bench_live_feed_"))
     d.mkdir(parents=True, exist_ok=True)
-    _run(["simulate", "opensky-radars", "--seed", "1", "--out", str(d), "-q",
+    _run(["simulate", "opensky-radars", "--seed", "1", "--no-attributes", "--out", str(d), "-q",
           *(["--scans", str(a.scans)] if a.scans else [])])
     _run(["export", str(d / "plots.csv"), "--sensors", str(d / "sensors.toml"), "--out",
           str(d / "radar.pcap"), "-q"])

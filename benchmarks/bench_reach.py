@@ -47,7 +47,8 @@ def main(seeds: list[int]) -> None:
     for seed in seeds:
         with tempfile.TemporaryDirectory() as tmp:
             d = Path(tmp)
-            cli.main(["simulate", "opensky-radars", "--seed", str(seed), "--out", str(d)],
+            cli.main(["simulate", "opensky-radars", "--seed", str(seed), "--no-attributes",
+                      "--out", str(d)],
                      standalone_mode=False)
             full = (d / "sensors.toml").read_text()
             true = [float(v) for v in re.findall(r"^max_range = (\S+)$", full, re.M)]

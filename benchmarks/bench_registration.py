@@ -105,8 +105,8 @@ def main(draws: list[int], quick: bool = False) -> None:
         with tempfile.TemporaryDirectory() as tmp:
             t = Path(tmp)
             for name, extra in (("clean", []), ("biased", flags)):
-                _cli(["simulate", "opensky-radars", "--seed", str(k), "--out",
-                      str(t / name), *extra])
+                _cli(["simulate", "opensky-radars", "--seed", str(k), "--no-attributes",
+                      "--out", str(t / name), *extra])
             rows = []
             for label, data, est in (("unbiased", "clean", False),
                                      ("unbiased, estimated", "clean", True),

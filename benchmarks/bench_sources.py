@@ -102,7 +102,8 @@ def main() -> int:
     with tempfile.TemporaryDirectory() as tmp:
         d = Path(tmp)
         r = CliRunner().invoke(cli, ["simulate", "opensky-radars", "--seed", str(args.seed),
-                                     "--scans", str(args.scans), "--out", str(d)])
+                                     "--scans", str(args.scans), "--no-attributes",
+                                     "--out", str(d)])
         if r.exit_code != 0:
             print(r.output, file=sys.stderr)
             return 1

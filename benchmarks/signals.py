@@ -95,7 +95,7 @@ def prepare(work: Path) -> dict[str, tuple[list[str], list[str]]]:
     """The inputs; per command ``(args of the new output, args of the old one)`` with
     ``{out}`` for the output folder."""
     sim = work / "sim"
-    _run(["simulate", "opensky-radars", "--seed", "1", "--out", str(sim)])
+    _run(["simulate", "opensky-radars", "--seed", "1", "--no-attributes", "--out", str(sim)])
     sensors = str(sim / "sensors.toml")
     rec = str(sim / "rec.pcap")
     _run(["export", str(sim / "plots.csv"), "--sensors", sensors, "--out", rec])

@@ -4,7 +4,7 @@ of data time (``docs/live.md``, *Soak*).
 
     python benchmarks/soak.py [--hours 6] [--out DIR] [--chunk-s 1200]
 
-Traffic: ``mhtrack simulate opensky-radars --seed 1`` (3 radars, 1 200 s, about 30
+Traffic: ``mhtrack simulate opensky-radars --seed 1 --no-attributes`` (3 radars, 1 200 s, about 30
 plots/s), its plots played again and again with the time running on — pass ``k`` is the
 same plots ``k · 1200 s`` later — from 23:30 UTC, so the data cross midnight once (the
 time of day wraps at 24:00; the tracker's axis goes on); each pass exported
@@ -59,7 +59,8 @@ def passes(d: Path, n: int, chunk_s: float) -> list[Path]:
     """``n`` pcaps: the simulated plots shifted by ``START_S + k · chunk_s``."""
     sim = d / "sim"
     if not (sim / "plots.csv").exists():
-        _run(["simulate", "opensky-radars", "--seed", "1", "--out", str(sim), "-q"])
+        _run(["simulate", "opensky-radars", "--seed", "1", "--no-attributes", "--out", str(sim),
+              "-q"])
     with (sim / "plots.csv").open() as fh:
         rows = list(csv.reader(fh))
     head, body = rows[0], rows[1:]

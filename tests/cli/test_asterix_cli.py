@@ -21,9 +21,10 @@ def _run(*args: object) -> object:
 
 @pytest.fixture(scope="module")
 def sim(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """opensky-radars plots cut to their first 2 000 rows, with sensors.toml and truth."""
+    """opensky-radars plots (positions only: ``--no-attributes``) cut to their first 2 000
+    rows, with sensors.toml and truth."""
     out = tmp_path_factory.mktemp("sim")
-    r = _run("simulate", "opensky-radars", "--seed", "1", "--out", out)
+    r = _run("simulate", "opensky-radars", "--seed", "1", "--no-attributes", "--out", out)
     assert r.exit_code == 0, r.output  # type: ignore[attr-defined]
     lines = (out / "plots.csv").read_text().splitlines()[:2001]
     (out / "plots.csv").write_text("\n".join(lines) + "\n")

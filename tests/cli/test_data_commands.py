@@ -166,7 +166,7 @@ def test_simulate_rotating_radars_writes_timed_plots_truth_and_sensors(tmp_path)
     assert code == 0, stderr
     assert "3 rotating radars over 60 s" in stdout
     plots, truth = _rows(tmp_path / "plots.csv"), _rows(tmp_path / "truth.csv")
-    assert list(plots[0]) == ["time", "sensor", "range", "bearing", "origin"]
+    assert list(plots[0])[:5] == ["time", "sensor", "range", "bearing", "origin"]
     assert {"time", "target_id", "lat", "lon", "vx", "vy", "x", "y"} <= set(truth[0])
     sim = simulate(preset("opensky-radars", scans=7), seed=1)
     assert len(plots) == len(sim.plots)
@@ -188,3 +188,43 @@ def test_simulate_rotating_radars_writes_timed_plots_truth_and_sensors(tmp_path)
     np.testing.assert_allclose(y, [float(r["y"]) for r in truth], atol=1e-3)
     speed = np.hypot([float(r["vx"]) for r in truth], [float(r["vy"]) for r in truth])
     np.testing.assert_allclose(speed, np.hypot(sim.truth.vx, sim.truth.vy), rtol=1e-3)
+
+
+def test_simulated_rotating_radars_carry_ssr_attributes_by_default(tmp_path):
+    """Rotating radars (secondary radars): the plots carry the attributes unless
+    ``--no-attributes``, and are then :func:`with_attributes` of the plain simulation
+    (positions unchanged); without rotating radars there are none unless asked, and a
+    reply probability without attributes is a usage error."""
+    from mhtrack.io import read_plots
+    from mhtrack.io.sensors import read_sensors
+    from mhtrack.scenario import preset, simulate
+    from mhtrack.scenario.identity import with_attributes
+
+    for name, flag in (("on", ()), ("off", ("--no-attributes",))):
+        code, stdout, stderr = invoke("simulate", "opensky-radars", "--seed", "3", "--scans",
+                                      "3", "--out", str(tmp_path / name), *flag)
+        assert code == 0, stderr
+        assert ("SSR attributes" in stdout) == (name == "on")
+    ss = read_sensors(tmp_path / "on" / "sensors.toml")
+    on, off = (read_plots(tmp_path / n / "plots.csv", sensors=ss) for n in ("on", "off"))
+    assert off.attrs is None and on.attrs is not None
+    np.testing.assert_array_equal(on.range, off.range)
+    np.testing.assert_array_equal(on.origin, off.origin)
+    plain = simulate(preset("opensky-radars", scans=3), seed=3)
+    want = with_attributes(plain).plots.attrs.columns()
+    p = plain.plots  # the file's rows matched to the simulation's by time, sensor, range
+    mine, theirs = (np.lexsort((t.range, t.sensor, t.time)) for t in (on, p))
+    np.testing.assert_array_equal(on.time[mine], p.time[theirs])
+    got = on.attrs.columns()
+    for k in ("plot_type", "mode_3a", "address", "flight_level"):
+        np.testing.assert_array_equal(got[k][mine], want[k][theirs], err_msg=k)
+    assert (got["address"] >= 0).sum() > 0.5 * (on.origin >= 0).sum()
+
+    code, _, stderr = invoke("simulate", "crossing", "--scans", "2", "--out",
+                             str(tmp_path / "c"))
+    assert code == 0, stderr
+    assert _rows(tmp_path / "c" / "plots.csv")[0].keys() == {
+        "scan", "time", "sensor", "x", "y", "origin"}
+    code, _, stderr = invoke("simulate", "radars-clutter", "--scans", "2", "--garble", "0.1",
+                             "--no-attributes", "--out", str(tmp_path / "r"))
+    assert code == 2 and "--garble" in stderr and "--no-attributes" in stderr

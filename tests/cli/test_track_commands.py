@@ -320,3 +320,24 @@ def test_track_area_ignores_and_reports_wild_plots(small_crossing, tmp_path, cap
                                  "--no-progress")
     assert code == 0, stderr
     assert "far outside" in caplog.text
+
+
+def test_run_on_rotating_radars_simulates_as_simulate_does(tmp_path):
+    """``run`` on a rotating-radar preset follows ``simulate``'s attributes default: its
+    plots file is ``simulate``'s, byte for byte (attributes on, or off with
+    ``--no-attributes``)."""
+    from mhtrack.io import read_plots
+    from mhtrack.io.sensors import read_sensors
+
+    for name, flag in (("on", ()), ("off", ("--no-attributes",))):
+        d = tmp_path / name
+        code, _, stderr = invoke("run", "radars-clutter", "--seed", "2", "--scans", "6",
+                                 "--out", str(d / "run"), *flag)
+        assert code == 0, stderr
+        code, _, stderr = invoke("simulate", "radars-clutter", "--seed", "2", "--scans", "6",
+                                 "--out", str(d / "sim"), *flag)
+        assert code == 0, stderr
+        assert (d / "run" / "plots.csv").read_bytes() == (d / "sim" / "plots.csv").read_bytes()
+        plots = read_plots(d / "run" / "plots.csv", sensors=read_sensors(d / "sim" /
+                                                                         "sensors.toml"))
+        assert (plots.attrs is not None) == (name == "on")

@@ -67,11 +67,12 @@ def run_dir(tmp_path_factory) -> Path:
 
 @pytest.fixture(scope="session")
 def geo_dir(tmp_path_factory) -> Path:
-    """``simulate opensky-radars`` (4 scans) and ``track``: timed plots of three radars
-    at WGS-84 sites, a sensors file, no metrics.json."""
+    """``simulate opensky-radars --no-attributes`` (4 scans) and ``track``: timed plots
+    of three radars at WGS-84 sites, a sensors file, no metrics.json. No secondary-radar
+    attributes: the hover test writes flight levels and codes of its own to check them."""
     out = tmp_path_factory.mktemp("html-geo")
     code, _, err = invoke("simulate", "opensky-radars", "--seed", "1", "--scans", "4",
-                          "--out", str(out))
+                          "--no-attributes", "--out", str(out))
     assert code == 0, err
     code, _, err = invoke("track", str(out / "plots.csv"), "--out", str(out / "tracks.csv"),
                           "--no-progress")

@@ -126,27 +126,35 @@ def test_recording_report_renders(recording_dir, open_in_browser, tmp_path, trac
         assert f"<h2>{heading}</h2>" in text
 
 
-#: Hover the middle one of the rows with a plot of the first per-track trace whose hover
-#: names a code (Plotly's own hover, as a pointer would), and return the label's text.
-HOVER_JS = """(() => {
+#: Hover, in the first per-track trace whose hover names a code (Plotly's own hover, as a
+#: pointer would), the middle one of its rows with a plot, then the middle one of its
+#: rows without (coasting; "none" if it has none); return the two labels' texts.
+HOVER_JS = """(async () => {
   const gd = document.getElementById('fig-scene');
   const i = gd.data.findIndex(t => t.legendgroup === 'tracks' && t.mode === 'lines'
                                    && (t.hovertemplate || '').includes('code'));
-  if (i < 0) return 'no track trace with a code';
-  const k = Number(gd.data[i].hovertemplate.match(/plot of sensor %{customdata.(\\d+)/)[1]);
-  const cd = gd._fullData[i].customdata;
-  const hits = Array.from({length: cd.length}, (_, p) => p).filter(p => cd[p][k] >= 0);
-  Plotly.Fx.hover(gd, [{curveNumber: i, pointNumber: hits[Math.floor(hits.length / 2)]}]);
-  return Array.from(gd.querySelectorAll('g.hoverlayer g.hovertext'))
-    .map(g => g.textContent).join(' | ');
+  if (i < 0) return ['no track trace with a code', ''];
+  const cd = gd._fullData[i].customdata, text = gd.data[i].text;
+  const rows = Array.from({length: cd.length}, (_, p) => p).filter(p => !isNaN(cd[p][0]));
+  const label = async pick => {
+    if (!pick.length) return 'none';
+    Plotly.Fx.unhover(gd);
+    await new Promise(r => setTimeout(r, 200));  // Plotly drops hovers 50 ms apart
+    Plotly.Fx.hover(gd, [{curveNumber: i, pointNumber: pick[Math.floor(pick.length / 2)]}]);
+    return Array.from(gd.querySelectorAll('g.hoverlayer g.hovertext'))
+      .map(g => g.textContent).join(' | ');
+  };
+  const hit = p => text ? text[p].includes('plot of sensor') : true;
+  return [await label(rows.filter(hit)), await label(rows.filter(p => !hit(p)))];
 })()"""
 
 
 def test_recording_hover_and_tables(recording_dir, open_in_browser, tmp_path):
     """A recording whose plots carry a flight level and a Mode 3/A code (as converted
     from ASTERIX): hovering a track's row with a plot in the browser shows its id, speed,
-    heading, flight level, score, the plot's sensor, its code and sensors (a coasting
-    row shows FL NaN and sensor -1: no plot); the radars table has a row
+    heading, flight level, score, the plot's sensor, its code and sensors; a coasting row
+    (no plot) names neither flight level nor sensor (no NaN, no -1); the radars table
+    has a row
     per radar with its plots counted, the tracks table the durations."""
     d = tmp_path / "rec-fl"
     d.mkdir()
@@ -163,11 +171,15 @@ def test_recording_hover_and_tables(recording_dir, open_in_browser, tmp_path):
     page = write_html_report(d, d / "report.html")
     check = open_in_browser(page, probe=HOVER_JS)
     _clean(check)
-    hover = check.probe
+    hover, coasting = check.probe
     assert re.search(r"^track \d+, frame \d+, t = [\d.]+ s", hover), hover
     for part in (r"speed \d+ m/s", r"heading \d+°", r"FL 3[123]0", r"score -?[\d.]+",
                  r"plot of sensor [123]", r"code 7000", r"sensors [123](, [123])*"):
         assert re.search(part, hover), (part, hover)
+    assert coasting != "none", "the fixture's tracks coast somewhere"
+    assert re.search(r"^track \d+, frame \d+, t = [\d.]+ s.*speed \d+ m/s", coasting)
+    for unknown in ("NaN", "sensor -1", "FL", "plot of sensor"):
+        assert unknown not in coasting, (unknown, coasting)
     text = page.read_text()
     radars = text[text.index("<h2>Radars</h2>"):text.index("<h2>Tracks</h2>")]
     counts = {s: sum(r["sensor"] == s for r in rows) for s in {r["sensor"] for r in rows}}

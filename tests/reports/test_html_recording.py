@@ -93,8 +93,54 @@ def test_hover_details_speed_heading_and_plot_fields(tmp_path):
     assert d["flight_level"][:2].tolist() == [350.0, 351.25] and np.isnan(d["flight_level"][2])
     assert d["mode_3a"].tolist() == ["7000", "7000", ""]
     page = report_page(tmp_path).render()
-    assert "speed %{customdata[3]:.0f} m\\u002fs" in page and "FL %{customdata[5]" in page
+    assert "speed %{customdata[3]:.0f} m\\u002fs" in page and "%{text}" in page
     assert "code 7000" in page and "sensors 7" in page
+
+
+def _hovered(trace) -> list[str]:
+    """The hover label of each drawn row of a track trace, the template filled in as
+    Plotly does for the specifiers it uses here (``%{customdata[i]:.Nf}``,
+    ``%{customdata[i]}``, ``%{text}``); the gap rows between tracks left out."""
+    out = []
+    for i, row in enumerate(trace["customdata"]):
+        if np.isnan(row[0]):
+            continue
+
+        def field(m, row=row, i=i):
+            if m[1] == "text":
+                return trace["text"][i]
+            v = row[int(m[2])]
+            return format(v, m[3][1:]) if m[3] else str(int(v))
+        label = re.sub(r"%\{(text|customdata\[(\d+)\])(:[^}]*)?\}", field,
+                       trace["hovertemplate"])
+        out.append(label.removesuffix("<extra></extra>"))
+    return out
+
+
+def test_hover_leaves_out_what_a_row_does_not_know(tmp_path):
+    """A coasting row (no plot) and a primary-only plot (no flight level): their hover
+    names no flight level and no sensor — no ``NaN``, no ``-1`` — while the rows that
+    know them show them; hand-written labels."""
+    (tmp_path / "plots.csv").write_text(
+        "scan,time,sensor,x,y,flight_level,mode_3a\n"
+        "0,0.0,7,0,0,350,7000\n1,1.0,2,0,-10,,\n")
+    (tmp_path / "tracks.csv").write_text(
+        "scan,time,track_id,x,y,vx,vy,plot,score\n"
+        "0,0.0,4,0,0,0,-10,0,1.5\n1,1.0,4,0,-10,0,-10,1,2.5\n2,2.0,4,5,-10,5,0,,3.5\n")
+    from mhtrack.io import read_plots
+
+    plots = read_plots(tmp_path / "plots.csv")
+    tracks = read_tracks(tmp_path / "tracks.csv")
+    d = track_details(tracks, tmp_path / "tracks.csv", plots, tmp_path / "plots.csv")
+    [trace, _labels] = html_scene.track_traces(tracks, 1.0, d)
+    head = "track 4, scan {}, t = {}.0 s<br>speed {} m/s, heading {}°, score {}"
+    assert _hovered(trace) == [
+        head.format(0, 0, 10, 180, 1.5) + ", FL 350, plot of sensor 7<br>code 7000, "
+        "sensors 2, 7",
+        head.format(1, 1, 10, 180, 2.5) + ", plot of sensor 2<br>code 7000, sensors 2, 7",
+        head.format(2, 2, 5, 90, 3.5) + "<br>code 7000, sensors 2, 7"]
+    page = report_page(tmp_path).render()
+    assert "NaN" not in "".join(_hovered(trace)) and "sensor -1" not in page
 
 
 def test_big_scenes_are_thinned_and_the_page_says_so(recording_dir, monkeypatch, tmp_path):

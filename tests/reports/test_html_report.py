@@ -314,3 +314,29 @@ def test_report_command_coastlines_flag(geo_dir, tmp_path, cached_coastlines):
     code, _, err = invoke("report", str(d), "--out", str(d / "n.html"), "--quiet")
     assert code == 0, err
     assert '"name":"coastlines"' not in (d / "n.html").read_text()
+
+
+def test_run_report_takes_the_report_page_options(tmp_path, cached_coastlines):
+    """``run --report --coastlines --plotlyjs file`` writes the page as ``report`` does
+    with the same options (the layers from the local cache, plotly.js beside the page);
+    without ``--report`` the page options are a usage error naming it."""
+    d = tmp_path / "r"
+    code, _, err = invoke("run", "opensky-radars", "--seed", "1", "--scans", "2", "--out",
+                          str(d), "--report", "--coastlines", "--plotlyjs", "file",
+                          "--quiet")
+    assert code == 0, err
+    page = (d / "report.html").read_text()
+    assert '"name":"coastlines"' in page and '"name":"borders"' in page
+    assert list(d.glob("plotly-*.min.js"))
+    code, _, err = invoke("report", str(d), "--coastlines", "--plotlyjs", "file", "--out",
+                          str(d / "again.html"), "--quiet")
+    assert code == 0, err
+    assert _scene(page) == _scene((d / "again.html").read_text())
+    code, _, err = invoke("run", "radars-clutter", "--scans", "3", "--out",
+                          str(tmp_path / "x"), "--coastlines")
+    assert code == 2 and "--report" in err
+
+
+def _scene(page: str) -> str:
+    """The scene figure's JSON of a page (its div and script)."""
+    return re.search(r'id="fig-scene".*?</script>', page, re.S)[0]

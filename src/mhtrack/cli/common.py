@@ -174,6 +174,52 @@ def clutter_scene_option(f: Callable[..., Any]) -> Callable[..., Any]:
              "storm; docs/clutter.md, Clutter scenes), e.g. with radars-clutter.")(f)
 
 
+def attributes_options(f: Callable[..., Any]) -> Callable[..., Any]:
+    """``--attributes/--no-attributes`` and the reply probabilities of a simulation
+    (:mod:`mhtrack.scenario.identity`), resolved by :func:`attributes_arg`."""
+    for opt in reversed([
+        click.option("--attributes/--no-attributes", "attributes", default=None,
+                     help="Give the plots secondary-radar attributes: each aircraft's "
+                     "address, Mode 3/A code and flight level (the data's own for the "
+                     "OpenSky presets), plot types, garbling [on for rotating radars, "
+                     "which are secondary radars; off otherwise]."),
+        click.option("--psr-only", type=click.FloatRange(0, 1), default=None,
+                     help="With attributes: probability of a primary-only detection "
+                     "[0.05]."),
+        click.option("--ssr-only", type=click.FloatRange(0, 1), default=None,
+                     help="With attributes: probability of a secondary-only detection "
+                     "[0.1]."),
+        click.option("--garble", type=click.FloatRange(0, 1), default=None,
+                     help="With attributes: probability of a garbled reply [0.02]."),
+    ]):
+        f = opt(f)
+    return f
+
+
+def attributes_arg(scenario: Any, attributes: bool | None, psr_only: float | None,
+                   ssr_only: float | None, garble: float | None) -> Any:
+    """The :class:`~mhtrack.scenario.identity.AttributeOptions` of a simulation of
+    ``scenario``, or ``None`` for none: ``attributes`` ``None`` follows
+    :func:`~mhtrack.scenario.identity.default_attributes`. A probability given without
+    attributes, or probabilities that do not add up, is a usage error."""
+    from mhtrack.scenario.identity import AttributeOptions, default_attributes
+
+    given = {k: v for k, v in (("psr_only", psr_only), ("ssr_only", ssr_only),
+                               ("garble", garble)) if v is not None}
+    on = default_attributes(scenario) if attributes is None else attributes
+    if not on:
+        if given:
+            why = "--no-attributes" if attributes is False else \
+                "a scenario without rotating radars (add --attributes)"
+            raise click.UsageError(f"--psr-only, --ssr-only and --garble need attributes: "
+                                   f"not with {why}")
+        return None
+    try:
+        return AttributeOptions(**given)
+    except ValueError as e:
+        raise click.UsageError(str(e)) from None
+
+
 def with_scene_arg(scenario: Any, name: str | None) -> Any:
     """``scenario`` with the clutter scene ``name`` (None: unchanged); a bad name or a
     scenario without rotating radars is a usage error naming ``--clutter-scene``."""

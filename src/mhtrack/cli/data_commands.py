@@ -9,6 +9,8 @@ import click
 
 from mhtrack.cli.common import (
     InputProblem,
+    attributes_arg,
+    attributes_options,
     clutter_scene_option,
     echo_json,
     load_scenario_arg,
@@ -29,18 +31,10 @@ from mhtrack.cli.terminal import say, show_progress
               help="Give rotating radar ID a registration bias (range offset m, range "
                    "gain, azimuth offset degrees; repeat per radar). Written to "
                    "DIR/scenario.toml, not to the sensors file.")
-@click.option("--attributes", is_flag=True, help="Give the plots secondary-radar "
-              "attributes: each aircraft's address, Mode 3/A code and flight level (the "
-              "data's own for the OpenSky presets), plot types, garbling.")
-@click.option("--psr-only", type=click.FloatRange(0, 1), default=None,
-              help="With --attributes: probability of a primary-only detection [0.05].")
-@click.option("--ssr-only", type=click.FloatRange(0, 1), default=None,
-              help="With --attributes: probability of a secondary-only detection [0.1].")
-@click.option("--garble", type=click.FloatRange(0, 1), default=None,
-              help="With --attributes: probability of a garbled reply [0.02].")
+@attributes_options
 @clutter_scene_option
 def simulate(scenario: str, seed: int, clutter: str | None, clutter_rate: float | None,
-             pd: float | None, scans: int | None, out: Path, fmt: str, attributes: bool,
+             pd: float | None, scans: int | None, out: Path, fmt: str, attributes: bool | None,
              psr_only: float | None, ssr_only: float | None, garble: float | None,
              biases: tuple[str, ...] = (), clutter_scene: str | None = None) -> None:
     """Simulate SCENARIO (a preset or a TOML file) and write DIR/plots, DIR/truth and the
@@ -64,11 +58,12 @@ def simulate(scenario: str, seed: int, clutter: str | None, clutter_rate: float 
             sc = with_biases(sc, [parse_bias(b) for b in biases])
         except ValueError as e:
             raise click.BadParameter(str(e), param_hint="--bias") from None
+    ssr = attributes_arg(sc, attributes, psr_only, ssr_only, garble)
     sim = run_simulation(sc, seed=seed)
-    if attributes:
-        sim = _with_attributes(sim, psr_only, ssr_only, garble)
-    elif (psr_only, ssr_only, garble) != (None, None, None):
-        raise click.UsageError("--psr-only, --ssr-only and --garble need --attributes")
+    if ssr is not None:
+        from mhtrack.scenario.identity import with_attributes
+
+        sim = with_attributes(sim, ssr)
     out.mkdir(parents=True, exist_ok=True)
     if sc.rotating:
         _write_rotating(sim, out, fmt)
@@ -79,34 +74,15 @@ def simulate(scenario: str, seed: int, clutter: str | None, clutter_rate: float 
     n_scans = sim.plots.n_scans
     n_clutter = int((sim.plots.origin < 0).sum()) if sim.plots.origin is not None else 0
     say(
-        f"{sc.name}: {n_scans} scans, {len(sim.plots)} plots ({n_clutter} clutter), "
+        f"{sc.name}: {n_scans} scans, {len(sim.plots)} plots ({n_clutter} clutter"
+        f"{_ssr_note(sim.plots)}), "
         f"{len(set(sim.truth.target_id.tolist()))} targets -> {out}"
     )
 
 
-def _with_attributes(sim: Any, psr_only: float | None, ssr_only: float | None,
-                     garble: float | None) -> Any:
-    """``sim`` with its plots' attributes (:mod:`mhtrack.scenario.identity`)."""
-    import dataclasses
-
-    from mhtrack.scenario.identity import (
-        AttributeOptions,
-        add_attributes,
-        drawn_identities,
-        opensky_identities,
-    )
-
-    given = {k: v for k, v in (("psr_only", psr_only), ("ssr_only", ssr_only),
-                               ("garble", garble)) if v is not None}
-    try:
-        options = AttributeOptions(**given)
-    except ValueError as e:
-        raise click.UsageError(str(e)) from None
-    ids = sorted(set(sim.truth.target_id.tolist()))
-    identities = opensky_identities() if sim.scenario.name in ("opensky", "opensky-radars") \
-        else drawn_identities(ids, sim.seed)
-    return dataclasses.replace(sim, plots=add_attributes(sim.plots, identities, options,
-                                                         sim.seed))
+def _ssr_note(plots: Any) -> str:
+    """``"; SSR attributes"`` when the plots carry them (``simulate --help``), else ``""``."""
+    return "; SSR attributes" if plots.attrs is not None else ""
 
 
 def _write_rotating(sim: Any, out: Path, fmt: str) -> None:
@@ -125,7 +101,8 @@ def _write_rotating(sim: Any, out: Path, fmt: str) -> None:
     t0, t1 = sc.first * sc.T, sc.last * sc.T
     say(
         f"{sc.name}: {len(sc.sensors)} rotating radars over {t1 - t0:g} s, {len(plots)} "
-        f"plots ({n_clutter} clutter), {len(set(truth.target_id.tolist()))} targets -> {out}"
+        f"plots ({n_clutter} clutter{_ssr_note(plots)}), "
+        f"{len(set(truth.target_id.tolist()))} targets -> {out}"
     )
 
 

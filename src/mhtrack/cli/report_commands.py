@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 import click
 
@@ -24,20 +26,31 @@ def write_report_or_fail(directory: Path, output: Path | None = None, *,
         raise click.ClickException(str(e)) from None
 
 
+def page_options(f: Callable[..., Any]) -> Callable[..., Any]:
+    """The page's options, ``--plotlyjs`` and ``--coastlines``, of every command that
+    writes a report (``report``, ``run --report``)."""
+    for opt in reversed([
+        click.option("--plotlyjs", type=click.Choice(["inline", "file"]), default=None,
+                     help="Plotly's JavaScript (4.8 MB) inlined in the page (one "
+                     "self-contained file), or written once beside it as "
+                     "plotly-VERSION.min.js and shared by every report in that folder "
+                     "[inline]."),
+        click.option("--coastlines", is_flag=True, help="Draw Natural Earth's coastlines "
+                     "and borders (public domain) in a geographic scene: downloaded once "
+                     "into the user's cache ($MHTRACK_CACHE, else ~/.cache/mhtrack), left "
+                     "off with a note on the page where unavailable."),
+    ]):
+        f = opt(f)
+    return f
+
+
 @click.command()
 @click.argument("directory", type=click.Path(exists=True, file_okay=False, path_type=Path))
 @click.option("--out", "-o", "out", type=click.Path(dir_okay=False, path_type=Path),
               default=None, help="HTML file to write [default: DIR/report.html].")
 @click.option("--output", "output_alias", type=click.Path(dir_okay=False, path_type=Path),
               default=None, hidden=True)  # the former spelling, kept for a release
-@click.option("--plotlyjs", type=click.Choice(["inline", "file"]), default=None,
-              help="Plotly's JavaScript (4.8 MB) inlined in the page (one self-contained "
-              "file), or written once beside it as plotly-VERSION.min.js and shared by "
-              "every report in that folder [inline].")
-@click.option("--coastlines", is_flag=True, help="Draw Natural Earth's coastlines and "
-              "borders (public domain) in a geographic scene: downloaded once into the "
-              "user's cache ($MHTRACK_CACHE, else ~/.cache/mhtrack), left off with a note "
-              "on the page where unavailable.")
+@page_options
 def report(directory: Path, out: Path | None, output_alias: Path | None,
            plotlyjs: str | None, coastlines: bool) -> None:
     """Write one HTML page of DIR (opens from disk, no network).

@@ -11,12 +11,15 @@ import click
 from mhtrack.cli.asterix_commands import needs_libasterix
 from mhtrack.cli.clutter_options import clutter_estimator_options, clutter_params
 from mhtrack.cli.common import (
+    attributes_arg,
+    attributes_options,
     clutter_scene_option,
     echo_json,
     load_scenario_arg,
     scenario_options,
     with_scene_arg,
 )
+from mhtrack.cli.report_commands import page_options
 from mhtrack.cli.terminal import say, show_progress
 from mhtrack.names import (
     BIRTHS,
@@ -272,13 +275,16 @@ def track(plots: Path, tracker: str, tracker_pd: float | None, meas_sigma: float
 @click.option("--json", "as_json", is_flag=True, help="Print one JSON object.")
 @click.option("--report", "html_report", is_flag=True,
               help="Also write report.html: one self-contained page (scene, metrics, "
-              "parameters; needs mhtrack[report]).")
+              "parameters; needs mhtrack[report]); with the page options of `report` "
+              "(--plotlyjs, --coastlines).")
+@page_options
 @birth_options
 @output_option
 @clutter_scene_option
 @click.option("--bias", "biases", multiple=True, metavar="ID:range=M,gain=G,azimuth=DEG",
               help="Give rotating radar ID a registration bias (as simulate --bias).")
 @bias_options
+@attributes_options
 @clutter_estimator_options
 def run(scenario: str, seed: int, clutter: str | None, clutter_rate: float | None,
         pd: float | None, scans: int | None, tracker: str, tracker_pd: float | None,
@@ -290,6 +296,9 @@ def run(scenario: str, seed: int, clutter: str | None, clutter_rate: float | Non
         clutter_scene: str | None = None, biases: tuple[str, ...] = (),
         estimate_bias: bool = False, bias_reference: int | None = None,
         bias_init: Path | None = None, bias_out: Path | None = None,
+        attributes: bool | None = None, psr_only: float | None = None,
+        ssr_only: float | None = None, garble: float | None = None,
+        plotlyjs: str | None = None, coastlines: bool = False,
         **estimator_opts: Any) -> None:
     """Simulate SCENARIO, track, evaluate and plot, in one go.
 
@@ -300,6 +309,9 @@ def run(scenario: str, seed: int, clutter: str | None, clutter_rate: float | Non
     from mhtrack.pipeline.options import warn_known_kappa
     from mhtrack.reports.run_files import run_dir, run_text, write_run
 
+    if not html_report and (plotlyjs is not None or coastlines):
+        raise click.UsageError("--plotlyjs and --coastlines are options of the page: "
+                               "they need --report")
     if out is not None:
         from mhtrack.io.paths import check_output_dir
 
@@ -321,14 +333,16 @@ def run(scenario: str, seed: int, clutter: str | None, clutter_rate: float | Non
                             clutter_params=clutter_params(tracker, **estimator_opts))
     warn_known_kappa(sc, options)
     result = run_scenario(sc, seed, options=options, cutoff=cutoff, order=order,
-                          progress=show_progress())
+                          progress=show_progress(),
+                          attributes=attributes_arg(sc, attributes, psr_only, ssr_only,
+                                                    garble))
     out = out if out is not None else run_dir(sc, tracker, birth, seed)
     summary = write_run(out, result, seed)
     page = None
     if html_report:
         from mhtrack.cli.report_commands import write_report_or_fail
 
-        page = write_report_or_fail(out)
+        page = write_report_or_fail(out, plotlyjs=plotlyjs, coastlines=coastlines)
     if as_json:
         echo_json(summary)
         if page is not None:

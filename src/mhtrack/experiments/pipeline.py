@@ -37,6 +37,7 @@ from mhtrack.sources.memory import MemorySource
 if TYPE_CHECKING:  # loaded by run_scenario only (fast start of `mhtrack track`)
     from mhtrack.metrics import Evaluation
     from mhtrack.scenario import Scenario, Simulation
+    from mhtrack.scenario.identity import AttributeOptions
 
 __all__ = ["ScenarioRun", "TrackingRun", "run_scenario", "track"]
 
@@ -157,6 +158,7 @@ def run_scenario(
     output: str = "history",
     clutter_params: dict[str, Any] | None = None,
     options: TrackOptions | None = None,
+    attributes: AttributeOptions | None = None,
 ) -> ScenarioRun:
     """Simulate ``scenario`` with ``seed``, run the tracker on it and evaluate.
 
@@ -168,7 +170,9 @@ def run_scenario(
     scenario of rotating radars (plots with their own times) is tracked frame by frame,
     unfused, with the radars' coverage and per-radar clutter; scans of several sensors
     are fused by default. ``cutoff``/``order``: OSPA/GOSPA's (default
-    :func:`~mhtrack.metrics.evaluate`'s)."""
+    :func:`~mhtrack.metrics.evaluate`'s). ``attributes``: the plots' secondary-radar
+    attributes (:func:`~mhtrack.scenario.identity.with_attributes`; ``None``: none, as
+    :func:`~mhtrack.scenario.simulate` draws)."""
     from mhtrack.metrics import evaluate
     from mhtrack.scenario import simulate
 
@@ -177,6 +181,10 @@ def run_scenario(
                                birth_theta_deg=theta_deg, fusion=fusion, output=output,
                                clutter_params=clutter_params)
     sim = simulate(scenario, seed=seed)
+    if attributes is not None:
+        from mhtrack.scenario.identity import with_attributes
+
+        sim = with_attributes(sim, attributes)
     pipe = Pipeline(scenario_source(scenario, sim.plots), options, config=config)
     rows = TrackCollector(pipe.output)
     result = pipe.run([rows], progress=progress)

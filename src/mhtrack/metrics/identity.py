@@ -81,19 +81,35 @@ def target_identities(plots: PlotTable) -> dict[int, tuple[int, int]]:
     a, origin = plots.attrs, plots.origin
     if a is None or origin is None:
         return {}
-    out = {}
-    for tid in np.unique(origin[origin >= 0]).tolist():
-        mine = origin == tid
-        out[int(tid)] = (_mode(a.mode_3a[mine & (a.mode_3a_g == 0)]), _mode(a.address[mine]))
-    return out
+    o = np.asarray(origin)
+    rows = o >= 0
+    code = np.where(a.mode_3a_g == 0, a.mode_3a, -1)  # a garbled code is not counted
+    codes, addresses = _modes(o[rows], code[rows]), _modes(o[rows], a.address[rows])
+    return {int(t): (codes.get(int(t), -1), addresses.get(int(t), -1))
+            for t in np.unique(o[rows]).tolist()}
 
 
-def _mode(v: np.ndarray) -> int:
-    v = v[v >= 0]
-    if not v.size:
-        return -1
-    values, counts = np.unique(v, return_counts=True)
-    return int(values[np.argmax(counts)])
+def _modes(key: np.ndarray, v: np.ndarray) -> dict[int, int]:
+    """Key → the most frequent of its values ``>= 0`` (ties: the smaller value; keys
+    without one left out), for all keys at once."""
+    ok = v >= 0
+    if not ok.any():
+        return {}
+    pairs, counts = np.unique(np.column_stack((key[ok], v[ok])), axis=0,
+                              return_counts=True)
+    order = np.lexsort((pairs[:, 1], -counts, pairs[:, 0]))  # per key: most, then smallest
+    first = order[np.r_[True, np.diff(pairs[order, 0]) != 0]]
+    return dict(zip(pairs[first, 0].tolist(), pairs[first, 1].tolist(), strict=True))
+
+
+def _groups(keys: np.ndarray) -> list[tuple[int, np.ndarray]]:
+    """``(key, positions)`` for each distinct key in increasing order, the positions in
+    increasing order (one stable sort: the grouping every per-target figure here uses,
+    instead of masking all rows once per target)."""
+    keys = np.asarray(keys)
+    order = np.argsort(keys, kind="stable")
+    cuts = np.flatnonzero(np.diff(keys[order])) + 1
+    return [(int(keys[g[0]]), g) for g in np.split(order, cuts)] if keys.size else []
 
 
 def identity_figures(tracks: TrackTable, truth: TruthTable, aligned: TrackTable,
@@ -137,13 +153,14 @@ def identity_figures(tracks: TrackTable, truth: TruthTable, aligned: TrackTable,
     """
     dom = dominant_targets(matching)
     tgt, trk = np.asarray(matching.target_id), np.asarray(matching.track_id)
-    n_ids = [len(np.unique(trk[tgt == t])) for t in np.unique(tgt).tolist()]
+    pairs = np.unique(np.column_stack((tgt, trk)), axis=0) if len(tgt) else np.empty((0, 2))
+    n_ids = np.unique(pairs[:, 0], return_counts=True)[1]  # distinct tracks per target
     d = np.asarray(matching.distance, float)
     rate, n_code = _wrong_code(tracks, plots, dom)
     T = _default_interval(truth, plots) if update_interval is None else float(update_interval)
     n_states = len(aligned)
     return IdentityFigures(
-        ids_per_aircraft=float(np.mean(n_ids)) if n_ids else float("nan"),
+        ids_per_aircraft=float(np.mean(n_ids)) if n_ids.size else float("nan"),
         wrong_code_rate=rate, n_code_rows=n_code,
         rms_horizontal=float(np.sqrt(np.mean(d**2))) if d.size else float("nan"),
         p_update=_p_update(tracks, truth, dom, T), update_interval=T,
@@ -178,8 +195,10 @@ def _wrong_code(tracks: TrackTable, plots: PlotTable | None, dom: dict[int, int]
 def _default_interval(truth: TruthTable, plots: PlotTable | None) -> float:
     if plots is not None and plots.origin is not None and (plots.origin >= 0).any():
         o, t = np.asarray(plots.origin), np.asarray(plots.time, float)
-        steps = np.concatenate([np.diff(np.sort(t[o == k]))
-                                for k in np.unique(o[o >= 0]).tolist()])
+        o, t = o[o >= 0], t[o >= 0]
+        order = np.lexsort((t, o))  # by target, then time
+        o, t = o[order], t[order]
+        steps = np.diff(t)[np.diff(o) == 0]  # successive plots of one target
     else:
         steps = np.diff(np.unique(np.asarray(truth.time, float)))
     steps = steps[steps > 0]
@@ -190,17 +209,24 @@ def _p_update(tracks: TrackTable, truth: TruthTable, dom: dict[int, int], T: flo
     if not (np.isfinite(T) and T > 0) or not len(truth):
         return float("nan")
     target = np.array([dom.get(int(k), -1) for k in tracks.track_id.tolist()], np.int64)
-    upd = np.asarray(tracks.plot) >= 0
-    total = updated = 0
-    for tid in np.unique(truth.target_id).tolist():
-        t = np.asarray(truth.time, float)[truth.target_id == tid]
-        t0, t1 = float(t.min()), float(t.max())
-        n = max(1, int(np.ceil((t1 - t0) / T)))
-        tu = np.asarray(tracks.time, float)[upd & (target == tid)]
-        tu = tu[(tu >= t0) & (tu <= t1)]
-        j = np.minimum(np.floor((tu - t0) / T).astype(np.int64), n - 1)
-        total, updated = total + n, updated + len(np.unique(j))
-    return updated / total
+    tt = np.asarray(truth.time, float)
+    ids, first, last = [], [], []
+    for tid, g in _groups(truth.target_id):
+        ids.append(tid)
+        first.append(tt[g].min())
+        last.append(tt[g].max())
+    ids_a, t0, t1 = np.array(ids, np.int64), np.array(first), np.array(last)
+    n = np.maximum(1, np.ceil((t1 - t0) / T).astype(np.int64))  # intervals per target
+    # each updating row's target among the truth's (rows of other targets count nowhere)
+    k = np.searchsorted(ids_a, target)
+    k = np.minimum(k, len(ids_a) - 1)
+    upd = (np.asarray(tracks.plot) >= 0) & (target >= 0) & (ids_a[k] == target)
+    tu, k = np.asarray(tracks.time, float)[upd], k[upd]
+    inside = (tu >= t0[k]) & (tu <= t1[k])
+    tu, k = tu[inside], k[inside]
+    j = np.minimum(np.floor((tu - t0[k]) / T).astype(np.int64), n[k] - 1)
+    updated = len(np.unique(np.column_stack((k, j)), axis=0)) if k.size else 0
+    return updated / int(n.sum())
 
 
 def _extra_kinds(aligned: TrackTable, truth: TruthTable, matching: MOTMatching,
@@ -215,12 +241,14 @@ def _extra_kinds(aligned: TrackTable, truth: TruthTable, matching: MOTMatching,
         matching.scan.tolist(), matching.target_id.tolist(), matching.track_id.tolist(),
         strict=True)}
     ts, tt = np.asarray(truth.scan), np.asarray(truth.target_id)
+    at_scan = dict(_groups(ts))  # scan -> truth rows at it
+    none = np.empty(0, np.int64)
     multiple = false = 0
     for i, (s, k) in enumerate(zip(aligned.scan.tolist(), aligned.track_id.tolist(),
                                    strict=True)):
         if (int(s), int(k)) in matched:
             continue
-        here = np.flatnonzero(ts == s)
+        here = at_scan.get(int(s), none)
         d = np.hypot(truth.x[here] - aligned.x[i], truth.y[here] - aligned.y[i])
         if not here.size or d.min() > limit:
             false += 1

@@ -21,6 +21,8 @@ import numpy as np
 
 from mhtrack.plotting.scene import KM_ABOVE_M, Site
 from mhtrack.records import PlotTable, TrackTable, TruthTable
+from mhtrack.reports.html_hover import hover as hover_template
+from mhtrack.reports.html_hover import row_text, track_labels
 
 if TYPE_CHECKING:
     import plotly.graph_objects as go
@@ -127,38 +129,6 @@ def _thin_rows(segs: list[np.ndarray], most: int) -> tuple[list[np.ndarray], boo
     return [np.unique(np.append(r[::k], r[-1])) if len(r) else r for r in segs], True
 
 
-def _hover(details: dict[str, np.ndarray], word: str) -> tuple[list[str], str]:
-    """The per-row hover columns (besides id, scan and time) and their template."""
-    names, parts = [], []
-    j = 3
-    for name, fmt_ in (("speed", "speed %{customdata[J]:.0f} m/s"),
-                       ("heading", "heading %{customdata[J]:.0f}°"),
-                       ("flight_level", "FL %{customdata[J]:.0f}"),
-                       ("score", "score %{customdata[J]:.1f}"),
-                       ("sensor", "plot of sensor %{customdata[J]}")):
-        v = details.get(name)
-        if v is None or (v.dtype.kind == "f" and not np.isfinite(v).any()):
-            continue
-        names.append(name)
-        parts.append(fmt_.replace("J", str(j)))
-        j += 1
-    head = f"track %{{customdata[0]}}, {word} %{{customdata[1]}}, t = %{{customdata[2]:.1f}} s"
-    return names, head + ("<br>" + ", ".join(parts) if parts else "")
-
-
-def _track_labels(rows: np.ndarray, details: dict[str, np.ndarray]) -> str:
-    """What is constant along a track: its Mode 3/A codes, callsigns and sensors."""
-    out = []
-    for name, label in (("mode_3a", "code"), ("callsign", "callsign"), ("sensor", "sensors")):
-        v = details.get(name)
-        if v is None:
-            continue
-        vals = [x for x in v[rows].tolist() if x not in ("", -1)]
-        if vals:
-            out.append(f"{label} " + ", ".join(str(x) for x in sorted(set(vals))))
-    return "<br>" + ", ".join(out) if out else ""
-
-
 def track_traces(tracks: TrackTable, scale: float, details: dict[str, np.ndarray] | None
                  = None, *, word: str = "scan") -> list[dict[str, Any]]:
     """Tracks: one trace per id (its own colour, labelled at its end) up to
@@ -168,20 +138,24 @@ def track_traces(tracks: TrackTable, scale: float, details: dict[str, np.ndarray
     SVG text element per row, blank or not). Hover: id,
     ``word`` (scan or frame), time and the ``details`` given per row (speed, heading,
     flight level, score, sensor; code, callsign and sensors per track —
-    :func:`mhtrack.reports.html_recording.track_details`). More than
+    :func:`mhtrack.reports.html_recording.track_details`), unknown ones left out
+    (:mod:`mhtrack.reports.html_hover`). More than
     :data:`MAX_TRACK_POINTS` rows are thinned to every k-th row of each track (the legend
     says so)."""
     details = details or {}
     tent = (np.zeros(len(tracks), bool) if tracks.tentative is None
             else np.asarray(tracks.tentative, bool))
     segs = _segments(tracks.track_id, tracks.time)
-    names, hover = _hover(details, word)
+    names, per_row, hover = hover_template(details, word)
     columns = [tracks.track_id, tracks.scan, tracks.time, *(details[n] for n in names)]
+    texts = row_text(details, per_row, lead=bool(names)) if per_row else None
 
     def trace(rows_list: list[np.ndarray], extra: str = "", **kw: Any) -> dict[str, Any]:
         data = [np.column_stack([c[r] for c in columns]) for r in rows_list]
         gaps = np.full((1, len(columns)), np.nan)
         custom = np.concatenate([p for d in data for p in (d, gaps)]) if data else gaps
+        if texts is not None:  # the details unknown on some rows (html_hover)
+            kw["text"] = [t for r in rows_list for t in (*texts[r].tolist(), "")]
         return {"type": "scatter", "mode": "lines", "legendgroup": "tracks",
                 "x": _gapped([tracks.x[r] / scale for r in rows_list]),
                 "y": _gapped([tracks.y[r] / scale for r in rows_list]),
@@ -212,7 +186,7 @@ def track_traces(tracks: TrackTable, scale: float, details: dict[str, np.ndarray
     for j, (r, full) in enumerate(zip(solid, whole, strict=True)):
         tid = int(tracks.track_id[r[0]])
         colour = PALETTE[tid % len(PALETTE)]
-        out.append(trace([r], _track_labels(full, details),
+        out.append(trace([r], track_labels(full, details),
                          name="tracks" + (f" ({note[2:]})" if note else ""),
                          showlegend=j == 0, line={"color": colour, "width": 1.8}))
         ends_x.append(float(tracks.x[r[-1]] / scale))

@@ -16,6 +16,12 @@ reply carries the code and the level: Mode S in 25 ft steps (0.25 FL), Mode C in
 (1 FL); with probability :attr:`AttributeOptions.garble` its code has one of its 12 bits
 flipped and its level a wrong value (FL + 1 to 50 either way), both flagged garbled (G),
 as a radar's reply processor flags overlapping replies. Clutter plots are primary.
+
+**Default.** :func:`default_attributes`: on for a scenario of rotating radars (civil
+surveillance radars are secondary radars: their plots carry the replies), off otherwise
+(the papers' scenarios: positions only). ``mhtrack simulate`` and ``run`` follow it
+(``--attributes/--no-attributes``); the library's :func:`~mhtrack.scenario.simulate`
+draws no attributes — :func:`with_attributes` adds them.
 """
 
 from __future__ import annotations
@@ -38,6 +44,8 @@ from mhtrack.attributes import (
     address_value,
 )
 from mhtrack.records import PlotTable
+from mhtrack.scenario.simulate import Simulation
+from mhtrack.scenario.spec import Scenario
 
 #: One flight level (m): 100 ft.
 FL_M = 30.48
@@ -169,3 +177,21 @@ def add_attributes(plots: PlotTable, identities: dict[int, Identity],
             cols["address"][rows] = np.where(reply, ident.address, ABSENT)
             cols["callsign"][rows] = np.where(reply, ident.callsign, "")
     return replace(plots, attrs=PlotAttributes.from_columns(cols, n))
+
+
+def default_attributes(scenario: Scenario) -> bool:
+    """Whether a simulation of ``scenario`` carries secondary-radar attributes unless told
+    otherwise: with rotating radars (module docstring, "Default")."""
+    return scenario.rotating
+
+
+def with_attributes(sim: Simulation, options: AttributeOptions | None = None) -> Simulation:
+    """``sim`` with its plots' attributes: the data's identities for the OpenSky presets
+    (:func:`opensky_identities`), drawn ones otherwise (:func:`drawn_identities`);
+    ``options`` default :class:`AttributeOptions`. Positions, times and origins unchanged
+    (the attributes' draws have their own streams)."""
+    options = AttributeOptions() if options is None else options
+    ids = sorted(set(sim.truth.target_id.tolist()))
+    identities = opensky_identities() if sim.scenario.name in ("opensky", "opensky-radars") \
+        else drawn_identities(ids, sim.seed)
+    return replace(sim, plots=add_attributes(sim.plots, identities, options, sim.seed))

@@ -30,8 +30,9 @@ from dataclasses import dataclass, fields, replace
 
 import numpy as np
 
-from mhtrack.attributes import FPM_PER_FL_S, TrackAttributes
+from mhtrack.attributes import TrackAttributes
 from mhtrack.kernels import changes
+from mhtrack.mht.track_attributes import identity
 from mhtrack.mht.tree import Leaves
 from mhtrack.records import TrackTable
 
@@ -85,11 +86,9 @@ class _Logged:
         logged."""
         if self.ident is None or self.level is None:
             return None
-        lv, ident = self.level.take(j, axis=0), self.ident.take(j, axis=0)
         return replace(TrackAttributes.absent(j.size, self.P.take(j, axis=0)),
-                       flight_level=lv[:, 0] + lv[:, 1] * (self.t[j] - lv[:, 5]),
-                       rate_of_climb=lv[:, 1] * FPM_PER_FL_S, mode_3a=ident[:, 0].copy(),
-                       address=ident[:, 1].copy())
+                       **identity(self.level.take(j, axis=0), self.ident.take(j, axis=0),
+                                  self.t[j]))
 
 
 class TentativeHistory:

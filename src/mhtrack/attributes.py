@@ -21,6 +21,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, fields
 
 import numpy as np
+from scipy.special import expit
 
 #: Plot type codes (I048/020 TYP grouped as in :mod:`mhtrack.io.asterix.notplots`).
 PLOT_TYPES = {0: "none", 1: "primary", 2: "secondary", 3: "combined", 4: "mode_s",
@@ -152,7 +153,8 @@ FPM_PER_FL_S = 6000.0
 TRACK_COLUMNS = ("flight_level", "rate_of_climb", "mode_3a", "address", "callsign",
                  "sigma_major", "sigma_minor", "sigma_orient", "sensors", "sensor_ages",
                  "age_psr", "age_ssr", "age_mds", "meas_sensor", "meas_type", "meas_mode_3a",
-                 "meas_mode_3a_vg", "meas_flight_level", "meas_flight_level_vg")
+                 "meas_mode_3a_vg", "meas_flight_level", "meas_flight_level_vg",
+                 "existence_probability")
 #: The plot types that count as a detection of each technology of I062/290's ages:
 #: primary (PSR), secondary (SSR: Mode A/C replies) and Mode S.
 TECHNOLOGIES = {"psr": (PRIMARY, COMBINED), "ssr": (SECONDARY, COMBINED), "mds": (MODE_S,)}
@@ -171,6 +173,14 @@ def accuracy(P: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
             np.mod(90.0 - theta, 180.0))
 
 
+def existence(score: np.ndarray) -> np.ndarray:
+    """The probability that a track is a true target from its score ``L``, the
+    log-likelihood ratio of target against false track with the prior odds in its
+    initial value: ``P_T = e^L / (1 + e^L) = 1 / (1 + e^−L)`` (Blackman & Popoli 1999,
+    §6.2; ``scipy.special.expit``, exact at both ends)."""
+    return expit(np.asarray(score, float))
+
+
 @dataclass(frozen=True)
 class TrackAttributes:
     """What a track says besides its state, one row per track row: ``flight_level`` (FL)
@@ -186,7 +196,9 @@ class TrackAttributes:
     none is known; and what the row's own plot measured (I062/340; on a miss: absent):
     ``meas_sensor`` (its sensor id, ``-1``), ``meas_type`` (:data:`PLOT_TYPES` code, 0),
     ``meas_mode_3a`` (its code as received, ``-1``) and ``meas_flight_level`` (FL, NaN)
-    with their validity bits ``meas_mode_3a_vg``, ``meas_flight_level_vg`` (``2·V + G``)."""
+    with their validity bits ``meas_mode_3a_vg``, ``meas_flight_level_vg`` (``2·V + G``);
+    and the track's ``existence_probability`` from its score (:func:`existence`), NaN
+    when unknown."""
 
     flight_level: np.ndarray
     rate_of_climb: np.ndarray
@@ -207,6 +219,7 @@ class TrackAttributes:
     meas_mode_3a_vg: np.ndarray
     meas_flight_level: np.ndarray
     meas_flight_level_vg: np.ndarray
+    existence_probability: np.ndarray
 
     def __len__(self) -> int:
         return len(self.mode_3a)
@@ -226,7 +239,7 @@ class TrackAttributes:
                    np.full(n, "", object), nan.copy(), nan.copy(), nan.copy(),
                    np.full(n, ABSENT, np.int64), np.zeros(n, np.int64),
                    np.full(n, ABSENT, np.int64), np.zeros(n, np.int64), nan.copy(),
-                   np.zeros(n, np.int64))
+                   np.zeros(n, np.int64), nan.copy())
 
     @classmethod
     def concat(cls, parts: list[TrackAttributes]) -> TrackAttributes:

@@ -30,7 +30,7 @@ from dataclasses import dataclass, fields, replace
 
 import numpy as np
 
-from mhtrack.attributes import TrackAttributes
+from mhtrack.attributes import TrackAttributes, existence
 from mhtrack.kernels import changes
 from mhtrack.mht.track_attributes import identity
 from mhtrack.mht.tree import Leaves
@@ -82,13 +82,14 @@ class _Logged:
     def attributes(self, j: np.ndarray) -> TrackAttributes | None:
         """The identity of logged leaves ``j`` at their own times (code, address, flight
         level and rate of their vertical state, as :mod:`mhtrack.mht.track_attributes`
-        reports a track; the accuracy of their covariance), ``None`` when none was
+        reports a track; the accuracy of their covariance and the existence probability
+        of their score), ``None`` when none was
         logged."""
         if self.ident is None or self.level is None:
             return None
         return replace(TrackAttributes.absent(j.size, self.P.take(j, axis=0)),
                        **identity(self.level.take(j, axis=0), self.ident.take(j, axis=0),
-                                  self.t[j]))
+                                  self.t[j]), existence_probability=existence(self.score[j]))
 
 
 class TentativeHistory:

@@ -12,6 +12,8 @@ address, its latest callsign and its position's accuracy
   (:class:`Callsigns`); identification comes in Mode S replies only when the aircraft
   is interrogated for it (BDS 2,0), not with every plot.
 * **Accuracy**: the position covariance's ellipse (:func:`~mhtrack.attributes.accuracy`).
+* **Existence probability**: ``1/(1 + e^−L)`` of the leaf's score ``L``
+  (:func:`~mhtrack.attributes.existence`).
 * **Sensors**: those whose plots updated the confirmed track, with the age of each one's
   last update at the row's time (:class:`~mhtrack.mht.sensor_ages.SensorAges`), and the
   age of its last PSR, SSR and Mode S update (by the plots' types).
@@ -21,7 +23,13 @@ from __future__ import annotations
 
 import numpy as np
 
-from mhtrack.attributes import FPM_PER_FL_S, PlotAttributes, TrackAttributes, accuracy
+from mhtrack.attributes import (
+    FPM_PER_FL_S,
+    PlotAttributes,
+    TrackAttributes,
+    accuracy,
+    existence,
+)
 from mhtrack.mht.attribute_scores import positions
 from mhtrack.mht.sensor_ages import SensorAges, technology_updates
 from mhtrack.mht.tree import Leaves
@@ -103,7 +111,7 @@ def track_attributes(leaves: Leaves, sel: np.ndarray, attrs: PlotAttributes,
         callsign=callsigns.latest(leaves.track.take(sel), seen, time).astype(object),
         sigma_major=major, sigma_minor=minor, sigma_orient=orient, sensors=sensors,
         sensor_ages=age, age_psr=tech[:, 0], age_ssr=tech[:, 1], age_mds=tech[:, 2],
-        **measured(attrs, j, sensor))
+        **measured(attrs, j, sensor), existence_probability=existence(leaves.score.take(sel)))
 
 
 def identity(level: np.ndarray, ident: np.ndarray, t: np.ndarray

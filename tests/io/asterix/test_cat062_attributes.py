@@ -45,7 +45,8 @@ def _table(n=400):
         meas_mode_3a=np.where(some[9] & some[10], rng.integers(0, 0o10000, n), -1),
         meas_mode_3a_vg=np.where(some[9], rng.integers(0, 4, n), 0),
         meas_flight_level=np.where(some[9] & some[11], rng.uniform(-10, 450, n), np.nan),
-        meas_flight_level_vg=np.where(some[9], rng.integers(0, 4, n), 0))
+        meas_flight_level_vg=np.where(some[9], rng.integers(0, 4, n), 0),
+        existence_probability=np.where(some[0], rng.random(n), np.nan))
     return TrackTable(scan=np.arange(n), time=1000.0 + np.arange(n) * 0.25,
                       track_id=rng.integers(0, 5000, n), x=rng.uniform(-2e5, 2e5, n),
                       y=rng.uniform(-2e5, 2e5, n), vx=rng.uniform(-250, 250, n),

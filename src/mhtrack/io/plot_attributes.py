@@ -62,6 +62,9 @@ def read_attributes(f: Frame, order: np.ndarray | None = None) -> PlotAttributes
             cols[name] = _parsed(f, name, parse)
     if f.has("callsign"):
         cols["callsign"] = np.array([s or "" for s in _text(f, "callsign")], object)
+    if f.has("range") and f.has("bearing"):  # polar plots: their measured position
+        cols["polar_range"] = f.floats("range", nullable=True)
+        cols["polar_bearing"] = f.floats("bearing", nullable=True)
     out = PlotAttributes.from_columns(cols, f.n)
     return out if order is None else out.take(order)
 

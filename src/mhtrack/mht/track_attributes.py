@@ -142,4 +142,6 @@ def measured(attrs: PlotAttributes, j: np.ndarray, sensor: np.ndarray
             "meas_mode_3a": take(attrs.mode_3a, -1),
             "meas_mode_3a_vg": take(2 * attrs.mode_3a_v + attrs.mode_3a_g, 0),
             "meas_flight_level": take(attrs.flight_level, np.nan),
-            "meas_flight_level_vg": take(2 * attrs.flight_level_v + attrs.flight_level_g, 0)}
+            "meas_flight_level_vg": take(2 * attrs.flight_level_v + attrs.flight_level_g, 0),
+            "meas_range": take(attrs.polar_range, np.nan),
+            "meas_bearing": take(attrs.polar_bearing, np.nan)}

@@ -94,9 +94,8 @@ class _Logged:
             j = positions(plots.rows, plot) if len(plots) else np.full(plot.size, -1)
             got = measured(plots.attrs, j, plots.sensor)
             meas = np.column_stack([got[k] for k in MEASURED]).astype(float)
-            cs = plots.attrs.callsign[np.maximum(j, 0)] if len(plots) else j
-            callsign = np.array([str(c).strip() if k >= 0 else "" for c, k in
-                                 zip(cs.tolist(), j.tolist(), strict=True)], "U8")
+            cs = plots.attrs.callsign[np.maximum(j, 0)] if len(plots) else np.full(j.size, "")
+            callsign = np.where(j >= 0, cs, "").astype("U8")  # stripped when backfilled
         return cls(np.array([scan], np.int64), np.array([time], float), node,
                    leaves.parent[sel], leaves.x.take(sel, axis=0), leaves.P.take(sel, axis=0),
                    plot, leaves.score[sel], leaves.time[sel],
@@ -111,7 +110,7 @@ class _Logged:
         if self.ident is None or self.level is None:
             return None
         meas = {} if self.meas is None or self.callsign is None else {
-            "callsign": self.callsign[j].astype(object),
+            "callsign": np.char.strip(self.callsign[j]).astype(object),
             **{k: self.meas[j, i].astype(np.int64 if k in _INT else float)
                for i, k in enumerate(MEASURED)}}
         return replace(TrackAttributes.absent(j.size, self.P.take(j, axis=0)),

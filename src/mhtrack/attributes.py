@@ -21,7 +21,6 @@ from collections.abc import Mapping
 from dataclasses import dataclass, fields
 
 import numpy as np
-from scipy.special import expit
 
 #: Plot type codes (I048/020 TYP grouped as in :mod:`mhtrack.io.asterix.notplots`).
 PLOT_TYPES = {0: "none", 1: "primary", 2: "secondary", 3: "combined", 4: "mode_s",
@@ -191,8 +190,9 @@ def existence(score: np.ndarray) -> np.ndarray:
     """The probability that a track is a true target from its score ``L``, the
     log-likelihood ratio of target against false track with the prior odds in its
     initial value: ``P_T = e^L / (1 + e^L) = 1 / (1 + e^−L)`` (Blackman & Popoli 1999,
-    §6.2; ``scipy.special.expit``, exact at both ends)."""
-    return expit(np.asarray(score, float))
+    §6.2), computed as ``exp(−ln(1 + e^−L))`` (``np.logaddexp``: no overflow at either
+    end; NumPy, as this module is loaded by every run and SciPy is not)."""
+    return np.exp(-np.logaddexp(0.0, -np.asarray(score, float)))
 
 
 @dataclass(frozen=True)

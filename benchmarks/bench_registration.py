@@ -11,7 +11,11 @@ reference, cycling 3, 1, 2. Draw ``k`` simulates with seed ``k``. Each run is th
 REF]``, ``mhtrack evaluate … --json``); the estimate at 600 s is read from the run's
 :attr:`~mhtrack.pipeline.registration.Registration.history` (the same pipeline, in
 process). Each estimate's error is also given in its reported σ, and the fraction of
-them within 2σ and 3σ over all draws (the coverage of the cluster-robust σ). Run:
+them within 2σ and 3σ over all draws (the coverage of the cluster-robust σ), and beside
+it the Cramér–Rao bound of an estimate from the radar's target plots up to that time if
+the targets' paths were known exactly (:func:`known_path_bound`: no estimator of the bias
+from those plots has a smaller σ; the real one must also estimate the paths from the
+reference's plots, so its σ is larger). Run:
 ``PYTHONPATH=src python benchmarks/bench_registration.py [--quick] [draws...]``
 (``--quick``: without the unbiased run with estimation).
 """
@@ -73,10 +77,48 @@ def _estimated(d: Path, ref: int, out: Path) -> list:  # type: ignore[type-arg]
     return pipe.registration.history
 
 
+def known_path_bound(d: Path, sid: int, until: float, near_s: float = 15.0
+                     ) -> tuple[float, float, float]:
+    """σ (m, gain, degrees) of the Cramér–Rao bound on radar ``sid``'s bias from its
+    target plots up to ``until`` whose target another sensor saw within ``near_s``
+    seconds (those a pair can use), the paths known: each plot measures
+    ``(r_m, θ_m) = (g r + Δr, θ + Δθ)`` with noise ``diag(σ_r², σ_θ²)``, so its Fisher
+    information is ``Jᵀ diag(σ_r⁻², σ_θ⁻²) J``, ``J = [[1, r, 0], [0, 0, 1]]``; the bound
+    is the diagonal of the inverse of their sum (Van Trees 1968, §2.4)."""
+    import tomllib
+    sensor = next(s for s in tomllib.loads((d / "sensors.toml").read_text())["sensors"]
+                  if s["id"] == sid)
+    a = np.genfromtxt(d / "plots.csv", delimiter=",", names=True)
+    a = a[(a["origin"] >= 0) & (a["time"] <= until)]
+    mine, other = a[a["sensor"] == sid], a[a["sensor"] != sid]
+    keep = np.zeros(len(mine), bool)
+    for target in np.unique(mine["origin"]):
+        seen = np.sort(other["time"][other["origin"] == target])
+        m = np.flatnonzero(mine["origin"] == target)
+        if seen.size:
+            k = np.clip(np.searchsorted(seen, mine["time"][m]), 1, max(seen.size - 1, 1))
+            gap = np.minimum(np.abs(seen[np.minimum(k, seen.size - 1)] - mine["time"][m]),
+                             np.abs(seen[k - 1] - mine["time"][m]))
+            keep[m] = gap <= near_s
+    r = mine["range"][keep]
+    sr, sb = sensor["sigma_range"], np.radians(sensor["sigma_bearing_deg"])
+    info = np.array([[r.size / sr**2, r.sum() / sr**2, 0.0],
+                     [r.sum() / sr**2, (r**2).sum() / sr**2, 0.0],
+                     [0.0, 0.0, r.size / sb**2]])
+    s = np.sqrt(np.diag(np.linalg.inv(info)))
+    return float(s[0]), float(s[1]), float(np.degrees(s[2]))
+
+
 def _within(est: tuple[float, float, float], true: tuple[float, float, float]) -> bool:
     errs = (est[0] - true[0], est[1] - true[1], est[2] - true[2])
     tv = (true[0], true[1] - 1.0, true[2])
     return all(abs(e) <= 0.2 * max(abs(t), s) for e, t, s in zip(errs, tv, SCALE, strict=True))
+
+
+def _in_bound(true: tuple[float, float, float], crb: tuple[float, float, float]) -> str:
+    """Each component's 20 % of its true value in the bound's σ ("-" for a true 0)."""
+    tv = (true[0], true[1] - 1.0, true[2])
+    return "/".join(f"{0.2 * abs(v) / c:.1f}" if v else "-" for v, c in zip(tv, crb, strict=True))
 
 
 def _relative(est: tuple[float, float, float], true: tuple[float, float, float]) -> str:
@@ -131,11 +173,18 @@ def main(draws: list[int], quick: bool = False) -> None:
             for label, hist in (("unbiased", rows[1][4]), ("biased", rows[3][4])):
                 if hist is None:
                     continue
-                at = next((b for tt, b in hist if tt >= AT_S), hist[-1][1])
-                end = hist[-1][1]
+                t_at, at = next(((tt, b) for tt, b in hist if tt >= AT_S), hist[-1])
+                t_end, end = hist[-1]
                 for sid in sorted(end):
                     true = (0.0, 1.0, 0.0) if label == "unbiased" else biases[sid]
-                    for when, b in ((f"{AT_S:.0f} s", at[sid]), ("end", end[sid])):
+                    for when, b, until in ((f"{AT_S:.0f} s", at[sid], t_at),
+                                           ("end", end[sid], t_end)):
+                        crb = known_path_bound(t / ("clean", "biased")[label == "biased"],
+                                               sid, until)
+                        print(f"  {label:8s} known-path bound radar {sid} at {when:6s}: σ range "
+                              f"{crb[0]:.1f} m, gain {crb[1]:.5f}, azimuth {crb[2]:.4f}°; "
+                              f"20 % of the true bias in bound σ "
+                              f"{_in_bound(true, crb)}")
                         e = (b.range_offset, b.range_gain, b.azimuth_deg)
                         z = _z(b, true)
                         if label == "biased":

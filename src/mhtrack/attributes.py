@@ -34,6 +34,10 @@ COLUMNS = ("plot_type", "mode_3a", "mode_3a_v", "mode_3a_g", "flight_level",
 _INT = ("plot_type", "mode_3a", "mode_3a_v", "mode_3a_g", "flight_level_v",
         "flight_level_g", "address")
 _FLOAT = ("flight_level", "amplitude")
+#: The plot's measured position from its sensor, carried for the tracks' ``meas_range``,
+#: ``meas_bearing`` (I062/340 POS) but not written as attributes (they are the plots
+#: table's own ``range`` and ``bearing``): range (m) and bearing (degrees), NaN absent.
+POLAR = ("polar_range", "polar_bearing")
 
 
 def code_value(text: str) -> int:
@@ -85,9 +89,14 @@ class PlotAttributes:
     address: np.ndarray
     callsign: np.ndarray
     amplitude: np.ndarray
+    polar_range: np.ndarray = None  # type: ignore[assignment]  # None: NaN on every row
+    polar_bearing: np.ndarray = None  # type: ignore[assignment]
 
     def __post_init__(self) -> None:
         n = len(self.plot_type)
+        for name in POLAR:
+            if getattr(self, name) is None:
+                object.__setattr__(self, name, np.full(n, np.nan))
         for f in fields(self):
             if len(getattr(self, f.name)) != n:
                 raise ValueError(f"PlotAttributes column {f.name!r} has "
@@ -114,6 +123,9 @@ class PlotAttributes:
                 out[name] = np.full(n, np.nan) if v is None else np.asarray(v, float)
             else:
                 out[name] = np.full(n, "", object) if v is None else np.asarray(v, object)
+        for name in POLAR:
+            if cols.get(name) is not None:
+                out[name] = np.asarray(cols[name], float)
         return cls(**out)
 
     @classmethod
@@ -121,17 +133,18 @@ class PlotAttributes:
         """``n`` plots without any attribute."""
         return cls.from_columns({}, n)
 
-    def columns(self) -> dict[str, np.ndarray]:
-        """The columns by name (:data:`COLUMNS`)."""
-        return {name: getattr(self, name) for name in COLUMNS}
+    def columns(self, polar: bool = False) -> dict[str, np.ndarray]:
+        """The columns by name (:data:`COLUMNS`; ``polar``: and :data:`POLAR`)."""
+        return {name: getattr(self, name) for name in COLUMNS + (POLAR if polar else ())}
 
     def take(self, idx: np.ndarray | slice) -> PlotAttributes:
         """Rows ``idx`` (index array, mask or slice), in that order."""
-        return PlotAttributes(**{k: v[idx] for k, v in self.columns().items()})
+        return PlotAttributes(**{k: v[idx] for k, v in self.columns(polar=True).items()})
 
     @classmethod
     def concat(cls, parts: list[PlotAttributes]) -> PlotAttributes:
-        return cls(**{k: np.concatenate([getattr(p, k) for p in parts]) for k in COLUMNS})
+        return cls(**{k: np.concatenate([getattr(p, k) for p in parts])
+                      for k in COLUMNS + POLAR})
 
     def any(self) -> bool:
         """Some plot carries a code, a flight level or an address."""
@@ -142,8 +155,9 @@ class PlotAttributes:
 def of_columns(cols: Mapping[str, np.ndarray]) -> PlotAttributes | None:
     """:meth:`PlotAttributes.from_columns` of the attribute columns among ``cols`` (a
     source's batch), ``None`` when there are none."""
-    mine = {k: v for k, v in cols.items() if k in COLUMNS}
-    return PlotAttributes.from_columns(mine, len(cols["time"])) if mine else None
+    mine = {k: v for k, v in cols.items() if k in COLUMNS + POLAR}
+    return PlotAttributes.from_columns(mine, len(cols["time"])) \
+        if any(k in COLUMNS for k in mine) else None
 
 
 #: Feet per minute in one flight level per second (1 FL = 100 ft).
@@ -152,7 +166,8 @@ FPM_PER_FL_S = 6000.0
 TRACK_COLUMNS = ("flight_level", "rate_of_climb", "mode_3a", "address", "callsign",
                  "sigma_major", "sigma_minor", "sigma_orient", "sensors", "sensor_ages",
                  "age_psr", "age_ssr", "age_mds", "meas_sensor", "meas_type", "meas_mode_3a",
-                 "meas_mode_3a_vg", "meas_flight_level", "meas_flight_level_vg")
+                 "meas_mode_3a_vg", "meas_flight_level", "meas_flight_level_vg",
+                 "meas_range", "meas_bearing", "existence_probability")
 #: The plot types that count as a detection of each technology of I062/290's ages:
 #: primary (PSR), secondary (SSR: Mode A/C replies) and Mode S.
 TECHNOLOGIES = {"psr": (PRIMARY, COMBINED), "ssr": (SECONDARY, COMBINED), "mds": (MODE_S,)}
@@ -171,6 +186,15 @@ def accuracy(P: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
             np.mod(90.0 - theta, 180.0))
 
 
+def existence(score: np.ndarray) -> np.ndarray:
+    """The probability that a track is a true target from its score ``L``, the
+    log-likelihood ratio of target against false track with the prior odds in its
+    initial value: ``P_T = e^L / (1 + e^L) = 1 / (1 + e^−L)`` (Blackman & Popoli 1999,
+    §6.2), computed as ``exp(−ln(1 + e^−L))`` (``np.logaddexp``: no overflow at either
+    end; NumPy, as this module is loaded by every run and SciPy is not)."""
+    return np.exp(-np.logaddexp(0.0, -np.asarray(score, float)))
+
+
 @dataclass(frozen=True)
 class TrackAttributes:
     """What a track says besides its state, one row per track row: ``flight_level`` (FL)
@@ -186,7 +210,11 @@ class TrackAttributes:
     none is known; and what the row's own plot measured (I062/340; on a miss: absent):
     ``meas_sensor`` (its sensor id, ``-1``), ``meas_type`` (:data:`PLOT_TYPES` code, 0),
     ``meas_mode_3a`` (its code as received, ``-1``) and ``meas_flight_level`` (FL, NaN)
-    with their validity bits ``meas_mode_3a_vg``, ``meas_flight_level_vg`` (``2·V + G``)."""
+    with their validity bits ``meas_mode_3a_vg``, ``meas_flight_level_vg`` (``2·V + G``),
+    ``meas_range`` (m) and ``meas_bearing`` (degrees) its position as its sensor measured
+    it (NaN: unknown, e.g. a Cartesian sensor's);
+    and the track's ``existence_probability`` from its score (:func:`existence`), NaN
+    when unknown."""
 
     flight_level: np.ndarray
     rate_of_climb: np.ndarray
@@ -207,6 +235,9 @@ class TrackAttributes:
     meas_mode_3a_vg: np.ndarray
     meas_flight_level: np.ndarray
     meas_flight_level_vg: np.ndarray
+    meas_range: np.ndarray
+    meas_bearing: np.ndarray
+    existence_probability: np.ndarray
 
     def __len__(self) -> int:
         return len(self.mode_3a)
@@ -226,7 +257,7 @@ class TrackAttributes:
                    np.full(n, "", object), nan.copy(), nan.copy(), nan.copy(),
                    np.full(n, ABSENT, np.int64), np.zeros(n, np.int64),
                    np.full(n, ABSENT, np.int64), np.zeros(n, np.int64), nan.copy(),
-                   np.zeros(n, np.int64))
+                   np.zeros(n, np.int64), nan.copy(), nan.copy(), nan.copy())
 
     @classmethod
     def concat(cls, parts: list[TrackAttributes]) -> TrackAttributes:

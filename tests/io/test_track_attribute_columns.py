@@ -32,7 +32,10 @@ def _table(n=4, attrs=True):
         meas_mode_3a=np.array([0o1174, -1, -1, 0o7700])[:n],
         meas_mode_3a_vg=np.array([0, 0, 0, 3])[:n],
         meas_flight_level=np.array([350.25, np.nan, np.nan, -5.0])[:n],
-        meas_flight_level_vg=np.array([2, 0, 0, 1])[:n])
+        meas_flight_level_vg=np.array([2, 0, 0, 1])[:n],
+        meas_range=np.array([151234.5, np.nan, np.nan, 2000.0])[:n],
+        meas_bearing=np.array([359.75, np.nan, np.nan, 0.0])[:n],
+        existence_probability=np.array([0.5, np.nan, 0.999, 1e-6])[:n])
     return TrackTable(scan=np.arange(n), time=np.arange(n) * 1.5, track_id=np.arange(n),
                       x=rng.normal(size=n), y=rng.normal(size=n), vx=rng.normal(size=n),
                       vy=rng.normal(size=n), plot=np.array([3, -1, 5, 7])[:n],
@@ -47,7 +50,8 @@ def test_attribute_columns_round_trip(tmp_path, suffix):
     for name in ("flight_level", "rate_of_climb", "sigma_major", "sigma_minor",
                  "sigma_orient", "age_psr", "age_ssr", "age_mds", "meas_sensor", "meas_type",
                  "meas_mode_3a", "meas_mode_3a_vg", "meas_flight_level",
-                 "meas_flight_level_vg"):
+                 "meas_flight_level_vg", "meas_range", "meas_bearing",
+                 "existence_probability"):
         np.testing.assert_array_equal(getattr(back.attrs, name), getattr(t.attrs, name))
     for name in ("mode_3a", "address", "callsign", "sensors", "sensor_ages"):
         assert getattr(back.attrs, name).tolist() == getattr(t.attrs, name).tolist()
@@ -57,17 +61,18 @@ def test_csv_cells_as_written(tmp_path):
     write_tracks(_table(), tmp_path / "t.csv")
     lines = (tmp_path / "t.csv").read_text().splitlines()
     head = lines[0].split(",")
-    assert head[-19:] == ["flight_level", "rate_of_climb", "mode_3a", "address", "callsign",
+    assert head[-22:] == ["flight_level", "rate_of_climb", "mode_3a", "address", "callsign",
                           "sigma_major", "sigma_minor", "sigma_orient", "sensors",
                           "sensor_ages", "age_psr", "age_ssr", "age_mds", "meas_sensor",
                           "meas_type", "meas_mode_3a", "meas_mode_3a_vg",
-                          "meas_flight_level", "meas_flight_level_vg"]
-    assert lines[1].split(",")[-19:] == ["350", "0", "1174", "3C4591", "BOX413", "30.5",
+                          "meas_flight_level", "meas_flight_level_vg", "meas_range",
+                          "meas_bearing", "existence_probability"]
+    assert lines[1].split(",")[-22:] == ["350", "0", "1174", "3C4591", "BOX413", "30.5",
                                          "3.25", "116.8", "1;3", "0.000;12.250", "0",
                                          "12.25", "", "6412", "mode_s", "1174", "0",
-                                         "350.25", "2"]
-    assert lines[2].split(",")[-19:] == [""] * 19  # nothing known: empty cells
-    assert lines[4].split(",")[-17:-14] == ["0000", "000001", "A"]
+                                         "350.25", "2", "151234.5", "359.75", "0.5"]
+    assert lines[2].split(",")[-22:] == [""] * 22  # nothing known: empty cells
+    assert lines[4].split(",")[-20:-17] == ["0000", "000001", "A"]
 
 
 @pytest.mark.parametrize("suffix", [".csv", ".parquet"])
@@ -89,6 +94,9 @@ def test_without_attributes_the_file_is_as_before(tmp_path, suffix):
     ("sensor_ages", "1.0", "one age"),
     ("sensor_ages", "x;1", "not numbers"),
     ("sensors", "a;3", "not ids"),
+    ("existence_probability", "1.5", "outside [0, 1]"),
+    ("meas_bearing", "360", "outside [0, 360)"),
+    ("meas_range", "-3", "negative"),
 ])
 def test_a_bad_cell_is_located(tmp_path, column, value, message):
     write_tracks(_table(), tmp_path / "t.csv")

@@ -6,7 +6,8 @@ import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from mhtrack.attributes import PlotAttributes, TrackAttributes, accuracy
+from mhtrack.attributes import PlotAttributes, TrackAttributes, accuracy, existence
+from mhtrack.mht.config import MHTConfig
 from mhtrack.mht.tracker import MHTTracker
 from mhtrack.records import Scan, TrackTable
 
@@ -37,12 +38,13 @@ def test_accuracy_of_axis_aligned_ellipses_by_hand():
     np.testing.assert_allclose(orient, [90.0, 0.0])
 
 
-def _climber(n=40, rate_fl_s=0.25, callsign_every=5, drop=()):
+def _climber(n=40, rate_fl_s=0.25, callsign_every=5, drop=(), past=False, config=None):
     """One aircraft east at 200 m/s climbing from FL 200 at ``rate_fl_s``, replying
     code 4321 and address 0x3C4591 on every plot, its callsign BOX413 only on every
-    ``callsign_every``-th; no clutter; scans ``drop`` without a plot."""
+    ``callsign_every``-th; no clutter; scans ``drop`` without a plot. ``past``: the
+    rows of the track's tentative past (the history output) too."""
     rng = np.random.default_rng(3)
-    trk, outs = MHTTracker(), []
+    trk, outs = MHTTracker(config), []
     row = 0
     for k in range(n):
         if k in drop:
@@ -58,6 +60,8 @@ def _climber(n=40, rate_fl_s=0.25, callsign_every=5, drop=()):
         m = len(z)
         outs.append(trk.step(Scan(k, float(k), z, np.zeros(m, np.int64),
                                   np.arange(row, row + m), attrs=attrs)))
+        if past:
+            outs.append(trk.last_backfill)
         row += m
     return trk, TrackTable.concat(outs)
 
@@ -79,6 +83,40 @@ def test_a_climbing_track_reports_its_level_rate_code_address_and_callsign():
     major, minor, _ = accuracy(tt.P)
     np.testing.assert_array_equal(a.sigma_major, major)
     np.testing.assert_array_equal(a.sigma_minor, minor)
+
+
+def test_existence_probability_by_hand():
+    # P = 1/(1 + e^-L): L = 0 even odds, ln 3 three to one, -ln 9 one to nine
+    L = np.array([0.0, np.log(3.0), -np.log(9.0), 800.0, -800.0])
+    np.testing.assert_allclose(existence(L), [0.5, 0.75, 0.1, 1.0, 0.0], atol=1e-15)
+
+
+def test_every_row_and_its_tentative_past_carry_the_existence_of_its_score():
+    _, tt = _climber(n=20, past=True)
+    back = tt.tentative.astype(bool)
+    assert back.any() and (~back).any()  # the history output: both kinds of rows
+    p = tt.attrs.existence_probability
+    np.testing.assert_allclose(p, 1.0 / (1.0 + np.exp(-tt.score)), rtol=1e-12)
+    assert np.all((p > 0) & (p <= 1))
+
+
+def test_the_tentative_past_says_what_its_plots_measured():
+    """The backfilled rows (scans before confirmation) carry their own plot's sensor,
+    code and level as the scenario made them, the callsign of scan 0's plot and the
+    sensor that updated them, as the confirmed rows do."""
+    slow = MHTConfig(alpha=1e-9)  # an SPRT that waits for more plots: a longer past
+    _, tt = _climber(n=20, drop=(2,), past=True, config=slow)
+    back = tt.tentative.astype(bool)
+    a = tt.attrs
+    hit = back & (tt.plot >= 0)
+    assert hit.sum() >= 2 and (back & (tt.plot < 0)).any()  # scan 2: a miss
+    assert (a.meas_sensor[hit] == 0).all() and (a.meas_mode_3a[hit] == 0o4321).all()
+    np.testing.assert_array_equal(a.meas_flight_level[hit], 200.0 + 0.25 * tt.scan[hit])
+    assert (a.meas_sensor[back & (tt.plot < 0)] == -1).all()
+    assert set(a.callsign[back].tolist()) == {"BOX413"}  # scan 0's plot carried it
+    assert set(a.sensors[back].tolist()) == {"0"}
+    ages = np.array([float(v) for v in a.sensor_ages[back].tolist()])
+    np.testing.assert_allclose(ages, np.where(tt.plot[back] >= 0, 0.0, 1.0))  # 1 s scans
 
 
 def test_a_miss_reports_the_predicted_level():

@@ -47,7 +47,7 @@ def test_plain_loops_equal_numpy(seed: int, r: int, per_row: bool) -> None:
     s = _store(rng, M, r)
     dt = rng.uniform(0.1, 8, M) if per_row else 2.5
     ref = model.predict(s, dt)
-    mubar, pim, Q = model._mixing(s.mu, dt)
+    mubar, pim, Q = model.mixing(s.mu, dt)
     out = States(np.empty((M, 4)), np.empty((M, 4, 4)), np.empty(s.xm.shape),
                  np.empty(s.Pm.shape), mubar)
     imm_rows.predict_rows(s.xm, s.Pm, s.mu, mubar, pim, np.atleast_1d(dt),

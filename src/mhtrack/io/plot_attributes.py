@@ -62,6 +62,9 @@ def read_attributes(f: Frame, order: np.ndarray | None = None) -> PlotAttributes
             cols[name] = _parsed(f, name, parse)
     if f.has("callsign"):
         cols["callsign"] = np.array([s or "" for s in _text(f, "callsign")], object)
+    if f.has("range") and f.has("bearing"):  # polar plots: their measured position
+        cols["polar_range"] = f.floats("range", nullable=True)
+        cols["polar_bearing"] = f.floats("bearing", nullable=True)
     out = PlotAttributes.from_columns(cols, f.n)
     return out if order is None else out.take(order)
 
@@ -129,7 +132,8 @@ def decoded_attributes(p: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
     """The attribute columns (:data:`~mhtrack.attributes.COLUMNS`, codes and addresses as
     integers) of decoded ASTERIX plot columns (:data:`mhtrack.io.asterix.decode.
     PLOT_COLUMNS`: ``mode_3a`` octal and ``address`` hexadecimal text, the validity bits
-    as ``2·V + G``)."""
+    as ``2·V + G``), and the measured slant range and bearing as
+    :data:`~mhtrack.attributes.POLAR`."""
     n = len(p["time"])
     out: dict[str, np.ndarray] = {
         "plot_type": np.asarray(p.get("plot_type", np.zeros(n, np.int64)), np.int64),
@@ -145,4 +149,7 @@ def decoded_attributes(p: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
     for base in ("mode_3a", "flight_level"):
         vg = np.asarray(p.get(f"{base}_vg", np.zeros(n, np.int64)), np.int64)
         out[f"{base}_v"], out[f"{base}_g"] = (vg >> 1) & 1, vg & 1
+    if "slant_range" in p and "bearing" in p:  # the measured position (I048/040)
+        out["polar_range"] = np.asarray(p["slant_range"], float)
+        out["polar_bearing"] = np.asarray(p["bearing"], float)
     return out

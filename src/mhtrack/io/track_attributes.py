@@ -8,7 +8,9 @@ attributes"), written when the plots had attributes and read back into
 (ids joined by ``;``) and ``sensor_ages`` (seconds, the same order), ``age_psr``,
 ``age_ssr``, ``age_mds`` (seconds since the last update of each technology), and the
 row's plot's measurements ``meas_sensor``, ``meas_type`` (plot type name),
-``meas_mode_3a``, ``meas_mode_3a_vg``, ``meas_flight_level``, ``meas_flight_level_vg``. Empty cells
+``meas_mode_3a``, ``meas_mode_3a_vg``, ``meas_flight_level``, ``meas_flight_level_vg``,
+``meas_range`` (m), ``meas_bearing`` (degrees), and
+``existence_probability`` (``1/(1 + e^−L)`` of the row's score). Empty cells
 (Parquet nulls) are absent values; every column is written once any is, so that a file's
 columns do not depend on its rows.
 """
@@ -32,7 +34,8 @@ from mhtrack.io._frame import FLOAT, INT, TIME, Frame, float_array, int_array
 from mhtrack.io.plot_attributes import _parsed, _text, _type_code
 
 _NUMBERS = ("flight_level", "rate_of_climb", "sigma_major", "sigma_minor", "sigma_orient",
-            "age_psr", "age_ssr", "age_mds", "meas_flight_level")
+            "age_psr", "age_ssr", "age_mds", "meas_flight_level", "meas_range", "meas_bearing",
+            "existence_probability")
 #: Integer columns and their absent value (written as an empty cell).
 _INTS = {"meas_sensor": -1, "meas_mode_3a_vg": 0, "meas_flight_level_vg": 0}
 #: Column kinds for :func:`~mhtrack.io._frame.read_frame` (TIME: read as text).
@@ -85,6 +88,13 @@ def read_track_attributes(f: Frame) -> TrackAttributes | None:
     for name in ("age_psr", "age_ssr", "age_mds"):
         v = cols[name]
         f.check(v < 0, name, lambda r, v=v: f"age {num(v[r])} s is negative")
+    mr, mb = cols["meas_range"], cols["meas_bearing"]
+    f.check(mr < 0, "meas_range", lambda r: f"range {num(mr[r])} m is negative")
+    f.check((mb < 0) | (mb >= 360), "meas_bearing",
+            lambda r: f"bearing {num(mb[r])}° is outside [0, 360)")
+    p = cols["existence_probability"]
+    f.check((p < 0) | (p > 1), "existence_probability",
+            lambda r: f"probability {num(p[r])} is outside [0, 1]")
     o = cols["sigma_orient"]
     f.check((o < 0) | (o >= 180), "sigma_orient",
             lambda r: f"orientation {num(o[r])}° is outside [0, 180)")

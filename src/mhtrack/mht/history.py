@@ -17,8 +17,9 @@ from the scan after it.
 
 Backfilled rows are *tentative*: at their scans the tracker had not yet decided that the
 track is a target. When the plots had attributes, the log also keeps each tentative
-leaf's code, address and vertical state, so that these rows carry the track's identity
-as it was at their scans (callsign, sensors and the measured plot are not logged).
+leaf's code, address and vertical state and what its plot measured (``meas_*``, its
+callsign), so that these rows carry the track's identity as it was at their scans, and
+the callsign, sensors and ages of the chain's plots up to each row (:func:`carried`).
 :attr:`mhtrack.records.TrackTable.tentative` marks them, so the online
 view (``tentative == 0``) is always recoverable from a history output.
 """
@@ -30,10 +31,19 @@ from dataclasses import dataclass, fields, replace
 
 import numpy as np
 
-from mhtrack.attributes import FPM_PER_FL_S, TrackAttributes
+from mhtrack.attributes import TECHNOLOGIES, TrackAttributes, existence
 from mhtrack.kernels import changes
+from mhtrack.mht.attribute_scores import positions
+from mhtrack.mht.track_attributes import identity, measured
 from mhtrack.mht.tree import Leaves
-from mhtrack.records import TrackTable
+from mhtrack.records import Scan, TrackTable
+
+#: The columns of what a logged leaf's plot measured
+#: (:func:`~mhtrack.mht.track_attributes.measured`), integers among them :data:`_INT`.
+MEASURED = ("meas_sensor", "meas_type", "meas_mode_3a", "meas_mode_3a_vg",
+            "meas_flight_level", "meas_flight_level_vg", "meas_range", "meas_bearing")
+_INT = {"meas_sensor", "meas_type", "meas_mode_3a", "meas_mode_3a_vg",
+        "meas_flight_level_vg"}
 
 
 @dataclass(frozen=True, slots=True)
@@ -53,6 +63,10 @@ class _Logged:
     #: when some leaf has one (plots with attributes): ``None`` otherwise
     ident: np.ndarray | None = None
     level: np.ndarray | None = None
+    #: what each leaf's plot at this scan measured (:data:`MEASURED` columns, NaN/absent
+    #: codes on a miss) and the callsign it carried (``""`` none); with ``ident`` only
+    meas: np.ndarray | None = None
+    callsign: np.ndarray | None = None
     #: each model's filtered state (kept for the smoother only: ``models``)
     mu: np.ndarray | None = None
     xm: np.ndarray | None = None
@@ -60,7 +74,8 @@ class _Logged:
 
     @classmethod
     def of(cls, scan: int, time: float, leaves: Leaves,
-           rows: np.ndarray | None = None, models: bool = False) -> _Logged:
+           rows: np.ndarray | None = None, models: bool = False,
+           plots: Scan | None = None) -> _Logged:
         tentative = leaves.track < 0
         sel = (tentative if rows is None else tentative & rows).nonzero()[0]
         node = leaves.node[sel]
@@ -73,23 +88,35 @@ class _Logged:
         known = bool((ident >= 0).any() or np.isfinite(level[:, 0]).any())
         m = (leaves.mu.take(sel, axis=0), leaves.xm.take(sel, axis=0),
              leaves.Pm.take(sel, axis=0)) if models else (None, None, None)
+        plot = leaves.window[:, -1][sel]
+        meas = callsign = None
+        if known and plots is not None and plots.attrs is not None:
+            j = positions(plots.rows, plot) if len(plots) else np.full(plot.size, -1)
+            got = measured(plots.attrs, j, plots.sensor)
+            meas = np.column_stack([got[k] for k in MEASURED]).astype(float)
+            cs = plots.attrs.callsign[np.maximum(j, 0)] if len(plots) else np.full(j.size, "")
+            callsign = np.where(j >= 0, cs, "").astype("U8")  # stripped when backfilled
         return cls(np.array([scan], np.int64), np.array([time], float), node,
                    leaves.parent[sel], leaves.x.take(sel, axis=0), leaves.P.take(sel, axis=0),
-                   leaves.window[:, -1][sel], leaves.score[sel], leaves.time[sel],
-                   ident if known else None, level if known else None, *m)
+                   plot, leaves.score[sel], leaves.time[sel],
+                   ident if known else None, level if known else None, meas, callsign, *m)
 
     def attributes(self, j: np.ndarray) -> TrackAttributes | None:
         """The identity of logged leaves ``j`` at their own times (code, address, flight
         level and rate of their vertical state, as :mod:`mhtrack.mht.track_attributes`
-        reports a track; the accuracy of their covariance), ``None`` when none was
+        reports a track; the accuracy of their covariance and the existence probability
+        of their score), ``None`` when none was
         logged."""
         if self.ident is None or self.level is None:
             return None
-        lv, ident = self.level.take(j, axis=0), self.ident.take(j, axis=0)
+        meas = {} if self.meas is None or self.callsign is None else {
+            "callsign": np.char.strip(self.callsign[j]).astype(object),
+            **{k: self.meas[j, i].astype(np.int64 if k in _INT else float)
+               for i, k in enumerate(MEASURED)}}
         return replace(TrackAttributes.absent(j.size, self.P.take(j, axis=0)),
-                       flight_level=lv[:, 0] + lv[:, 1] * (self.t[j] - lv[:, 5]),
-                       rate_of_climb=lv[:, 1] * FPM_PER_FL_S, mode_3a=ident[:, 0].copy(),
-                       address=ident[:, 1].copy())
+                       **identity(self.level.take(j, axis=0), self.ident.take(j, axis=0),
+                                  self.t[j]), existence_probability=existence(self.score[j]),
+                       **meas)
 
 
 class TentativeHistory:
@@ -110,13 +137,15 @@ class TentativeHistory:
         self._claimed: deque[np.ndarray] = deque(maxlen=max(self.depth, 1))
 
     def record(self, scan: int, time: float, leaves: Leaves,
-               rows: np.ndarray | None = None, rep: np.ndarray | None = None) -> None:
+               rows: np.ndarray | None = None, rep: np.ndarray | None = None,
+               plots: Scan | None = None) -> None:
         """Keep the tentative leaves (``track < 0``) of this scan, and the plots of the
         tracks reported at it (:meth:`Leaves.reported`; ``rep``: that mask, when known,
         not modified); ``rows`` (mask): of those leaves only (the leaves a frame
-        stepped), as if given ``leaves.take(rows)``."""
+        stepped), as if given ``leaves.take(rows)``; ``plots``: the frame's plots, whose
+        attributes give what each leaf's plot measured."""
         if self.depth:
-            self._log.append(_Logged.of(scan, time, leaves, rows, self.models))
+            self._log.append(_Logged.of(scan, time, leaves, rows, self.models, plots))
             rep = leaves.reported() if rep is None else rep
             if rows is not None:
                 rep = rep & rows
@@ -171,7 +200,7 @@ class TentativeHistory:
             if wait_cur.size:
                 cur, tid = np.concatenate((cur, wait_cur)), np.concatenate((tid, wait_tid))
         parts.reverse()
-        return TrackTable.concat(parts).sorted()
+        return carried(TrackTable.concat(parts).sorted())
 
     # ------------------------------------------------------------- persistence
     def arrays(self) -> dict[str, np.ndarray]:
@@ -194,6 +223,39 @@ class TentativeHistory:
             got.setdefault("t", np.full(got["node"].size, float(got["time"][0])))
             self._log.append(_Logged(**got))
             self._claimed.append(np.asarray(arrays[f"{i}__claimed"], np.int64))
+
+
+def carried(past: TrackTable) -> TrackTable:
+    """``past`` (a backfill, by scan then track id) with each row's callsign, sensors and
+    their ages, and the technologies' ages, as :mod:`mhtrack.mht.track_attributes`
+    reports a confirmed track, from the plots of the track's own chain up to that row:
+    the callsign of the latest plot that carried one, each sensor's (each technology's)
+    latest plot time against the row's time."""
+    a = past.attrs
+    if a is None or not (a.meas_sensor >= 0).any():
+        return past
+    sensors, ages = a.sensors.copy(), a.sensor_ages.copy()
+    callsign, tech = a.callsign.copy(), np.full((len(past), len(TECHNOLOGIES)), np.nan)
+    for tid in np.unique(past.track_id).tolist():
+        last: dict[int, float] = {}
+        when: dict[int, float] = {}
+        name = ""
+        for r in np.flatnonzero(past.track_id == tid).tolist():  # in time order
+            t = float(past.time[r])
+            if a.meas_sensor[r] >= 0:
+                last[int(a.meas_sensor[r])] = t
+                for k, types in enumerate(TECHNOLOGIES.values()):
+                    if a.meas_type[r] in types:
+                        when[k] = t
+            name = str(callsign[r]) or name
+            callsign[r] = name
+            sensors[r] = ";".join(str(s) for s in sorted(last))
+            ages[r] = ";".join(f"{max(t - last[s], 0.0):.3f}" for s in sorted(last))
+            for k, w in when.items():
+                tech[r, k] = max(t - w, 0.0)
+    return replace(past, attrs=replace(a, callsign=callsign, sensors=sensors,
+                                       sensor_ages=ages, age_psr=tech[:, 0],
+                                       age_ssr=tech[:, 1], age_mds=tech[:, 2]))
 
 
 def _models(log: _Logged, j: np.ndarray) -> dict[str, np.ndarray]:

@@ -12,6 +12,8 @@ address, its latest callsign and its position's accuracy
   (:class:`Callsigns`); identification comes in Mode S replies only when the aircraft
   is interrogated for it (BDS 2,0), not with every plot.
 * **Accuracy**: the position covariance's ellipse (:func:`~mhtrack.attributes.accuracy`).
+* **Existence probability**: ``1/(1 + e^−L)`` of the leaf's score ``L``
+  (:func:`~mhtrack.attributes.existence`).
 * **Sensors**: those whose plots updated the confirmed track, with the age of each one's
   last update at the row's time (:class:`~mhtrack.mht.sensor_ages.SensorAges`), and the
   age of its last PSR, SSR and Mode S update (by the plots' types).
@@ -21,7 +23,13 @@ from __future__ import annotations
 
 import numpy as np
 
-from mhtrack.attributes import FPM_PER_FL_S, PlotAttributes, TrackAttributes, accuracy
+from mhtrack.attributes import (
+    FPM_PER_FL_S,
+    PlotAttributes,
+    TrackAttributes,
+    accuracy,
+    existence,
+)
 from mhtrack.mht.attribute_scores import positions
 from mhtrack.mht.sensor_ages import SensorAges, technology_updates
 from mhtrack.mht.tree import Leaves
@@ -83,31 +91,37 @@ def track_attributes(leaves: Leaves, sel: np.ndarray, attrs: PlotAttributes,
     """The attributes (module docstring) of the reported leaves ``sel`` (in row order),
     from the frame's plots' ``attrs`` (row ids ``rows``, sensors ``sensor``, times
     ``plot_t``) at frame time ``time``."""
-    lv = leaves.level.take(sel, axis=0)
     t = leaves.time.take(sel)
-    h = lv[:, 0] + lv[:, 1] * (t - lv[:, 5])
     plot = leaves.window[:, -1].take(sel)
     j = positions(rows, plot) if rows.size else np.full(sel.size, -1)
     cs = attrs.callsign[np.maximum(j, 0)] if len(attrs) else np.full(sel.size, "", object)
     seen = np.array([str(c).strip() if k >= 0 else "" for c, k in
                      zip(cs.tolist(), j.tolist(), strict=True)], "U8")
-    ident = leaves.ident.take(sel, axis=0)
     major, minor, orient = accuracy(leaves.P.take(sel, axis=0))
     tid = leaves.track.take(sel)
     hit = j >= 0
-    ages.update(tid[hit], sensor[j[hit]], plot_t[j[hit]], time)
+    upd = [(tid[hit], sensor[j[hit]], plot_t[j[hit]])]
     if len(attrs):
-        ages.update(*technology_updates(tid[hit], attrs.plot_type[j[hit]], plot_t[j[hit]]),
-                    time)
+        upd.append(technology_updates(tid[hit], attrs.plot_type[j[hit]], plot_t[j[hit]]))
+    ages.update(*(np.concatenate(c) for c in zip(*upd, strict=True)), time)  # once a report
     sensors, age = ages.of(tid, t)
     tech = ages.technologies(tid, t)
     return TrackAttributes(
-        flight_level=h, rate_of_climb=lv[:, 1] * FPM_PER_FL_S,
-        mode_3a=ident[:, 0].copy(), address=ident[:, 1].copy(),
+        **identity(leaves.level.take(sel, axis=0), leaves.ident.take(sel, axis=0), t),
         callsign=callsigns.latest(leaves.track.take(sel), seen, time).astype(object),
         sigma_major=major, sigma_minor=minor, sigma_orient=orient, sensors=sensors,
         sensor_ages=age, age_psr=tech[:, 0], age_ssr=tech[:, 1], age_mds=tech[:, 2],
-        **measured(attrs, j, sensor))
+        **measured(attrs, j, sensor), existence_probability=existence(leaves.score.take(sel)))
+
+
+def identity(level: np.ndarray, ident: np.ndarray, t: np.ndarray
+             ) -> dict[str, np.ndarray]:
+    """``flight_level``, ``rate_of_climb``, ``mode_3a`` and ``address`` (module docstring)
+    of leaves with vertical states ``level`` and ``ident`` (rows of ``Leaves.level``,
+    ``Leaves.ident``) at their times ``t``: ``ĥ = h + ḣ (t − t₀)``, ``ḣ`` in ft/min."""
+    return {"flight_level": level[:, 0] + level[:, 1] * (t - level[:, 5]),
+            "rate_of_climb": level[:, 1] * FPM_PER_FL_S, "mode_3a": ident[:, 0].copy(),
+            "address": ident[:, 1].copy()}
 
 
 def measured(attrs: PlotAttributes, j: np.ndarray, sensor: np.ndarray
@@ -128,4 +142,6 @@ def measured(attrs: PlotAttributes, j: np.ndarray, sensor: np.ndarray
             "meas_mode_3a": take(attrs.mode_3a, -1),
             "meas_mode_3a_vg": take(2 * attrs.mode_3a_v + attrs.mode_3a_g, 0),
             "meas_flight_level": take(attrs.flight_level, np.nan),
-            "meas_flight_level_vg": take(2 * attrs.flight_level_v + attrs.flight_level_g, 0)}
+            "meas_flight_level_vg": take(2 * attrs.flight_level_v + attrs.flight_level_g, 0),
+            "meas_range": take(attrs.polar_range, np.nan),
+            "meas_bearing": take(attrs.polar_bearing, np.nan)}

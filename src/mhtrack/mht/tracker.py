@@ -313,7 +313,7 @@ class MHTTracker:
         confirmed tracks of the best hypothesis that the frame ``stepped`` (mask;
         ``None``: all)."""
         rep = leaves.reported()
-        self._history.record(frame.index, frame.time, leaves, stepped, rep)
+        self._history.record(frame.index, frame.time, leaves, stepped, rep, frame.scan)
         self._book.record(leaves, rep, frame.time)
         self._forget(leaves, frame.rows, rep)
         self._leaves, self._last_time, self._last_index = leaves, frame.time, frame.index

@@ -81,11 +81,11 @@ class CVModelSet(MotionModel):
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Mixing and per-model prediction: ``(x⁻, P⁻, μ̄)`` (module docstring); ``dt``
         one interval or one per row."""
-        mubar, pim, Q = self._mixing(mu, dt)
+        mubar, pim, Q = self.mixing(mu, dt)
         xp, Pp = _mix_predict(xm, Pm, mu, mubar, pim, dt, Q)
         return xp, Pp, mubar
 
-    def _mixing(self, mu: np.ndarray, dt: float | np.ndarray) -> tuple[np.ndarray, ...]:
+    def mixing(self, mu: np.ndarray, dt: float | np.ndarray) -> tuple[np.ndarray, ...]:
         """``(μ̄, π, Q)`` of :meth:`predict_models`: ``π`` (1, r, r) or (M, r, r), ``Q``
         (r, 4, 4) or (M, r, 4, 4)."""
         if np.ndim(dt) == 0:  # one interval: π and Q are the interval's (cached) constants
@@ -107,7 +107,7 @@ class CVModelSet(MotionModel):
         temporaries stay in the CPU cache: every operation is row by row, so the floats
         are those of one pass (``tests/models/test_inplace_identity.py``)."""
         xm, Pm, mu = states.xm, states.Pm, states.mu
-        mubar, pim, Q = self._mixing(mu, dt)
+        mubar, pim, Q = self.mixing(mu, dt)
         M = len(mu)
         if (k := imm_rows.kernels(M)) is not None:  # the same floats, compiled
             out = States(np.empty((M, 4)), np.empty((M, 4, 4)), np.empty(xm.shape),
@@ -226,7 +226,7 @@ def _mix_predict(xm: np.ndarray, Pm: np.ndarray, mu: np.ndarray, mubar: np.ndarr
                  pim: np.ndarray, dt: float | np.ndarray,
                  Q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Mixing (``μ_i|j``, ``x0_j``, ``P0_j``) and each model's prediction, row by row,
-    given ``μ̄``, ``π`` and ``Q`` (:meth:`CVModelSet._mixing`)."""
+    given ``μ̄``, ``π`` and ``Q`` (:meth:`CVModelSet.mixing`)."""
     w = pim * mu[:, :, None] / np.maximum(mubar, 1e-300)[:, None, :]  # (M,i,j)
     x0 = _mix_sum(w[..., None], xm[:, :, None, :])  # (M, j, 4)
     d = xm[:, :, None, :] - x0[:, None, :, :]  # (M, i, j, 4)
@@ -250,7 +250,7 @@ def _transition(r: int, mode_time: float, dt: float) -> np.ndarray:
 @functools.lru_cache(maxsize=64)
 def _interval_constants(r: int, mode_time: float, sigmas: tuple[float, ...],
                         dt: float) -> tuple[np.ndarray, np.ndarray]:
-    """``(π[None], Q)`` of one interval for :meth:`CVModelSet._mixing`: :func:`_transition`
+    """``(π[None], Q)`` of one interval for :meth:`CVModelSet.mixing`: :func:`_transition`
     as (1, r, r) and :func:`_process_noise` (read-only; one cache look-up a scan: 0.05
     against 74 µs computed, ~5 % of a crossing scan — ``docs/performance.md``, *Speed
     idioms in one place*)."""

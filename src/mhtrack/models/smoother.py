@@ -123,12 +123,10 @@ def _imm(motion: CVModelSet, t: np.ndarray, rank: np.ndarray, mu: np.ndarray,
     for s in range(1, int(rank.max()) + 1):
         k = (rank == s).nonzero()[0]
         dt = t[k + 1] - t[k]
-        pi = motion.transition(dt)  # (M, r, r)
-        mubar = np.einsum("mi,mij->mj", mu[k], pi)
+        mubar, pi, Q = motion.mixing(mu[k], dt)  # π (M, r, r), Q (M, r, 4, 4)
         b = pi * mu[k][:, :, None] * (mus[k + 1] / np.maximum(mubar, 1e-300))[:, None, :]
         mus_k = b.sum(axis=2)
         w = b / np.maximum(mus_k, 1e-300)[:, :, None]  # w[m, i, j] = w_j|i
-        Q = np.stack([ConstantVelocity(sg).Q(dt) for sg in motion.sigmas], axis=1)  # (M,j,4,4)
         # pairs (i, j): model i's filtered state towards model j's smoothed one
         xij, Pij = _gain_step(
             np.repeat(Pm[k][:, :, None], r, axis=2), np.repeat(xm[k][:, :, None], r, axis=2),

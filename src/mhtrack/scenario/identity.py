@@ -145,7 +145,9 @@ def add_attributes(plots: PlotTable, identities: dict[int, Identity],
     if plots.origin is None:
         raise ValueError("plots without origin: attributes are drawn per target")
     n = len(plots)
-    cols = PlotAttributes.absent(n).columns()
+    cols = PlotAttributes.absent(n).columns(polar=True)
+    if plots.range is not None and plots.bearing is not None:  # the measured position
+        cols["polar_range"], cols["polar_bearing"] = plots.range, plots.bearing
     cols["plot_type"][:] = PRIMARY
     key = plots.sensor.astype(np.int64) * (1 << 32) + plots.origin
     target = plots.origin >= 0

@@ -92,7 +92,7 @@ class TableSource(Source):
         if c.origin is not None:
             cols["origin"] = c.origin
         if c.attrs is not None:
-            cols.update(c.attrs.columns())
+            cols.update(c.attrs.columns(polar=True))
         for a in range(0, c.time.size, CHUNK):
             yield from stream.push({k: v[a:a + CHUNK] for k, v in cols.items()})
         yield from stream.finish()

@@ -117,3 +117,8 @@ def test_decoder_and_source_give_the_attributes_back(attributed: Path, fast: boo
             np.testing.assert_allclose(w, v, atol=0.125)
         else:
             assert np.array_equal(w, v, equal_nan=w.dtype.kind == "f"), name
+    # the plot's measured position (I062/340 POS of the tracks): I048/040 as decoded —
+    # the slant range, and the plots file's bearing within THETA's LSB
+    assert np.array_equal(back.polar_range, rec.plots["slant_range"])
+    d = (back.polar_bearing - want.polar_bearing + 180.0) % 360.0 - 180.0
+    assert np.abs(d).max() <= 360.0 / 2**16 / 2 + 1e-9

@@ -45,7 +45,11 @@ def _table(n=400):
         meas_mode_3a=np.where(some[9] & some[10], rng.integers(0, 0o10000, n), -1),
         meas_mode_3a_vg=np.where(some[9], rng.integers(0, 4, n), 0),
         meas_flight_level=np.where(some[9] & some[11], rng.uniform(-10, 450, n), np.nan),
-        meas_flight_level_vg=np.where(some[9], rng.integers(0, 4, n), 0))
+        meas_flight_level_vg=np.where(some[9], rng.integers(0, 4, n), 0),
+        # its measured position: ranges beyond I062/340 POS's 256 NM are not written
+        meas_range=np.where(some[9] & some[10], rng.uniform(0, 500e3, n), np.nan),
+        meas_bearing=np.where(some[9] & some[10], rng.uniform(0, 360, n), np.nan),
+        existence_probability=np.where(some[0], rng.random(n), np.nan))
     return TrackTable(scan=np.arange(n), time=1000.0 + np.arange(n) * 0.25,
                       track_id=rng.integers(0, 5000, n), x=rng.uniform(-2e5, 2e5, n),
                       y=rng.uniform(-2e5, 2e5, n), vx=rng.uniform(-250, 250, n),
@@ -118,7 +122,8 @@ def _compare(tracks: TrackTable, items: list[dict]) -> None:
 
 def _wrong_340(got: dict | None, a: TrackAttributes, i: int) -> list[str]:
     """I062/340 against the row's plot: SID = SAC·256 + SIC, TYP (1 PSR, 2 SSR, 3 both,
-    5 Mode S), MDA code with V, G, MDC level within ¼ FL with V, G."""
+    5 Mode S), MDA code with V, G, MDC level within ¼ FL with V, G, POS range within
+    1/256 NM and bearing within 360°/2¹⁶ (modulo 360°; absent beyond 256 NM)."""
     if (got is None) != (a.meas_sensor[i] < 0):
         return ["340 present"]
     if got is None:
@@ -135,6 +140,11 @@ def _wrong_340(got: dict | None, a: TrackAttributes, i: int) -> list[str]:
     if (mda is None) != (code < 0) or (mda is not None and (
             mda["Mode3A"], mda["V"], mda["G"]) != (code_text(code), vg >> 1, vg & 1)):
         bad.append("340 MDA")
+    pos, r, b = got.get("POS"), a.meas_range[i], a.meas_bearing[i]
+    if (pos is None) != (np.isnan(r) or r / 1852.0 > 65535 / 256) or (pos is not None and (
+            abs(pos["RHO"] * 1852.0 - r) > 1852.0 / 256
+            or abs((pos["THETA"] - b + 180.0) % 360.0 - 180.0) > 360.0 / 65536)):
+        bad.append("340 POS")
     mdc, fl = got.get("MDC"), a.meas_flight_level[i]
     vg = int(a.meas_flight_level_vg[i])
     if (mdc is None) != np.isnan(fl) or (mdc is not None and (
@@ -212,4 +222,11 @@ def test_a_tracker_run_exports_its_attributes(tmp_path):
     upd = online & (tracks.plot >= 0)  # a row with a plot says what that plot measured
     assert (tracks.attrs.meas_sensor[upd] >= 0).all()
     assert (tracks.attrs.meas_sensor[tracks.plot < 0] < 0).all()
+    # ... and where it was, as its radar measured it: the plots file's range and bearing
+    measured = np.genfromtxt(tmp_path / "plots.csv", delimiter=",", names=True)
+    k = tracks.plot[upd]
+    np.testing.assert_allclose(tracks.attrs.meas_range[upd], measured["range"][k], rtol=1e-12)
+    np.testing.assert_allclose(tracks.attrs.meas_bearing[upd], measured["bearing"][k],
+                               rtol=1e-12)
+    assert np.isnan(tracks.attrs.meas_range[tracks.plot < 0]).all()
     _compare(tracks, _decoded(tmp_path / "export.ast"))

@@ -7,10 +7,13 @@ characters of the 6-bit ICAO set), 500 subfields APC (σ of x and y, 0.5 m) and 
 target": our callsigns come from Mode S replies, I048/240; CHR the callsign) and 290
 system track update ages PSR, SSR and MDS (¼ s, 8 bits: an age beyond 63.75 s is written
 as 63.75 s, saturated, as the item cannot hold more), and 340 measured information of
-the row's own plot: SID (the sensor id as SAC·256 + SIC), TYP (plot type: 1 PSR, 2 SSR,
-3 SSR + PSR, 5 Mode S — roll-call: all-call and roll-call replies are not told apart
-here), MDA (the code as received with its V, G; L 0) and MDC (its Mode C level, ¼ FL,
-with V, G). Each item only where its value is known.
+the row's own plot: SID (the sensor id as SAC·256 + SIC), POS (its measured range, 1/256
+NM, and bearing, 360°/2¹⁶; a range beyond the item's 256 NM is not written), TYP (plot
+type: 1 PSR, 2 SSR, 3 SSR + PSR, 5 Mode S — roll-call: all-call and roll-call replies
+are not told apart here), MDA (the code as received with its V, G; L 0) and MDC (its
+Mode C level, ¼ FL, with V, G). Each item only where its value is known. HEIGHT (the
+height a 3-D radar measured) is not written: no plot source here gives one (Mode C is
+MDC).
 
 σx, σy and Pxy come from the tracks file's ellipse (σ major ``M``, minor ``m``, the
 major axis' bearing ``β`` from north): with the axis ``u = (sin β, cos β)``,
@@ -29,6 +32,8 @@ import numpy as np
 import mhtrack.io.asterix._lib as _lib
 from mhtrack.attributes import COMBINED, MODE_S, PRIMARY, SECONDARY, TrackAttributes, code_text
 
+#: The international nautical mile (m).
+NM = 1852.0
 #: I062/340 TYP of our plot types.
 TYP340 = {PRIMARY: 1, SECONDARY: 2, COMBINED: 3, MODE_S: 5}
 #: Characters of I062/380 ID (ICAO 6-bit: A–Z, 0–9, space).
@@ -44,7 +49,16 @@ def lsb_attributes() -> dict[str, float]:
             "m": float(apc.create((("X", 1), ("Y", 1))).variation.get_item("X")
                        .variation.content.as_quantity("m")),
             "age": float(rec.spec("290").create({"PSR": 1}).variation.get_item("PSR")
-                         .variation.content.as_quantity("s"))}
+                         .variation.content.as_quantity("s")),
+            **_lsb_pos(rec)}
+
+
+def _lsb_pos(rec: Any) -> dict[str, float]:
+    """LSBs of I062/340 POS: RHO (m, from NM of 1 852 m) and THETA (degrees)."""
+    pos = rec.spec("340").cv_rule.cv_variation.cv_items_dict["POS"].create(
+        (("RHO", 1), ("THETA", 1))).variation
+    return {"rho_m": float(pos.get_item("RHO").variation.content.as_quantity("NM")) * NM,
+            "theta_deg": float(pos.get_item("THETA").variation.content.as_quantity("°"))}
 
 
 def cartesian(a: TrackAttributes) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -88,6 +102,9 @@ def attribute_items(a: TrackAttributes, check: Callable[..., None]
           lambda r: f"measured flight level {a.meas_flight_level[r]:g} beyond I062/340 MDC")
     check(a.meas_sensor > 0xFFFF, "meas_sensor", lambda r: f"sensor {a.meas_sensor[r]} "
           "is not SAC·256 + SIC (I062/340 SID)")
+    rho = np.round(np.nan_to_num(a.meas_range) / L["rho_m"]).astype(np.int64)
+    theta = np.round(np.nan_to_num(a.meas_bearing) / L["theta_deg"]).astype(np.int64) % 65536
+    pos = np.isfinite(a.meas_range) & np.isfinite(a.meas_bearing) & (rho <= 0xFFFF)
     ages = {k: (np.isfinite(v), np.clip(np.round(np.nan_to_num(v) / L["age"]), 0, 0xFF)
                 .astype(np.int64))
             for k, v in (("PSR", a.age_psr), ("SSR", a.age_ssr), ("MDS", a.age_mds))}
@@ -114,6 +131,8 @@ def attribute_items(a: TrackAttributes, check: Callable[..., None]
             out["290"] = age
         if a.meas_sensor[i] >= 0:
             out["340"] = measured_item(a, i, int(mfl[i]))
+            if pos[i]:
+                out["340"]["POS"] = (("RHO", int(rho[i])), ("THETA", int(theta[i])))
         if known[i]:
             out["500"] = {"APC": (("X", int(ax[i])), ("Y", int(ay[i]))),
                           "COV": int(cov[i])}

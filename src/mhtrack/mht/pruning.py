@@ -128,7 +128,8 @@ def n_scan_keep(tree: np.ndarray, oldest: np.ndarray, chosen: np.ndarray,
 
     Trees not in the best hypothesis keep their other leaves, and so do the leaves
     marked in ``defer`` (L,) (``MHTConfig.defer_tentative``: the tentative trees' —
-    rule 1 waits until the tree is confirmed; rule 2 still holds).
+    rule 1 waits until the tree is confirmed, a larger N for them alone; rule 2 still
+    holds).
 
     ``window`` (L, W), frames of several sensors (each tree's columns are its own looks):
     rule 2 holds for the chosen leaves' plots at their own ``k − N`` found in *any*

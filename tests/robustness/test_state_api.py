@@ -116,6 +116,8 @@ CASES = [
     ("async", ("clutter_state", "inner", 0, "inner", "count"), -1, "clutter_state.count"),
     ("async", ("clutter_state", "inner", 0, "inner", "mixture", "background_box"), [],
      "clutter_state.mixture.background_box"),
+    # a KeyError at step: pending frames of a radar without their start time
+    ("async", ("clutter_state", "start"), {}, "clutter_state.start"),
 ]
 
 

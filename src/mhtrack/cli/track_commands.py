@@ -91,6 +91,34 @@ def birth_options(f: Callable[..., Any]) -> Callable[..., Any]:
     return f
 
 
+def young_track_options(f: Callable[..., Any]) -> Callable[..., Any]:
+    """``--startup-density`` and ``--defer-tentative``: how the MHT treats the targets a
+    run starts on and its young trees (``docs/mht.md``; issue 30's dense scene)."""
+    opts = [
+        click.option("--startup-density", is_flag=True, help="Score the first scans' plots "
+                     "with the density of targets not yet detected, estimated from the "
+                     "first scan's plots in excess of the clutter, instead of λv "
+                     "(MHTConfig.startup_density; --birth every-plot only)."),
+        click.option("--defer-tentative", is_flag=True, help="N-scan pruning does not "
+                     "commit a tentative tree to its chosen branch until the tree is "
+                     "confirmed (MHTConfig.defer_tentative)."),
+    ]
+    for opt in reversed(opts):
+        f = opt(f)
+    return f
+
+
+def young_track_fields(startup_density: bool, defer_tentative: bool,
+                       birth: str | None) -> dict[str, Any]:
+    """The :class:`~mhtrack.pipeline.TrackOptions` fields of :func:`young_track_options`
+    (``None``: not given); ``--startup-density`` with another birth is a usage error."""
+    if startup_density and birth not in (None, EVERY_PLOT):
+        raise click.UsageError(f"--startup-density goes with --birth {EVERY_PLOT} "
+                               f"(not {birth})")
+    return {"startup_density": True if startup_density else None,
+            "defer_tentative": True if defer_tentative else None}
+
+
 _OUTPUT_HELP = (
     "history: each confirmed track also at the scans before its confirmation, back to its "
     "first plot (at most MHTConfig.history_scans back; from the seed scan with an "
@@ -223,6 +251,7 @@ def track_options(tracker: str, tracker_pd: float | None, meas_sigma: float | No
               "(docs/real-radar.md: measured, and why it is not the default).")
 @bias_options
 @birth_options
+@young_track_options
 @output_option
 @clutter_estimator_options
 @needs_libasterix
@@ -236,6 +265,7 @@ def track(plots: Path, tracker: str, tracker_pd: float | None, meas_sigma: float
           birth_theta: float | None, fusion: str | None, output: str | None,
           estimate_bias: bool = False, bias_reference: int | None = None,
           bias_init: Path | None = None, bias_out: Path | None = None,
+          startup_density: bool = False, defer_tentative: bool = False,
           **estimator_opts: Any) -> None:
     """Run a tracker on a PLOTS file and write its tracks."""
     from mhtrack.io.paths import check_output_file
@@ -247,6 +277,7 @@ def track(plots: Path, tracker: str, tracker_pd: float | None, meas_sigma: float
                             clutter_density, birth_density, nscan, birth, birth_theta,
                             fusion, output, clutter_frame=clutter_frame,
                             **bias_fields(estimate_bias, bias_reference, bias_init, bias_out),
+                            **young_track_fields(startup_density, defer_tentative, birth),
                             clutter_params=clutter_params(tracker, **estimator_opts))
     bars = show_progress()
     pipe = Pipeline.open(plots, options, scenario_file=scenario_file,
@@ -279,6 +310,7 @@ def track(plots: Path, tracker: str, tracker_pd: float | None, meas_sigma: float
               "(--plotlyjs, --coastlines).")
 @page_options
 @birth_options
+@young_track_options
 @output_option
 @clutter_scene_option
 @click.option("--bias", "biases", multiple=True, metavar="ID:range=M,gain=G,azimuth=DEG",
@@ -299,6 +331,7 @@ def run(scenario: str, seed: int, clutter: str | None, clutter_rate: float | Non
         attributes: bool | None = None, psr_only: float | None = None,
         ssr_only: float | None = None, garble: float | None = None,
         plotlyjs: str | None = None, coastlines: bool = False,
+        startup_density: bool = False, defer_tentative: bool = False,
         **estimator_opts: Any) -> None:
     """Simulate SCENARIO, track, evaluate and plot, in one go.
 
@@ -330,6 +363,7 @@ def run(scenario: str, seed: int, clutter: str | None, clutter_rate: float | Non
                             clutter_density, birth_density, nscan, birth, birth_theta,
                             fusion, output, sensor_pd=pd,
                             **bias_fields(estimate_bias, bias_reference, bias_init, bias_out),
+                            **young_track_fields(startup_density, defer_tentative, birth),
                             clutter_params=clutter_params(tracker, **estimator_opts))
     warn_known_kappa(sc, options)
     result = run_scenario(sc, seed, options=options, cutoff=cutoff, order=order,

@@ -156,6 +156,8 @@ class PerSensorClutter(ClutterEstimator):
         for i in state["sensors"]:
             for j, s in enumerate(state["pending"][str(i)]):
                 check_scan(s, f"{f}.pending[{i}][{j}]")
+            if state["pending"][str(i)] and str(i) not in state["start"]:
+                raise ValueError(f"field {f}.start: no time for sensor {i}'s pending frames")
         self._current = state["current"]
         self._fed = {int(i) for i in state["fed"]}
         self._start = {int(i): float(v) for i, v in state["start"].items()}

@@ -70,6 +70,12 @@ class MHTConfig:
         P1/P2 targets move at ≤ 200 m/s, within 1.4 σ).
     n_scan : depth ``N`` of N-scan pruning; leaves remember their plots over the last
         ``N + 1`` scans. Default 3 (P1 §3).
+    defer_tentative : N-scan pruning does not commit a tentative tree to its chosen
+        branch (no decision at ``k − N`` within the tree) until the tree is confirmed; its
+        branches are still removed when another tree of the best hypothesis holds their
+        plot at ``k − N``, and bounded by SPRT deletion, ``prune_drop`` and the caps
+        (:func:`~mhtrack.mht.pruning.n_scan_keep`'s ``defer``). Default False (P1: every
+        tree in the best hypothesis is committed).
     alpha : SPRT false-confirmation probability. Default 0.02 (our choice, measured in
         ``docs/mht.md``, *Motion model*: lowest mean OSPA on uniform clutter with the true
         κ within 0.3 m of α = 0.03, which confirms more clutter where the clutter drifts).
@@ -163,6 +169,7 @@ class MHTConfig:
     miss_uses_gate_probability: bool = False
     v_max: float = 300.0
     n_scan: int = 3
+    defer_tentative: bool = False
     alpha: float = 0.02
     beta: float = 1e-4
     confirm_min_plots: int = 2
@@ -216,7 +223,8 @@ class MHTConfig:
             and self.imm_sigma_v >= 0,
             "finite >= 0",
         )
-        for name in ("miss_uses_gate_probability", "scale_caps", "startup_density"):
+        for name in ("miss_uses_gate_probability", "scale_caps", "startup_density",
+                     "defer_tentative"):
             check(name, isinstance(getattr(self, name), bool), "a bool")
         check("n_scan", _is_int(self.n_scan) and 1 <= self.n_scan <= MAX_N_SCAN,
               f"an integer in [1, {MAX_N_SCAN}]")

@@ -115,7 +115,8 @@ def cap_trees(
 
 
 def n_scan_keep(tree: np.ndarray, oldest: np.ndarray, chosen: np.ndarray,
-                window: np.ndarray | None = None) -> np.ndarray:
+                window: np.ndarray | None = None, defer: np.ndarray | None = None
+                ) -> np.ndarray:
     """N-scan pruning (P1 §1.3; Blackman & Popoli 1999 §16.3.4).
 
     ``oldest`` (L,) is each leaf's plot at scan ``k − N`` (window column 0), ``chosen`` the
@@ -125,7 +126,10 @@ def n_scan_keep(tree: np.ndarray, oldest: np.ndarray, chosen: np.ndarray,
       the chosen leaf (the decision at ``k − N`` is made), or
     * its plot at ``k − N`` is used by the best hypothesis in another tree.
 
-    Trees not in the best hypothesis keep their other leaves.
+    Trees not in the best hypothesis keep their other leaves, and so do the leaves
+    marked in ``defer`` (L,) (``MHTConfig.defer_tentative``: the tentative trees' —
+    rule 1 waits until the tree is confirmed, a larger N for them alone; rule 2 still
+    holds).
 
     ``window`` (L, W), frames of several sensors (each tree's columns are its own looks):
     rule 2 holds for the chosen leaves' plots at their own ``k − N`` found in *any*
@@ -144,6 +148,8 @@ def n_scan_keep(tree: np.ndarray, oldest: np.ndarray, chosen: np.ndarray,
     i = ctree.searchsorted(tree)  # chosen leaves are ascending, hence sorted by tree
     np.minimum(i, ctree.size - 1, out=i)
     drop = (ctree[i] == tree) & (oldest != cplot[i])
+    if defer is not None:
+        drop &= ~defer
     # rule 2: plot at k − N taken by the best hypothesis in another tree
     used = cplot != NO_PLOT
     if np.count_nonzero(used):
@@ -280,7 +286,8 @@ def prune_after_solve(frame: FrameContext, leaves: Leaves, chosen: np.ndarray, *
     is_chosen = np.zeros(n, bool)
     is_chosen[chosen] = True
     keep = n_scan_keep(leaves.tree, leaves.window[:, 0], chosen,
-                       leaves.window if by_id else None)
+                       leaves.window if by_id else None,
+                       leaves.track < 0 if frame.limits.defer_tentative else None)
     if remove is not None:
         keep &= ~remove
     n_kept = int(np.count_nonzero(keep))

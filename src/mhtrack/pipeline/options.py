@@ -57,6 +57,8 @@ class TrackOptions:
     imm_sigma_v: float | None = None
     new_target_density: float | None = None
     n_scan: int | None = None
+    startup_density: bool | None = None
+    defer_tentative: bool | None = None
     #: The known κ of ``--tracker mht`` (default :data:`~mhtrack.build.DEFAULT_CLUTTER_DENSITY`).
     clutter_density: float | None = None
     #: Birth process (:data:`mhtrack.names.BIRTHS`) and θ of the modified initiators.
@@ -88,7 +90,8 @@ class TrackOptions:
             pd = capped_pd(self.sensor_pd)
         fields = {"p_detection": pd, "sigma_w": self.sigma_w, "sigma_v": self.sigma_v,
                   "new_target_density": self.new_target_density, "n_scan": self.n_scan,
-                  "imm_sigma_v": self.imm_sigma_v}
+                  "imm_sigma_v": self.imm_sigma_v, "startup_density": self.startup_density,
+                  "defer_tentative": self.defer_tentative}
         return {k: v for k, v in fields.items() if v is not None}
 
 

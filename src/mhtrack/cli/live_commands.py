@@ -68,7 +68,10 @@ class DelayArg(click.ParamType):
               help="Time scale: 1 real time, 10 ten times faster, max as fast as the socket "
               "takes them [1].")
 @click.option("--loop", is_flag=True, help="Play the recording again and again until "
-              "Ctrl-C (times of day repeat: for load, not for one track picture).")
+              "Ctrl-C, each pass's times of day moved on by the recording's span (whole "
+              "seconds; wrapping at midnight): one longer feed.")
+@click.option("--loops", type=click.IntRange(min=1), default=None,
+              help="As --loop, this many passes.")
 @click.option("--drop", type=click.FloatRange(0, 1), default=None,
               help="Damage (tests): each copy of a datagram is not sent with this chance "
               "[0].")
@@ -80,8 +83,8 @@ class DelayArg(click.ParamType):
               "copies at any speed [0].")
 @needs_libasterix
 def replay(recording: Path, to: tuple[str, ...], speed: float | None, loop: bool,
-           drop: float | None, delay: tuple[float, float] | None, seed: int | None
-           ) -> None:
+           loops: int | None, drop: float | None, delay: tuple[float, float] | None,
+           seed: int | None) -> None:
     """Send RECORDING's ASTERIX datagrams over UDP with their original spacing."""
     from mhtrack.sources.damage import Damage
     from mhtrack.sources.replay import replay as play
@@ -93,8 +96,12 @@ def replay(recording: Path, to: tuple[str, ...], speed: float | None, loop: bool
         raise click.BadParameter(f"--drop {drop} and --delay's chance {p} add up to "
                                  "more than 1", param_hint="--drop/--delay")
     damage = Damage(drop, p, s, Damage.seed if seed is None else seed)
+    if loop and loops is not None:
+        raise click.BadParameter("--loop (endless) or --loops N, not both",
+                                 param_hint="--loop/--loops")
     with stop_on_signals(threading.Event()) as stop:
-        stats = play(recording, to, loops=None if loop else 1, stop=stop, damage=damage,
+        stats = play(recording, to, loops=None if loop else (loops or 1), stop=stop,
+                     damage=damage,
                      **({} if speed is None else {"speed": speed}))
     hurt = (f"; {stats.dropped} copies dropped, {stats.delayed} delayed"
             if drop or p else "")

@@ -160,6 +160,9 @@ def replay(recording: Path, to: tuple[str, ...], speed: float | None, loop: bool
               help="Close the frames held after this many wall-clock seconds without a "
               "datagram (a feed gone quiet); 0: never [the re-order window plus the "
               "longest rotation period].")
+@click.option("--preload/--no-preload", default=True, show_default=True,
+              help="Load the tracker's one-time code (SciPy's solvers, the compiled IMM "
+              "rows) at start, not in the frame that first needs it (docs/live.md, Soak).")
 @tracker_options("--pd")
 @click.option("--clutter-frame", type=click.Choice(CLUTTER_FRAMES),
               default=DEFAULT_CLUTTER_FRAME, show_default=True,
@@ -173,8 +176,8 @@ def live(listen: tuple[str, ...], stdin: str | None, sensors_file: Path,
          status_every: float | None, status_json: Path | None, prometheus: Path | None,
          metrics_http: str | None, view: str | None, checkpoint: Path | None,
          checkpoint_every: float | None, resume: bool, reorder_window_s: float | None,
-         idle_close_s: float | None, tracker: str, tracker_pd: float | None,
-         meas_sigma: float | None, accel_sigma: float | None,
+         idle_close_s: float | None, preload: bool, tracker: str,
+         tracker_pd: float | None, meas_sigma: float | None, accel_sigma: float | None,
          imm_accel_sigma: float | None, clutter_density: float | None,
          birth_density: float | None, nscan: int | None, clutter_frame: str, birth: str,
          birth_theta: float | None, fusion: str | None, estimate_bias: bool = False,
@@ -197,7 +200,7 @@ def live(listen: tuple[str, ...], stdin: str | None, sensors_file: Path,
                            checkpoint_every_s=(None if checkpoint_every is None
                                                else 60.0 * checkpoint_every),
                            resume=resume, reorder_window_s=reorder_window_s,
-                           idle_close_s=idle_close_s,
+                           idle_close_s=idle_close_s, preload=preload,
                            **({} if day_from is None else {"day_from": day_from}))
     with stop_on_signals(threading.Event()) as stop:
         run = Live(read_sensors(sensors_file), options, settings, stop=stop,

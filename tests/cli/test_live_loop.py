@@ -1,5 +1,5 @@
 """``mhtrack replay --loops 3`` into ``mhtrack live`` (``docs/live.md``, *Replay*): an
-exported 8-scan ``opensky-radars`` recording played three times over loopback, each pass's
+exported 5-scan ``opensky-radars`` recording played three times over loopback, each pass's
 times of day moved on by the recording's span. ``live`` takes it as one feed three times
 as long — no late drops — and its rows equal ``track --output online`` on a recording
 exported from the same plots written three times, ``k · S`` seconds later (the moved
@@ -43,7 +43,7 @@ def looped(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, int]:
 
     out = tmp_path_factory.mktemp("loop")
     sensors = str(out / "sensors.toml")
-    _run("simulate", "opensky-radars", "--seed", "1", "--scans", "8", "--out", str(out),
+    _run("simulate", "opensky-radars", "--seed", "1", "--scans", "5", "--out", str(out),
          "-q")
     _run("export", str(out / "plots.csv"), "--sensors", sensors, "--out",
          str(out / "radar.pcap"), "-q")

@@ -121,12 +121,30 @@ def wait_taken(status: Path, before: int, live: subprocess.Popen) -> dict:
     raise RuntimeError(f"live did not take the pass within {PASS_TIMEOUT_S} s")
 
 
+def probe(d: Path, tag: str, live: subprocess.Popen) -> dict:
+    """Ask ``memprobe.py`` in ``live`` for ``probe-TAG.json`` and wait for it."""
+    (d / f"req-{tag}").touch()
+    for _ in range(6000):  # bounded: 10 min
+        out = d / f"probe-{tag}.json"
+        if out.exists():
+            return json.loads(out.read_text())
+        if live.poll() is not None:
+            raise RuntimeError(f"live ended (exit {live.returncode})")
+        time.sleep(0.1)
+    raise RuntimeError(f"no probe {tag}")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--hours", type=int, default=6)
     ap.add_argument("--chunk-s", type=float, default=1200.0,
                     help="data seconds of one pass (the simulation's length)")
     ap.add_argument("--out", type=Path, default=None)
+    ap.add_argument("--probe", type=int, default=None, metavar="FRAMES",
+                    help="run live under benchmarks/memprobe.py (tracemalloc with FRAMES "
+                         "frames, 0: off) and probe its memory before the first pass "
+                         "(probe-p0.json), after each pass (probe-pK.json) and at each "
+                         "hour, then malloc_trim (probe-hN-trim.json)")
     a = ap.parse_args()
     d = a.out or Path(tempfile.mkdtemp(prefix="soak_"))
     d.mkdir(parents=True, exist_ok=True)
@@ -143,8 +161,12 @@ def main() -> None:
                  "--checkpoint-every", "10", "-q"]
     print("$ mhtrack " + " ".join(live_args), flush=True)
     err_path = d / "live.err"  # a file, not a pipe: a status line a second would fill one
+    cmd = [*CLI, *live_args]
+    if a.probe is not None:
+        cmd = [sys.executable, str(Path(__file__).with_name("memprobe.py")), "--dir",
+               str(d / "probes"), "--trace", str(a.probe), "--", *live_args]
     with err_path.open("w") as err_file:
-        live = subprocess.Popen([*CLI, *live_args], stderr=err_file,
+        live = subprocess.Popen(cmd, stderr=err_file,
                                 stdout=subprocess.DEVNULL, text=True, env=_env())
     rows = []
     try:
@@ -158,6 +180,8 @@ def main() -> None:
         if m is None:
             raise RuntimeError(f"live did not start: {err_path.read_text()!r}")
         to, sent, t0, got = m.group(1), 0, time.monotonic(), 0
+        if a.probe is not None:
+            probe(d / "probes", "p0", live)
         print("$ mhtrack replay PASS.pcap --to " + to + " --speed max  (each pass)")
         print("| data hour | wall s | datagrams sent | received | kernel drops | plots | "
               "frames | tracks | RSS MB | peak RSS MB |", flush=True)
@@ -175,6 +199,10 @@ def main() -> None:
                 rows.append(row)
                 print("| {} | {:.0f} | {} | {} | {} | {} | {} | {} | {:.1f} | {:.1f} |"
                       .format(*row), flush=True)
+                if a.probe is not None:
+                    probe(d / "probes", f"h{row[0]}-trim", live)
+            elif a.probe is not None:
+                probe(d / "probes", f"p{k + 1}", live)
         live.send_signal(signal.SIGTERM)
         live.wait(timeout=600)
         err = err_path.read_text().strip().splitlines()

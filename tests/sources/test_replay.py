@@ -15,7 +15,8 @@ from udp_drain import drain
 from mhtrack.io.asterix.decode import Decoder
 from mhtrack.io.asterix.framings import recognise, units
 from mhtrack.io.asterix.problems import Problems
-from mhtrack.sources.replay import recording_datagrams, replay, schedule
+from mhtrack.io.asterix.timeaxis import TimeAxis
+from mhtrack.sources.replay import pass_seconds, recording_datagrams, replay, schedule
 
 pytest.importorskip("asterix.generated", reason="libasterix not installed")
 
@@ -61,6 +62,49 @@ def test_schedule_by_hand() -> None:
     assert [d for _, d in schedule([5.0, 9.0], math.inf, 1)] == [0.0, 0.0]
     endless = schedule([1.0], 1.0, None)
     assert [next(endless) for _ in range(3)] == [(0, 0.0)] * 3
+    # passes every 5 s (span 3 + spacing 1.5 = 4.5, rounded up): at speed 2, 2.5 s apart
+    assert pass_seconds([10.0, 11.0, 13.0]) == 5
+    assert list(schedule([10.0, 11.0, 13.0], 2.0, 2, every=5)) == [
+        (0, 0.0), (1, 0.5), (2, 1.5), (0, 2.5), (1, 3.0), (2, 4.0)]
+    assert pass_seconds([7.0]) == 1
+
+
+def _times(payloads: list[bytes]) -> list[float]:
+    """Plot and mark times, in order, on one time axis."""
+    decoder, axis, out = Decoder(duplicates=False), TimeAxis(), []
+    for p in payloads:
+        for _, _, found in decoder.blocks(p, 0, Problems()):
+            out.extend(axis.times_list([r[0] for r in found]))
+    return out
+
+
+def test_a_loop_moves_the_times_on(recordings: Path) -> None:
+    """Three passes of 150 datagrams at ``max``: pass ``n`` is the recording's datagrams
+    with every time ``n · S`` later (decoded on one axis: later passes are not late)."""
+    items = recording_datagrams(recordings / "r.pcap")[:150]
+    path = recordings / "loop.ast"
+    path.write_bytes(b"".join(p for p, _ in items))
+    items = recording_datagrams(path)
+    every = pass_seconds([t for _, t in items])
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as rx:
+        rx.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 1 << 22)
+        rx.bind(("127.0.0.1", 0))
+        stats = replay(path, f"udp://127.0.0.1:{rx.getsockname()[1]}", speed=math.inf,
+                       loops=3)
+        got = drain(rx)
+    assert (stats.datagrams, stats.passes) == (450, 3) and len(got) == 450
+    assert got[:150] == [p for p, _ in items]
+    t = np.array(_times(got)).reshape(3, -1)
+    assert np.array_equal(t[1] - t[0], np.full(t.shape[1], float(every)))
+    assert np.array_equal(t[2] - t[0], np.full(t.shape[1], 2.0 * every))
+    assert np.all(np.diff(t.ravel()) >= -1.0)  # in time order across the passes
+    # the same times again without moving them
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as rx:
+        rx.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 1 << 22)
+        rx.bind(("127.0.0.1", 0))
+        replay(path, f"udp://127.0.0.1:{rx.getsockname()[1]}", speed=math.inf, loops=2,
+               move_times=False)
+        assert drain(rx) == [p for p, _ in items] * 2
 
 
 def test_replay_on_a_fake_clock(recordings: Path) -> None:

@@ -68,7 +68,10 @@ class DelayArg(click.ParamType):
               help="Time scale: 1 real time, 10 ten times faster, max as fast as the socket "
               "takes them [1].")
 @click.option("--loop", is_flag=True, help="Play the recording again and again until "
-              "Ctrl-C (times of day repeat: for load, not for one track picture).")
+              "Ctrl-C, each pass's times of day moved on by the recording's span (whole "
+              "seconds; wrapping at midnight): one longer feed.")
+@click.option("--loops", type=click.IntRange(min=1), default=None,
+              help="As --loop, this many passes.")
 @click.option("--drop", type=click.FloatRange(0, 1), default=None,
               help="Damage (tests): each copy of a datagram is not sent with this chance "
               "[0].")
@@ -80,8 +83,8 @@ class DelayArg(click.ParamType):
               "copies at any speed [0].")
 @needs_libasterix
 def replay(recording: Path, to: tuple[str, ...], speed: float | None, loop: bool,
-           drop: float | None, delay: tuple[float, float] | None, seed: int | None
-           ) -> None:
+           loops: int | None, drop: float | None, delay: tuple[float, float] | None,
+           seed: int | None) -> None:
     """Send RECORDING's ASTERIX datagrams over UDP with their original spacing."""
     from mhtrack.sources.damage import Damage
     from mhtrack.sources.replay import replay as play
@@ -93,8 +96,12 @@ def replay(recording: Path, to: tuple[str, ...], speed: float | None, loop: bool
         raise click.BadParameter(f"--drop {drop} and --delay's chance {p} add up to "
                                  "more than 1", param_hint="--drop/--delay")
     damage = Damage(drop, p, s, Damage.seed if seed is None else seed)
+    if loop and loops is not None:
+        raise click.BadParameter("--loop (endless) or --loops N, not both",
+                                 param_hint="--loop/--loops")
     with stop_on_signals(threading.Event()) as stop:
-        stats = play(recording, to, loops=None if loop else 1, stop=stop, damage=damage,
+        stats = play(recording, to, loops=None if loop else (loops or 1), stop=stop,
+                     damage=damage,
                      **({} if speed is None else {"speed": speed}))
     hurt = (f"; {stats.dropped} copies dropped, {stats.delayed} delayed"
             if drop or p else "")
@@ -153,6 +160,9 @@ def replay(recording: Path, to: tuple[str, ...], speed: float | None, loop: bool
               help="Close the frames held after this many wall-clock seconds without a "
               "datagram (a feed gone quiet); 0: never [the re-order window plus the "
               "longest rotation period].")
+@click.option("--preload/--no-preload", default=True, show_default=True,
+              help="Load the tracker's one-time code (SciPy's solvers, the compiled IMM "
+              "rows) at start, not in the frame that first needs it (docs/live.md, Soak).")
 @tracker_options("--pd")
 @click.option("--clutter-frame", type=click.Choice(CLUTTER_FRAMES),
               default=DEFAULT_CLUTTER_FRAME, show_default=True,
@@ -166,8 +176,8 @@ def live(listen: tuple[str, ...], stdin: str | None, sensors_file: Path,
          status_every: float | None, status_json: Path | None, prometheus: Path | None,
          metrics_http: str | None, view: str | None, checkpoint: Path | None,
          checkpoint_every: float | None, resume: bool, reorder_window_s: float | None,
-         idle_close_s: float | None, tracker: str, tracker_pd: float | None,
-         meas_sigma: float | None, accel_sigma: float | None,
+         idle_close_s: float | None, preload: bool, tracker: str,
+         tracker_pd: float | None, meas_sigma: float | None, accel_sigma: float | None,
          imm_accel_sigma: float | None, clutter_density: float | None,
          birth_density: float | None, nscan: int | None, clutter_frame: str, birth: str,
          birth_theta: float | None, fusion: str | None, estimate_bias: bool = False,
@@ -190,7 +200,7 @@ def live(listen: tuple[str, ...], stdin: str | None, sensors_file: Path,
                            checkpoint_every_s=(None if checkpoint_every is None
                                                else 60.0 * checkpoint_every),
                            resume=resume, reorder_window_s=reorder_window_s,
-                           idle_close_s=idle_close_s,
+                           idle_close_s=idle_close_s, preload=preload,
                            **({} if day_from is None else {"day_from": day_from}))
     with stop_on_signals(threading.Event()) as stop:
         run = Live(read_sensors(sensors_file), options, settings, stop=stop,

@@ -114,6 +114,9 @@ class Live:
         if live.resume and live.checkpoint is None:
             raise ValueError("live: --resume needs --checkpoint FILE")
         self.live, self.emit = live, emit
+        if live.preload:  # before "listening on": senders wait for that line
+            from mhtrack.pipeline.preload import preload
+            preload()
         self.stop = threading.Event() if stop is None else stop
         resumed = None
         if live.resume and live.checkpoint is not None and live.checkpoint.exists():

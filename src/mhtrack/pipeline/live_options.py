@@ -57,6 +57,8 @@ class LiveOptions:
     checkpoint: Path | None = None
     checkpoint_every_s: float | None = None
     resume: bool = False
+    #: Load the tracker's one-time code at start (:mod:`~mhtrack.pipeline.preload`).
+    preload: bool = True
     #: CAT062 data source (I062/010).
     sac: int | None = None
     sic: int | None = None

@@ -8,7 +8,13 @@ datagram, at the time of day of the block's first CAT048/CAT034 record (on one a
 across midnight, :class:`TimeAxis`; a block without one keeps the previous time). The
 spacing of the times is kept, divided by ``speed`` (``math.inf``: as fast as the socket
 takes them). ``loops`` plays the file that many times
-(``None``: until ``stop``), each pass starting one mean spacing after the last. Several
+(``None``: until ``stop``), pass ``n`` ``n · S`` seconds after the first, ``S`` the
+recording's span plus one mean spacing rounded up to a whole second; the times of day
+inside the datagrams move on by the same ``n · S`` (:mod:`~mhtrack.io.asterix.retime`:
+wrapping at midnight), so that a looped replay is one longer feed, its passes in time
+order, not the same minutes again (which ``live`` would drop as late). The time items'
+places in each datagram are found once (by libasterix, about 3 ms a datagram), then
+patched at each pass. Several
 destinations (redundant LANs) get every datagram each; ``damage`` drops and delays copies
 at random, reproducibly (:mod:`~mhtrack.sources.damage`).
 """
@@ -27,6 +33,7 @@ from pathlib import Path
 from mhtrack.io.asterix.decode import Decoder
 from mhtrack.io.asterix.framings import recognise, units
 from mhtrack.io.asterix.problems import Problems
+from mhtrack.io.asterix.retime import patch_times, time_fields
 from mhtrack.io.asterix.timeaxis import TimeAxis
 from mhtrack.io.paths import check_input_file
 from mhtrack.sources.damage import Damage, DamageCounts, damaged
@@ -78,18 +85,28 @@ class ReplayStats:
     delayed: int = 0
 
 
-def schedule(times: list[float], speed: float, loops: int | None
-             ) -> Iterator[tuple[int, float]]:
+def pass_seconds(times: list[float]) -> int:
+    """``S``, the whole seconds from one pass's start to the next (module docstring): the
+    span of ``times`` plus their mean spacing, rounded up (at least 1)."""
+    if len(times) < 2:
+        return 1
+    span = times[-1] - times[0]
+    return max(1, math.ceil(span + span / (len(times) - 1)))
+
+
+def schedule(times: list[float], speed: float, loops: int | None,
+             every: float | None = None) -> Iterator[tuple[int, float]]:
     """``(datagram index, due time in s from the start)`` of a replay: the recording's
     spacing divided by ``speed`` (``math.inf``: all due at 0), ``loops`` passes (``None``:
-    endless), each pass one mean spacing after the last datagram of the one before."""
+    endless), pass ``n`` starting ``n · every`` after the first (``None``: one mean
+    spacing after the last datagram of the one before)."""
     if not times:
         return
     t0, span = times[0], times[-1] - times[0]
     gap = span / (len(times) - 1) if len(times) > 1 else 0.0
     n = 0
     while loops is None or n < loops:
-        base = n * (span + gap)
+        base = n * (span + gap if every is None else every)
         for i, t in enumerate(times):
             yield i, (base + max(t - t0, 0.0)) / speed
         n += 1
@@ -99,12 +116,13 @@ def replay(path: str | Path, to: str | Endpoint | Sequence[str | Endpoint], *,
            speed: float = 1.0, loops: int | None = 1, stop: threading.Event | None = None,
            clock: Callable[[], float] = time.monotonic,
            sleep: Callable[[float], object] | None = None,
-           damage: Damage | None = None) -> ReplayStats:
+           damage: Damage | None = None, move_times: bool = True) -> ReplayStats:
     """Send the datagrams of recording ``path`` to ``to`` (``udp://HOST:PORT``, or
     several: every datagram to each) on the :func:`schedule` of ``speed`` and ``loops``,
     each copy dropped or delayed by ``damage`` (:func:`~mhtrack.sources.damage.damaged`),
     until done or ``stop`` is set (a wait ends at once when it is: default ``sleep`` is
-    ``stop.wait``). ``datagrams`` counts the copies sent."""
+    ``stop.wait``). ``datagrams`` counts the copies sent. Pass ``n`` moves the times of
+    day on by ``n · S`` (module docstring; ``move_times=False``: the same times again)."""
     if sleep is None:
         sleep = time.sleep if stop is None else stop.wait
     if not speed > 0:
@@ -121,11 +139,15 @@ def replay(path: str | Path, to: str | Endpoint | Sequence[str | Endpoint], *,
     stats, counts = ReplayStats(), DamageCounts()
     socks = [socket.socket(e.family, socket.SOCK_DGRAM) for e in eps]
     last = len(items) - 1
+    times = [t for _, t in items]
+    every = pass_seconds(times) if move_times else None
+    fields: dict[int, tuple[tuple[int, int, int], ...]] = {}
     try:
         start = clock()
-        plan = damaged(_passes(schedule([t for _, t in items], 1.0, loops), last, stats),
+        plan = damaged(_passes(schedule(times, 1.0, loops, every), last, stats),
                        len(eps), damage or Damage(), counts)
-        for i, k, due in plan:
+        for j, k, due in plan:
+            n, i = divmod(j, len(items))  # pass n, datagram i
             if stop is not None and stop.is_set():
                 break
             wait = start + (due / speed if speed < math.inf else 0.0) - clock()
@@ -133,9 +155,14 @@ def replay(path: str | Path, to: str | Endpoint | Sequence[str | Endpoint], *,
                 sleep(wait)
                 if stop is not None and stop.is_set():
                     break
-            socks[k].sendto(items[i][0], addrs[k])
+            data = items[i][0]
+            if every is not None and n:
+                if i not in fields:
+                    fields[i] = time_fields(data)
+                data = patch_times(data, fields[i], n * every, near=items[i][1])
+            socks[k].sendto(data, addrs[k])
             stats.datagrams += 1
-            stats.bytes += len(items[i][0])
+            stats.bytes += len(data)
     finally:
         for s in socks:
             s.close()
@@ -145,7 +172,9 @@ def replay(path: str | Path, to: str | Endpoint | Sequence[str | Endpoint], *,
 
 def _passes(items: Iterator[tuple[int, float]], last: int, stats: ReplayStats
             ) -> Iterator[tuple[int, float]]:
-    """``items``, counting in ``stats.passes`` each pass whose last datagram is reached."""
+    """``items`` with each index numbered on through the passes (``n · (last + 1) + i``
+    in pass ``n``), counting in ``stats.passes`` each pass whose last datagram is
+    reached."""
     for i, due in items:
-        yield i, due
+        yield stats.passes * (last + 1) + i, due
         stats.passes += i == last

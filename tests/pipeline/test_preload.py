@@ -1,0 +1,58 @@
+"""One-time code loaded at a live run's start (:mod:`mhtrack.pipeline.preload`): in a
+fresh interpreter, after :func:`preload` the lazily imported modules are there, and the
+compiled IMM rows (numba, when installed) are compiled for the signatures the tracker
+uses — a tracker-sized call afterwards with another model set compiles nothing more and
+gives the NumPy path's floats."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+SRC = str(Path(__file__).resolve().parents[2] / "src")
+
+CHECK = """
+import sys
+sys.path.insert(0, {src!r})
+import numpy as np
+from mhtrack.pipeline.preload import LAZY_MODULES, preload
+added, used = preload()
+missing = [m for m in LAZY_MODULES if m not in sys.modules]
+assert not missing, missing
+from mhtrack.models import imm_rows
+try:
+    import numba  # noqa: F401
+    has_numba = True
+except ImportError:
+    has_numba = False
+assert used == has_numba, (used, has_numba)
+if used:
+    from mhtrack.models.imm import CVModelSet
+    from mhtrack.models.motion import States
+    k = imm_rows._KERNELS
+    before = {{n: len(f.signatures) for n, f in k.items()}}
+    assert all(v >= 1 for v in before.values()), before
+    rng = np.random.default_rng(1)
+    M, r = imm_rows.MIN_ROWS + 7, 3
+    A = rng.normal(0, 30, (M, r, 4, 4))
+    s = States(np.zeros((M, 4)), np.zeros((M, 4, 4)), rng.normal(0, 1e3, (M, r, 4)),
+               A @ A.swapaxes(-1, -2) + 100 * np.eye(4), rng.dirichlet(np.ones(r), M))
+    model = CVModelSet((0.5, 5.0, 20.0), 60.0)
+    dt = rng.uniform(0.5, 8, M)
+    got = model.predict(s, dt)
+    model.predict(s, 2.5)
+    assert {{n: len(f.signatures) for n, f in k.items()}} == before, "compiled again"
+    imm_rows.MIN_ROWS = 10**12  # the NumPy path
+    ref = model.predict(s, dt)
+    for f in ("x", "P", "xm", "Pm", "mu"):
+        assert np.array_equal(getattr(got, f), getattr(ref, f)), f
+print("ok", added, used)
+"""
+
+
+def test_preload_loads_the_lazy_code() -> None:
+    done = subprocess.run([sys.executable, "-c", CHECK.format(src=SRC)],
+                          capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.startswith("ok")

@@ -147,12 +147,15 @@ def test_state_round_trip_and_hostile_states() -> None:
     bad_m[0, 0] = 0.0
     for key, bad, word in (("moments", bad_m, "weight"), ("moments", np.zeros((2, 14)), "shape"),
                            ("anchors", np.zeros((99, 2)), "shape"),
-                           ("looks", 6.0, "looks"), ("bg_mass", -1.0, "bg_mass"),
-                           ("box", [1.0, 0.0, 0.0, 1.0], "box")):
+                           ("looks", -1.0, "looks"), ("bg_mass", -1.0, "bg_mass"),
+                           ("box", [1.0, 0.0, 0.0, 1.0], "box"), ("time", np.nan, "time")):
         with pytest.raises(ValueError, match=word):
             ForgettingGMMClutter().set_state({**good, key: bad})
-    for kw in ({"forgetting": 0.0}, {"n_components": 0}, {"split_kurtosis": 3.0},
-               {"merge_distance": -1.0}, {"max_iter": 0}, {"reg_covar": 0.0}):
+    with pytest.raises(ValueError, match="looks"):  # beyond 1/(1 − γ) with a constant γ
+        ForgettingGMMClutter(forgetting=0.7).set_state({**good, "looks": 6.0})
+    for kw in ({"forgetting": 0.0}, {"half_life": 0.0}, {"n_components": 0},
+               {"split_kurtosis": 3.0}, {"merge_distance": -1.0}, {"max_iter": 0},
+               {"reg_covar": 0.0}):
         with pytest.raises(ValueError, match=next(iter(kw))):
             ForgettingGMMClutter(**kw)
 

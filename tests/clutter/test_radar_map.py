@@ -149,11 +149,13 @@ def test_state_round_trip_continues_identically_and_hostile_states_fail() -> Non
     good = a.get_state()
     for key, bad, word in (("sums", -good["sums"] - 1, "negative"),
                            ("sums", np.zeros((3, 7)), "shape"),
-                           ("looks", 11.0, "looks"), ("looks", float("nan"), "looks"),
-                           ("last", np.array([10**9]), "last"),
+                           ("looks", -1.0, "looks"), ("looks", float("nan"), "looks"),
+                           ("last", np.array([10**9]), "last"), ("time", np.inf, "time"),
                            ("n_updates", -1, "n_updates"), ("sums", "x", "sums")):
         with pytest.raises(ValueError, match=word):
             ClutterMap(range_cell=300.0).set_state({**good, key: bad})
+    with pytest.raises(ValueError, match="looks"):  # beyond 1/(1 − γ) with a constant γ
+        ClutterMap(range_cell=300.0, forgetting=0.9).set_state({**good, "looks": 11.0})
 
 
 def test_birth_scale() -> None:

@@ -8,7 +8,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from mhtrack.clutter.radar_map import ClutterMap, birth_scale, cell_areas
+from mhtrack.clutter.radar_map import ClutterMap, birth_scale, cell_areas, smooth_cells
 from mhtrack.records import Scan
 
 
@@ -51,7 +51,7 @@ def test_stationary_poisson_clutter_converges_within_the_forgetting_interval() -
     have mean ≈ 0 and variance ≈ 1, and the map-wide mean is within 3 σ of ρ."""
     gamma, n_rot, radius, rho = 0.8, 25, 20_000.0, 2e-6
     m = ClutterMap(site=(5e3, 7e3), range_cell=2000.0, n_azimuth=16, forgetting=gamma,
-                   prior_weight=0.0, max_range=radius)
+                   smoothing=0, prior_weight=0.0, max_range=radius)
     rng = np.random.default_rng(12)
     lam = rho * np.pi * radius**2  # ≈ 2513 plots per rotation
     for k in range(n_rot):
@@ -75,7 +75,7 @@ def test_step_change_follows_the_exponential_response() -> None:
     ``λ₂ + (λ₁ − λ₂) γ^m N_k₀ / N_k`` (closed form), within 4 standard errors."""
     gamma, k0, k1, radius = 0.7, 12, 12, 10_000.0
     lam1, lam2 = 400.0, 1600.0  # per rotation over the disc
-    m = ClutterMap(range_cell=1000.0, n_azimuth=8, forgetting=gamma, prior_weight=0.0,
+    m = ClutterMap(range_cell=1000.0, n_azimuth=8, forgetting=gamma, smoothing=0, prior_weight=0.0,
                    max_range=radius)
     rng = np.random.default_rng(3)
     area = np.pi * radius**2
@@ -95,7 +95,7 @@ def test_step_change_follows_the_exponential_response() -> None:
 
 
 def test_forget_takes_used_plots_out_and_shrinkage_floors_empty_cells() -> None:
-    m = ClutterMap(range_cell=100.0, n_azimuth=4, forgetting=1.0, prior_weight=1.0)
+    m = ClutterMap(range_cell=100.0, n_azimuth=4, forgetting=1.0, prior_weight=1.0, smoothing=0)
     z = np.array([[0.0, 50.0], [0.0, 60.0], [0.0, 150.0]])
     m.update(_scan(0, z))
     a0, a1 = cell_areas(2, 4, 100.0)
@@ -110,7 +110,8 @@ def test_forget_takes_used_plots_out_and_shrinkage_floors_empty_cells() -> None:
 
 
 def test_outside_gates_source_and_bad_input() -> None:
-    m = ClutterMap(source="outside-gates", range_cell=100.0, n_azimuth=1, prior_weight=0)
+    m = ClutterMap(source="outside-gates", range_cell=100.0, n_azimuth=1, prior_weight=0,
+                   smoothing=0)
     m.update(_scan(0, [[0.0, 10.0], [0.0, 20.0]]), np.array([True, False]))
     assert m.sums_.sum() == 1.0
     with pytest.raises(ValueError, match="in_track_gates has 1"):
@@ -164,3 +165,21 @@ def test_birth_scale() -> None:
     assert birth_scale(k, 2e-7, 1.0).tolist() == [1.0, 1.0, 0.5]
     assert birth_scale(k, 2e-7, 2.0)[2] == pytest.approx(0.25)
     assert birth_scale(k, 0.0, 1.0).tolist() == [1.0, 1.0, 1.0]
+
+
+@given(st.integers(1, 12), st.integers(1, 16), st.integers(0, 5), st.integers(0, 2**31))
+@settings(max_examples=40, deadline=None)
+def test_smoothing_keeps_the_total_and_a_constant(rings: int, sectors: int, passes: int,
+                                                  seed: int) -> None:
+    """``[1, 2, 1]/4`` along both axes (reflecting rings, circular sectors) keeps the
+    map's total and leaves a constant map as it is; one pass on a single spike gives the
+    kernel's outer product (where the map is at least 3 × 3)."""
+    a = np.random.default_rng(seed).poisson(3.0, (rings, sectors)).astype(float)
+    out = smooth_cells(a, passes)
+    assert out.sum() == pytest.approx(a.sum(), rel=1e-12, abs=1e-12)
+    np.testing.assert_allclose(smooth_cells(np.full((rings, sectors), 2.5), passes), 2.5)
+    if rings >= 3 and sectors >= 3:
+        spike = np.zeros((rings, sectors))
+        spike[1, 1] = 16.0
+        k = np.array([1.0, 2.0, 1.0])
+        np.testing.assert_allclose(smooth_cells(spike, 1)[:3, :3], np.outer(k, k), atol=1e-12)

@@ -46,6 +46,9 @@ from mhtrack.records import Scan
 PRIOR_COUNT = 5.0
 #: Smoothing passes over the cells (measured: docs/clutter.md).
 SMOOTHING = 1
+#: Rings over the reach and sectors of the cells, unless given (measured: docs/clutter.md;
+#: coarser than the plain map's, as the base gives the shape within a cell).
+RINGS, SECTORS = 12, 32
 
 
 class MapCalibratedClutter(ClutterEstimator):
@@ -57,7 +60,8 @@ class MapCalibratedClutter(ClutterEstimator):
         :class:`~mhtrack.clutter.gmm.GMMClutter` with ``base_params``).
     base_params : keywords of the default base.
     site, range_cell, n_azimuth, max_range, max_rings, half_life, forgetting : the cells
-        and the discount, as :class:`~mhtrack.clutter.radar_map.ClutterMap`'s.
+        and the discount, as :class:`~mhtrack.clutter.radar_map.ClutterMap`'s, but with a
+        ``max_range`` the cells are :data:`RINGS` rings by :data:`SECTORS` sectors.
     prior_count : ``b₀`` (expected plots), the shrinkage of each ratio toward 1. Default
         :data:`PRIOR_COUNT`.
     smoothing : passes of :func:`~mhtrack.clutter.radar_map.smooth_cells` over ``S`` and
@@ -82,6 +86,10 @@ class MapCalibratedClutter(ClutterEstimator):
             base = GMMClutter(**(base_params or {}))
         self.base = base
         self.base_params = dict(base_params or {})
+        self.cell_args = (range_cell, n_azimuth)  # as given: placed() re-derives the rest
+        if max_range is not None:
+            range_cell = max_range / RINGS if range_cell is None else range_cell
+            n_azimuth = SECTORS if n_azimuth is None else n_azimuth
         self.counts = ClutterMap(site=site, range_cell=range_cell, n_azimuth=n_azimuth,
                                  max_range=max_range, max_rings=max_rings,
                                  half_life=half_life, forgetting=forgetting,
@@ -92,6 +100,7 @@ class MapCalibratedClutter(ClutterEstimator):
             raise ValueError(f"smoothing must be an integer in [0, 64], got {smoothing!r}")
         self.expected_ = np.zeros_like(self.counts.sums_)
         self._ratio: np.ndarray | None = None
+        self._centres = np.zeros((0, 2))
 
     @property
     def site(self) -> tuple[float, float]:
@@ -107,20 +116,24 @@ class MapCalibratedClutter(ClutterEstimator):
         ``max_range``), calibrating ``base`` (default: a fresh default base)."""
         c = self.counts
         return MapCalibratedClutter(
-            base=base, base_params=self.base_params, site=site, range_cell=c.cell_args[0],
-            n_azimuth=c.cell_args[1], max_range=c.max_range if max_range is None else max_range,
+            base=base, base_params=self.base_params, site=site, range_cell=self.cell_args[0],
+            n_azimuth=self.cell_args[1], max_range=c.max_range if max_range is None else max_range,
             max_rings=c.max_rings, half_life=c.half_life, forgetting=c.forgetting,
             prior_count=self.prior_count, smoothing=self.smoothing,
             birth_scaling=c.birth_scaling)
 
     def centres(self) -> np.ndarray:
-        """(n_rings·n_azimuth, 2) plane centres of the map's cells, ring-major."""
+        """(n_rings·n_azimuth, 2) plane centres of the map's cells, ring-major (made
+        again only when rings are added)."""
         c = self.counts
+        if len(self._centres) == c.sums_.size:
+            return self._centres
         r = (np.arange(c.n_rings) + 0.5) * c.range_cell
         t = (np.arange(c.n_azimuth) + 0.5) * (2.0 * np.pi / c.n_azimuth)
         x = c.site[0] + r[:, None] * np.sin(t)[None, :]
         y = c.site[1] + r[:, None] * np.cos(t)[None, :]
-        return np.column_stack([x.reshape(-1), y.reshape(-1)])
+        self._centres = np.column_stack([x.reshape(-1), y.reshape(-1)])
+        return self._centres
 
     def update(self, scan: Scan, in_track_gates: np.ndarray | None = None) -> None:
         """The base's update, then the map's counts and the base's expected counts."""

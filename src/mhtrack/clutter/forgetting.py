@@ -69,7 +69,7 @@ CHI2_2_99 = 9.2103
 #: Each scan's EM starts with ``π₀`` at least this (the GMM's warm start does the same).
 START_WEIGHT = 0.05
 #: Half-life ``h`` (s of data time) of the statistics (measured: docs/clutter.md).
-HALF_LIFE = 20.0
+HALF_LIFE = 10.0
 
 
 class ForgettingGMMClutter(ClutterEstimator):

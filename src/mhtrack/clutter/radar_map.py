@@ -60,8 +60,10 @@ from mhtrack.records import Scan
 
 #: Rings over the reach and sectors of a map placed with a ``max_range`` and no
 #: ``range_cell`` / ``n_azimuth`` given (module docstring, *Cell size*).
-REACH_RINGS = 12
-REACH_SECTORS = 32
+REACH_RINGS = 24
+REACH_SECTORS = 64
+#: Passes of :func:`smooth_cells` (measured: docs/clutter.md).
+SMOOTHING = 2
 #: Half-life ``h`` (s of data time) of the counts (measured: docs/clutter.md).
 HALF_LIFE = 40.0
 #: Cells of a map without a reach.
@@ -121,7 +123,7 @@ class ClutterMap(ClutterEstimator):
         rotations); default ``None``: ``half_life``.
     prior_weight : ``b₀`` (rotations) of the shrinkage toward the map's mean. Default 1.
     smoothing : passes ``p`` of the binomial kernel over neighbouring cells (0: none;
-        :func:`smooth_cells`). Default 0.
+        :func:`smooth_cells`). Default :data:`SMOOTHING`.
     max_range : rings made at once to reach this range (m); ``None``: as plots arrive.
     max_rings : most rings (bounded memory). Default 4096.
     source : ``"all"`` plots, or ``"outside-gates"`` (leave out plots in confirmed tracks'
@@ -139,7 +141,7 @@ class ClutterMap(ClutterEstimator):
     def __init__(self, *, site: tuple[float, float] = (0.0, 0.0),
                  range_cell: float | None = None, n_azimuth: int | None = None,
                  half_life: float | None = None, forgetting: float | None = None,
-                 prior_weight: float = 1.0, smoothing: int = 0,
+                 prior_weight: float = 1.0, smoothing: int = SMOOTHING,
                  max_range: float | None = None, max_rings: int = 4096,
                  source: Source = "all", birth_scaling: float = 0.0,
                  forget_used: bool = True) -> None:

@@ -146,3 +146,22 @@ def test_a_variant_runs_the_tracker_its_build_gives(tmp_path, monkeypatch):
                          methods=("gmm",), resolution=16, workers=1)
     (a,), (b,) = st.records["burst"]["gmm"], old.records["burst"]["gmm"]
     assert _strip(a) == _strip(b)
+
+
+def test_html_page_holds_every_comparison_and_verdict(tiny):
+    """``report.html``: one interval plot per scene, every comparison's sentence and the
+    pair summaries, from the same study the Markdown report is written from."""
+    pytest.importorskip("plotly")
+    import html as html_lib
+
+    from mhtrack.reports.clutter_scenes import pair_summary
+    from mhtrack.reports.html_clutter_scenes import write_clutter_scenes_html
+
+    path = write_clutter_scenes_html(tiny)
+    text = html_lib.unescape(path.read_text(encoding="utf-8"))
+    assert path.name == "report.html" and 'id="fig-paired-storm"' in text
+    assert 'id="fig-clutter-error"' in text
+    for c in tiny.paired["storm"]:
+        assert c.sentence in text
+    for line in pair_summary(tiny.paired["storm"]):
+        assert line in text

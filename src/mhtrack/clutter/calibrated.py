@@ -11,8 +11,7 @@ parametric start", *Ann. Statist.* 23(3), 1995: ``f̂ = f_θ̂ · r̂``). Per ce
 map, with the same discount ``γ_k`` as the map (half-life in seconds of data time),
 
     S_c ← γ_k S_c + n_c,k           (the plots counted in the cell),
-    E_c ← γ_k E_c + κ̂_base,k(x_c) A_c   (the plots the base expects there: its intensity
-                                       at the cell's centre ``x_c`` times the cell's area),
+    E_c ← γ_k E_c + ∫_c κ̂_base,k       (the plots the base expects there),
 
 and the ratio is the Poisson–Gamma (empirical Bayes) estimate of a relative rate from
 observed and expected counts, shrunk toward 1 by a prior worth ``b₀`` expected plots
@@ -22,7 +21,14 @@ in disease mapping", *Biometrics* 43(3), 1987): ``S_c ~ Poisson(r_c E_c)``,
 
     r̂_c = (S̃_c + b₀) / (Ẽ_c + b₀),       κ̂(z) = κ̂_base(z) · r̂_c(z),
 
-``S̃``, ``Ẽ`` the counts smoothed over neighbouring cells
+``E``'s integral (:meth:`MapCalibratedClutter.expected`): for a Gaussian-mixture base
+(``κ̂ = M̂ (π₀ u + Σ_j π_j N_j)``, in the plane or in range and bearing) each Gaussian's
+mass per cell by the midpoint rule ``N_j(x_c)·A_c`` when the cells resolve it (its σ
+along range and across bearing at least :data:`RESOLVED` times the cell's sides there),
+else by the 7 × 7 Gauss–Hermite nodes ``μ_j + L_j ξ_q`` each put with its weight into
+its cell (a clump narrower than a cell, which the midpoint rule would miss or blow up);
+the background and any other base by the midpoint rule. ``S̃``, ``Ẽ`` the
+counts smoothed over neighbouring cells
 (:func:`~mhtrack.clutter.radar_map.smooth_cells`, ``smoothing`` passes). Beyond the map
 ``κ̂ = κ̂_base``. Plots that confirmed tracks used are taken out of both (:meth:`forget`).
 The cells' reference level ``ρ̄`` (:meth:`reference_intensity`) is the map's mean, so that
@@ -39,6 +45,7 @@ from typing import Any
 import numpy as np
 
 from mhtrack.clutter.base import ClutterEstimator
+from mhtrack.clutter.density import Mixture
 from mhtrack.clutter.radar_map import ClutterMap, smooth_cells
 from mhtrack.records import Scan
 
@@ -46,13 +53,29 @@ from mhtrack.records import Scan
 PRIOR_COUNT = 5.0
 #: Smoothing passes over the cells (measured: docs/clutter.md).
 SMOOTHING = 1
+#: A Gaussian is resolved by the cells when its σ along each of the cell's axes is at
+#: least this times the cell's side (the midpoint rule's error is then small).
+RESOLVED = 0.5
 #: Rings over the reach and sectors of the cells, unless given (measured: docs/clutter.md;
 #: coarser than the plain map's, as the base gives the shape within a cell).
 RINGS, SECTORS = 12, 32
 
 
+def _gauss_hermite(n: int = 7) -> tuple[np.ndarray, np.ndarray]:
+    """(n², 2) nodes ``ξ`` and weights (sum 1) of the n × n probabilists' Gauss–Hermite
+    product rule for ``E f(ξ)``, ``ξ ~ N(0, I)`` (Abramowitz & Stegun 25.4.46)."""
+    x, w = np.polynomial.hermite_e.hermegauss(n)
+    w = w / w.sum()
+    gx, gy = np.meshgrid(x, x, indexing="ij")
+    return np.column_stack([gx.ravel(), gy.ravel()]), np.outer(w, w).ravel()
+
+
+_NODES = _gauss_hermite()
+
+
 class MapCalibratedClutter(ClutterEstimator):
-    """``κ̂ = κ̂_base · r̂_c`` (module docstring).
+    """A GMM calibrated cell by cell by a range–azimuth clutter map,
+    ``κ̂ = κ̂_GMM · r̂_c`` (module docstring).
 
     Parameters
     ----------
@@ -145,9 +168,69 @@ class MapCalibratedClutter(ClutterEstimator):
         grow = c.n_rings - self.expected_.shape[0]
         if grow > 0:
             self.expected_ = np.vstack([self.expected_, np.zeros((grow, c.n_azimuth))])
-        kappa = self.base.intensity(self.centres()).reshape(c.sums_.shape)
-        self.expected_ = g * self.expected_ + kappa * c.areas()
+        self.expected_ = g * self.expected_ + self.expected()
         self._ratio = None
+
+    def expected(self) -> np.ndarray:
+        """(n_rings, n_azimuth) ``∫_c κ̂_base`` now, the plots the base expects per cell
+        (module docstring)."""
+        from mhtrack.clutter.mixture import MixtureClutter
+        from mhtrack.clutter.polar import PolarClutter
+
+        c, base = self.counts, self.base
+        polar = isinstance(base, PolarClutter)
+        inner = base.inner if polar else base
+        mix = getattr(inner, "mixture_", None)
+        mid = np.asarray(base.intensity(self.centres()), float).reshape(c.sums_.shape)
+        if not isinstance(inner, MixtureClutter) or mix is None or not len(mix.weights):
+            return mid * c.areas()
+        pts = base.to_polar(self.centres()) if polar else self.centres()  # type: ignore[attr-defined]
+        d_theta = 2.0 * np.pi / c.n_azimuth
+        # cell sides and areas in the base's coordinates
+        if polar:
+            r0 = base.r0  # type: ignore[attr-defined]
+            area_b = np.full(c.sums_.shape, c.range_cell * r0 * d_theta)
+        else:
+            area_b = c.areas()
+        cov, means = mix.covariances, mix.means
+        if polar:  # cells are Δr by r₀Δθ rectangles in the base's coordinates
+            sd_a, sd_b = np.sqrt(cov[:, 0, 0]), np.sqrt(cov[:, 1, 1])
+            side_a, side_b = c.range_cell, np.full(len(means), r0 * d_theta)
+        else:  # along and across the bearing at the Gaussian's mean
+            d = means - np.asarray(c.site)
+            u = d / np.maximum(np.hypot(d[:, 0], d[:, 1]), 1e-9)[:, None]
+            v = np.column_stack([-u[:, 1], u[:, 0]])
+            sd_a = np.sqrt(np.einsum("ki,kij,kj->k", u, cov, u))
+            sd_b = np.sqrt(np.einsum("ki,kij,kj->k", v, cov, v))
+            side_b = np.maximum(np.hypot(d[:, 0], d[:, 1]), 0.5 * c.range_cell) * d_theta
+            side_a = c.range_cell
+        resolved = (sd_a >= RESOLVED * side_a) & (sd_b >= RESOLVED * side_b)
+        out = np.zeros(c.sums_.size)
+        if resolved.any():
+            sub = Mixture(mix.weights[resolved], means[resolved], cov[resolved])
+            out += sub.pdf(pts) * area_b.reshape(-1)
+        if not resolved.all():  # Gauss–Hermite nodes μ + Lξ, each with its mass
+            nodes, w = _NODES
+            low = np.flatnonzero(~resolved)
+            chol = np.linalg.cholesky(cov[low])
+            x = means[low, None, :] + np.einsum("kij,qj->kqi", chol, nodes)
+            mass = mix.weights[low, None] * w[None, :]
+            x = x.reshape(-1, 2)
+            if polar:
+                theta = x[:, 1] / r0 + base.cut  # type: ignore[attr-defined]
+                x = np.column_stack([c.site[0] + x[:, 0] * np.sin(theta),
+                                     c.site[1] + x[:, 0] * np.cos(theta)])
+            ring, sector = c.cells(x)
+            inside = ring < c.n_rings
+            np.add.at(out, ring[inside] * c.n_azimuth + sector[inside],
+                      mass.reshape(-1)[inside])
+        if mix.background_box is not None and mix.background_weight > 0:
+            x0, x1, y0, y1 = mix.background_box
+            inbox = ((pts[:, 0] >= x0) & (pts[:, 0] <= x1) & (pts[:, 1] >= y0)
+                     & (pts[:, 1] <= y1))
+            out += np.where(inbox, mix.background_weight / mix.background_area, 0.0) \
+                * area_b.reshape(-1)
+        return inner.count_ * out.reshape(c.sums_.shape)
 
     def ratio(self) -> np.ndarray:
         """(n_rings, n_azimuth) ``r̂_c`` (module docstring), computed once per change."""

@@ -95,7 +95,7 @@ def test_an_estimator_registered_by_name_joins_the_study(monkeypatch, tmp_path):
     monkeypatch.setitem(CLUTTER_ESTIMATOR_CLASSES, "flat", Flat)
     registered = tuple(n for n in CLUTTER_ESTIMATOR_CLASSES if n != "known")
     assert registered[-1] == "flat"
-    assert all_methods() == ("known", "uniform", *registered, "map-birth")
+    assert all_methods() == ("known", "uniform", *registered, "map-birth", "mapgmm-birth")
     assert ("flat", "gmm") in study_pairs(all_methods())
     assert ("flat", "uniform") in study_pairs(all_methods())
     st = clutter_scenes(tmp_path, runs=1, base=preset("radars-clutter", scans=10),

@@ -124,6 +124,7 @@ class MapCalibratedClutter(ClutterEstimator):
         self.expected_ = np.zeros_like(self.counts.sums_)
         self._ratio: np.ndarray | None = None
         self._centres = np.zeros((0, 2))
+        self._polar_centres = np.zeros((0, 2))
 
     @property
     def site(self) -> tuple[float, float]:
@@ -158,6 +159,17 @@ class MapCalibratedClutter(ClutterEstimator):
         self._centres = np.column_stack([x.reshape(-1), y.reshape(-1)])
         return self._centres
 
+    def _base_centres(self, polar: bool) -> np.ndarray:
+        """The cells' centres in the base's coordinates (range and bearing for a
+        :class:`~mhtrack.clutter.polar.PolarClutter` base), made again only when rings are
+        added."""
+        xy = self.centres()
+        if not polar:
+            return xy
+        if len(self._polar_centres) != len(xy):
+            self._polar_centres = self.base.to_polar(xy)  # type: ignore[attr-defined]
+        return self._polar_centres
+
     def update(self, scan: Scan, in_track_gates: np.ndarray | None = None) -> None:
         """The base's update, then the map's counts and the base's expected counts."""
         self.base.update(scan, in_track_gates)
@@ -181,10 +193,10 @@ class MapCalibratedClutter(ClutterEstimator):
         polar = isinstance(base, PolarClutter)
         inner = base.inner if polar else base
         mix = getattr(inner, "mixture_", None)
-        mid = np.asarray(base.intensity(self.centres()), float).reshape(c.sums_.shape)
         if not isinstance(inner, MixtureClutter) or mix is None or not len(mix.weights):
-            return mid * c.areas()
-        pts = base.to_polar(self.centres()) if polar else self.centres()  # type: ignore[attr-defined]
+            mid = np.asarray(base.intensity(self.centres()), float)
+            return mid.reshape(c.sums_.shape) * c.areas()
+        pts = self._base_centres(polar)
         d_theta = 2.0 * np.pi / c.n_azimuth
         # cell sides and areas in the base's coordinates
         if polar:

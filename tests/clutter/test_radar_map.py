@@ -183,3 +183,19 @@ def test_smoothing_keeps_the_total_and_a_constant(rings: int, sectors: int, pass
         spike[1, 1] = 16.0
         k = np.array([1.0, 2.0, 1.0])
         np.testing.assert_allclose(smooth_cells(spike, 1)[:3, :3], np.outer(k, k), atol=1e-12)
+
+
+def test_a_half_life_is_the_per_rotation_factor_of_the_rotations_spacing() -> None:
+    """Rotations ``Δt = 6`` s apart with ``half_life = 40`` s give the sums, looks and
+    intensities of the constant ``forgetting = 2^(−6/40)``."""
+    rng = np.random.default_rng(5)
+    a = ClutterMap(range_cell=1000.0, n_azimuth=8, half_life=40.0)
+    b = ClutterMap(range_cell=1000.0, n_azimuth=8, forgetting=2.0 ** (-6.0 / 40.0))
+    for k in range(10):
+        z = _uniform_disc(rng, 30 + 5 * k, 8000.0, (0.0, 0.0))
+        for m in (a, b):
+            m.update(Scan(k, 6.0 * k, z, np.zeros(len(z), np.int64), np.arange(len(z))))
+    np.testing.assert_allclose(a.sums_, b.sums_, rtol=1e-12)
+    assert a.looks_ == pytest.approx(b.looks_, rel=1e-12)
+    q = _uniform_disc(rng, 30, 9000.0, (0.0, 0.0))
+    np.testing.assert_allclose(a.intensity(q), b.intensity(q), rtol=1e-12)

@@ -41,8 +41,8 @@ def clutter_estimator_options(f: Callable[..., Any]) -> Callable[..., Any]:
                      "(map) or 32 (mapgmm) with a reach, else 64]."),
         click.option("--clutter-half-life", type=click.FloatRange(0, None, min_open=True),
                      default=None, help="Half-life (s of data time) of the clutter "
-                     "estimate's memory (mht-map, mht-fgmm, mht-mapgmm) [map 40, fgmm 10, "
-                     "mapgmm 40]."),
+                     "estimate's memory (mht-map, mht-fgmm, mht-mapgmm) [map 40, mapgmm 40; "
+                     "fgmm none: γ = 0.7 per scan]."),
     ]
     for opt in reversed(opts):
         f = opt(f)

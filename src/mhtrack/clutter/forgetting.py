@@ -13,15 +13,15 @@ of scan ``k`` and ``d = z − a_j`` about the component's anchor,
 — the online EM of Neal & Hinton ("A view of the EM algorithm that justifies incremental,
 sparse, and other variants", 1998, §5: statistics decayed exponentially for changing
 data) and Cappé & Moulines ("On-line expectation–maximization algorithm for latent data
-models", JRSS B 71(3), 2009) with step ``1 − γ``. The discount is per second of data
-time, ``γ_k = 2^(−Δt_k / h)`` (``Δt_k`` the time since the previous scan, ``h`` the
-half-life, ``half_life``), so that the memory is the same whatever the radar's period or
-how its frames are gathered; ``forgetting`` gives a constant ``γ`` per scan instead. Each
-scan runs EM on its own
-plots only: the E-step on the new plots under the current parameters, the M-step from the
-discounted past statistics plus the new ones, until ``|ΔL| < tol·|L|``: memory and time per
-scan are O(K) and O(n K), whatever the history. With ``γ = 1`` and all data in one scan it
-is batch EM (P1 eqs. 9–11).
+models", JRSS B 71(3), 2009) with step ``1 − γ``: ``γ_k = forgetting`` per scan, or, with
+a half-life ``h`` (``half_life``), ``2^(−Δt_k/h)`` per second of data time (``Δt_k`` since
+the previous scan). The default is per scan: measured (docs/clutter.md), the memory
+the mixture needs is a number of scans' plots, not of seconds (10 s suits 4–6 s
+rotations; on 1 s scans it raises the clutter error by two thirds). Each scan runs EM
+on its own plots only: the E-step on the new plots under the current parameters, the
+M-step from the discounted past statistics plus the new ones, until ``|ΔL| < tol·|L|``:
+memory and time per scan are O(K) and O(n K), whatever the history. With ``γ = 1`` and
+all data in one scan it is batch EM (P1 eqs. 9–11).
 
 After each scan, as the cells drift:
 
@@ -68,8 +68,8 @@ from mhtrack.records import Scan
 CHI2_2_99 = 9.2103
 #: Each scan's EM starts with ``π₀`` at least this (the GMM's warm start does the same).
 START_WEIGHT = 0.05
-#: Half-life ``h`` (s of data time) of the statistics (measured: docs/clutter.md).
-HALF_LIFE = 10.0
+#: ``γ`` per scan (rotation) of the statistics (measured: docs/clutter.md).
+FORGETTING = 0.7
 
 
 class ForgettingGMMClutter(ClutterEstimator):
@@ -77,10 +77,10 @@ class ForgettingGMMClutter(ClutterEstimator):
 
     Parameters
     ----------
-    half_life : ``h`` (s of data time, ``inf``: no forgetting): the statistics are
-        discounted by ``γ_k = 2^(−Δt_k/h)``. Default :data:`HALF_LIFE`.
-    forgetting : a constant ``γ`` in (0, 1] per scan instead (memory ``1/(1 − γ)`` scans);
-        default ``None``: ``half_life``.
+    forgetting : ``γ`` in (0, 1] per scan (memory ``1/(1 − γ)`` scans). Default
+        :data:`FORGETTING`.
+    half_life : ``h`` (s of data time, ``inf``: no forgetting): when given, the statistics
+        are discounted by ``γ_k = 2^(−Δt_k/h)`` instead. Default ``None``.
     n_components : most Gaussians. Default 8.
     background : a uniform component over ``region`` or the box of the plots seen so far
         (padded 5 %, at least ``min_extent`` wide). Default True.
@@ -97,7 +97,7 @@ class ForgettingGMMClutter(ClutterEstimator):
 
     name = "fgmm"
 
-    def __init__(self, *, half_life: float = HALF_LIFE, forgetting: float | None = None,
+    def __init__(self, *, forgetting: float = FORGETTING, half_life: float | None = None,
                  n_components: int = 8,
                  background: bool = True, background_floor: float = 0.01,
                  region: Region | tuple[float, float, float, float] | None = None,
@@ -105,9 +105,9 @@ class ForgettingGMMClutter(ClutterEstimator):
                  min_points: float = 3.0, min_contrast: float = 5.0,
                  min_extent: float = 1000.0, merge_distance: float = 1.0,
                  split_kurtosis: float = 2.0, seed: int = 0) -> None:
-        if forgetting is not None and not (np.isfinite(forgetting) and 0 < forgetting <= 1):
+        if not (np.isfinite(forgetting) and 0 < forgetting <= 1):
             raise ValueError(f"forgetting must be in (0, 1], got {forgetting!r}")
-        if not half_life > 0:
+        if half_life is not None and not half_life > 0:
             raise ValueError(f"half_life must be > 0 s, got {half_life!r}")
         if not (isinstance(n_components, int | np.integer) and 1 <= n_components <= 256):
             raise ValueError(f"n_components must be an integer in [1, 256], got "
@@ -127,8 +127,8 @@ class ForgettingGMMClutter(ClutterEstimator):
             raise ValueError(f"split_kurtosis must be in [0, 3), got {split_kurtosis!r}")
         if region is not None and not isinstance(region, Region):
             region = Region(*(float(v) for v in region))
-        self.forgetting = None if forgetting is None else float(forgetting)
-        self.half_life = float(half_life)
+        self.forgetting = float(forgetting)
+        self.half_life = None if half_life is None else float(half_life)
         self.n_components = int(n_components)
         self.background = bool(background)
         self.background_floor = float(background_floor) if background else 0.0
@@ -259,9 +259,10 @@ class ForgettingGMMClutter(ClutterEstimator):
         self._finish()
 
     def _discount(self, t: float) -> float:
-        """``γ_k``: ``forgetting``, else ``2^(−Δt/h)`` since the last scan (1 at the first)."""
+        """``γ_k``: ``2^(−Δt/h)`` since the last scan (1 at the first) with a half-life,
+        else ``forgetting``."""
         last, self.time_ = self.time_, t
-        if self.forgetting is not None:
+        if self.half_life is None:
             return self.forgetting
         return 1.0 if last is None else float(2.0 ** (-max(t - last, 0.0) / self.half_life))
 
@@ -359,7 +360,8 @@ class ForgettingGMMClutter(ClutterEstimator):
         from mhtrack.bounds import MAX_TIME_S
         from mhtrack.clutter.state_checks import MAX_COORDINATE, array, check_forgetting, number
 
-        m, a, box, extent = check_forgetting(state, self.n_components, self.forgetting or 1.0)
+        m, a, box, extent = check_forgetting(
+            state, self.n_components, 1.0 if self.half_life else self.forgetting)
         self.moments_, self.anchors_, self.box_, self.extent_ = m, a, box, extent
         self.bg_mass_ = float(state["bg_mass"])
         self.count_sum_, self.looks_ = float(state["count_sum"]), float(state["looks"])

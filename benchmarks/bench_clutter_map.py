@@ -1,5 +1,6 @@
 """Clutter-stage time per scan and clutter error of the new estimators (``map``, the
-per-radar clutter map; ``fgmm``, the forgetting mixture) beside the GMM's, in one run.
+per-radar clutter map; ``fgmm``, the forgetting mixture; ``mapgmm``, the GMM calibrated by
+a map) beside the GMM's, in one run.
 
 Run: ``python benchmarks/bench_clutter_map.py [--seeds N] [--figure PATH]``.
 
@@ -8,10 +9,11 @@ Run: ``python benchmarks/bench_clutter_map.py [--seeds N] [--figure PATH]``.
   estimators taking turns scan by scan — median and mean ms per scan, ratios to the GMM's
   (of the medians, the median of the per-scan ratios, of the means), and the clutter error
   ``IAE = ∫|κ̂ − κ|`` (plots per scan, 100² grid) averaged over scans and seeds;
-* timed path, ``opensky-radars`` (rotating radars, frames of one sensor's sector): the
-  tracker's per-radar estimator (``PerSensorClutter`` of maps, of GMMs in polar) fed the
-  frames in order — ms per frame and ratio; with ``--figure``, each radar's clutter map
-  at four times drawn to PATH.
+* timed path, ``opensky-radars`` and ``radars-clutter`` with the ``storm`` clutter scene
+  (rotating radars, frames of one sensor's sector): the tracker's per-radar estimator
+  (``PerSensorClutter`` of maps, of GMMs in polar) fed the frames in order — ms per frame
+  and ratio; with ``--figure``, each radar's clutter map on ``opensky-radars`` at four
+  times drawn to PATH.
 """
 
 from __future__ import annotations
@@ -31,7 +33,7 @@ from mhtrack.metrics.clutter import integrated_absolute_error, true_intensity_gr
 from mhtrack.records import Scan
 from mhtrack.scenario import preset, simulate
 
-NAMES = ("gmm", "agmm", "fgmm", "map")
+NAMES = ("gmm", "agmm", "fgmm", "map", "mapgmm")
 
 
 def interleaved(ests: dict[str, ClutterEstimator], scans: list[Scan],
@@ -88,18 +90,21 @@ def scan_path(seeds: int) -> None:
     _table(times, "scan", iae)
 
 
-def timed_path(figure: str | None) -> None:
-    sc = preset("opensky-radars")
+def timed_path(figure: str | None, scene: str | None = None) -> None:
+    from mhtrack.scenario.scenes import with_clutter_scene
+
+    sc = (preset("opensky-radars") if scene is None
+          else with_clutter_scene(preset("radars-clutter", scans=150), scene))
     sim = simulate(sc, seed=1)
     frames = list(scenario_source(sc, sim.plots))
     sensors = scenario_source(sc, sim.plots).sensors
     t_all = [float(f.time) for f in frames]
     when = np.quantile(t_all, [0.25, 0.5, 0.75, 1.0])
     snaps: list[dict] = []
-    print(f"timed path: opensky-radars seed 1, {len(frames)} frames, "
+    print(f"timed path: {sc.name} seed 1, {len(frames)} frames, "
           f"{sum(len(f) for f in frames)} plots")
     clutters = {n: make_tracker(f"mht-{n}", sensors=sensors).clutter
-                for n in ("gmm", "fgmm", "map")}
+                for n in ("gmm", "fgmm", "map", "mapgmm")}
     nxt = [0]
 
     def probe(n: str, clutter: ClutterEstimator, s: Scan) -> None:
@@ -108,7 +113,7 @@ def timed_path(figure: str | None) -> None:
             nxt[0] += 1
     res = interleaved(clutters, frames, probe)
     _table({n: [t] for n, t in res.items()}, "frame")
-    if figure:
+    if figure and scene is None:
         from mhtrack.plotting.clutter_map import plot_clutter_maps
         from mhtrack.plotting.scene import save_figure
 
@@ -126,6 +131,7 @@ def main() -> int:
     scan_path(a.seeds)
     if not a.skip_timed:
         timed_path(a.figure)
+        timed_path(None, "storm")
     return 0
 
 

@@ -11,11 +11,12 @@ from __future__ import annotations
 #: Trackers of P1 §3: the plain MHT with a known clutter density, and the MHT whose
 #: clutter intensity is estimated online by a GMM or by the adaptive GMM; and ours: by a
 #: per-radar range–azimuth clutter map or by a GMM with exponential forgetting.
-TRACKERS: tuple[str, ...] = ("mht", "mht-agmm", "mht-gmm", "mht-map", "mht-fgmm")
+TRACKERS: tuple[str, ...] = ("mht", "mht-agmm", "mht-gmm", "mht-map", "mht-fgmm",
+                             "mht-mapgmm")
 #: The tracker of a run when none is named: the MHT with P1's adaptive GMM.
 DEFAULT_TRACKER = "mht-agmm"
 #: Clutter-intensity estimators (``mhtrack.clutter``).
-CLUTTER_ESTIMATORS: tuple[str, ...] = ("known", "gmm", "agmm", "map", "fgmm")
+CLUTTER_ESTIMATORS: tuple[str, ...] = ("known", "gmm", "agmm", "map", "fgmm", "mapgmm")
 #: Coordinates a radar's clutter is estimated in (asynchronous data): the local
 #: east-north plane, or the radar's own range and bearing.
 CLUTTER_FRAMES: tuple[str, ...] = ("plane", "polar")

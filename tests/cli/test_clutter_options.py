@@ -17,7 +17,12 @@ def test_params_of_the_options():
         "forgetting": 0.8, "birth_scaling": 1.0, "range_cell": 2000.0, "n_azimuth": 16}
     assert clutter_params("mht-fgmm", 0.5, None, None, None) == {"forgetting": 0.5}
     assert clutter_params("mht-gmm", None, None, None, None) is None
-    with pytest.raises(click.UsageError, match="--birth-scaling goes with --tracker mht-map"):
+    assert clutter_params("mht-mapgmm", None, 1.0, None, 16, clutter_half_life=30.0) == {
+        "birth_scaling": 1.0, "n_azimuth": 16, "half_life": 30.0}
+    with pytest.raises(click.UsageError, match="--clutter-half-life"):
+        clutter_params("mht-gmm", None, None, None, None, clutter_half_life=30.0)
+    with pytest.raises(click.UsageError,
+                       match="--birth-scaling goes with --tracker mht-map or mht-mapgmm"):
         clutter_params("mht-fgmm", None, 1.0, None, None)
     with pytest.raises(click.UsageError, match="--clutter-forgetting"):
         clutter_params("mht-agmm", 0.9, None, None, None)

@@ -147,12 +147,15 @@ def test_state_round_trip_and_hostile_states() -> None:
     bad_m[0, 0] = 0.0
     for key, bad, word in (("moments", bad_m, "weight"), ("moments", np.zeros((2, 14)), "shape"),
                            ("anchors", np.zeros((99, 2)), "shape"),
-                           ("looks", 6.0, "looks"), ("bg_mass", -1.0, "bg_mass"),
-                           ("box", [1.0, 0.0, 0.0, 1.0], "box")):
+                           ("looks", -1.0, "looks"), ("bg_mass", -1.0, "bg_mass"),
+                           ("box", [1.0, 0.0, 0.0, 1.0], "box"), ("time", np.nan, "time")):
         with pytest.raises(ValueError, match=word):
             ForgettingGMMClutter().set_state({**good, key: bad})
-    for kw in ({"forgetting": 0.0}, {"n_components": 0}, {"split_kurtosis": 3.0},
-               {"merge_distance": -1.0}, {"max_iter": 0}, {"reg_covar": 0.0}):
+    with pytest.raises(ValueError, match="looks"):  # beyond 1/(1 − γ) with a constant γ
+        ForgettingGMMClutter(forgetting=0.7).set_state({**good, "looks": 6.0})
+    for kw in ({"forgetting": 0.0}, {"half_life": 0.0}, {"n_components": 0},
+               {"split_kurtosis": 3.0}, {"merge_distance": -1.0}, {"max_iter": 0},
+               {"reg_covar": 0.0}):
         with pytest.raises(ValueError, match=next(iter(kw))):
             ForgettingGMMClutter(**kw)
 
@@ -174,3 +177,20 @@ def test_forget_takes_the_tracks_plots_out_of_count_and_statistics() -> None:
     assert np.isfinite(e.intensity(b)).all()
     e.forget(used)  # once per scan: a second call changes nothing
     assert e.count_ == pytest.approx((0.5 * 40 + 40 - used.sum()) / 1.5)
+
+
+def test_a_half_life_is_the_per_scan_factor_of_the_scans_spacing() -> None:
+    """With scans ``Δt`` apart, ``half_life = h`` discounts exactly as the constant
+    ``forgetting = 2^(−Δt/h)``: the same statistics, count and intensity."""
+    rng = np.random.default_rng(3)
+    dt, h = 4.0, 10.0
+    a = ForgettingGMMClutter(half_life=h)
+    b = ForgettingGMMClutter(forgetting=2.0 ** (-dt / h))
+    for k in range(8):
+        z = _clumps(rng, [(0, 0), (3000, 1000 + 100 * k)], 25, 300.0)
+        for est in (a, b):
+            est.update(Scan(k, k * dt, z, np.zeros(len(z), np.int64), np.arange(len(z))))
+    np.testing.assert_allclose(a.moments_, b.moments_, rtol=1e-12, atol=1e-9)
+    assert a.count_ == pytest.approx(b.count_, rel=1e-12)
+    q = rng.uniform(-3000, 5000, (40, 2))
+    np.testing.assert_allclose(a.intensity(q), b.intensity(q), rtol=1e-10)

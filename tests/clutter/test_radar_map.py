@@ -8,7 +8,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from mhtrack.clutter.radar_map import ClutterMap, birth_scale, cell_areas
+from mhtrack.clutter.radar_map import ClutterMap, birth_scale, cell_areas, smooth_cells
 from mhtrack.records import Scan
 
 
@@ -51,7 +51,7 @@ def test_stationary_poisson_clutter_converges_within_the_forgetting_interval() -
     have mean ≈ 0 and variance ≈ 1, and the map-wide mean is within 3 σ of ρ."""
     gamma, n_rot, radius, rho = 0.8, 25, 20_000.0, 2e-6
     m = ClutterMap(site=(5e3, 7e3), range_cell=2000.0, n_azimuth=16, forgetting=gamma,
-                   prior_weight=0.0, max_range=radius)
+                   smoothing=0, prior_weight=0.0, max_range=radius)
     rng = np.random.default_rng(12)
     lam = rho * np.pi * radius**2  # ≈ 2513 plots per rotation
     for k in range(n_rot):
@@ -75,7 +75,7 @@ def test_step_change_follows_the_exponential_response() -> None:
     ``λ₂ + (λ₁ − λ₂) γ^m N_k₀ / N_k`` (closed form), within 4 standard errors."""
     gamma, k0, k1, radius = 0.7, 12, 12, 10_000.0
     lam1, lam2 = 400.0, 1600.0  # per rotation over the disc
-    m = ClutterMap(range_cell=1000.0, n_azimuth=8, forgetting=gamma, prior_weight=0.0,
+    m = ClutterMap(range_cell=1000.0, n_azimuth=8, forgetting=gamma, smoothing=0, prior_weight=0.0,
                    max_range=radius)
     rng = np.random.default_rng(3)
     area = np.pi * radius**2
@@ -95,7 +95,7 @@ def test_step_change_follows_the_exponential_response() -> None:
 
 
 def test_forget_takes_used_plots_out_and_shrinkage_floors_empty_cells() -> None:
-    m = ClutterMap(range_cell=100.0, n_azimuth=4, forgetting=1.0, prior_weight=1.0)
+    m = ClutterMap(range_cell=100.0, n_azimuth=4, forgetting=1.0, prior_weight=1.0, smoothing=0)
     z = np.array([[0.0, 50.0], [0.0, 60.0], [0.0, 150.0]])
     m.update(_scan(0, z))
     a0, a1 = cell_areas(2, 4, 100.0)
@@ -110,7 +110,8 @@ def test_forget_takes_used_plots_out_and_shrinkage_floors_empty_cells() -> None:
 
 
 def test_outside_gates_source_and_bad_input() -> None:
-    m = ClutterMap(source="outside-gates", range_cell=100.0, n_azimuth=1, prior_weight=0)
+    m = ClutterMap(source="outside-gates", range_cell=100.0, n_azimuth=1, prior_weight=0,
+                   smoothing=0)
     m.update(_scan(0, [[0.0, 10.0], [0.0, 20.0]]), np.array([True, False]))
     assert m.sums_.sum() == 1.0
     with pytest.raises(ValueError, match="in_track_gates has 1"):
@@ -149,11 +150,13 @@ def test_state_round_trip_continues_identically_and_hostile_states_fail() -> Non
     good = a.get_state()
     for key, bad, word in (("sums", -good["sums"] - 1, "negative"),
                            ("sums", np.zeros((3, 7)), "shape"),
-                           ("looks", 11.0, "looks"), ("looks", float("nan"), "looks"),
-                           ("last", np.array([10**9]), "last"),
+                           ("looks", -1.0, "looks"), ("looks", float("nan"), "looks"),
+                           ("last", np.array([10**9]), "last"), ("time", np.inf, "time"),
                            ("n_updates", -1, "n_updates"), ("sums", "x", "sums")):
         with pytest.raises(ValueError, match=word):
             ClutterMap(range_cell=300.0).set_state({**good, key: bad})
+    with pytest.raises(ValueError, match="looks"):  # beyond 1/(1 − γ) with a constant γ
+        ClutterMap(range_cell=300.0, forgetting=0.9).set_state({**good, "looks": 11.0})
 
 
 def test_birth_scale() -> None:
@@ -162,3 +165,37 @@ def test_birth_scale() -> None:
     assert birth_scale(k, 2e-7, 1.0).tolist() == [1.0, 1.0, 0.5]
     assert birth_scale(k, 2e-7, 2.0)[2] == pytest.approx(0.25)
     assert birth_scale(k, 0.0, 1.0).tolist() == [1.0, 1.0, 1.0]
+
+
+@given(st.integers(1, 12), st.integers(1, 16), st.integers(0, 5), st.integers(0, 2**31))
+@settings(max_examples=40, deadline=None)
+def test_smoothing_keeps_the_total_and_a_constant(rings: int, sectors: int, passes: int,
+                                                  seed: int) -> None:
+    """``[1, 2, 1]/4`` along both axes (reflecting rings, circular sectors) keeps the
+    map's total and leaves a constant map as it is; one pass on a single spike gives the
+    kernel's outer product (where the map is at least 3 × 3)."""
+    a = np.random.default_rng(seed).poisson(3.0, (rings, sectors)).astype(float)
+    out = smooth_cells(a, passes)
+    assert out.sum() == pytest.approx(a.sum(), rel=1e-12, abs=1e-12)
+    np.testing.assert_allclose(smooth_cells(np.full((rings, sectors), 2.5), passes), 2.5)
+    if rings >= 3 and sectors >= 3:
+        spike = np.zeros((rings, sectors))
+        spike[1, 1] = 16.0
+        k = np.array([1.0, 2.0, 1.0])
+        np.testing.assert_allclose(smooth_cells(spike, 1)[:3, :3], np.outer(k, k), atol=1e-12)
+
+
+def test_a_half_life_is_the_per_rotation_factor_of_the_rotations_spacing() -> None:
+    """Rotations ``Δt = 6`` s apart with ``half_life = 40`` s give the sums, looks and
+    intensities of the constant ``forgetting = 2^(−6/40)``."""
+    rng = np.random.default_rng(5)
+    a = ClutterMap(range_cell=1000.0, n_azimuth=8, half_life=40.0)
+    b = ClutterMap(range_cell=1000.0, n_azimuth=8, forgetting=2.0 ** (-6.0 / 40.0))
+    for k in range(10):
+        z = _uniform_disc(rng, 30 + 5 * k, 8000.0, (0.0, 0.0))
+        for m in (a, b):
+            m.update(Scan(k, 6.0 * k, z, np.zeros(len(z), np.int64), np.arange(len(z))))
+    np.testing.assert_allclose(a.sums_, b.sums_, rtol=1e-12)
+    assert a.looks_ == pytest.approx(b.looks_, rel=1e-12)
+    q = _uniform_disc(rng, 30, 9000.0, (0.0, 0.0))
+    np.testing.assert_allclose(a.intensity(q), b.intensity(q), rtol=1e-12)

@@ -95,7 +95,7 @@ def test_an_estimator_registered_by_name_joins_the_study(monkeypatch, tmp_path):
     monkeypatch.setitem(CLUTTER_ESTIMATOR_CLASSES, "flat", Flat)
     registered = tuple(n for n in CLUTTER_ESTIMATOR_CLASSES if n != "known")
     assert registered[-1] == "flat"
-    assert all_methods() == ("known", "uniform", *registered, "map-birth")
+    assert all_methods() == ("known", "uniform", *registered, "map-birth", "mapgmm-birth")
     assert ("flat", "gmm") in study_pairs(all_methods())
     assert ("flat", "uniform") in study_pairs(all_methods())
     st = clutter_scenes(tmp_path, runs=1, base=preset("radars-clutter", scans=10),
@@ -146,3 +146,22 @@ def test_a_variant_runs_the_tracker_its_build_gives(tmp_path, monkeypatch):
                          methods=("gmm",), resolution=16, workers=1)
     (a,), (b,) = st.records["burst"]["gmm"], old.records["burst"]["gmm"]
     assert _strip(a) == _strip(b)
+
+
+def test_html_page_holds_every_comparison_and_verdict(tiny):
+    """``report.html``: one interval plot per scene, every comparison's sentence and the
+    pair summaries, from the same study the Markdown report is written from."""
+    pytest.importorskip("plotly")
+    import html as html_lib
+
+    from mhtrack.reports.clutter_scenes import pair_summary
+    from mhtrack.reports.html_clutter_scenes import write_clutter_scenes_html
+
+    path = write_clutter_scenes_html(tiny)
+    text = html_lib.unescape(path.read_text(encoding="utf-8"))
+    assert path.name == "report.html" and 'id="fig-paired-storm"' in text
+    assert 'id="fig-clutter-error"' in text
+    for c in tiny.paired["storm"]:
+        assert c.sentence in text
+    for line in pair_summary(tiny.paired["storm"]):
+        assert line in text

@@ -30,6 +30,7 @@ from mhtrack.build.defaults import DEFAULT_CLUTTER_DENSITY, config_with
 from mhtrack.build.recipe import sensors_from_recipe, sensors_recipe
 from mhtrack.clutter.agmm import AGMMClutter
 from mhtrack.clutter.base import ClutterEstimator
+from mhtrack.clutter.calibrated import MapCalibratedClutter
 from mhtrack.clutter.forgetting import ForgettingGMMClutter
 from mhtrack.clutter.gmm import GMMClutter
 from mhtrack.clutter.known import KnownClutter
@@ -61,7 +62,7 @@ TIMED_CONFIRM_MIN_PLOTS = 3
 #: Clutter-estimator name (:data:`mhtrack.names.CLUTTER_ESTIMATORS`) → class.
 CLUTTER_ESTIMATOR_CLASSES: dict[str, type[Any]] = dict(
     zip(names.CLUTTER_ESTIMATORS, (KnownClutter, GMMClutter, AGMMClutter, ClutterMap,
-                                   ForgettingGMMClutter), strict=True))
+                                   ForgettingGMMClutter, MapCalibratedClutter), strict=True))
 
 
 def make_clutter_estimator(name: str, *, kappa: float | None = None,
@@ -87,7 +88,8 @@ def make_clutter_estimator(name: str, *, kappa: float | None = None,
 #: with its defaults and fed all plots (``docs/clutter.md`` says why not
 #: ``"outside-gates"``).
 TRACKER_ESTIMATORS: dict[str, str] = {"mht": "known", "mht-gmm": "gmm", "mht-agmm": "agmm",
-                                      "mht-map": "map", "mht-fgmm": "fgmm"}
+                                      "mht-map": "map", "mht-fgmm": "fgmm",
+                                      "mht-mapgmm": "mapgmm"}
 
 
 def takes_clutter_density(tracker: str) -> bool:
@@ -170,6 +172,14 @@ def radar_clutter(estimator: str, sensors: SensorSet, *, kappa: float | None = N
             s = sensors.sensor(sid)
             return inner.placed(sensors.site_xy(sid) if s.has_site else (0.0, 0.0),
                                 s.max_range)  # type: ignore[attr-defined]
+    elif estimator == "mapgmm":  # the map about the site; its GMM in the clutter frame
+        def wrap(sid: int, inner: ClutterEstimator) -> ClutterEstimator:
+            s = sensors.sensor(sid)
+            site = sensors.site_xy(sid) if s.has_site else (0.0, 0.0)
+            base = GMMClutter(**inner.base_params)  # type: ignore[attr-defined]
+            if clutter_frame == "polar" and s.has_site:
+                base = PolarClutter(base, site)  # type: ignore[assignment]
+            return inner.placed(site, s.max_range, base)  # type: ignore[attr-defined]
     elif clutter_frame == "polar" and estimator != "known":
         def wrap(sid: int, inner: ClutterEstimator) -> ClutterEstimator:
             s = sensors.sensor(sid)

@@ -176,18 +176,20 @@ def clutter_shift(runs: int, out: Path, seed: int, ablation_runs: int,
               "[all].")
 @click.option("--scans", type=click.IntRange(min=2), default=None,
               help="Shorten the radars-clutter scenario to this many scans (1 s each).")
+@click.option("--html", "html", is_flag=True,
+              help="Also write OUT/report.html (needs Plotly: the [report] extra).")
 @executor_options
 def clutter_scenes(runs: int, out: Path, seed: int, scenes: tuple[str, ...],
-                   methods: tuple[str, ...], scans: int | None, workers: int | None,
-                   dask_scheduler: str | None) -> None:
+                   methods: tuple[str, ...], scans: int | None, html: bool,
+                   workers: int | None, dask_scheduler: str | None) -> None:
     """Every clutter estimator on rotating radars in changing clutter scenes.
 
     The radars-clutter scenario with each clutter scene (weather cells drifting and
     growing, ground and sea clutter, a burst; docs/clutter.md): known κ (oracle), uniform
     κ̂, and every registered estimator, RUNS paired runs per scene; the report compares
     them run by run (95 % interval, verdict) on the clutter error, OSPA (history and
-    online views), false tracks, ids and HOTA. Writes OUT/results.json and OUT/report.md.
-    Exit status 1 if any job failed.
+    online views), false tracks, ids and HOTA. Writes OUT/results.json and OUT/report.md
+    (and OUT/report.html with --html). Exit status 1 if any job failed.
     """
     from mhtrack.experiments import clutter_scenes as cs
     from mhtrack.reports.clutter_scenes import pair_summary, write_clutter_scenes_report
@@ -203,6 +205,13 @@ def clutter_scenes(runs: int, out: Path, seed: int, scenes: tuple[str, ...],
     except ValueError as e:
         raise InputProblem(str(e)) from None
     rep = write_clutter_scenes_report(study)
+    if html:
+        from mhtrack.reports.html_clutter_scenes import write_clutter_scenes_html
+
+        try:
+            rep.paths.insert(2, write_clutter_scenes_html(study))
+        except ImportError as e:
+            raise InputProblem(str(e)) from None
     for line in pair_summary(study.paired.get(cs.POOLED, next(iter(study.paired.values()),
                                                               []))):
         say(f"* {line}")

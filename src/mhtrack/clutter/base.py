@@ -6,7 +6,9 @@ as likely target plots), then :meth:`ClutterEstimator.intensity` on the plots it
 The intensity is in plots per m² per scan, the ``κ`` of P1 eqs. 3, 5, 14–15. After the
 scan's best global hypothesis it calls :meth:`ClutterEstimator.forget` with the mask of
 the plots confirmed tracks used — an optional hook for estimators that learn from past
-scans (a no-op by default).
+scans (a no-op by default). :meth:`ClutterEstimator.reference_intensity` is the clutter
+level a birth scaling compares ``κ̂`` with (a clutter map's mean; 0 by default: none), so
+that a wrapper forwards it like any other method.
 
 To plug in an estimator, subclass :class:`ClutterEstimator`, set ``name`` and implement
 the four abstract methods::
@@ -58,3 +60,10 @@ class ClutterEstimator(ABC):
         """Optional hook: ``used`` (n,) marks the last scan's plots that the best
         hypothesis gives to confirmed tracks (target plots, not clutter). Default: nothing
         (an estimator that keeps no past scans has nothing to forget)."""
+
+    def reference_intensity(self) -> float:
+        """The clutter level (per m² per scan) the clutter-scaled birth density compares
+        ``κ̂(z)`` with (:func:`~mhtrack.clutter.radar_map.birth_scale`): a clutter map's
+        mean intensity ``ρ̄``. Default 0: the estimator has none, and the scaling does
+        nothing."""
+        return 0.0

@@ -53,6 +53,16 @@ def _lse_t(a_t: np.ndarray) -> np.ndarray:
     return s
 
 
+def responsibilities_t(wlp_t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The E-step (P1 eq. 9) of the component-major (K+1, n) ``log π_j + log f_j(z_i)``
+    (:func:`weighted_t`): each plot's ``log c(z_i)`` (n,) and the responsibilities
+    ``r_ij = exp(log π_j f_j(z_i) − log c(z_i))`` (K+1, n). Caller ignores log 0 warnings."""
+    norm = _lse_t(wlp_t)
+    resp = np.subtract(wlp_t, norm)
+    np.exp(resp, out=resp)
+    return norm, resp
+
+
 def logsumexp_rows(a: np.ndarray) -> np.ndarray:
     """``log Σ_j exp(a_ij)`` per row, stable; ``−inf`` for a row of ``−inf``."""
     if a.shape[1] == 0:

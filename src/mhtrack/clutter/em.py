@@ -53,6 +53,7 @@ from mhtrack.clutter.density import (
     offsets_t,
     plot_sums,
     plots_t,
+    responsibilities_t,
     weighted_t,
 )
 from mhtrack.kernels import any_, mean, sum_
@@ -243,9 +244,7 @@ def fit_em(
         n_iter = 0
         for n_iter in range(1, max_iter + 1):  # noqa: B007
             if norm is None or resp is None:  # E-step (P1 eq. 9)
-                norm = _lse_t(wlp)
-                resp = np.subtract(wlp, norm)
-                np.exp(resp, out=resp)
+                norm, resp = responsibilities_t(wlp)
             ll = _mean_ll(norm, sample_weight)
             w, means, q, w0, nk, dxy = _m_step(z, z_t, resp, box, sample_weight, reg_covar,
                                                background_floor, sums)

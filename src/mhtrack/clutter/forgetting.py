@@ -2,9 +2,9 @@
 for clutter that drifts, swells, splits and fades.
 
 The mixture ``ĉ(z) = π₀ u(z) + Σ_j π_j N(z; μ_j, Σ_j)`` (P1 eq. 6 with our uniform
-background) is held as each component's *sufficient statistics*, discounted by ``γ`` per
-scan (rotation): with ``r_ij`` the responsibility of component ``j`` for plot ``i`` of scan
-``k`` and ``d = z − a_j`` about the component's anchor,
+background) is held as each component's *sufficient statistics*, discounted by ``γ_k``
+at scan (rotation) ``k``: with ``r_ij`` the responsibility of component ``j`` for plot ``i``
+of scan ``k`` and ``d = z − a_j`` about the component's anchor,
 
     M_j,pq ← γ M_j,pq + Σ_i r_ij dx^p dy^q      (p + q ≤ 4),      B ← γ B + Σ_i r_i0,
     π_j = M_j,00 / (Σ_l M_l,00 + B),    μ_j = a_j + M_j,1 / M_j,00,
@@ -13,23 +13,23 @@ scan (rotation): with ``r_ij`` the responsibility of component ``j`` for plot ``
 — the online EM of Neal & Hinton ("A view of the EM algorithm that justifies incremental,
 sparse, and other variants", 1998, §5: statistics decayed exponentially for changing
 data) and Cappé & Moulines ("On-line expectation–maximization algorithm for latent data
-models", JRSS B 71(3), 2009) with constant step ``1 − γ``. Each scan runs EM on its own
-plots only: the E-step on the new plots under the current parameters, the M-step from the
-discounted past statistics plus the new ones, until ``|ΔL| < tol·|L|``: memory and time per
-scan are O(K) and O(n K), whatever the history. With ``γ = 1`` and all data in one scan it
-is batch EM (P1 eqs. 9–11).
+models", JRSS B 71(3), 2009) with step ``1 − γ``: ``γ_k = forgetting`` per scan, or, with
+a half-life ``h`` (``half_life``), ``2^(−Δt_k/h)`` per second of data time (``Δt_k`` since
+the previous scan). The default is per scan: measured (docs/clutter.md), the memory
+the mixture needs is a number of scans' plots, not of seconds (10 s suits 4–6 s
+rotations; on 1 s scans it raises the clutter error by two thirds). Each scan runs EM
+on its own plots only: the E-step on the new plots under the current parameters, the
+M-step from the discounted past statistics plus the new ones, until ``|ΔL| < tol·|L|``:
+memory and time per scan are O(K) and O(n K), whatever the history. With ``γ = 1`` and
+all data in one scan it is batch EM (P1 eqs. 9–11).
 
 After each scan, as the cells drift:
 
 * *prune*: a component with fewer than ``min_points`` discounted plots, or whose peak is
   below ``min_contrast`` times the background's density, gives its mass to the background;
-* *merge*: two components whose means are closer than ``merge_distance`` (Mahalanobis,
-  under their mean covariance) are one: their statistics add, which is the
-  moment-preserving merge (Salmond 1990; Runnalls, IEEE TAES 43(3), 2007);
-* *split*: a component whose kurtosis along its principal axis is below ``split_kurtosis``
-  (a Gaussian has 3; two clumps drifting apart, well below 2) becomes two Gaussians at
-  ``μ ± ½√λ₁ v`` with the principal variance reduced to keep the second moment
-  (the split moves of Ueda et al., "SMEM algorithm for mixture models", 2000);
+* *merge* and *split* (:mod:`mhtrack.clutter.split_merge`): two Gaussians closer than
+  ``merge_distance`` (Mahalanobis) are one, their statistics added; one whose
+  principal-axis kurtosis is below ``split_kurtosis`` becomes two;
 * *birth*: plots beyond χ²₂(0.99) of every Gaussian (at least ``min_points``) seed new
   components by k-means++, taking their background mass (as the GMM's warm start).
 
@@ -37,8 +37,8 @@ As the GMM's warm start, each scan's EM starts with ``π₀ ≥ 0.05``, and a fr
 gives the background half the plots, so that broad Gaussians do not swallow uniform
 clutter before the contrast test can see them.
 
-The count is the discounted Poisson ML ``M̂_k = C_k / N_k``, ``C ← γC + n_k``,
-``N ← γN + 1`` (the window mean of :mod:`mhtrack.clutter.mixture` with forgetting).
+The count is the discounted Poisson ML ``M̂_k = C_k / N_k``, ``C ← γ_k C + n_k``,
+``N ← γ_k N + 1`` (the window mean of :mod:`mhtrack.clutter.mixture` with forgetting).
 """
 
 from __future__ import annotations
@@ -50,32 +50,26 @@ import numpy as np
 from mhtrack.clutter.base import ClutterEstimator
 from mhtrack.clutter.density import (
     Mixture,
-    _lse_t,
     log_pdf_t,
     logsumexp_rows,
     maha_det_t,
     mahalanobis2,
     offsets_t,
     plots_t,
+    responsibilities_t,
     weighted_t,
 )
-from mhtrack.clutter.moments import (
-    I00,
-    gaussian_moments,
-    mean_cov,
-    plot_moments,
-    principal_kurtosis,
-    shift,
-)
+from mhtrack.clutter.moments import I00, mean_cov, plot_moments
 from mhtrack.clutter.seeding import kmeanspp_centres
+from mhtrack.clutter.split_merge import merge, reanchor, split
 from mhtrack.models.clutter import Region
-from mhtrack.models.linalg2 import sym_mahalanobis2
 from mhtrack.records import Scan
 
 CHI2_2_99 = 9.2103
 #: Each scan's EM starts with ``π₀`` at least this (the GMM's warm start does the same).
 START_WEIGHT = 0.05
-_SPLIT_OFFSET = 0.5  # children at μ ± ½√λ₁ v
+#: ``γ`` per scan (rotation) of the statistics (measured: docs/clutter.md).
+FORGETTING = 0.7
 
 
 class ForgettingGMMClutter(ClutterEstimator):
@@ -83,7 +77,10 @@ class ForgettingGMMClutter(ClutterEstimator):
 
     Parameters
     ----------
-    forgetting : ``γ`` in (0, 1]; memory ``1/(1 − γ)`` scans. Default 0.7.
+    forgetting : ``γ`` in (0, 1] per scan (memory ``1/(1 − γ)`` scans). Default
+        :data:`FORGETTING`.
+    half_life : ``h`` (s of data time, ``inf``: no forgetting): when given, the statistics
+        are discounted by ``γ_k = 2^(−Δt_k/h)`` instead. Default ``None``.
     n_components : most Gaussians. Default 8.
     background : a uniform component over ``region`` or the box of the plots seen so far
         (padded 5 %, at least ``min_extent`` wide). Default True.
@@ -100,15 +97,18 @@ class ForgettingGMMClutter(ClutterEstimator):
 
     name = "fgmm"
 
-    def __init__(self, *, forgetting: float = 0.7, n_components: int = 8,
+    def __init__(self, *, forgetting: float = FORGETTING, half_life: float | None = None,
+                 n_components: int = 8,
                  background: bool = True, background_floor: float = 0.01,
                  region: Region | tuple[float, float, float, float] | None = None,
                  reg_covar: float = 100.0, tol: float = 1e-4, max_iter: int = 20,
                  min_points: float = 3.0, min_contrast: float = 5.0,
                  min_extent: float = 1000.0, merge_distance: float = 1.0,
                  split_kurtosis: float = 2.0, seed: int = 0) -> None:
-        if not (np.isfinite(forgetting) and 0.0 < forgetting <= 1.0):
+        if not (np.isfinite(forgetting) and 0 < forgetting <= 1):
             raise ValueError(f"forgetting must be in (0, 1], got {forgetting!r}")
+        if half_life is not None and not half_life > 0:
+            raise ValueError(f"half_life must be > 0 s, got {half_life!r}")
         if not (isinstance(n_components, int | np.integer) and 1 <= n_components <= 256):
             raise ValueError(f"n_components must be an integer in [1, 256], got "
                              f"{n_components!r}")
@@ -128,6 +128,7 @@ class ForgettingGMMClutter(ClutterEstimator):
         if region is not None and not isinstance(region, Region):
             region = Region(*(float(v) for v in region))
         self.forgetting = float(forgetting)
+        self.half_life = None if half_life is None else float(half_life)
         self.n_components = int(n_components)
         self.background = bool(background)
         self.background_floor = float(background_floor) if background else 0.0
@@ -144,6 +145,7 @@ class ForgettingGMMClutter(ClutterEstimator):
         self.box_: tuple[float, float, float, float] | None = None
         self.extent_: tuple[float, float, float, float] | None = None  # plots seen, unpadded
         self.n_updates_ = 0
+        self.time_: float | None = None  # the last scan's time
         self.mixture_: Mixture | None = None
         #: the mixture the last scan's EM started from
         self.start_: Mixture | None = None
@@ -192,7 +194,7 @@ class ForgettingGMMClutter(ClutterEstimator):
         z = np.asarray(scan.z, float).reshape(-1, 2)
         if not np.isfinite(z).all():
             raise ValueError(f"scan {scan.index}: plots must be finite")
-        g = self.forgetting
+        g = self._discount(float(scan.time))
         self.count_sum_ = g * self.count_sum_ + len(z)
         self.looks_ = g * self.looks_ + 1.0
         self.moments_ = self.moments_ * g
@@ -225,9 +227,8 @@ class ForgettingGMMClutter(ClutterEstimator):
                 maha, det = maha_det_t(*offsets_t(z_t, mix.means), mix.covariances)
                 wlp = weighted_t(mix.background_weight, mix.weights, log_pdf_t(maha, det),
                                  log_bg)
-                norm = _lse_t(wlp)
+                norm, resp = responsibilities_t(wlp)  # (K+1, n), row 0 the background
                 ll = float(norm.mean())
-                resp = np.exp(wlp - norm)  # (K+1, n), row 0 the background
                 new = plot_moments(z, self.anchors_, resp[1:], order=2)  # M-step's sums
                 new_bg = float(resp[0].sum())
                 if abs(ll - prev) < self.tol * abs(prev):
@@ -237,8 +238,12 @@ class ForgettingGMMClutter(ClutterEstimator):
         self.moments_, self.bg_mass_ = past + new, past_bg + new_bg
         self._reanchor()
         self._prune()
-        self._merge()
-        self._split()
+        if self.merge_distance > 0:
+            self.moments_, self.anchors_ = merge(self.moments_, self.anchors_,
+                                                 self.reg_covar, self.merge_distance)
+        self.moments_, self.anchors_ = split(self.moments_, self.anchors_,
+                                             self.n_components - len(self.moments_),
+                                             self.min_points, self.split_kurtosis)
         if len(self.moments_):
             mix = self._mixture(self.moments_, self.bg_mass_)
             d2 = mahalanobis2(z, mix.means, mix.covariances).min(axis=1)
@@ -253,6 +258,14 @@ class ForgettingGMMClutter(ClutterEstimator):
             self._birth(z, np.ones(len(z)), rng)
         self._finish()
 
+    def _discount(self, t: float) -> float:
+        """``γ_k``: ``2^(−Δt/h)`` since the last scan (1 at the first) with a half-life,
+        else ``forgetting``."""
+        last, self.time_ = self.time_, t
+        if self.half_life is None:
+            return self.forgetting
+        return 1.0 if last is None else float(2.0 ** (-max(t - last, 0.0) / self.half_life))
+
     def _finish(self) -> None:
         self.mixture_ = (None if len(self.moments_) == 0 and self.box_ is None
                          else self._mixture(self.moments_, self.bg_mass_)
@@ -261,10 +274,7 @@ class ForgettingGMMClutter(ClutterEstimator):
                                                             self.box_))
 
     def _reanchor(self) -> None:
-        if len(self.moments_):
-            _, means, _ = mean_cov(self.moments_, self.anchors_, 0.0)
-            self.moments_ = shift(self.moments_, means - self.anchors_)
-            self.anchors_ = means
+        self.moments_, self.anchors_ = reanchor(self.moments_, self.anchors_)
 
     def _drop(self, keep: np.ndarray) -> None:
         self.bg_mass_ += float(self.moments_[~keep, I00].sum()) if self.background else 0.0
@@ -279,44 +289,6 @@ class ForgettingGMMClutter(ClutterEstimator):
             keep &= peak >= self.min_contrast * mix.background_weight / mix.background_area
         if not keep.all():
             self._drop(keep)
-
-    def _merge(self) -> None:
-        while len(self.moments_) > 1:
-            _, means, cov = mean_cov(self.moments_, self.anchors_, self.reg_covar)
-            k = len(means)
-            i, j = np.triu_indices(k, 1)
-            d = means[i] - means[j]
-            s = 0.5 * (cov[i] + cov[j])
-            d2, _ = sym_mahalanobis2(d[:, 0], d[:, 1], s[:, 0, 0], s[:, 0, 1], s[:, 1, 1])
-            best = int(np.argmin(d2))
-            if d2[best] >= self.merge_distance**2:
-                return
-            a, b = int(i[best]), int(j[best])
-            self.moments_[a] += shift(self.moments_[b:b + 1],
-                                      self.anchors_[a:a + 1] - self.anchors_[b:b + 1])[0]
-            keep = np.ones(k, bool)
-            keep[b] = False
-            self.moments_, self.anchors_ = self.moments_[keep], self.anchors_[keep]
-            self._reanchor()
-
-    def _split(self) -> None:
-        if self.split_kurtosis <= 0 or not len(self.moments_):
-            return
-        w, means, cov = mean_cov(self.moments_, self.anchors_, 0.0)
-        v, lam, beta = principal_kurtosis(self.moments_, cov)
-        room = self.n_components - len(w)
-        cand = np.flatnonzero((beta < self.split_kurtosis) & (w >= 2 * self.min_points)
-                              & (lam > 0))
-        cand = cand[np.argsort(beta[cand], kind="stable")][:max(room, 0)]
-        if not cand.size:
-            return
-        off = _SPLIT_OFFSET * np.sqrt(lam[cand])[:, None] * v[cand]
-        child = cov[cand] - (off[:, :, None] * off[:, None, :])
-        cm = gaussian_moments(0.5 * w[cand], child)
-        self.moments_[cand] = cm
-        self.anchors_[cand] = means[cand] + off
-        self.moments_ = np.vstack([self.moments_, cm])
-        self.anchors_ = np.vstack([self.anchors_, means[cand] - off])
 
     def _birth(self, z: np.ndarray, mass: np.ndarray, rng: np.random.Generator,
                first: bool = False) -> None:
@@ -379,18 +351,23 @@ class ForgettingGMMClutter(ClutterEstimator):
         return {"moments": self.moments_.copy(), "anchors": self.anchors_.copy(),
                 "bg_mass": float(self.bg_mass_), "count_sum": float(self.count_sum_),
                 "looks": float(self.looks_), "n_updates": int(self.n_updates_),
+                "time": self.time_,
                 "box": None if self.box_ is None else list(self.box_),
                 "extent": None if self.extent_ is None else list(self.extent_),
                 "last_z": np.zeros((0, 2)) if self._last_z is None else self._last_z.copy()}
 
     def set_state(self, state: dict[str, Any]) -> None:
-        from mhtrack.clutter.state_checks import MAX_COORDINATE, array, check_forgetting
+        from mhtrack.bounds import MAX_TIME_S
+        from mhtrack.clutter.state_checks import MAX_COORDINATE, array, check_forgetting, number
 
-        m, a, box, extent = check_forgetting(state, self.n_components, self.forgetting)
+        m, a, box, extent = check_forgetting(
+            state, self.n_components, 1.0 if self.half_life else self.forgetting)
         self.moments_, self.anchors_, self.box_, self.extent_ = m, a, box, extent
         self.bg_mass_ = float(state["bg_mass"])
         self.count_sum_, self.looks_ = float(state["count_sum"]), float(state["looks"])
         self.n_updates_ = int(state["n_updates"])
+        self.time_ = None if state.get("time") is None else float(
+            number(state["time"], "clutter_state.time", -MAX_TIME_S, MAX_TIME_S))
         last = array(state["last_z"], "clutter_state.last_z", (-1, 2), bound=MAX_COORDINATE)
         self._last_z = np.asarray(last, float) if len(last) else None
         self._finish()

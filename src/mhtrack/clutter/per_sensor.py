@@ -109,9 +109,9 @@ class PerSensorClutter(ClutterEstimator):
         """The current sensor's estimator's ``reference_intensity()`` (a clutter map's mean
         intensity, for the birth scaling), 0 before its first rotation or without one."""
         sid = self._current
-        ref = None if sid is None or sid not in self._fed else getattr(
-            self._inner[sid], "reference_intensity", None)
-        return float(ref()) if callable(ref) else 0.0
+        if sid is None or sid not in self._fed:
+            return 0.0
+        return float(self._inner[sid].reference_intensity())
 
     def forget(self, used: np.ndarray) -> None:
         sid = self._current

@@ -71,6 +71,12 @@ class PolarClutter(ClutterEstimator):
     def forget(self, used: np.ndarray) -> None:
         self.inner.forget(used)
 
+    def reference_intensity(self) -> float:
+        """The inner estimator's mean level, per m² of its own (polar) plane: ``0`` unless
+        the inner estimator has one (a clutter map is never wrapped; the builder places it
+        about the site in the plane)."""
+        return self.inner.reference_intensity()
+
     def get_state(self) -> dict[str, Any]:
         return {"inner": self.inner.get_state()}
 

@@ -60,8 +60,12 @@ from mhtrack.records import Scan
 
 #: Rings over the reach and sectors of a map placed with a ``max_range`` and no
 #: ``range_cell`` / ``n_azimuth`` given (module docstring, *Cell size*).
-REACH_RINGS = 12
-REACH_SECTORS = 32
+REACH_RINGS = 24
+REACH_SECTORS = 64
+#: Passes of :func:`smooth_cells` (measured: docs/clutter.md).
+SMOOTHING = 2
+#: Half-life ``h`` (s of data time) of the counts (measured: docs/clutter.md).
+HALF_LIFE = 40.0
 #: Cells of a map without a reach.
 DEFAULT_RANGE_CELL = 500.0
 DEFAULT_SECTORS = 64
@@ -74,6 +78,24 @@ def cell_areas(n_rings: int, n_azimuth: int, range_cell: float) -> np.ndarray:
     """(n_rings,) area (m²) of one cell of each ring: ``½ Δθ (2i + 1) Δr²``."""
     i = np.arange(int(n_rings), dtype=float)
     return 0.5 * (2.0 * np.pi / n_azimuth) * (2.0 * i + 1.0) * range_cell**2
+
+
+def smooth_cells(a: np.ndarray, passes: int) -> np.ndarray:
+    """``a`` (rings, sectors) convolved ``passes`` times with the binomial kernel
+    ``[1, 2, 1]/4`` along the rings (the first and last ring reflected) and along the
+    sectors (circular). The map's smoothed density is the ratio of the smoothed counts to
+    the smoothed cell areas, ``Σ w S / (N Σ w A)``: a kernel-smoothed histogram (the
+    averaged shifted histogram of Scott, *Ann. Statist.* 13(3), 1985, whose weights are
+    these binomial ones), which keeps the map's total and trades the blocks' bias and the
+    cells' Poisson variance."""
+    out = np.asarray(a, float)
+    for _ in range(int(passes)):
+        out = 0.5 * out + 0.25 * (np.roll(out, 1, axis=1) + np.roll(out, -1, axis=1))
+        if out.shape[0] > 1:
+            up = np.vstack([out[:1], out[:-1]])
+            down = np.vstack([out[1:], out[-1:]])
+            out = 0.5 * out + 0.25 * (up + down)
+    return out
 
 
 def forgetting_variance_factor(gamma: float, k: int) -> float:
@@ -94,8 +116,14 @@ class ClutterMap(ClutterEstimator):
         else 500.
     n_azimuth : ``n_θ``, sectors of bearing. Default :data:`REACH_SECTORS` (11.25°) with
         a ``max_range``, else 64 (5.6°).
-    forgetting : ``γ`` in (0, 1]; the memory is ``1/(1 − γ)`` rotations. Default 0.9.
+    half_life : ``h`` (s of data time, ``inf``: no forgetting): each rotation discounts
+        the sums by ``γ_k = 2^(−Δt_k/h)``, ``Δt_k`` the time since the previous one, so
+        the memory is the same whatever the radar's period. Default :data:`HALF_LIFE`.
+    forgetting : a constant ``γ`` in (0, 1] per rotation instead (memory ``1/(1 − γ)``
+        rotations); default ``None``: ``half_life``.
     prior_weight : ``b₀`` (rotations) of the shrinkage toward the map's mean. Default 1.
+    smoothing : passes ``p`` of the binomial kernel over neighbouring cells (0: none;
+        :func:`smooth_cells`). Default :data:`SMOOTHING`.
     max_range : rings made at once to reach this range (m); ``None``: as plots arrive.
     max_rings : most rings (bounded memory). Default 4096.
     source : ``"all"`` plots, or ``"outside-gates"`` (leave out plots in confirmed tracks'
@@ -112,7 +140,8 @@ class ClutterMap(ClutterEstimator):
 
     def __init__(self, *, site: tuple[float, float] = (0.0, 0.0),
                  range_cell: float | None = None, n_azimuth: int | None = None,
-                 forgetting: float = 0.9, prior_weight: float = 1.0,
+                 half_life: float | None = None, forgetting: float | None = None,
+                 prior_weight: float = 1.0, smoothing: int = SMOOTHING,
                  max_range: float | None = None, max_rings: int = 4096,
                  source: Source = "all", birth_scaling: float = 0.0,
                  forget_used: bool = True) -> None:
@@ -130,10 +159,15 @@ class ClutterMap(ClutterEstimator):
             raise ValueError(f"range_cell must be finite and > 0 m, got {range_cell!r}")
         if not (isinstance(n_azimuth, int | np.integer) and 1 <= n_azimuth <= 65536):
             raise ValueError(f"n_azimuth must be an integer in [1, 65536], got {n_azimuth!r}")
-        if not (np.isfinite(forgetting) and 0.0 < forgetting <= 1.0):
+        if forgetting is not None and not (np.isfinite(forgetting) and 0 < forgetting <= 1):
             raise ValueError(f"forgetting must be in (0, 1], got {forgetting!r}")
+        half_life = HALF_LIFE if half_life is None else half_life
+        if not half_life > 0:
+            raise ValueError(f"half_life must be > 0 s, got {half_life!r}")
         if not (np.isfinite(prior_weight) and prior_weight >= 0):
             raise ValueError(f"prior_weight must be finite and >= 0, got {prior_weight!r}")
+        if not (isinstance(smoothing, int | np.integer) and 0 <= smoothing <= 64):
+            raise ValueError(f"smoothing must be an integer in [0, 64], got {smoothing!r}")
         if not (isinstance(max_rings, int | np.integer) and 1 <= max_rings <= 1_000_000):
             raise ValueError(f"max_rings must be an integer in [1, 1e6], got {max_rings!r}")
         if source not in SOURCES:
@@ -143,8 +177,10 @@ class ClutterMap(ClutterEstimator):
         self.site = (site_t[0], site_t[1])
         self.range_cell = float(range_cell)
         self.n_azimuth = int(n_azimuth)
-        self.forgetting = float(forgetting)
+        self.forgetting = None if forgetting is None else float(forgetting)
+        self.half_life = float(half_life)
         self.prior_weight = float(prior_weight)
+        self.smoothing = int(smoothing)
         self.max_range = None if max_range is None else float(max_range)
         self.max_rings = int(max_rings)
         self.source = source
@@ -155,6 +191,8 @@ class ClutterMap(ClutterEstimator):
         self.looks_ = 0.0
         self.n_updates_ = 0
         self.n_outside_ = 0
+        self.time_: float | None = None  # the last rotation's time
+        self._map: np.ndarray | None = None  # intensity_map() until the next change
         self._last = np.zeros(0, np.int64)  # flat cell of each counted plot of the last update
 
     def placed(self, site: tuple[float, float], max_range: float | None = None
@@ -162,7 +200,8 @@ class ClutterMap(ClutterEstimator):
         """A fresh map with this one's parameters about ``site`` (rings made out to
         ``max_range`` when given, else this map's)."""
         return ClutterMap(site=site, range_cell=self.cell_args[0], n_azimuth=self.cell_args[1],
-                          forgetting=self.forgetting, prior_weight=self.prior_weight,
+                          half_life=self.half_life, forgetting=self.forgetting,
+                          prior_weight=self.prior_weight, smoothing=self.smoothing,
                           max_range=self.max_range if max_range is None else max_range,
                           max_rings=self.max_rings, source=self.source,
                           birth_scaling=self.birth_scaling, forget_used=self.forget_used)
@@ -209,13 +248,23 @@ class ClutterMap(ClutterEstimator):
             grow = int(ring[inside].max()) + 1 - self.n_rings
             self.sums_ = np.vstack([self.sums_, np.zeros((grow, self.n_azimuth))])
         flat = np.where(inside, ring * self.n_azimuth + sector, -1)
-        self.sums_ *= self.forgetting
+        g = self._discount(float(scan.time))
+        self.sums_ *= g
         counted = flat[inside]
         if counted.size:
             self.sums_.reshape(-1)[:] += np.bincount(counted, minlength=self.sums_.size)
-        self.looks_ = self.forgetting * self.looks_ + 1.0
+        self.looks_ = g * self.looks_ + 1.0
         self.n_updates_ += 1
         self._last = flat
+        self._map = None
+
+    def _discount(self, t: float) -> float:
+        """``γ_k``: ``forgetting``, else ``2^(−Δt/h)`` since the last rotation (1 at the
+        first)."""
+        last, self.time_ = self.time_, t
+        if self.forgetting is not None:
+            return self.forgetting
+        return 1.0 if last is None else float(2.0 ** (-max(t - last, 0.0) / self.half_life))
 
     def forget(self, used: np.ndarray) -> None:
         """Take the last rotation's plots that confirmed tracks used out of their cells."""
@@ -228,6 +277,7 @@ class ClutterMap(ClutterEstimator):
             np.subtract.at(flat, cells, 1.0)
             np.maximum(flat, 0.0, out=flat)
             self._last = np.where(used, -1, self._last)
+            self._map = None
 
     def mean_intensity(self) -> float:
         """``ρ̄``: the map's clutter plots per look over its area (per m²); 0 before any
@@ -238,11 +288,17 @@ class ClutterMap(ClutterEstimator):
         return float(self.sums_.sum() / (self.looks_ * area))
 
     def intensity_map(self) -> np.ndarray:
-        """(n_rings, n_azimuth) ``κ̂`` of every cell (per m² per look)."""
+        """(n_rings, n_azimuth) ``κ̂`` of every cell (per m² per look), computed once per
+        change of the map."""
         if self.looks_ == 0.0:
             return np.zeros_like(self.sums_)
-        b0 = self.prior_weight
-        return (self.sums_ / self.areas() + b0 * self.mean_intensity()) / (self.looks_ + b0)
+        if self._map is None:
+            b0 = self.prior_weight
+            p = self.smoothing
+            density = (self.sums_ / self.areas() if p == 0 else
+                       smooth_cells(self.sums_, p) / smooth_cells(self.areas(), p))
+            self._map = (density + b0 * self.mean_intensity()) / (self.looks_ + b0)
+        return self._map
 
     def intensity(self, z: np.ndarray) -> np.ndarray:
         """``κ̂(z)`` (module docstring), plots per m² per look; 0 before any rotation."""
@@ -266,17 +322,19 @@ class ClutterMap(ClutterEstimator):
     def get_state(self) -> dict[str, Any]:
         return {"sums": self.sums_.copy(), "looks": float(self.looks_),
                 "n_updates": int(self.n_updates_), "n_outside": int(self.n_outside_),
-                "last": self._last.copy()}
+                "last": self._last.copy(), "time": self.time_}
 
     def set_state(self, state: dict[str, Any]) -> None:
         from mhtrack.clutter.state_checks import check_map
 
-        sums, looks, last = check_map(state, self.n_azimuth, self.max_rings, self.forgetting)
+        sums, looks, last, t = check_map(state, self.n_azimuth, self.max_rings,
+                                         self.forgetting or 1.0)
         self.sums_ = sums
         self.looks_ = looks
         self.n_updates_ = int(state["n_updates"])
         self.n_outside_ = int(state["n_outside"])
         self._last = last
+        self.time_, self._map = t, None
 
 
 @dataclass(frozen=True)

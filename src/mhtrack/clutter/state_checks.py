@@ -137,10 +137,11 @@ def check_scan(d: Mapping[str, Any], field: str) -> None:
 
 
 def check_map(state: Mapping[str, Any], n_azimuth: int, max_rings: int, gamma: float
-              ) -> tuple[np.ndarray, float, np.ndarray]:
+              ) -> tuple[np.ndarray, float, np.ndarray, float | None]:
     """A clutter map's state (:meth:`ClutterMap.get_state`): ``sums`` (rings, ``n_azimuth``)
     with at most ``max_rings`` rings, each ≥ 0; ``looks`` in ``[0, 1/(1 − γ)]`` (at most
-    ``MAX_INDEX`` for ``γ = 1``); ``last`` flat cells in ``[−1, cells)``."""
+    ``MAX_INDEX`` for ``γ = 1``); ``last`` flat cells in ``[−1, cells)``; ``time`` (the
+    last rotation's, absent or null before one) finite."""
     f = "clutter_state"
     sums = array(state["sums"], f"{f}.sums", (-1, n_azimuth)).astype(float)
     if sums.shape[0] > max_rings:
@@ -154,7 +155,9 @@ def check_map(state: Mapping[str, Any], n_azimuth: int, max_rings: int, gamma: f
     last = array(state["last"], f"{f}.last", (-1,), kind="i", bound=MAX_INDEX).astype(np.int64)
     if last.size and (last.min() < -1 or last.max() >= sums.size):
         raise _fail(f"{f}.last", f"cells must be in [-1, {sums.size})")
-    return np.ascontiguousarray(sums), looks, last
+    t = state.get("time")
+    t = None if t is None else float(number(t, f"{f}.time", -MAX_TIME_S, MAX_TIME_S))
+    return np.ascontiguousarray(sums), looks, last, t
 
 
 def check_forgetting(state: Mapping[str, Any], max_components: int, gamma: float

@@ -104,6 +104,9 @@ class TimedClutter(ClutterEstimator):
     def forget(self, used: np.ndarray) -> None:
         self.inner.forget(used)
 
+    def reference_intensity(self) -> float:
+        return self.inner.reference_intensity()
+
     def get_state(self) -> dict[str, Any]:
         return self.inner.get_state()
 

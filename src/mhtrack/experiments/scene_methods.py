@@ -38,18 +38,20 @@ UNIFORM_WINDOW = 5
 #: driving the birth density; the others switch one component off (the ablation).
 VARIANTS: dict[str, tuple[str, dict[str, Any]]] = {
     "map-birth": ("map", {"birth_scaling": 1.0}),
+    "mapgmm-birth": ("mapgmm", {"birth_scaling": 1.0}),
     "map-no-shrinkage": ("map", {"prior_weight": 0.0}),
     "map-keeps-track-plots": ("map", {"forget_used": False}),
     "fgmm-no-forgetting": ("fgmm", {"forgetting": 1.0}),
     "fgmm-no-split-merge": ("fgmm", {"merge_distance": 0.0, "split_kurtosis": 0.0}),
 }
 #: The variants run by default (the ablations only when asked for by name).
-DEFAULT_VARIANTS = ("map-birth",)
+DEFAULT_VARIANTS = ("map-birth", "mapgmm-birth")
 #: What each fixed method is; the registered estimators are described by their class.
 DESCRIPTIONS = {
     ORACLE: "true κ_s(x, t) of the scene at every frame (oracle)",
     UNIFORM: "κ̂ = mean plot count of the radar's last 5 rotations / (π R²), inside its reach",
     "map-birth": "clutter map driving the birth density, s(z) = min(1, ρ̄/κ̂(z))^β, β = 1",
+    "mapgmm-birth": "map-calibrated GMM, its map driving the birth density (β = 1)",
     "map-no-shrinkage": "clutter map without the shrinkage toward its mean (b₀ = 0)",
     "map-keeps-track-plots": "clutter map that keeps the plots confirmed tracks used",
     "fgmm-no-forgetting": "forgetting mixture with γ = 1 (no forgetting)",

@@ -58,7 +58,7 @@ class MHTrackTracker(Tracker):
                              "(time, set of Detection)")
     tracker: str = Property(default="mht-agmm", doc="mhtrack tracker name "
                             "(mhtrack.names.TRACKERS): mht, mht-gmm, mht-agmm, mht-map, "
-                            "mht-fgmm")
+                            "mht-fgmm, mht-mapgmm")
     config: Any = Property(default=None, doc="mhtrack.mht.MHTConfig (default: MHTConfig())")
     clutter_density: float = Property(default=None, doc="known clutter density per m² per "
                                       "scan of tracker 'mht'")

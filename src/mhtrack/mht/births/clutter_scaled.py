@@ -24,20 +24,14 @@ from mhtrack.mht.numbering import Counter
 from mhtrack.mht.tree import Leaves
 
 
-def reference_intensity(clutter: ClutterEstimator) -> float:
-    """The estimator's ``reference_intensity()`` (a clutter map's ``ρ̄``, per radar for a
-    per-radar estimator), 0 when it has none."""
-    ref = getattr(clutter, "reference_intensity", None)
-    return float(ref()) if callable(ref) else 0.0
-
-
 class ClutterScaledBirth(Birth):
     """``inner`` with the birth density scaled by ``s(z)`` (module docstring).
 
     Parameters
     ----------
     inner : the birth process to wrap.
-    clutter : the tracker's clutter estimator (its :func:`reference_intensity`).
+    clutter : the tracker's clutter estimator (its
+        :meth:`~mhtrack.clutter.base.ClutterEstimator.reference_intensity`).
     beta : ``β > 0``, the exponent of the scaling.
     """
 
@@ -47,9 +41,14 @@ class ClutterScaledBirth(Birth):
         super().__init__(inner.motion)
         self.inner, self.clutter, self.beta = inner, clutter, float(beta)
 
+    def scan_density(self, frame: FrameContext, kappa: np.ndarray) -> float | None:
+        """The inner process's new-target density of the frame (e.g. the start-up
+        density's), from the unscaled ``κ̂``: the scaling acts on births only."""
+        return self.inner.scan_density(frame, kappa)
+
     def propose(self, frame: FrameContext, kappa: np.ndarray,
                 in_gates: np.ndarray | None) -> BirthCandidates:
-        s = birth_scale(kappa, reference_intensity(self.clutter), self.beta)
+        s = birth_scale(kappa, self.clutter.reference_intensity(), self.beta)
         return self.inner.propose(frame, np.asarray(kappa, float) / s, in_gates)
 
     def select(self, frame: FrameContext, cand: BirthCandidates,

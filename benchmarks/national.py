@@ -207,7 +207,8 @@ def live_run(d: Path, meta: dict, a: argparse.Namespace) -> dict:
                 rss.append((time.time() - t0, rss_mb(live.pid)[0]))
         sampler = threading.Thread(target=sample, daemon=True)
         sampler.start()
-        rep = ["replay", str(d / "radar.pcap"), "--to", port[0], "--speed", "1"]
+        rec = d / "radar.pcap" if a.live_s is None else first_seconds(d, a.live_s)
+        rep = ["replay", str(rec), "--to", port[0], "--speed", "1"]
         said = _run(rep)
         t_replay = time.time() - t0
         time.sleep(3.0)
@@ -239,6 +240,29 @@ def live_run(d: Path, meta: dict, a: argparse.Namespace) -> dict:
             "lines": per_line, "rss_peak_mb": max(hwm, max((r for _, r in rss), default=0)),
             "rss": rss, "cat062_datagrams": drain.count, "last_lines": [ln for _, ln in
                                                                        lines[-3:]]}
+
+
+def first_seconds(d: Path, seconds: float) -> Path:
+    """``d/radar_first{S}s.pcap``: the recording's packets of its first ``seconds`` of
+    capture time (pcap: a 24-octet file header, then per packet a 16-octet header —
+    seconds, microseconds, captured length, length — and its octets)."""
+    out = d / f"radar_first{seconds:g}s.pcap"
+    if out.is_file():
+        return out
+    data = (d / "radar.pcap").read_bytes()
+    magic = data[:4]
+    end = "<" if magic in (bytes.fromhex("d4c3b2a1"), bytes.fromhex("4d3cb2a1")) else ">"
+    frac = 1e-9 if magic in (bytes.fromhex("4d3cb2a1"), bytes.fromhex("a1b23c4d")) else 1e-6
+    at, t0 = 24, None
+    while at + 16 <= len(data):
+        sec, usec, n, _ = np.frombuffer(data, np.dtype(f"{end}u4"), 4, at)
+        t = float(sec) + frac * float(usec)
+        t0 = t if t0 is None else t0
+        if t - t0 > seconds:
+            break
+        at += 16 + int(n)
+    out.write_bytes(data[:at])
+    return out
 
 
 # ------------------------------------------------------------------ 4. Stone Soup
@@ -286,6 +310,8 @@ def main() -> None:
     ap.add_argument("--seed", type=int, default=1, help="simulation seed")
     ap.add_argument("--scene-seed", type=int, default=0)
     ap.add_argument("--reorder-window", type=float, default=0.2)
+    ap.add_argument("--live-s", type=float, default=None,
+                    help="replay only the recording's first seconds into live")
     ap.add_argument("--stop-timeout", type=float, default=300.0,
                     help="seconds live may take to finish after SIGTERM (then killed: a "
                     "tracker that fell behind; its last status counts)")

@@ -235,7 +235,8 @@ class MHTTracker:
         birth process is told its limit."""
         plots = validate_scan(scan, self._R, self._last_time, self._last_index)
         previous = Reported.of(self._leaves, by_id=self.coverage.per_tree_looks)
-        frame = FrameContext.of(scan, plots, config=self.config, previous=previous)
+        frame = FrameContext.of(scan, plots, config=self.config, previous=previous,
+                                n_sensors=self.coverage.n_sensors)
         self.birth.limit(frame.limits.max_births_per_scan)
         return frame
 

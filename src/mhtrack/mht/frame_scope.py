@@ -40,7 +40,7 @@ from mhtrack.mht.clustering import dense_index, raw_plot_keys, tree_clusters
 from mhtrack.mht.config import MHTConfig
 from mhtrack.mht.context import FrameContext
 from mhtrack.mht.hypothesis import GlobalHypothesis, best_hypothesis
-from mhtrack.mht.tree import NO_PLOT, Leaves, contains, segment_starts
+from mhtrack.mht.tree import NO_PLOT, Leaves, segment_starts
 
 
 @dataclass(frozen=True, slots=True)
@@ -161,7 +161,7 @@ class FrameScope:
             return
         dirty = pend.dirty
         if len(after) < len(before):
-            lost = ~contains(after.node, before.node)
+            lost = ~np.isin(before.node, after.node)  # a table when the ids allow
             leaf_group = np.repeat(pend.group, segment_sizes(segment_starts(before.tree),
                                                              len(before)))
             dirty = dirty.copy()
@@ -220,7 +220,7 @@ def _scope_trees(leaves: Leaves, old: _Groups, tree: np.ndarray, starts: np.ndar
     plots = plots[plots != NO_PLOT]
     if plots.size and not in_scope.all():
         clean = (~in_scope).nonzero()[0]
-        hit = contains(plots, w.take(clean, axis=0)).any(axis=1)
+        hit = np.isin(w.take(clean, axis=0), plots).any(axis=1)  # a table if small
         if hit.any():
             gdirty[np.repeat(group, size)[clean[hit]]] = True
             dirty_tree = ~carried | gdirty[group]

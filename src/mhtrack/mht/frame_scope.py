@@ -40,7 +40,7 @@ from mhtrack.mht.clustering import dense_index, raw_plot_keys, tree_clusters
 from mhtrack.mht.config import MHTConfig
 from mhtrack.mht.context import FrameContext
 from mhtrack.mht.hypothesis import GlobalHypothesis, best_hypothesis
-from mhtrack.mht.tree import NO_PLOT, Leaves, segment_starts
+from mhtrack.mht.tree import NO_PLOT, Leaves, contains, segment_starts
 
 
 @dataclass(frozen=True, slots=True)
@@ -161,7 +161,7 @@ class FrameScope:
             return
         dirty = pend.dirty
         if len(after) < len(before):
-            lost = ~np.isin(before.node, after.node)  # a table when the ids allow
+            lost = ~contains(after.node, before.node)  # node ids span the run: no table
             leaf_group = np.repeat(pend.group, segment_sizes(segment_starts(before.tree),
                                                              len(before)))
             dirty = dirty.copy()

@@ -24,7 +24,8 @@ Stages (each prints its command or what it does, and how long it took):
 3. **Profile** (``national_profile.py``) — ``cProfile`` of the same pipeline
    (``Pipeline.open(radar.pcap)``, same options) on the recording's first ``--profile-s``
    seconds at full speed: plots per wall- and CPU-second (the capacity of one core) and
-   where the time goes, per stage (``--no-cprofile``: timed without the profiler).
+   where the time goes, per stage, in CPU seconds (the profiler's timer is the process's CPU
+   time: the machine is shared) (``--no-cprofile``: timed without the profiler).
 4. **Stone Soup** — its GNN (``benchmarks/stonesoup_timed.py``, as in ``bench_async.py``)
    and mhtrack on a slice of the same scene: the plots within a ``--box-km`` square about
    the centre over the first ``--stonesoup-s`` seconds; plots/s of each.
@@ -374,7 +375,7 @@ def main() -> None:
               f"{p['plots'] / p['wall']:.0f} plots/s of wall time; CPU {p['cpu']:.1f} s "
               f"= {p['plots'] / p['cpu']:.0f} plots per CPU-second")
         for label, sec in p["stages"]:
-            print(f"  {label:70s} {sec:8.2f} s {100 * sec / p['wall']:5.1f} %")
+            print(f"  {label:70s} {sec:8.2f} s {100 * sec / p['cpu']:5.1f} %")  # CPU s
     s = stonesoup(d, a)
     print(f"\nslice: {a.box_km:g} km square about the centre, first {a.stonesoup_s:g} s: "
           f"{s['plots']} plots, {s['frames']} frames, {s['radars']} radars")

@@ -38,7 +38,7 @@ def profile(d: Path, meta: dict, a: argparse.Namespace) -> dict:
     pipe = Pipeline.open(d / "radar.pcap", opts, sensors_file=str(d / "sensors.toml"),
                          reorder_window_s=a.reorder_window)
     sink = Stop()
-    prof = cProfile.Profile()
+    prof = cProfile.Profile(time.process_time)  # CPU seconds: the machine is shared
     c0, t0 = time.process_time(), time.perf_counter()
     if not a.no_cprofile:
         prof.enable()
@@ -71,7 +71,8 @@ STAGE_FUNCS = (
     ("  grow (Kalman update)", "grow_children", "mht/extend.py"),
     ("  births: seed", "seed", "mht/births/"),
     ("  number and merge", "_number", "mht/tracker.py"),
-    ("  global hypothesis", "_hypothesis", "mht/tracker.py"),
+    ("  global hypothesis", "_hypothesis", "mht/tracker.py"),  # before the frame scope
+    ("  global hypothesis (frame scope)", "solve", "mht/frame_scope.py"),
     ("  N-scan pruning", "prune_after_solve", "mht/pruning.py"),
     ("  confirm", "_confirm", "mht/tracker.py"),
     ("  report", "_report", "mht/tracker.py"),

@@ -58,6 +58,17 @@ def test_hand_worked_limits_and_switch_off():
         "fusion_greedy 9, max_trees 3 (limit 5000)"
 
 
+def test_the_tree_floor_is_per_sensor_of_the_frames():
+    # 30 radars, a sector of 70 plots, 4 000 tracks: floor 30·5 000 over 5·70 + 4 000;
+    # the other limits are the frame's (one sensor's)
+    assert scaled_limits(DEFAULT, 70, 4000, n_sensors=30) == {
+        **scaled_limits(DEFAULT, 70, 4000), "max_trees": 150_000}
+    assert scaled_limits(DEFAULT, 6000, 1000, n_sensors=3)["max_trees"] == 31_000  # 5n'+t
+    assert scaled_limits(DEFAULT, 6000, 1000, n_sensors=7)["max_trees"] == 35_000
+    off = MHTConfig(scale_caps=False)  # the configured values, whatever the sensors
+    assert scaled_limits(off, 70, 4000, n_sensors=30) == {k: getattr(off, k) for k in SCALED}
+
+
 def _scene_scans(n_clutter: int, n_scans: int, seed: int) -> list[Scan]:
     """Four targets crossing in uniform clutter over 8 km × 8 km, P_D = 1."""
     rng = np.random.default_rng(seed)

@@ -24,12 +24,12 @@ def test_run_caps_sum_each_cap_and_count_the_scans_where_any_acted():
 
 def test_the_node_limit_is_reported_as_a_cap(monkeypatch):
     """The tracker's hypothesis stage counts the clusters the node limit stopped."""
-    from mhtrack.mht import tracker
+    from mhtrack.mht import frame_scope
 
     def stopped(*a, **k):
         return GlobalHypothesis(np.zeros(0, np.int64), 0.0, n_node_limited=2)
 
-    monkeypatch.setattr(tracker, "best_hypothesis", stopped)
+    monkeypatch.setattr(frame_scope, "best_hypothesis", stopped)
     trk = MHTTracker(MHTConfig(imm_sigma_v=0.0))
     trk.step(Scan.from_positions(0, 0.0, np.zeros((0, 2))))
     assert trk.last_stats is not None and trk.last_stats.caps == {"milp_node_limit": 2}

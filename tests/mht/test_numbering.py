@@ -40,6 +40,20 @@ def test_number_and_merge_equals_the_composition(seed):
     assert np.all(np.diff(got.tree) >= 0)
 
 
+@pytest.mark.parametrize("seed", range(5))
+def test_grown_leaves_out_of_tree_order_are_sorted_alike(seed):
+    """The one-write merge takes sorted parts; other orders go through the stable sort."""
+    rng = np.random.default_rng(seed)
+    grown = leaves_of_trees(rng, 12, np.arange(10))
+    grown = grown.take(rng.permutation(12))
+    births = leaves_of_trees(rng, 3, np.arange(20, 23))
+    idle = leaves_of_trees(rng, 9, np.arange(10, 20))
+    got = number_and_merge(grown, births, idle, Counter(5))
+    ref = _reference(grown, births, idle, Counter(5))
+    for name, a in ref.arrays().items():
+        np.testing.assert_array_equal(got.arrays()[name], a, err_msg=name)
+
+
 def test_hand_worked_node_ids():
     """Two grown leaves and one new leaf get ids 7, 8, 9 in row order; the idle leaf of
     tree 1 keeps its id and lands between trees 0 and 2."""

@@ -14,7 +14,11 @@ with the confirmed tracks ``t`` carried into it. With ``n' = min(n, BURST_PLOTS)
 
 the floors being the configured values (``MHTConfig``), so that nothing changes up to
 ~900 plots and 100 tracks per scan, and a burst of more than ``BURST_PLOTS`` plots gets
-the limits of ``BURST_PLOTS``.
+the limits of ``BURST_PLOTS``. ``max_trees``' floor is per sensor: with frames of several
+sensors (each one radar's sector, :attr:`~mhtrack.mht.coverage.Coverage.n_sensors`) the
+store holds the trees of every radar's last rotations while ``n`` counts one sector's
+plots, so the floor is the configured value times the sensors (issue 30: 30 radars and
+4 000 aircraft hold ~20 000 trees, which a floor of 5 000 cut at nearly every frame).
 
 **Overload rule** (:func:`mhtrack.mht.pruning.cap_per_plot`, with ``scale_caps``). A
 scan of ``n`` plots entered with ``t`` confirmed tracks supports ``16·n' + 50·t`` leaves
@@ -70,12 +74,15 @@ CHILDREN_PER_PLOT, MISSES_PER_TREE = 4, 2
 SCALED = ("max_births_per_scan", "max_trees", "max_leaves", "max_gated_pairs")
 
 
-def scaled_limits(cfg: MHTConfig, n_plots: int, n_tracks: int) -> dict[str, int]:
+def scaled_limits(cfg: MHTConfig, n_plots: int, n_tracks: int,
+                  n_sensors: int = 1) -> dict[str, int]:
     """The limits of a scan of ``n_plots`` plots entered with ``n_tracks`` confirmed
-    tracks (module docstring); the configured values when ``cfg.scale_caps`` is off."""
+    tracks, the store holding the trees of ``n_sensors`` sensors' frames (module
+    docstring); the configured values when ``cfg.scale_caps`` is off."""
     floors = {k: int(getattr(cfg, k)) for k in SCALED}
     if not cfg.scale_caps:
         return floors
+    floors["max_trees"] *= max(int(n_sensors), 1)
     n, t = min(int(n_plots), BURST_PLOTS), int(n_tracks)
     return {
         "max_births_per_scan": max(floors["max_births_per_scan"], n),
@@ -102,10 +109,11 @@ def _leaves_supported(n: int, t: int) -> int:
     return LEAVES_PER_PLOT * n + LEAVES_PER_TRACK * t
 
 
-def scan_config(cfg: MHTConfig, n_plots: int, n_tracks: int) -> MHTConfig:
+def scan_config(cfg: MHTConfig, n_plots: int, n_tracks: int,
+                n_sensors: int = 1) -> MHTConfig:
     """``cfg`` with :func:`scaled_limits` for this scan (``cfg`` itself when they are its
     own values)."""
-    lim = scaled_limits(cfg, n_plots, n_tracks)
+    lim = scaled_limits(cfg, n_plots, n_tracks, n_sensors)
     if all(lim[k] == getattr(cfg, k) for k in SCALED):
         return cfg
     return dataclasses.replace(cfg, **lim)

@@ -43,13 +43,14 @@ class FrameContext:
 
     @classmethod
     def of(cls, scan: Scan, plots: tuple[np.ndarray, np.ndarray, np.ndarray], *,
-           config: MHTConfig, previous: Reported) -> FrameContext:
+           config: MHTConfig, previous: Reported, n_sensors: int = 1) -> FrameContext:
         """The context of ``scan`` with its validated ``plots`` ``(z, R, rows)``, entered
         with the tracks ``previous`` reported: the limits of ``config`` scaled to its
-        plots and those tracks (:mod:`mhtrack.mht.caps`)."""
+        plots and those tracks, ``max_trees``' floor to the ``n_sensors`` whose frames
+        the store holds (:mod:`mhtrack.mht.caps`)."""
         z, R, rows = plots
         n_tracks = len(previous.track)
-        return cls(scan, z, R, rows, scan_config(config, len(z), n_tracks),
+        return cls(scan, z, R, rows, scan_config(config, len(z), n_tracks, n_sensors),
                    scene_leaves(config, len(z), n_tracks), previous)
 
     @property

@@ -70,6 +70,9 @@ class Coverage(ABC):
     #: :func:`~mhtrack.mht.hypothesis.best_hypothesis`; ids unique over the window, as a
     #: :class:`~mhtrack.records.PlotTable`'s rows are).
     per_tree_looks: bool = False
+    #: The sensors whose frames the tracker's store holds (``max_trees``' floor is per
+    #: sensor, :func:`mhtrack.mht.caps.scaled_limits`); 1: one scan holds the scene.
+    n_sensors: int = 1
 
     @abstractmethod
     def detection(self, scan: Scan, x: np.ndarray, P: np.ndarray,
@@ -155,6 +158,7 @@ class RadarCoverage(Coverage):
     def __init__(self, sensors: SensorSet, *, max_pd: float = MAX_COVERAGE_PD,
                  learn_reach: bool = True) -> None:
         self.sensors = sensors
+        self.n_sensors = len(sensors.sensors)
         self.max_pd = float(max_pd)
         #: Whether a radar without ``max_range`` has its reach learned (else it sees to
         #: infinity, the former rule; kept for comparisons).

@@ -65,6 +65,9 @@ class GlobalHypothesis:
     n_best_cut : clusters whose N best were not enumerated in full (larger than
         ``max_cluster_size``, or the search of one of them passed its node limit); their
         probabilities come from the hypotheses found (at least the best).
+    leaf_cluster : (L,) each input leaf's cluster (``0 … n_clusters − 1``, numbered by
+        smallest tree), ``-1`` for leaves with score ≤ 0.
+    cut_clusters : the clusters counted in ``n_greedy`` and ``n_node_limited``.
     """
 
     leaves: np.ndarray
@@ -76,10 +79,13 @@ class GlobalHypothesis:
     n_node_limited: int = 0
     probability: np.ndarray = field(default_factory=lambda: np.zeros(0))
     n_best_cut: int = 0
+    leaf_cluster: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
+    cut_clusters: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
 
 
 def _empty(n: int) -> GlobalHypothesis:
-    return GlobalHypothesis(np.zeros(0, np.int64), 0.0, probability=np.zeros(n))
+    return GlobalHypothesis(np.zeros(0, np.int64), 0.0, probability=np.zeros(n),
+                            leaf_cluster=np.full(n, -1, np.int64))
 
 
 def best_hypothesis(
@@ -138,6 +144,7 @@ def best_hypothesis(
         clash[leaf_cluster[bl[dup]]] = True
     chosen = [best[~clash[leaf_cluster[best]]]]
     n_greedy = n_limited = 0
+    cut: list[int] = []
     hard = clash.nonzero()[0]
     if hard.size:
         # small clusters: branch-and-bound, all at once; what it cannot finish and
@@ -158,11 +165,14 @@ def best_hypothesis(
             if max_cluster_size is not None and members.size > max_cluster_size:
                 pick = solve_greedy(s[members], tree_index[members], w[members], by_id=by_id)
                 n_greedy += 1
+                cut.append(int(leaf_cluster[members[0]]))
             else:
                 pick, exact = solve_milp(
                     s[members], tree_index[members], w[members], node_limit, by_id=by_id
                 )
                 n_limited += not exact
+                if not exact:
+                    cut.append(int(leaf_cluster[members[0]]))
             chosen.append(members[pick])
     is_sel = np.zeros(cand.size, bool)
     is_sel[np.concatenate(chosen)] = True
@@ -174,6 +184,8 @@ def best_hypothesis(
     sel = is_sel.nonzero()[0]
     if n_best == 1:
         probability[cand[sel]] = 1.0
+    cluster_of = np.full(score.size, -1, np.int64)
+    cluster_of[cand] = leaf_cluster
     return GlobalHypothesis(
         leaves=cand[sel],
         total=float(s[sel].sum()),
@@ -184,6 +196,8 @@ def best_hypothesis(
         n_node_limited=n_limited,
         probability=probability,
         n_best_cut=n_cut,
+        leaf_cluster=cluster_of,
+        cut_clusters=np.asarray(cut, np.int64),
     )
 
 

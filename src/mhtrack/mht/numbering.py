@@ -45,9 +45,26 @@ def number_and_merge(grown: Leaves, births: Leaves, idle: Leaves, nodes: Counter
         return deferred_concat(grown, births, node=np.arange(first, nodes.next, dtype=np.int64))
     n_new = len(grown) + len(births)
     first = nodes.take(n_new)
-    cols = {f: np.concatenate((getattr(grown, f), getattr(births, f), getattr(idle, f)))
-            for f in FIELDS}
-    cols["node"] = np.concatenate((np.arange(first, first + n_new, dtype=np.int64),
-                                   idle.node))
-    order = cols["tree"].argsort(kind="stable")
-    return Leaves(**{k: np.take(v, order, axis=0) for k, v in cols.items()})
+    new_tree = np.concatenate((grown.tree, births.tree))
+    if np.count_nonzero(new_tree[1:] < new_tree[:-1]):  # not sorted: sort all (stable)
+        cols = {f: np.concatenate((getattr(grown, f), getattr(births, f), getattr(idle, f)))
+                for f in FIELDS}
+        cols["node"] = np.concatenate((np.arange(first, first + n_new, dtype=np.int64),
+                                       idle.node))
+        order = cols["tree"].argsort(kind="stable")
+        return Leaves(**{k: np.take(v, order, axis=0) for k, v in cols.items()})
+    # both parts sorted by tree: each row's place in the stable sort of their
+    # concatenation is its rank in its part plus the rows of the other part before it
+    # (the new rows first among equal trees); one write of every column
+    at_new = np.arange(n_new) + np.searchsorted(idle.tree, new_tree, side="left")
+    at_idle = np.arange(len(idle)) + np.searchsorted(new_tree, idle.tree, side="right")
+    out = {}
+    for f in FIELDS:
+        a, b, c = getattr(grown, f), getattr(births, f), getattr(idle, f)
+        col = np.empty((n_new + len(idle), *c.shape[1:]), np.result_type(a, b, c))
+        col[at_new[:len(a)]] = a
+        col[at_new[len(a):]] = b
+        col[at_idle] = c
+        out[f] = col
+    out["node"][at_new] = np.arange(first, first + n_new, dtype=np.int64)
+    return Leaves(**out)

@@ -17,6 +17,7 @@ from mhtrack.mht.caps import CHILDREN_PER_PLOT, MISSES_PER_TREE
 from mhtrack.mht.config import MHTConfig
 from mhtrack.mht.context import FrameContext
 from mhtrack.mht.extend import Children
+from mhtrack.mht.frame_scope import Scope
 from mhtrack.mht.hypothesis import GlobalHypothesis
 from mhtrack.mht.merging import merge_keep
 from mhtrack.mht.sprt import SPRT
@@ -274,20 +275,30 @@ def removed_after_solve(leaves: Leaves, hyp: GlobalHypothesis,
 
 def prune_after_solve(frame: FrameContext, leaves: Leaves, chosen: np.ndarray, *,
                       by_id: bool = False, remove: np.ndarray | None = None,
-                      parts: tuple[Leaves, Leaves] | None = None) -> Leaves:
+                      parts: tuple[Leaves, Leaves] | None = None,
+                      scope: Scope | None = None) -> Leaves:
     """N-scan pruning around the best hypothesis (leaf indices ``chosen``), then the cap
     on trees (the frame's ``max_trees``, counted in its caps); marks the surviving chosen
     leaves. ``by_id``: trees step on their own looks (:func:`n_scan_keep`'s ``window``).
     ``remove``: a mask of further leaves to drop (:func:`removed_after_solve`).
     ``parts``: ``leaves`` is their :func:`~mhtrack.mht.tree.deferred_concat`, whose
-    states are copied once for the rows kept (:func:`~mhtrack.mht.tree.take_deferred`)."""
+    states are copied once for the rows kept (:func:`~mhtrack.mht.tree.take_deferred`).
+    ``scope``: N-scan pruning looks at these rows only, the others are kept
+    (:mod:`mhtrack.mht.frame_scope`: the groups a frame touched; the same keep mask)."""
     max_trees = frame.limits.max_trees
     n = len(leaves)
     is_chosen = np.zeros(n, bool)
     is_chosen[chosen] = True
-    keep = n_scan_keep(leaves.tree, leaves.window[:, 0], chosen,
-                       leaves.window if by_id else None,
-                       leaves.track < 0 if frame.limits.defer_tentative else None)
+    tentative = leaves.track < 0 if frame.limits.defer_tentative else None
+    if scope is None or scope.rows is None:
+        keep = n_scan_keep(leaves.tree, leaves.window[:, 0], chosen,
+                           leaves.window if by_id else None, tentative)
+    else:
+        w = leaves.window.take(scope.rows, axis=0)
+        keep = np.ones(n, bool)
+        keep[scope.rows] = n_scan_keep(
+            leaves.tree.take(scope.rows), w[:, 0], scope.chosen, w if by_id else None,
+            None if tentative is None else tentative.take(scope.rows))
     if remove is not None:
         keep &= ~remove
     n_kept = int(np.count_nonzero(keep))

@@ -20,8 +20,10 @@ tracks on air, the caps' counters) where it needs more than its own arrays::
     grow        extend.grow_children            the children's filter update
     births      births.Birth.seed,              the new trees, with tree ids; leaf ids for
                 numbering.number_and_merge        the history links; idle trees merged back
-    hypothesis  hypothesis.best_hypothesis      clusters → best compatible leaves
-    prune       pruning.prune_after_solve       N-scan: decide scan k − N; cap on trees
+    hypothesis  frame_scope.FrameScope.solve    clusters → best compatible leaves (the
+                                                  groups of trees the frame touched)
+    prune       pruning.prune_after_solve       N-scan: decide scan k − N (in that
+                                                  scope); cap on trees
     confirm     identity.hand_over,             a track follows its plots; SPRT (or
                 sprt.SPRT.confirms,               M-of-N) confirmation → new track ids;
                 history.TentativeHistory          the tentative past of new tracks
@@ -66,9 +68,9 @@ from mhtrack.mht.config import MHTConfig
 from mhtrack.mht.context import FrameContext
 from mhtrack.mht.coverage import Coverage, Everywhere, Looks
 from mhtrack.mht.extend import grow_children, propose_children
+from mhtrack.mht.frame_scope import FrameScope
 from mhtrack.mht.gating import Gate, plots_in_confirmed_gates
 from mhtrack.mht.history import TentativeHistory
-from mhtrack.mht.hypothesis import GlobalHypothesis, best_hypothesis
 from mhtrack.mht.identity import Reported, confirm, hand_over, newly_confirmed
 from mhtrack.mht.intensity import clutter_intensity
 from mhtrack.mht.numbering import Counter, number_and_merge
@@ -144,6 +146,9 @@ class MHTTracker:
         self._book = AddressBook(self.attributes.resume_s)
         self._callsigns = Callsigns(self.attributes.resume_s)
         self._ages = SensorAges(self.attributes.resume_s)
+        #: The solve stage over the groups of trees a frame touched
+        #: (:mod:`mhtrack.mht.frame_scope`; ``scope.enabled = False``: all at every frame).
+        self.scope = FrameScope(cfg, self.coverage.per_tree_looks)
         self.last_stats: StepStats | None = None
         #: The clutter intensity κ̂ (per m² per scan, floored) the last :meth:`step` scored
         #: each of its plots with (kept for the pipeline's DEBUG line, not recomputed).
@@ -210,10 +215,11 @@ class MHTTracker:
         if attrs is not None:
             grown, births = self._attributes(f, attrs, grown, births, children.plot)
         leaves, parts, first_node = self._number(grown, births, idle)
-        hyp = self._hypothesis(f, leaves)
-        leaves = prune_after_solve(f, leaves, hyp.leaves, by_id=self.coverage.per_tree_looks,
-                                   remove=removed_after_solve(leaves, hyp, self.config),
-                                   parts=parts)
+        hyp, scope = self.scope.solve(f, leaves, first_node)
+        solved, leaves = leaves, prune_after_solve(
+            f, leaves, hyp.leaves, by_id=self.coverage.per_tree_looks, scope=scope,
+            remove=removed_after_solve(leaves, hyp, self.config), parts=parts)
+        self.scope.pruned(solved, leaves)
         stepped = None if len(idle) == 0 else leaves.node >= first_node
         leaves = self._confirm(f, leaves)
         out = self._report(f, leaves, stepped)
@@ -229,7 +235,8 @@ class MHTTracker:
         birth process is told its limit."""
         plots = validate_scan(scan, self._R, self._last_time, self._last_index)
         previous = Reported.of(self._leaves, by_id=self.coverage.per_tree_looks)
-        frame = FrameContext.of(scan, plots, config=self.config, previous=previous)
+        frame = FrameContext.of(scan, plots, config=self.config, previous=previous,
+                                n_sensors=self.coverage.n_sensors)
         self.birth.limit(frame.limits.max_births_per_scan)
         return frame
 
@@ -270,19 +277,6 @@ class MHTTracker:
         parts = (grown, births) if len(idle) == 0 and len(births) else None
         leaves = number_and_merge(grown, births, idle, self.nodes, parts is not None)
         return leaves, parts, first_node
-
-    def _hypothesis(self, frame: FrameContext, leaves: Leaves) -> GlobalHypothesis:
-        """The best global hypothesis; clusters solved greedily (over
-        ``max_cluster_size``) or stopped by ``milp_node_limit`` count as caps."""
-        cfg = self.config
-        hyp = best_hypothesis(leaves.score, leaves.tree, leaves.window, cfg.max_cluster_size,
-                              cfg.milp_node_limit, by_id=self.coverage.per_tree_looks,
-                              n_best=cfg.n_best)
-        if hyp.n_greedy:
-            frame.cut("max_cluster_size", hyp.n_greedy)
-        if hyp.n_node_limited:
-            frame.cut("milp_node_limit", hyp.n_node_limited)
-        return hyp
 
     def _confirm(self, frame: FrameContext, leaves: Leaves) -> Leaves:
         """Hand over track ids that follow their plots, confirm by the SPRT (new track ids),

@@ -22,7 +22,7 @@ import sys
 import threading
 import time
 from collections.abc import Callable, Iterable, Iterator
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, BinaryIO, TextIO
 
@@ -43,6 +43,7 @@ from mhtrack.pipeline.live_options import (
     KEEP_ROWS,
     LiveOptions,
     idle_wait,
+    longest_period,
 )
 from mhtrack.pipeline.monitor import MetricsServer, host_port, prometheus_text, write_status
 from mhtrack.pipeline.options import TrackOptions
@@ -167,10 +168,7 @@ class Live:
             # stopped with a checkpoint: the plots held go into it, tracked on resume
             hold=lambda: self.stop.is_set() and live.checkpoint is not None)
         try:
-            # a live run reports what it tracked as it goes: online unless told otherwise
-            online = options if options.output is not None else replace(options,
-                                                                        output="online")
-            self.pipeline = Pipeline(self.source, online, survey=survey)
+            self.pipeline = Pipeline(self.source, options, survey=survey, live=True)
         except BaseException:
             if isinstance(self.reader, UdpReader):
                 self.reader.close()
@@ -249,8 +247,8 @@ class Live:
                                          else "tick"))
         self.periodic: PeriodicSink | None = None
         if live.period_out_s is not None:
-            longest = max((float(s.period) for s in sensors.sensors  # type: ignore[arg-type]
-                           if s.period is not None), default=live.period_out_s)
+            longest = longest_period(sensors)
+            longest = live.period_out_s if longest is None else longest
             self.periodic = PeriodicSink(
                 outputs, live.period_out_s, self._picture,
                 max_extrapolation_s=(EXTRAPOLATION_PERIODS * longest

@@ -81,7 +81,14 @@ def idle_wait(sensors: SensorSet, live: LiveOptions) -> float | None:
         return float(live.idle_close_s) if live.idle_close_s > 0 else None
     window = DEFAULT_REORDER_WINDOW_S if live.reorder_window_s is None \
         else float(live.reorder_window_s)
-    longest = max((float(s.period) for s in sensors.sensors  # type: ignore[arg-type]
-                   if s.kind == "polar" and s.period is not None), default=DEFAULT_FRAME_S)
-    return window + longest
+    longest = longest_period(sensors)
+    return window + (DEFAULT_FRAME_S if longest is None else longest)
+
+
+def longest_period(sensors: SensorSet) -> float | None:
+    """The longest period (s) among the sensors that have one — a radar's rotation, any
+    other sensor's update period — or ``None``: what a quiet feed's wait
+    (:func:`idle_wait`) and the periodic output's extrapolation limit are counted in."""
+    return max((float(s.period) for s in sensors.sensors if s.period is not None),
+               default=None)
 

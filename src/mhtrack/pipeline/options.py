@@ -115,7 +115,7 @@ class Choices:
 
 
 def choose(source: Source, options: TrackOptions, survey: Survey | None,
-           config: MHTConfig | None = None) -> Choices:
+           config: MHTConfig | None = None, *, live: bool = False) -> Choices:
     """Every default of a run on ``source``, chosen once:
 
     * configuration: ``config`` if given, else :func:`~mhtrack.build.default_config` of
@@ -127,8 +127,9 @@ def choose(source: Source, options: TrackOptions, survey: Survey | None,
     * the tracker (:func:`~mhtrack.build.make_tracker`) with the source's sensors
       (radar coverage, per-radar clutter in ``clutter_frame``);
     * the output frame: the sensors' local frame when they have a geodetic reference;
-    * the output mode: :data:`~mhtrack.names.RADAR_OUTPUT` (the history smoothed) for
-      timed plots of rotating radars, else :data:`~mhtrack.names.DEFAULT_OUTPUT`.
+    * the output mode: ``"online"`` for a ``live`` run (it reports what it tracked as it
+      goes), else :data:`~mhtrack.names.RADAR_OUTPUT` (the history smoothed) for timed
+      plots of rotating radars, else :data:`~mhtrack.names.DEFAULT_OUTPUT`.
     """
     scenario, area, radars = source.scenario, None, None
     if config is None and scenario is not None:
@@ -167,7 +168,8 @@ def choose(source: Source, options: TrackOptions, survey: Survey | None,
             "bounding box" if area is not None else "P1's 8 km × 8 km region")
     output = options.output
     if output is None:
-        output = RADAR_OUTPUT if radars is not None else DEFAULT_OUTPUT
+        output = ("online" if live else RADAR_OUTPUT if radars is not None
+                  else DEFAULT_OUTPUT)
     return Choices(config, fusion, tracker, frame, area, text, radars, check_output(output))
 
 

@@ -208,16 +208,18 @@ class Pipeline:
     configuration (``config`` if given, else from the source's scenario or plots),
     fusion, the tracker with the source's sensors, the output frame. ``options``: what
     the user set (:class:`TrackOptions`); ``survey``: the source's survey when it was
-    taken elsewhere (else :meth:`Source.survey`)."""
+    taken elsewhere (else :meth:`Source.survey`); ``live``: a live run (its default
+    output mode is online)."""
 
     def __init__(self, source: Source, options: TrackOptions | None = None, *,
-                 config: MHTConfig | None = None, survey: Survey | None = None) -> None:
+                 config: MHTConfig | None = None, survey: Survey | None = None,
+                 live: bool = False) -> None:
         self.source = source
         self.options = TrackOptions() if options is None else options
         if survey is not None:  # surveyed elsewhere (live: its first rotations)
             self.__dict__["survey"] = survey
         survey = self.survey if source.scenario is None else None
-        self.choices = choose(source, self.options, survey, config)
+        self.choices = choose(source, self.options, survey, config, live=live)
         self.config, self.tracker = self.choices.config, self.choices.tracker
         self.fusion, self.frame = self.choices.fusion, self.choices.frame
         self.output = self.choices.output

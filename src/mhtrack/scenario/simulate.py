@@ -191,10 +191,7 @@ def simulate_rotating(scenario: Scenario, seed: int = 0) -> Simulation:
     sites = {s.id: sensor_set.site_latlon(s.id) for s in scenario.sensors}
     window = (float(scenario.first * scenario.T), float(scenario.last * scenario.T))
     radars = sorted(zip(scenario.sensors, scenario.pd, strict=True), key=lambda s: s[0].id)
-    scene = scenario.clutter_scene
-    sites_xy = None if scene is None else {s.id: sensor_set.site_xy(s.id)
-                                            for s in scenario.sensors}
     plots = rotating_plots(radars, frame, sites, segs, window, seed,  # type: ignore[arg-type]
-                           scene, sites_xy)
+                           scenario.clutter_scene)
     truth = sample_truth(segs, *window, scenario.truth_dt)
     return Simulation(scenario=scenario, seed=seed, plots=plots, truth=truth)

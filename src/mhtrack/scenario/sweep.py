@@ -160,11 +160,10 @@ def radar_plots(
     window: tuple[float, float],
     seed: int,
     scene: ClutterScene | None = None,
-    site_xy: tuple[float, float] | None = None,
 ) -> dict[str, np.ndarray]:
     """One radar's plots over ``window`` (s, inclusive): columns ``time, range, bearing,
     origin`` (unsorted: targets in ``segs`` order, then clutter by rotation, then the
-    ``scene``'s clutter by rotation about the site's plane position ``site_xy``)."""
+    ``scene``'s clutter by rotation about the site's position in ``frame``)."""
     cols: dict[str, list[np.ndarray]] = {k: [] for k in ("time", "range", "bearing", "origin")}
     site_xy = np.array(frame.to_local(*site), float).ravel()
     for seg in segs:
@@ -211,11 +210,10 @@ def rotation_middle(radar: RotatingRadar, t: np.ndarray | float) -> np.ndarray:
 
 
 def _scene_plots(radar: RotatingRadar, frame: LocalFrame, site: tuple[float, float],
-                 site_xy: tuple[float, float] | None, scene: ClutterScene,
+                 site_xy: np.ndarray, scene: ClutterScene,
                  window: tuple[float, float], seed: int) -> dict[str, np.ndarray]:
-    """The scene's clutter of one radar, rotation by rotation (module docstring)."""
-    if site_xy is None:
-        raise ValueError("a clutter scene needs the radar's site in the local frame")
+    """The scene's clutter of one radar, rotation by rotation (module docstring), about
+    the site's local position ``site_xy``."""
     cols: dict[str, list[np.ndarray]] = {k: [] for k in ("time", "range", "bearing", "origin")}
     for n, t0 in enumerate(_rotation_starts(radar, *window).tolist()):
         rng = _rng(seed, _SCENE_STREAM, radar.id, n)
@@ -240,18 +238,16 @@ def rotating_plots(
     window: tuple[float, float],
     seed: int,
     scene: ClutterScene | None = None,
-    sites_xy: dict[int, tuple[float, float]] | None = None,
 ) -> PlotTable:
     """The timed :class:`~mhtrack.records.PlotTable` of several rotating radars
     ``(radar, P_D)`` at ``sites`` (id → lat, lon): rows cut into frames by
     :func:`~mhtrack.frames.make_frames` (one radar, at most an eighth of its rotation)
-    and sorted by frame, then time; ``scene``: a clutter scene drawn about ``sites_xy``
-    (id → local x, y) on top of each radar's own clutter; ``x, y, R`` from
+    and sorted by frame, then time; ``scene``: a clutter scene drawn about each site on top
+    of each radar's own clutter; ``x, y, R`` from
     :func:`~mhtrack.models.geodesy.polar_to_local`; ``origin`` target id or −1."""
     parts = []
     for radar, pd in radars:
-        c = radar_plots(radar, pd, frame, sites[radar.id], segs, window, seed, scene,
-                        None if sites_xy is None else sites_xy[radar.id])
+        c = radar_plots(radar, pd, frame, sites[radar.id], segs, window, seed, scene)
         z, R = polar_to_local(frame, *sites[radar.id], c["range"], c["bearing"],
                               radar.sigma_range, radar.sigma_bearing_deg)
         c.update(sensor=np.full(len(c["time"]), radar.id, np.int64), z=z.reshape(-1, 2),

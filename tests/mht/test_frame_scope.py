@@ -57,6 +57,8 @@ CASES = {
     # small caps: clusters solved greedily, the cap on trees cutting (scope marked dirty)
     "caps": MHTConfig(new_target_density=1e-10, max_cluster_size=3, scale_caps=False,
                       max_trees=150, max_births_per_scan=40, max_leaves=2_000),
+    # tentative trees left uncommitted by N-scan (the scope takes their rows' rule too)
+    "defer": MHTConfig(new_target_density=1e-10, defer_tentative=True),
 }
 
 

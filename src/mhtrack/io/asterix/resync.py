@@ -61,13 +61,14 @@ def judged(data: bytes, framed: Callable[[int], int], fits: Callable[[bytes], bo
     (``framed``) and ``fits`` finds that its records fill it exactly: a damaged
     length that lands on octets framed like a block still leaves records that do not
     end at its end, so the walk resumes at the good blocks it would cover. Remembered
-    for the last offsets asked (the walk asks each twice)."""
+    for the last 64 offsets asked (the walk asks each more than once, a few blocks
+    ahead), so that each block is judged once."""
     memo: dict[int, int] = {}
 
     def at(q: int) -> int:
         if q not in memo:
-            if len(memo) > 64:
-                memo.clear()
+            if len(memo) >= 64:
+                del memo[next(iter(memo))]
             step = framed(q)
             memo[q] = step if step and fits(data[q:q + step]) else 0
         return memo[q]

@@ -320,6 +320,24 @@ def check(base: Base, sensors: Path, work: Path, seed: int, kind: str, timeout: 
     return res
 
 
+def _tables(columns: tuple[str, ...], counts: dict[tuple[str, str], list[int]],
+            detail: bool = True) -> None:
+    """The counts per format (and, with ``detail``, per format and damage)."""
+    head = f"{'format':8} {'damage':10} " + " ".join(f"{c:>{max(7, len(c))}}"
+                                                    for c in columns)
+    for title, key in (("per format and damage", lambda fk: fk),
+                       ("per format", lambda fk: (fk[0], "all")))[0 if detail else 1:]:
+        table: dict[tuple[str, str], list[int]] = collections.defaultdict(
+            lambda: [0] * len(columns))
+        for fk, row in counts.items():
+            table[key(fk)] = [a + b for a, b in zip(table[key(fk)], row, strict=True)]
+        print(f"\n{title}\n{head}")
+        for (fmt, kind), row in sorted(table.items()):
+            print(f"{fmt:8} {kind:10} " + " ".join(
+                f"{v:>{max(7, len(c))}d}" for c, v in zip(columns, row, strict=True)))
+    sys.stdout.flush()
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--mutants", type=int, default=2000)
@@ -330,6 +348,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--shard", default="0/1", help="K/N: run the mutants K, K + N, ...")
     ap.add_argument("--formats", default=",".join(FORMATS),
                     help="only these formats' mutants (the same seeds as in the full run)")
+    ap.add_argument("--every", type=int, default=200,
+                    help="print the counts so far every this many mutants")
     ap.add_argument("--no-track", action="store_true",
                     help="run convert only (the plots lost and the garbage)")
     args = ap.parse_args(argv)
@@ -363,20 +383,10 @@ def main(argv: list[str] | None = None) -> int:
         if o.fails:
             failures.append(f"{fmt}-{kind}-{seed}: " + " | ".join(o.fails))
             print("FAIL", failures[-1], flush=True)
-        if i % 200 == 0:
+        if i % args.every == 0:
             print(f"  {i} mutants, {len(failures)} failed", flush=True)
-    head = f"{'format':8} {'damage':10} " + " ".join(f"{c:>{max(7, len(c))}}"
-                                                    for c in columns)
-    for title, key in (("per format and damage", lambda fk: fk),
-                       ("per format", lambda fk: (fk[0], "all"))):
-        table: dict[tuple[str, str], list[int]] = collections.defaultdict(
-            lambda: [0] * len(columns))
-        for fk, row in counts.items():
-            table[key(fk)] = [a + b for a, b in zip(table[key(fk)], row, strict=True)]
-        print(f"\n{title}\n{head}")
-        for (fmt, kind), row in sorted(table.items()):
-            print(f"{fmt:8} {kind:10} " + " ".join(
-                f"{v:>{max(7, len(c))}d}" for c, v in zip(columns, row, strict=True)))
+            _tables(columns, counts, detail=False)
+    _tables(columns, counts)
     total = sum(c[0] for c in counts.values())
     print(f"mutants: {total}, failed: {len(failures)}, raw blocks lost to a damaged "
           f"length (documented): {sum(c[7] for c in counts.values())}")

@@ -11,7 +11,11 @@ markers / sector crossings (``mhtrack export``), then times, best of ``--repeat`
   blocks judged by their content too, :mod:`mhtrack.io.asterix.resync`);
 * decoding alone through :mod:`mhtrack.io.asterix.fast` (layouts learnt from libasterix);
 * decoding alone through libasterix record by record (``read_recording(fast=False)``),
-  the reference path, once.
+  the reference path, once;
+* ``convert`` of a raw stream of the categories libasterix decodes record by record
+  (:data:`OTHER_PLOTS` of the hour's plots as CAT001 with their radars' CAT002 north
+  markers, and as many CAT021 ADS-B reports): blocks judged by their content, then
+  decoded.
 
 libasterix is imported before the clocks start (its generated module takes ~1 s to
 import). Timings are wall time on a shared machine: noisy.
@@ -26,7 +30,37 @@ import time
 from collections.abc import Callable
 from pathlib import Path
 
+import numpy as np
 from click.testing import CliRunner
+
+#: Plots of the hour encoded as CAT001 (and as many CAT021 reports) for the last case:
+#: libasterix's encoder takes a few ms a record, so not the whole hour.
+OTHER_PLOTS = 4000
+
+
+def other_categories(rec: Path, out: Path) -> int:
+    """``out``: the first :data:`OTHER_PLOTS` plots of recording ``rec`` as CAT001 plots
+    with CAT002 north markers, and as CAT021 reports of one ADS-B station (positions made
+    up from range and bearing: only the decoding's cost matters), as raw data blocks.
+    Returns the number of records."""
+    from mhtrack.io.asterix import read_recording
+    from mhtrack.io.asterix.encode_other import blocks, mark002, plot001, report021
+
+    r = read_recording(rec)
+    p, sw = r.plots, r.sweeps
+    n = min(OTHER_PLOTS, p["time"].size)
+    last = float(p["time"][n - 1])
+    msgs = [(float(p["time"][i]), int(p["sensor"][i]), 1, plot001(
+        float(p["time"][i]), int(p["sensor"][i]), float(p["slant_range"][i]),
+        float(p["bearing"][i]))) for i in range(n)]
+    north = np.flatnonzero((sw["kind"] == 1) & (sw["time"] <= last))
+    msgs += [(float(sw["time"][i]), int(sw["sensor"][i]), 2, mark002(
+        float(sw["time"][i]), int(sw["sensor"][i]), 1)) for i in north]
+    msgs += [(float(p["time"][i]), 0x0707, 21, report021(
+        float(p["time"][i]), 0x0707, 46.0 + float(p["slant_range"][i]) * 1e-6,
+        7.0 + float(p["bearing"][i]) * 1e-3, address=f"{i:06x}")) for i in range(n)]
+    out.write_bytes(b"".join(b for _, _, b in blocks(msgs)))
+    return len(msgs)
 
 
 def best_of(f: Callable[[], object], repeat: int) -> float:
@@ -74,12 +108,17 @@ def main() -> int:
         t_raw = best_of(lambda: convert(raw, d / "out.csv", sensors), args.repeat)
         t_fast = best_of(lambda: read_recording(rec), args.repeat)
         t_slow = best_of(lambda: read_recording(rec, fast=False), 1)
+        other = d / "other.ast"
+        n_other = other_categories(rec, other)
+        t_other = best_of(lambda: convert(other, d / "out.csv", sensors), args.repeat)
         print(f"{'what':44s} {'s':>7s} {'plots/s':>9s}")
         for what, t in (("convert (decode, ground range, write CSV)", t_conv),
                         ("convert, raw data blocks (.ast)", t_raw),
                         ("decode, fast path", t_fast),
                         ("decode, libasterix record by record", t_slow)):
             print(f"{what:44s} {t:7.2f} {n / t:9.0f}")
+        print(f"{'convert, raw CAT001/002/021 (.ast)':44s} {t_other:7.2f} "
+              f"{n_other / t_other:9.0f} records/s ({n_other} records)")
         print(f"libasterix {_lib.version()}; target >= 20000 plots/s for convert: "
               f"{'met' if n / t_conv >= 20000 else 'NOT met'}")
     return 0

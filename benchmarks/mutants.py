@@ -24,9 +24,14 @@ mutant:
 * every plot of every untouched packet is in ``convert``'s output (sensor, slant range,
   bearing, time of day compared exactly; a multiset, so that a duplicate hides nothing).
 
-Prints the counts per format and per kind of damage, and the failures (at most 20, each
-with its seed so that it can be replayed: ``--only SEED``). Exit status 1 when any check
-failed.
+Also counted, not failures: **garbage** plots (in ``convert``'s output, not in the
+original recording at all: damaged octets that still decode as valid ASTERIX) and the
+raw blocks lost inside a damaged length (``raw-covered``, documented).
+
+Prints the counts per format and per kind of damage (tracebacks, hangs, refusals,
+mutants losing plots of untouched packets and the plots lost, garbage), and the failures
+(each with its seed so that it can be replayed: ``--only FORMAT-KIND-SEED``).
+``--no-track`` runs ``convert`` alone. Exit status 1 when any check failed.
 """
 
 from __future__ import annotations
@@ -38,7 +43,7 @@ import signal
 import struct
 import sys
 import tempfile
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -252,9 +257,37 @@ def covered(base: Base, damaged: bytes, touched: set[int],
     return out
 
 
+@dataclass
+class Outcome:
+    """What one mutant did: commands ending in a traceback or a hang, refusals of a
+    recording that still holds plots, plots of untouched packets lost (``covered``: all
+    of them inside a damaged raw length, documented), plots ``convert`` wrote that the
+    original does not hold (garbage: damaged octets that decode as valid ASTERIX), and a
+    line per failure."""
+
+    tracebacks: int = 0
+    hangs: int = 0
+    refusals: int = 0
+    lost: int = 0
+    covered: bool = False
+    garbage: int = 0
+    fails: list[str] = field(default_factory=list)
+
+
+def _run(outcome: Outcome, what: str, args: list[str], may_refuse: bool,
+         timeout: float) -> int:
+    status, text = _invoke(args, timeout)
+    if status not in (0, 2) or (status == 2 and not may_refuse):
+        outcome.tracebacks += status == 1
+        outcome.hangs += status == 124
+        outcome.refusals += status == 2
+        outcome.fails.append(f"{what} status {status}: {text.strip()[-400:]}")
+    return status
+
+
 def check(base: Base, sensors: Path, work: Path, seed: int, kind: str, timeout: float,
-          ) -> list[str]:
-    """The failures of one mutant (empty: it passed)."""
+          track: bool = True) -> Outcome:
+    """What one mutant did (:class:`Outcome`; no ``fails``: it passed)."""
     rng = random.Random(f"{base.fmt}-{kind}-{seed}")
     damaged, touched, head, region = mutate(base, rng, kind)
     excused = covered(base, damaged, touched, region)
@@ -263,28 +296,46 @@ def check(base: Base, sensors: Path, work: Path, seed: int, kind: str, timeout: 
     path.write_bytes(damaged)
     kept = [k for i, keys in enumerate(base.plots) if i not in touched for k in keys]
     may_refuse = head or not kept
-    fails = []
+    res = Outcome()
     out = work / "c.csv"
     out.unlink(missing_ok=True)
-    status, text = _invoke(["convert", str(path), str(out)], timeout)
-    if status not in (0, 2) or (status == 2 and not may_refuse):
-        fails.append(f"convert status {status}: {text.strip()[-400:]}")
-    elif status == 0 and not head:
+    status = _run(res, "convert", ["convert", str(path), str(out)], may_refuse, timeout)
+    if status == 0 and not head:
         t = pacsv.read_csv(out).to_pydict()
         got = collections.Counter(zip(*(map(float, t[k]) for k in KEY),
                                       (float(x) % 86400 for x in t["time"]), strict=True))
+        known = {k for keys in base.plots for k in keys}
+        res.garbage = sum(c for k, c in got.items() if k not in known)
         missing = collections.Counter(kept) - got
         also = collections.Counter(k for i in excused for k in base.plots[i])
+        res.lost = sum(missing.values())
         if missing and not missing - also:
-            fails.append("raw-covered")
+            res.covered = True
         elif missing:
-            fails.append(f"convert lost {sum(missing.values())} plot(s) of untouched "
-                         f"packets, e.g. {next(iter(missing))}")
-    status, text = _invoke(["track", str(path), "--sensors", str(sensors), "--out",
-                            str(work / "t.csv")], timeout)
-    if status not in (0, 2) or (status == 2 and not may_refuse):
-        fails.append(f"track status {status}: {text.strip()[-400:]}")
-    return fails
+            res.fails.append(f"convert lost {res.lost} plot(s) of untouched packets, e.g. "
+                             f"{next(iter(missing))}")
+    if track:
+        _run(res, "track", ["track", str(path), "--sensors", str(sensors), "--out",
+                            str(work / "t.csv")], may_refuse, timeout)
+    return res
+
+
+def _tables(columns: tuple[str, ...], counts: dict[tuple[str, str], list[int]],
+            detail: bool = True) -> None:
+    """The counts per format (and, with ``detail``, per format and damage)."""
+    head = f"{'format':8} {'damage':10} " + " ".join(f"{c:>{max(7, len(c))}}"
+                                                    for c in columns)
+    for title, key in (("per format and damage", lambda fk: fk),
+                       ("per format", lambda fk: (fk[0], "all")))[0 if detail else 1:]:
+        table: dict[tuple[str, str], list[int]] = collections.defaultdict(
+            lambda: [0] * len(columns))
+        for fk, row in counts.items():
+            table[key(fk)] = [a + b for a, b in zip(table[key(fk)], row, strict=True)]
+        print(f"\n{title}\n{head}")
+        for (fmt, kind), row in sorted(table.items()):
+            print(f"{fmt:8} {kind:10} " + " ".join(
+                f"{v:>{max(7, len(c))}d}" for c, v in zip(columns, row, strict=True)))
+    sys.stdout.flush()
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -297,6 +348,10 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--shard", default="0/1", help="K/N: run the mutants K, K + N, ...")
     ap.add_argument("--formats", default=",".join(FORMATS),
                     help="only these formats' mutants (the same seeds as in the full run)")
+    ap.add_argument("--every", type=int, default=200,
+                    help="print the counts so far every this many mutants")
+    ap.add_argument("--no-track", action="store_true",
+                    help="run convert only (the plots lost and the garbage)")
     args = ap.parse_args(argv)
     work = args.work or Path(tempfile.mkdtemp(prefix="mutants-"))
     work.mkdir(parents=True, exist_ok=True)
@@ -313,26 +368,28 @@ def main(argv: list[str] | None = None) -> int:
                 for _ in range(args.mutants)]
         k, n = map(int, args.shard.split("/"))
         jobs = [j for j in jobs[k::n] if j[0] in args.formats.split(",")]
-    counts: dict[tuple[str, str], list[int]] = collections.defaultdict(lambda: [0, 0, 0])
+    columns = ("mutants", "failed", "tracebacks", "hangs", "refusals", "losing",
+               "plots lost", "raw-covered", "garbage", "garbage plots")
+    counts: dict[tuple[str, str], list[int]] = collections.defaultdict(
+        lambda: [0] * len(columns))
     failures: list[str] = []
     for i, (fmt, kind, seed) in enumerate(jobs, 1):
-        fails = check(bases[fmt], sensors, work, seed, kind, args.timeout)
-        counts[fmt, kind][0] += 1
-        if "raw-covered" in fails:
-            fails.remove("raw-covered")
-            counts[fmt, kind][2] += 1
-        if fails:
-            counts[fmt, kind][1] += 1
-            failures.append(f"{fmt}-{kind}-{seed}: " + " | ".join(fails))
+        o = check(bases[fmt], sensors, work, seed, kind, args.timeout, not args.no_track)
+        losing = o.lost > 0 and not o.covered
+        for j, v in enumerate((1, bool(o.fails), o.tracebacks, o.hangs, o.refusals,
+                               losing, o.lost if losing else 0, o.covered,
+                               o.garbage > 0, o.garbage)):
+            counts[fmt, kind][j] += int(v)
+        if o.fails:
+            failures.append(f"{fmt}-{kind}-{seed}: " + " | ".join(o.fails))
             print("FAIL", failures[-1], flush=True)
-        if i % 200 == 0:
+        if i % args.every == 0:
             print(f"  {i} mutants, {len(failures)} failed", flush=True)
-    print(f"{'format':8} {'damage':10} {'mutants':>8} {'failed':>7} {'raw-covered':>12}")
-    for (fmt, kind), (n, bad, cov) in sorted(counts.items()):
-        print(f"{fmt:8} {kind:10} {n:8d} {bad:7d} {cov:12d}")
+            _tables(columns, counts, detail=False)
+    _tables(columns, counts)
     total = sum(c[0] for c in counts.values())
     print(f"mutants: {total}, failed: {len(failures)}, raw blocks lost to a damaged "
-          f"length (documented): {sum(c[2] for c in counts.values())}")
+          f"length (documented): {sum(c[7] for c in counts.values())}")
     return 1 if failures else 0
 
 

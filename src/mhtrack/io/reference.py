@@ -106,6 +106,7 @@ def _adsb_reports(path: str | Path, walked: Walked | None = None
     from mhtrack.errors import InputError
     from mhtrack.io.asterix.cat021 import COLUMNS, block021
     from mhtrack.io.asterix.category_file import category_rows
+    from mhtrack.io.asterix.notplots import real_plots
     from mhtrack.io.asterix.timeaxis import unwrap_days
 
     at: list[int] = []
@@ -122,19 +123,23 @@ def _adsb_reports(path: str | Path, walked: Walked | None = None
                          "and a time: not a reference", file=str(path))
     c = {k: np.array(v) for k, v in zip(COLUMNS, zip(*rows, strict=True), strict=True)}
     where = np.asarray(at, np.int64)
-    flagged = (c["sim"] == 1) | (c["tst"] == 1) | (c["rab"] == 1)
-    for i in np.flatnonzero(flagged):
-        problems.add("not_plot", int(where[i]))
+    real, _ = real_plots(np.full(where.size, -1), c["sim"], c["rab"], c["tst"])
+    _count(problems, "not_plot", where, ~real)
     address = np.array([int(a, 16) if a else -1 for a in c["address"].tolist()], np.int64)
     tn = c["track_number"].astype(np.int64)
     key = np.where(address >= 0, address,
                    np.where(tn >= 0, 2**24 + c["sensor"].astype(np.int64) * 65536 + tn, -1))
-    for i in np.flatnonzero(~flagged & (key < 0)):
-        problems.add("no_identity", int(where[i]))
-    keep = ~flagged & (key >= 0)
+    _count(problems, "no_identity", where, real & (key < 0))
+    keep = real & (key >= 0)
     if not keep.any():
         raise InputError(f"{path}: no CAT021 ADS-B report of an aircraft with an address "
                          "or a track number: not a reference", file=str(path))
     cols = {"time": unwrap_days(c["time"][keep].astype(float)),
             "lat": c["lat"][keep].astype(float), "lon": c["lon"][keep].astype(float)}
     return cols, key[keep], problems
+
+
+def _count(problems: Problems, kind: str, where: np.ndarray, mask: np.ndarray) -> None:
+    """Count the reports of ``mask`` as ``kind``, the first at its byte offset."""
+    if mask.any():
+        problems.add(kind, int(where[mask][0]), int(np.count_nonzero(mask)))

@@ -66,24 +66,24 @@ def read_timed_plots(
     f, c = read_timed_columns(path, sensors)
     on_time, late = kept_and_late(c.time, reorder_window_s)
     rows = np.flatnonzero(on_time)
+    time, sensor = c.time, c.sensor
     if late.n:
         logging.getLogger("mhtrack").warning("%s", late.line(
             str(path), f.src.where(int(late.first["row"]))))  # type: ignore[call-overload]
-        c = TimedColumns(*(None if v is None else v[on_time] for v in (
-            c.time, c.sensor, c.x, c.y, c.range, c.bearing, c.origin, c.R)),
-            attrs=None if c.attrs is None else c.attrs.take(rows))
+        time, sensor = time[rows], sensor[rows]
     periods = {s: sensors.sensor(s).period if sensors is not None else None
-               for s in np.unique(c.sensor).tolist()}
-    frame, order = make_frames(c.time, c.sensor, frame_lengths(periods))
+               for s in np.unique(sensor).tolist()}
+    frame, order = make_frames(time, sensor, frame_lengths(periods))
+    idx = rows[order]  # file rows in table order: each column is copied once, by them
 
     def take(v: np.ndarray | None) -> np.ndarray | None:
-        return None if v is None else np.ascontiguousarray(v[order])
+        return None if v is None else v[idx]
 
     return PlotTable(
-        scan=frame[order], time=c.time[order], sensor=c.sensor[order], x=take(c.x),
+        scan=frame[order], time=c.time[idx], sensor=c.sensor[idx], x=take(c.x),
         y=take(c.y), range=take(c.range), bearing=take(c.bearing), origin=take(c.origin),
-        R=take(c.R), timed=True, file_row=rows[order].astype(np.int64), iso_times=is_iso(f),
-        attrs=None if c.attrs is None else c.attrs.take(order),
+        R=take(c.R), timed=True, file_row=idx.astype(np.int64), iso_times=is_iso(f),
+        attrs=None if c.attrs is None else c.attrs.take(idx),
     )  # type: ignore[arg-type]
 
 

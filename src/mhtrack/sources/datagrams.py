@@ -51,6 +51,7 @@ from mhtrack.io.reorder import kept as kept_by_buffer
 from mhtrack.models.radars import SensorSet
 from mhtrack.records import Scan
 from mhtrack.sources.base import IDLE, Source, SourceStats, Survey
+from mhtrack.sources.gather import Gathered
 from mhtrack.sources.positions import local_positions
 from mhtrack.sources.timed import TimedStream
 
@@ -134,7 +135,7 @@ class DatagramSource(Source):
             yield offset, payload, when
             offset += len(payload)
 
-    def _decoded(self, problems: Problems, sweeps: list[tuple[Any, ...]] | None = None,
+    def _decoded(self, problems: Problems, sweeps: Gathered | None = None,
                  convert: bool = True, idle: bool = False
                  ) -> Iterator[dict[str, np.ndarray]]:
         """Chunks of decoded plots in decoding order: converted (columns ``time, sensor,
@@ -327,15 +328,20 @@ class DatagramSource(Source):
         their CAT034 sites), their periods from their CAT034 marks
         (:func:`~mhtrack.io.asterix.decode.sweep_periods`) and the :class:`Survey`
         (every kept plot's ``x, y``). The plots of radars the sensors file lists are
-        converted as they come (16 octets a plot kept); the others wait, as decoded,
+        converted as they come (40 octets a plot kept: ``x, y``, time, sensor, row, in
+        :class:`~mhtrack.sources.gather.Gathered` buffers); the others wait, as decoded,
         for the sites of the whole input. Reads the datagrams: only for a replayable
         input."""
-        sweeps: list[tuple[Any, ...]] = []
+        sweeps = Gathered({"time": float, "sensor": np.int64, "kind": np.int64,
+                           "azimuth": float, "period": float})
         self._seen, self.sensors = set(), self.given
         listed = np.asarray([s.id for s in self.given.sensors if s.kind == "polar" and
                              s.has_site] if self.given is not None else [], np.int64)
         self._seen.update(listed.tolist())
-        xs, ys, ts, ss, rows, kept, waiting = [], [], [], [], [], set(), []
+        got = Gathered({"x": float, "y": float, "time": float, "sensor": np.int64,
+                        "file_row": np.int64})
+        kept: set[int] = set()
+        waiting = []
         for c in self._decoded(Problems(), sweeps, convert=False):
             now = np.isin(c["sensor"], listed)
             if "lat" in c:
@@ -344,11 +350,7 @@ class DatagramSource(Source):
                 done = self._convert({k: c[k][now] for k in (
                     "sensor", "slant_range", "bearing", "flight_level", "offset", "time",
                     "file_row")})
-                xs.append(done["x"])
-                ys.append(done["y"])
-                ts.append(done["time"])
-                ss.append(done["sensor"])
-                rows.append(done["file_row"])
+                got.add(done)
                 kept.update(np.unique(done["sensor"]).tolist())
             if not now.all():
                 waiting.append({k: v[~now] for k, v in c.items() if k in (
@@ -364,20 +366,13 @@ class DatagramSource(Source):
         self._seen.update(radars)  # the radars left out stay out (one warning, later)
         for c in waiting:
             done = self._convert(c)
-            xs.append(done["x"])
-            ys.append(done["y"])
-            ts.append(done["time"])
-            ss.append(done["sensor"])
-            rows.append(done["file_row"])
+            got.add(done)
             kept.update(np.unique(done["sensor"]).tolist())
-        cols = list(zip(*sweeps, strict=True)) if sweeps else [()] * 5
-        marks = {k: np.array(c, dtype=d) for k, c, d in zip(
-            ("time", "sensor", "kind", "azimuth", "period"), cols,
-            (float, np.int64, np.int64, float, float), strict=True)}
-        x, y, t, sensor = (np.concatenate(a) if a else np.zeros(0, d) for a, d in (
-            (xs, float), (ys, float), (ts, float), (ss, np.int64)))
+        marks = sweeps.columns()
+        cols = got.columns()
+        x, y, t, sensor = cols["x"], cols["y"], cols["time"], cols["sensor"]
         # the plots the re-order buffer will let through, replayed in decoding order
-        order = np.argsort(np.concatenate(rows), kind="stable") if rows else np.zeros(0, int)
+        order = np.argsort(cols["file_row"], kind="stable")
         on_time = np.zeros(x.size, bool)
         on_time[order] = kept_by_buffer(t[order], self.window_s)
         return sweep_periods(marks), Survey(int(x.size), tuple(sorted(kept)), x[on_time],

@@ -8,6 +8,7 @@ import struct
 
 import pytest
 
+from mhtrack.io.asterix.capture import START, start_time
 from mhtrack.io.asterix.framings import units
 from mhtrack.io.asterix.problems import Problems
 from mhtrack.io.asterix.writer import datagram
@@ -73,15 +74,17 @@ def test_pcapng_time_a_day_off_its_neighbours_is_not_used() -> None:
     assert problems.counts == {"bad_time": 1}
     head = len(_pcapng(b"", []))
     assert problems.first["bad_time"] == head + 2 * len(_epb(t0))
-    # the clock set forward by two days: the first packet after the jump is refused,
-    # the next one, agreeing with it, is taken and the check goes on from it
+    # the clock set forward by two days after the first START packets: the first packet
+    # after the jump is refused, the next one, agreeing with it, is taken and the check
+    # goes on from it
     jump = 2 * 86_400_000_000
-    stamps = [t0, t0 + 1_000_000 + jump, t0 + 2_000_000 + jump, t0 + 3_000_000 + jump]
+    stamps = [t0 + k * 1_000_000 + (jump if k > START else 0) for k in range(START + 4)]
     problems = Problems()
     got = [when for _, when, _ in units(_pcapng(b"", [_epb(ts) for ts in stamps]),
                                         "pcapng", "x", {48}, problems)]
-    assert got[1] is None
-    assert got[2:] == [pytest.approx(1_700_172_802.0), pytest.approx(1_700_172_803.0)]
+    assert got[:START + 1] == [pytest.approx(ts * 1e-6) for ts in stamps[:START + 1]]
+    assert got[START + 1] is None
+    assert got[START + 2:] == [pytest.approx(ts * 1e-6) for ts in stamps[START + 2:]]
     assert problems.counts == {"bad_time": 1}
 
 
@@ -96,3 +99,46 @@ def test_pcapng_first_time_beyond_any_clock_is_not_used() -> None:
                                         "pcapng", "x", {48}, problems)]
     assert got == [None, pytest.approx(1_700_000_001.0), pytest.approx(1_700_000_002.0)]
     assert problems.counts == {"bad_time": 1}
+
+
+@pytest.mark.parametrize("bad", range(START + 1))
+def test_pcapng_time_damaged_within_range_is_outvoted_wherever_it_comes(bad: int) -> None:
+    """A timestamp with bit 40 flipped (2⁴⁰ µs: 12.7 days off, still within [0, 2³²) s) in
+    any of the first packets, the very first included: that packet's time is dropped and
+    counted, every other packet keeps its own. Before, a damaged first time was taken and
+    the next packet refused in its stead (the check started from the first time)."""
+    t0 = 1_700_000_000_000_000
+    stamps = [t0 + k * 1_000_000 for k in range(START + 3)]
+    stamps[bad] ^= 1 << 40
+    assert abs(stamps[bad] - t0) * 1e-6 > 86_400 and stamps[bad] * 1e-6 < 2**32
+    problems = Problems()
+    data = _pcapng(b"", [_epb(ts) for ts in stamps])
+    got = [when for _, when, _ in units(data, "pcapng", "x", {48}, problems)]
+    want = [None if k == bad else pytest.approx(1_700_000_000.0 + k)
+            for k in range(len(stamps))]
+    assert got == want
+    assert problems.counts == {"bad_time": 1}
+    assert problems.first["bad_time"] == len(_pcapng(b"", [])) + bad * len(_epb(t0))
+
+
+def test_start_time_is_the_median_of_the_first_packets() -> None:
+    """Worked by hand: the median of the first five (the upper one of an even count);
+    later times have no say."""
+    assert start_time([]) is None
+    assert start_time([7.0]) == 7.0
+    assert start_time([5.0, 1.0]) == 5.0
+    assert start_time([9e9, 3.0, 1.0, 2.0, 4.0, 9e9, 9e9, 9e9]) == 3.0
+
+
+def test_pcap_damaged_first_time_is_the_packet_refused() -> None:
+    """pcap's reader starts from the same median: a first packet 12.7 days off the next
+    four is the one refused (damaged framing), not the four after it."""
+    head = struct.pack("<IHHiIII", 0xA1B2C3D4, 2, 4, 0, 0, 65535, 1)
+    secs = [1_700_000_000 + k for k in range(5)]
+    secs[0] ^= 1 << 20
+    pkts = b"".join(struct.pack("<IIII", s, 0, len(FRAME), len(FRAME)) + FRAME
+                    for s in secs)
+    problems = Problems()
+    got = [when for _, when, _ in units(head + pkts, "pcap", "x", {48}, problems)]
+    assert got == [float(s) for s in secs[1:]]
+    assert problems.counts["resync"] == 1

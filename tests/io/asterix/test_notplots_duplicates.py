@@ -25,6 +25,7 @@ from mhtrack.io.asterix.notplots import (
     flags048_octets,
     plot_type048,
     real_plots,
+    reason,
 )
 from mhtrack.io.asterix.problems import Problems
 
@@ -75,6 +76,23 @@ def _plots_of(data: bytes, kind: str, dedupe: DuplicateFilter | None
                 rows += [r for r in (plot_row(x, at, problems) for x in _parse048(raw))
                          if r is not None]
     return rows
+
+
+flag = st.integers(-1, 1)
+
+
+@given(st.lists(st.tuples(st.integers(-1, 7), flag, flag, flag, flag), max_size=40))
+def test_real_plots_is_reason_row_by_row(rows: list[tuple[int, ...]]) -> None:
+    """The columns' mask and counts are those of :func:`reason` asked report by report
+    (the former implementation of ``real_plots``)."""
+    typ, sim, rab, tst, track = (np.array(c, np.int64).reshape(-1)
+                                 for c in zip(*rows, strict=True)) if rows else \
+        (np.zeros(0, np.int64),) * 5
+    keep, counts = real_plots(typ, sim, rab, tst, track=track)
+    why = [reason(*r) for r in zip(typ.tolist(), sim.tolist(), rab.tolist(), tst.tolist(),
+                                   track.tolist(), strict=True)]
+    assert keep.tolist() == [w is None for w in why]
+    assert counts == {name: why.count(name) for name in REASONS}
 
 
 def test_the_dual_lan_capture_has_63_distinct_plots(conformance_pcap: Path) -> None:

@@ -47,26 +47,30 @@ def _uint(item: Any, name: str) -> int:
     return 0 if found is None else uint(found)
 
 
-def records001(raw: bytes) -> list[Any] | ValueError:
-    """The records of a CAT001 data block (the octets after its header), each parsed with
-    the plot or the track UAP by its I001/020 TYP; a ``ValueError`` when they do not fill
-    the block."""
+def record001(bits: Any) -> tuple[Any, Any] | ValueError:
+    """One CAT001 record from libasterix ``bits``: by the plot UAP, or the track UAP when
+    its I001/020 TYP is 1; ``(record, the bits after it)`` or a ``ValueError``."""
     base = _lib.modules()[0]
     uaps = specs()[0].cv_uap.cv_uaps
-    bits, out = base.Bits.from_bytes(raw), []
+    got = uaps["plot"].parse(base.ParsingMode.StrictParsing, bits)
+    if isinstance(got, ValueError):
+        return got
+    i020 = got[0].get_item("020")
+    if i020 is not None and _uint(i020, "TYP") == 1:
+        return uaps["track"].parse(base.ParsingMode.StrictParsing, bits)
+    return got
+
+
+def records001(raw: bytes) -> list[Any] | ValueError:
+    """The records of a CAT001 data block (the octets after its header), each by
+    :func:`record001`; a ``ValueError`` when they do not fill the block."""
+    bits, out = _lib.modules()[0].Bits.from_bytes(raw), []
     while len(bits):
-        got = uaps["plot"].parse(base.ParsingMode.StrictParsing, bits)
+        got = record001(bits)
         if isinstance(got, ValueError):
             return got
-        rec, rest = got
-        i020 = rec.get_item("020")
-        if i020 is not None and _uint(i020, "TYP") == 1:
-            got = uaps["track"].parse(base.ParsingMode.StrictParsing, bits)
-            if isinstance(got, ValueError):
-                return got
-            rec, rest = got
+        rec, bits = got
         out.append(rec)
-        bits = rest
     return out
 
 
@@ -128,6 +132,13 @@ def records002(raw: bytes) -> list[Any] | ValueError:
     return specs()[1].cv_uap.parse(base.Bits.from_bytes(raw))
 
 
+def record002(bits: Any) -> tuple[Any, Any] | ValueError:
+    """One CAT002 record from libasterix ``bits``: ``(record, the bits after it)`` or a
+    ``ValueError`` (:func:`records002` reads a block of them)."""
+    base = _lib.modules()[0]
+    return specs()[1].cv_record.parse(base.ParsingMode.StrictParsing, bits)
+
+
 def nearest_tod(truncated: float, ref: float) -> float:
     """The time of day in [0, 86 400) whose value modulo 512 s is ``truncated`` and which
     is nearest to ``ref`` across midnight (exact when ``ref`` is within 192 s of it):
@@ -175,10 +186,12 @@ class TimeRestorer:
 
 
 def block001(raw: bytes, at: int, capture: float | None, restorer: TimeRestorer,
-             problems: Problems) -> list[tuple[Any, ...]] | None:
+             problems: Problems, recs: list[Any] | None = None
+             ) -> list[tuple[Any, ...]] | None:
     """The plot rows (:data:`COLUMNS`, full times of day) of one CAT001 data block, or
-    ``None`` when its records do not fill it (the caller counts ``undecodable``)."""
-    recs = records001(raw)
+    ``None`` when its records do not fill it (the caller counts ``undecodable``);
+    ``recs``: its records already parsed (:func:`records001`)."""
+    recs = records001(raw) if recs is None else recs
     if isinstance(recs, ValueError):
         return None
     out = []
@@ -192,10 +205,12 @@ def block001(raw: bytes, at: int, capture: float | None, restorer: TimeRestorer,
     return out
 
 
-def block002(raw: bytes, restorer: TimeRestorer) -> list[tuple[Any, ...]] | None:
+def block002(raw: bytes, restorer: TimeRestorer, recs: list[Any] | None = None
+             ) -> list[tuple[Any, ...]] | None:
     """The sweep marks of one CAT002 data block (each also a time reference for its
-    radar's CAT001 plots), or ``None`` when its records do not fill it."""
-    recs = records002(raw)
+    radar's CAT001 plots), or ``None`` when its records do not fill it; ``recs``: its
+    records already parsed (:func:`records002`)."""
+    recs = records002(raw) if recs is None else recs
     if isinstance(recs, ValueError):
         return None
     out = []

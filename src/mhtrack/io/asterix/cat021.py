@@ -118,11 +118,18 @@ def report_row(rec: Any, at: int, problems: Problems) -> tuple[Any, ...] | None:
             -1, ADSB, 0, 0, *flags, lat, lon, sigma_m(nacp, nucp, version))
 
 
-def block021(raw: bytes, at: int, problems: Problems) -> list[tuple[Any, ...]] | None:
+def record021(bits: Any) -> tuple[Any, Any] | ValueError:
+    """One CAT021 record (:func:`spec`) from libasterix ``bits``: ``(record, the bits
+    after it)`` or a ``ValueError``."""
+    return spec().cv_record.parse(_lib.modules()[0].ParsingMode.StrictParsing, bits)
+
+
+def block021(raw: bytes, at: int, problems: Problems, recs: list[Any] | None = None
+             ) -> list[tuple[Any, ...]] | None:
     """The ADS-B rows of one CAT021 data block, or ``None`` when its records do not fill
-    it (the caller counts ``undecodable``)."""
-    base = _lib.modules()[0]
-    recs = spec().cv_uap.parse(base.Bits.from_bytes(raw))
+    it (the caller counts ``undecodable``); ``recs``: its records already parsed."""
+    if recs is None:
+        recs = spec().cv_uap.parse(_lib.modules()[0].Bits.from_bytes(raw))
     if isinstance(recs, ValueError):
         return None
     return [r for r in (report_row(rec, at, problems) for rec in recs) if r is not None]

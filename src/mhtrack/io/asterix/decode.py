@@ -25,14 +25,14 @@ import numpy as np
 
 import mhtrack.io.asterix._lib as _lib
 from mhtrack.io.asterix._lib import quantity
-from mhtrack.io.asterix.cat001 import TimeRestorer, block001, block002
-from mhtrack.io.asterix.cat021 import block021
+from mhtrack.io.asterix.cat001 import TimeRestorer, block001, block002, record001, record002
+from mhtrack.io.asterix.cat021 import block021, record021
 from mhtrack.io.asterix.characteristics import CHARACTERISTICS, characteristics
 from mhtrack.io.asterix.columns import columns
 from mhtrack.io.asterix.container import blocks
 from mhtrack.io.asterix.duplicates import DuplicateFilter
 from mhtrack.io.asterix.fast import reader034, reader048
-from mhtrack.io.asterix.fill import fills_any_edition
+from mhtrack.io.asterix.fill import fills_any_edition, whole_records
 from mhtrack.io.asterix.framings import recognise, units
 from mhtrack.io.asterix.notplots import flags048, plot_type048_of, reason
 from mhtrack.io.asterix.problems import Problems
@@ -122,6 +122,14 @@ def read_recording(path: str | Path, *, fast: bool = True, progress: bool = Fals
     return Recording(name, kind, plots, sweeps, problems, dict(decoder.sites))
 
 
+#: The record reader of each category decoded by libasterix record by record (the
+#: edition and UAP choice the decoding uses): a block judged by it is not parsed again.
+OWN_RECORDS = {1: record001, 2: record002, 21: record021}
+#: Blocks judged and not yet decoded whose records are kept (the walk over a raw stream
+#: judges a few blocks ahead of the one decoded).
+JUDGED_KEPT = 16
+
+
 class Decoder:
     """Decodes data blocks, block by block, into plot rows (:data:`PLOT_COLUMNS`: CAT048
     through :mod:`~mhtrack.io.asterix.fast` unless ``fast=False``, CAT001), sweep marks
@@ -144,6 +152,7 @@ class Decoder:
         self.duplicates = DuplicateFilter() if duplicates is True else \
             (duplicates or None)
         self.restorer = TimeRestorer()
+        self._judged: dict[tuple[int, bytes], list[Any]] = {}  # :meth:`fills`' records
 
     def blocks(self, payload: bytes, offset: int, problems: Problems,
                when: float | None = None
@@ -175,22 +184,31 @@ class Decoder:
 
     def fills(self, block: bytes) -> bool:
         """Whether the records of data block ``block`` (header included) fill it
-        exactly: by this decoder's fast layouts (CAT048, CAT034), else by any edition
+        exactly: by this decoder's fast layouts (CAT048, CAT034) or its own reading of
+        CAT001/002/021 (:data:`OWN_RECORDS`, through
+        :func:`~mhtrack.io.asterix.fill.whole_records`: the records found are kept for
+        the decoding, the last :data:`JUDGED_KEPT` blocks), else by any edition
         libasterix carries (:func:`~mhtrack.io.asterix.fill.fills_any_edition`)."""
         cat, raw = block[0], block[3:]
         if cat in self.readers and self.readers[cat].fills(raw):
+            return True
+        if cat in OWN_RECORDS and (recs := whole_records(raw, OWN_RECORDS[cat])) is not None:
+            if len(self._judged) >= JUDGED_KEPT:
+                del self._judged[next(iter(self._judged))]
+            self._judged[cat, bytes(raw)] = recs
             return True
         return fills_any_edition(cat, raw)
 
     def _records(self, cat: int, raw: bytes, at: int, when: float | None,
                  problems: Problems) -> list[tuple[Any, ...]] | None:
         """The rows of one block's records (``None``: they do not fill the block)."""
+        recs = self._judged.pop((cat, bytes(raw)), None) if self._judged else None
         if cat == 1:
-            return block001(raw, at, when, self.restorer, problems)
+            return block001(raw, at, when, self.restorer, problems, recs)
         if cat == 2:
-            return block002(raw, self.restorer)
+            return block002(raw, self.restorer, recs)
         if cat == 21:
-            return block021(raw, at, problems)
+            return block021(raw, at, problems, recs)
         if cat in self.readers:
             return self.readers[cat].block(raw, at, problems)
         records = self.specs[cat].cv_uap.parse(self.bits(raw))

@@ -14,6 +14,7 @@ rule a block's header (category, length) read as records could pass for them.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from functools import cache
 from typing import Any
 
@@ -47,19 +48,32 @@ def fills_any_edition(cat: int, raw: bytes) -> bool:
     return any(_records_fill(parsers, raw, base) for parsers in _editions(cat))
 
 
-def _records_fill(parsers: tuple[Any, ...], raw: bytes, base: Any) -> bool:
-    bits, n = base.Bits.from_bytes(raw), len(raw)
+def whole_records(raw: bytes, parse: Callable[[Any], Any]) -> list[Any] | None:
+    """The records of ``raw`` (a block's octets after its header) read one after another
+    by ``parse`` (libasterix bits -> ``(record, the bits after it)`` or a
+    ``ValueError``), each FSPEC announcing an item (:func:`announces`); ``None`` when
+    they do not fill ``raw`` exactly."""
+    bits, n, out = _lib.modules()[0].Bits.from_bytes(raw), len(raw), []
     while len(bits):
         if not announces(raw, n - len(bits) // 8):
-            return False
+            return None
+        got = _parsed(parse, bits)
+        if isinstance(got, ValueError):
+            return None
+        rec, bits = got
+        out.append(rec)
+    return out
+
+
+def _records_fill(parsers: tuple[Any, ...], raw: bytes, base: Any) -> bool:
+    def first(bits: Any) -> Any:  # each record by the first of the UAPs that parses it
         for parse in parsers:
             got = _parsed(parse.parse, base.ParsingMode.StrictParsing, bits)
             if not isinstance(got, ValueError):
-                bits = got[1]
-                break
-        else:
-            return False
-    return True
+                return got
+        return ValueError("no UAP parses the record")
+
+    return whole_records(raw, first) is not None
 
 
 def _parsed(parse: Any, *args: Any) -> Any:

@@ -28,9 +28,10 @@ Layouts of ORADIS, GPS and Final as the Croatia Control ``asterix`` decoder read
 
 Damage (a length beyond the data, a missing trailer, a time beyond a day; a pcap packet
 empty, more than a day from the one before, or whose captured length is neither its
-length nor the snap length) is skipped at the level of one record: the reader moves on to
-the next offset where :data:`~mhtrack.io.asterix.resync.CONFIRM` records in a row are
-valid (or valid ones end the file), counts one ``resync`` and the octets skipped
+length nor the snap length; capture times: :mod:`~mhtrack.io.asterix.capture`) is
+skipped at the level of one record: the reader moves on to the next offset where
+:data:`~mhtrack.io.asterix.resync.CONFIRM` records in a row are valid (or valid ones end
+the file), counts one ``resync`` and the octets skipped
 (:mod:`mhtrack.io.asterix.resync`). It raises only on the file's own headers: a file that
 is no recording, a capture link type not read (:class:`InputError`, naming the byte). A
 raw stream has no framing of its own beyond category and length, so its blocks are
@@ -45,8 +46,10 @@ from __future__ import annotations
 
 import struct
 from collections.abc import Callable, Iterator
+from itertools import chain
 
 from mhtrack.errors import InputError
+from mhtrack.io.asterix.capture import START, CaptureClock, plausible, start_time
 from mhtrack.io.asterix.link import LINKS, payload
 from mhtrack.io.asterix.problems import Problems
 from mhtrack.io.asterix.resync import judged, walk
@@ -65,8 +68,6 @@ STREAMS = ("final", "oradis", "gps", "raw")
 PROBE = 16
 #: Octets searched for the first valid record of a file whose first records are damaged.
 SEARCH = 4096
-#: Capture times at or beyond this (s, 2³²: pcap's 32-bit seconds, the year 2106) are damage.
-MAX_CAPTURE_S = 2.0 ** 32
 #: pcap packets longer than this are damage (the largest snap length tcpdump uses).
 MAX_PACKET = 262144
 
@@ -270,11 +271,11 @@ def _pcap(data: bytes, name: str, problems: Problems) -> Iterator[Unit]:
         return 16 + incl if ok else 0
 
     secs, q = [], 24  # to begin with, the median time of the first packets chained
-    while len(secs) < 5 and (step := at(q)):
+    while len(secs) < START and (step := at(q)):
         secs.append(rec.unpack_from(data, q)[0])
         q += step
     if secs:
-        last[0] = sorted(secs)[len(secs) // 2]
+        last[0] = start_time(secs)
     for p, step in walk(data, 24, at, problems):
         sec, frac, _, _ = rec.unpack_from(data, p)
         nxt = p + step
@@ -305,41 +306,26 @@ def _clock(data: bytes, e: str, start: int, end: int) -> tuple[float, float]:
     return unit, offset
 
 
-class _Clock:
-    """Capture times checked against the packets around them: a time more than a day
-    from the last one taken is damage (a flipped high bit of a 64-bit timestamp), counted
-    as ``bad_time`` and not used (``None``: the time axis then goes by the times of day
-    alone); the next packet that agrees with the refused time rather than the last one
-    taken is taken, and the check goes on from it (the clock was set). A time outside
-    ``[0, 2³²)`` s (before 1970 or after 2106, pcap's own range) is damage wherever it
-    comes, the first packet included; a first time damaged within that range is not
-    caught (pcap's reader starts from the median of its first packets; this one from the
-    first)."""
-
-    def __init__(self, problems: Problems) -> None:
-        self.problems = problems
-        self.last: float | None = None  # the last time taken
-        self.odd: float | None = None  # the last time refused
-
-    def take(self, t: float | None, offset: int) -> float | None:
-        """``t`` if it is plausible, else ``None`` (counted at byte ``offset``)."""
-        if t is None:
-            return None
-        if not 0.0 <= t < MAX_CAPTURE_S:  # before 1970 or after 2106: no clock's time
-            self.problems.add("bad_time", offset)
-            return None
-        if self.last is None or abs(t - self.last) <= DAY_S \
-                or (self.odd is not None and abs(t - self.odd) <= DAY_S):
-            self.last, self.odd = t, None
-            return t
-        self.odd = t
-        self.problems.add("bad_time", offset)
-        return None
-
-
 def _pcapng(data: bytes, name: str, problems: Problems) -> Iterator[Unit]:
+    """The units of a pcapng file, their capture times checked (:class:`CaptureClock`,
+    started from the median of the first :data:`START` plausible ones)."""
+    clock = CaptureClock(problems)
+    packets = _pcapng_packets(data, name, problems)
+    ahead: list[tuple[int, float | None, int, bytes]] = []
+    for packet in packets:  # read ahead to the first START plausible times
+        ahead.append(packet)
+        if sum(t is not None and plausible(t) for _, t, _, _ in ahead) == START:
+            break
+    clock.start([t for _, t, _, _ in ahead])
+    for offset, t, block, octets in chain(ahead, packets):
+        yield offset, clock.take(t, block), octets
+
+
+def _pcapng_packets(data: bytes, name: str, problems: Problems
+                    ) -> Iterator[tuple[int, float | None, int, bytes]]:
+    """``(offset of the payload, capture time as stamped or None, offset of the block,
+    payload)`` of each packet carrying a payload."""
     state = {"e": "<"}
-    clock = _Clock(problems)
     links: list[tuple[int, tuple[float, float]]] = []
 
     def at(p: int) -> int:
@@ -385,5 +371,4 @@ def _pcapng(data: bytes, name: str, problems: Problems) -> Iterator[Unit]:
             if found is None:
                 problems.add("non_udp", p)
             else:
-                yield found[0], clock.take(None if ts is None else ts * unit + offset, p), \
-                    found[1]
+                yield found[0], None if ts is None else ts * unit + offset, p, found[1]

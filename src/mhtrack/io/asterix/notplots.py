@@ -100,13 +100,15 @@ def reason(typ: int, sim: int, rab: int, tst: int, track: int = 0) -> str | None
 def real_plots(typ: np.ndarray, sim: np.ndarray, rab: np.ndarray, tst: np.ndarray, *,
                track: np.ndarray | None = None) -> tuple[np.ndarray, dict[str, int]]:
     """The mask of reports that are plots of real targets, and the count of the others
-    by reason (:data:`REASONS`; every reason present, zeros included), by :func:`reason`.
-    ``typ`` is the CAT048 TYP (CAT001: SSR/PSR, the same 0–3), ``-1`` where unknown
-    (kept); ``track`` marks CAT001 track reports."""
+    by reason (:data:`REASONS`; every reason present, zeros included): :func:`reason`'s
+    rule, on whole columns. ``typ`` is the CAT048 TYP (CAT001: SSR/PSR, the same 0–3),
+    ``-1`` where unknown (kept); ``track`` marks CAT001 track reports."""
     typ, sim, rab, tst = (np.asarray(a, np.int64).reshape(-1) for a in (typ, sim, rab, tst))
     trk = np.zeros(typ.size, np.int64) if track is None else \
         np.asarray(track, np.int64).reshape(-1)
-    why = [reason(*r) for r in zip(typ.tolist(), sim.tolist(), rab.tolist(), tst.tolist(),
-                                   trk.tolist(), strict=True)]
-    counts = {name: why.count(name) for name in REASONS}
-    return np.array([w is None for w in why], bool), counts
+    left, counts = np.ones(typ.size, bool), {}
+    for name, hit in zip(REASONS, (typ == 0, trk == 1, tst == 1, rab == 1, sim == 1),
+                         strict=True):  # each report under its first reason, in order
+        counts[name] = int(np.count_nonzero(left & hit))
+        left &= ~hit
+    return left, counts

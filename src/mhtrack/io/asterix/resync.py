@@ -28,10 +28,11 @@ def _confirmed(data: bytes, q: int, at: Callable[[int], int]) -> bool:
 def walk(data: bytes, start: int, at: Callable[[int], int], problems: Problems
          ) -> Iterator[tuple[int, int]]:
     """``(offset, length)`` of each valid record from ``start``. A record is taken when the
-    one after it is valid too (or the file ends there), or else when no record confirmed
-    by :data:`CONFIRM` valid records in a row (or by the end of the file) starts inside it
-    (it is the last good record before damage, not a false length swallowing good
-    records). After damage, reading resumes at the next confirmed record, searched octet
+    records after it confirm it (:data:`CONFIRM` valid ones in a row, or valid ones to the
+    end of the file), or else when no record so confirmed starts inside it (it is the last
+    good record before damage, not a false length swallowing good records): of two
+    readings that both give valid records, the one that goes on through valid records
+    wins. After damage, reading resumes at the next confirmed record, searched octet
     by octet (damage may add or remove octets, so no alignment is assumed)."""
     n = len(data)
 
@@ -41,7 +42,7 @@ def walk(data: bytes, start: int, at: Callable[[int], int], problems: Problems
     p = start
     while p < n:
         step = at(p)
-        if step and (p + step == n or at(p + step)
+        if step and (confirmed(p + step)
                      or not any(confirmed(q) for q in range(p + 1, p + step))):
             yield p, step
             p += step
@@ -60,13 +61,14 @@ def judged(data: bytes, framed: Callable[[int], int], fits: Callable[[bytes], bo
     (``framed``) and ``fits`` finds that its records fill it exactly: a damaged
     length that lands on octets framed like a block still leaves records that do not
     end at its end, so the walk resumes at the good blocks it would cover. Remembered
-    for the last offsets asked (the walk asks each twice)."""
+    for the last 64 offsets asked (the walk asks each more than once, a few blocks
+    ahead), so that each block is judged once."""
     memo: dict[int, int] = {}
 
     def at(q: int) -> int:
         if q not in memo:
-            if len(memo) > 64:
-                memo.clear()
+            if len(memo) >= 64:
+                del memo[next(iter(memo))]
             step = framed(q)
             memo[q] = step if step and fits(data[q:q + step]) else 0
         return memo[q]

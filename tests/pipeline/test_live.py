@@ -48,10 +48,10 @@ def test_refusals(rec: Path) -> None:
     rf, writer = _pipe(b"")  # no CAT034 mark to take a period from
     writer.start()
     with rf, pytest.raises(ValueError, match=r"no rotation period for radar\(s\) 2"):
-        Live(no_period, OPTIONS, LiveOptions(stdin="raw"), stdin=rf)
+        Live(no_period, OPTIONS, LiveOptions(preload=False, stdin="raw"), stdin=rf)
     writer.join()
     with pytest.raises(ValueError, match="one of them"):
-        Live(sensors, OPTIONS, LiveOptions())
+        Live(sensors, OPTIONS, LiveOptions(preload=False))
 
 
 def test_periods_and_density_from_the_first_rotations(rec: Path, tmp_path: Path) -> None:
@@ -69,7 +69,7 @@ def test_periods_and_density_from_the_first_rotations(rec: Path, tmp_path: Path)
     with rf:
         writer.start()
         live = Live(bare, TrackOptions(output="online"),
-                    LiveOptions(stdin="raw", day_from="stream", json=True), stdin=rf,
+                    LiveOptions(preload=False, stdin="raw", day_from="stream", json=True), stdin=rf,
                     stdout=out, emit=lines.append)
         live.run()
         writer.join()
@@ -130,7 +130,8 @@ def test_stdin_run_equals_the_pipeline_on_the_file(rec: Path) -> None:
     writer = threading.Thread(target=lambda: (os.write(w, data), os.close(w)))
     out = io.StringIO()
     with os.fdopen(r, "rb", buffering=0) as rf:
-        live = Live(sensors, OPTIONS, LiveOptions(stdin="raw", day_from="stream", json=True),
+        live = Live(sensors, OPTIONS, LiveOptions(preload=False,
+                                                  stdin="raw", day_from="stream", json=True),
                     stdin=rf, stdout=out)
         writer.start()
         result = live.run()
@@ -149,12 +150,32 @@ def test_stdin_run_equals_the_pipeline_on_the_file(rec: Path) -> None:
 def test_stopped_before_any_datagram(rec: Path, tmp_path: Path) -> None:
     stop = threading.Event()
     live = Live(read_sensors(rec / "sensors.toml"), OPTIONS,
-                LiveOptions(listen=("udp://127.0.0.1:0",), out_file=tmp_path / "e.ast"),
+                LiveOptions(preload=False,
+                            listen=("udp://127.0.0.1:0",), out_file=tmp_path / "e.ast"),
                 stop=stop)
     stop.set()
     result = live.run()
     assert (result.reader.datagrams, len(result.run.stats), result.sent_rows) == (0, 0, 0)
     assert (tmp_path / "e.ast").read_bytes() == b""  # an empty recording, written
+
+
+
+@pytest.mark.parametrize("preload", [None, True, False])
+def test_live_preloads_unless_told_not_to(rec: Path, preload: bool | None,
+                                          monkeypatch: pytest.MonkeyPatch) -> None:
+    """``LiveOptions()`` loads the one-time code at start; ``preload=False`` does not
+    (:func:`mhtrack.pipeline.preload.preload` replaced by a counter)."""
+    import mhtrack.pipeline.preload as preload_mod
+
+    calls: list[int] = []
+    monkeypatch.setattr(preload_mod, "preload", lambda: calls.append(1) or (0, False))
+    stop = threading.Event()
+    kw = {} if preload is None else {"preload": preload}
+    live = Live(read_sensors(rec / "sensors.toml"), OPTIONS,
+                LiveOptions(listen=("udp://127.0.0.1:0",), **kw), stop=stop)
+    stop.set()
+    live.run()
+    assert calls == ([] if preload is False else [1])
 
 
 def test_a_quiet_feed_closes_its_frames_on_the_idle_clock(rec: Path) -> None:
@@ -175,7 +196,8 @@ def test_a_quiet_feed_closes_its_frames_on_the_idle_clock(rec: Path) -> None:
     writer.start()
     ended = io.StringIO()
     with rf:
-        Live(sensors, OPTIONS, LiveOptions(stdin="raw", day_from="stream", json=True),
+        Live(sensors, OPTIONS, LiveOptions(preload=False,
+                                           stdin="raw", day_from="stream", json=True),
              stdin=rf, stdout=ended).run()
     writer.join()
     want = ended.getvalue().splitlines()
@@ -184,7 +206,8 @@ def test_a_quiet_feed_closes_its_frames_on_the_idle_clock(rec: Path) -> None:
     r, w = os.pipe()
     out = io.StringIO()
     with os.fdopen(r, "rb", buffering=0) as rf:
-        live = Live(sensors, OPTIONS, LiveOptions(stdin="raw", day_from="stream", json=True,
+        live = Live(sensors, OPTIONS, LiveOptions(preload=False,
+                                                  stdin="raw", day_from="stream", json=True,
                                                   idle_close_s=5.0),
                     stdin=rf, stdout=out, idle_clock=lambda: float(next(ticks)))
         runner = threading.Thread(target=live.run)

@@ -49,7 +49,8 @@ def _run(rec: Path, blocks: list[bytes], stop_after: int | None = None,
     out = io.StringIO()
     with os.fdopen(r, "rb", buffering=0) as rf:
         live = Live(read_sensors(rec / "sensors.toml"), track,
-                    LiveOptions(stdin="raw", day_from="stream", json=True, **options),
+                    LiveOptions(preload=False,
+                                stdin="raw", day_from="stream", json=True, **options),
                     stdin=rf, stdout=out, stop=stop)
 
         def feed() -> None:
@@ -146,9 +147,9 @@ def test_periodic_checkpoints_on_data_time(rec: Path, tmp_path: Path) -> None:
 def test_resume_needs_a_checkpoint_file(rec: Path, tmp_path: Path) -> None:
     sensors = read_sensors(rec / "sensors.toml")
     with pytest.raises(ValueError, match="--checkpoint"):
-        Live(sensors, OPTIONS, LiveOptions(stdin="raw", resume=True))
+        Live(sensors, OPTIONS, LiveOptions(preload=False, stdin="raw", resume=True))
     # --resume without the file yet: a fresh start (the first start of a service)
-    live = Live(sensors, OPTIONS, LiveOptions(stdin="raw", resume=True,
+    live = Live(sensors, OPTIONS, LiveOptions(preload=False, stdin="raw", resume=True,
                                               checkpoint=tmp_path / "none.npz"),
                 stdin=io.BytesIO(b""))
     assert live.resumed is None

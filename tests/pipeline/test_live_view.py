@@ -119,7 +119,7 @@ def test_live_view_shows_what_the_json_lists(rec: Path, tmp_path: Path) -> None:
 
     stop = threading.Event()
     live = Live(sensors, OPTIONS, LiveOptions(
-        listen=("udp://127.0.0.1:0",), day_from="stream", json=True,
+        listen=("udp://127.0.0.1:0",), day_from="stream", json=True, preload=False,
         view="127.0.0.1:0"), stop=stop, stdout=out, emit=emit)
     results: list[Any] = []
     runner = threading.Thread(target=lambda: results.append(live.run()))

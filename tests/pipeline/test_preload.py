@@ -1,18 +1,23 @@
 """One-time code loaded at a live run's start (:mod:`mhtrack.pipeline.preload`): in a
 fresh interpreter, after :func:`preload` the lazily imported modules are there, and the
 compiled IMM rows (numba, when installed) are compiled for the signatures the tracker
-uses — a tracker-sized call afterwards with another model set compiles nothing more and
-gives the NumPy path's floats."""
+uses — tracker-sized predict, update and children_states calls afterwards with another
+model set compile nothing more, and the prediction gives the NumPy path's floats; with
+``MHTRACK_COMPILED=0`` nothing is compiled."""
 
 from __future__ import annotations
 
+import os
 import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 SRC = str(Path(__file__).resolve().parents[2] / "src")
 
 CHECK = """
+import os
 import sys
 sys.path.insert(0, {src!r})
 import numpy as np
@@ -26,7 +31,8 @@ try:
     has_numba = True
 except ImportError:
     has_numba = False
-assert used == has_numba, (used, has_numba)
+on = os.environ.get("MHTRACK_COMPILED", "1") != "0"
+assert used == (has_numba and on), (used, has_numba, on)
 if used:
     from mhtrack.models.imm import CVModelSet
     from mhtrack.models.motion import States
@@ -42,6 +48,13 @@ if used:
     dt = rng.uniform(0.5, 8, M)
     got = model.predict(s, dt)
     model.predict(s, 2.5)
+    rows = np.arange(M)
+    z = rng.normal(0, 1e3, (M, 2))
+    for R in (100.0 * np.eye(2), np.broadcast_to(50.0 * np.eye(2), (M, 2, 2))):
+        _, post = model.gating_scores(got, rows, rows, z, R, np.zeros(M))
+        model.update(got, z, R, post)
+        model.update(got, z, R)
+        assert model.children_states(got, rows, rows, rows, z, R, post) is not None
     assert {{n: len(f.signatures) for n, f in k.items()}} == before, "compiled again"
     imm_rows.MIN_ROWS = 10**12  # the NumPy path
     ref = model.predict(s, dt)
@@ -51,8 +64,12 @@ print("ok", added, used)
 """
 
 
-def test_preload_loads_the_lazy_code() -> None:
+@pytest.mark.parametrize("compiled", [None, "0"])
+def test_preload_loads_the_lazy_code(compiled: str | None) -> None:
+    env = {k: v for k, v in os.environ.items() if k != "MHTRACK_COMPILED"}
+    if compiled is not None:
+        env["MHTRACK_COMPILED"] = compiled
     done = subprocess.run([sys.executable, "-c", CHECK.format(src=SRC)],
-                          capture_output=True, text=True)
+                          capture_output=True, text=True, env=env)
     assert done.returncode == 0, done.stderr
     assert done.stdout.startswith("ok")

@@ -105,6 +105,8 @@ def replay(recording: Path, to: tuple[str, ...], speed: float | None, loop: bool
                      **({} if speed is None else {"speed": speed}))
     hurt = (f"; {stats.dropped} copies dropped, {stats.delayed} delayed"
             if drop or p else "")
+    if stats.unmoved:
+        hurt += f"; {stats.unmoved} blocks sent with their old times"
     say(f"sent {stats.datagrams} datagrams ({stats.bytes} bytes, {stats.passes} "
         f"passes) to {', '.join(to)}{hurt}")
 

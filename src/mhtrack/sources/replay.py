@@ -5,16 +5,20 @@ Each datagram of a pcap or pcapng recording is sent as it was captured (its ASTE
 payload, one UDP datagram), at its capture time (the recorder formats: each record at its
 own time); a raw recording (data blocks back to back) is sent one data block per
 datagram, at the time of day of the block's first CAT048/CAT034 record (on one axis
-across midnight, :class:`TimeAxis`; a block without one keeps the previous time). The
+across midnight, :class:`TimeAxis`; a block without one keeps the previous time, blocks
+before the first timed one take its time). The
 spacing of the times is kept, divided by ``speed`` (``math.inf``: as fast as the socket
 takes them). ``loops`` plays the file that many times
 (``None``: until ``stop``), pass ``n`` ``n · S`` seconds after the first, ``S`` the
-recording's span plus one mean spacing rounded up to a whole second; the times of day
+recording's span (latest time less earliest) plus one mean spacing rounded up to a whole
+second; the times of day
 inside the datagrams move on by the same ``n · S`` (:mod:`~mhtrack.io.asterix.retime`:
 wrapping at midnight), so that a looped replay is one longer feed, its passes in time
-order, not the same minutes again (which ``live`` would drop as late). The time items'
-places in each datagram are found once (by libasterix, about 3 ms a datagram), then
-patched at each pass. Several
+order, not the same minutes again (which ``live`` would drop as late); a recording
+without any time of day cannot be moved on (:class:`~mhtrack.errors.InputError`). The
+time items' places in each datagram are found once, before the first datagram is sent
+(by libasterix, about 3 ms a datagram), then patched at each pass; blocks left unmoved
+(:func:`~mhtrack.io.asterix.retime.time_layout`) are counted. Several
 destinations (redundant LANs) get every datagram each; ``damage`` drops and delays copies
 at random, reproducibly (:mod:`~mhtrack.sources.damage`).
 """
@@ -30,10 +34,11 @@ from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
+from mhtrack.errors import InputError
 from mhtrack.io.asterix.decode import Decoder
 from mhtrack.io.asterix.framings import recognise, units
 from mhtrack.io.asterix.problems import Problems
-from mhtrack.io.asterix.retime import patch_times, time_fields
+from mhtrack.io.asterix.retime import patch_times, time_layout
 from mhtrack.io.asterix.timeaxis import TimeAxis
 from mhtrack.io.paths import check_input_file
 from mhtrack.sources.damage import Damage, DamageCounts, damaged
@@ -42,7 +47,17 @@ from mhtrack.sources.udp import Endpoint, parse_endpoint
 
 def recording_datagrams(path: str | Path) -> list[tuple[bytes, float]]:
     """``(payload, time)`` of every datagram of the recording ``path`` (module
-    docstring), in file order; times in seconds (capture: POSIX; raw: the time axis)."""
+    docstring), in file order; times in seconds (capture: POSIX; raw: the time axis;
+    a recording without any time: all ``0.0``, :func:`has_times` ``False``)."""
+    return _datagrams(path)[0]
+
+
+def has_times(path: str | Path) -> bool:
+    """Whether any datagram of the recording ``path`` has a time."""
+    return _datagrams(path)[1]
+
+
+def _datagrams(path: str | Path) -> tuple[list[tuple[bytes, float]], bool]:
     path = check_input_file(Path(path))
     name = str(path)
     decoder, problems = Decoder(), Problems()
@@ -53,16 +68,21 @@ def recording_datagrams(path: str | Path) -> list[tuple[bytes, float]]:
             kind = recognise(data, name, decoder.categories)
             raw = [(bytes(payload), when) for _, when, payload in units(
                 data, kind, name, decoder.categories, problems)]  # raw: one block each
-    out, axis, last = [], TimeAxis(), 0.0
+    whens: list[float | None] = []
+    axis = TimeAxis()
     for payload, when in raw:
         if when is None:
             for _, _, found in decoder.blocks(payload, 0, Problems()):
                 if found:
                     when = axis.times_list([found[0][0]])[0]
                     break
-        last = last if when is None else float(when)
+        whens.append(None if when is None else float(when))
+    first = next((w for w in whens if w is not None), None)
+    out, last = [], 0.0 if first is None else first
+    for (payload, _), when in zip(raw, whens, strict=True):
+        last = last if when is None else when
         out.append((payload, last))
-    return out
+    return out, first is not None
 
 
 class _Empty:
@@ -83,6 +103,13 @@ class ReplayStats:
     #: Copies dropped and delayed by the ``damage`` (:mod:`~mhtrack.sources.damage`).
     dropped: int = 0
     delayed: int = 0
+    #: Blocks sent with their old times in a moved pass (no time items found in them).
+    unmoved: int = 0
+
+
+def _span(times: list[float]) -> float:
+    """The latest time less the earliest (a recording need not be in time order)."""
+    return max(times) - min(times)
 
 
 def pass_seconds(times: list[float]) -> int:
@@ -90,7 +117,7 @@ def pass_seconds(times: list[float]) -> int:
     span of ``times`` plus their mean spacing, rounded up (at least 1)."""
     if len(times) < 2:
         return 1
-    span = times[-1] - times[0]
+    span = _span(times)
     return max(1, math.ceil(span + span / (len(times) - 1)))
 
 
@@ -102,7 +129,7 @@ def schedule(times: list[float], speed: float, loops: int | None,
     spacing after the last datagram of the one before)."""
     if not times:
         return
-    t0, span = times[0], times[-1] - times[0]
+    t0, span = times[0], _span(times)
     gap = span / (len(times) - 1) if len(times) > 1 else 0.0
     n = 0
     while loops is None or n < loops:
@@ -133,15 +160,20 @@ def replay(path: str | Path, to: str | Endpoint | Sequence[str | Endpoint], *,
     if not eps:
         raise ValueError("replay needs at least one destination")
     eps = [e if isinstance(e, Endpoint) else parse_endpoint(e) for e in eps]
-    items = recording_datagrams(path)
+    items, timed = _datagrams(path)
     addrs = [socket.getaddrinfo(e.host, e.port, e.family, socket.SOCK_DGRAM)[0][4][:2]
              for e in eps]
     stats, counts = ReplayStats(), DamageCounts()
-    socks = [socket.socket(e.family, socket.SOCK_DGRAM) for e in eps]
     last = len(items) - 1
     times = [t for _, t in items]
-    every = pass_seconds(times) if move_times else None
-    fields: dict[int, tuple[tuple[int, int, int], ...]] = {}
+    every = pass_seconds(times) if move_times and loops != 1 else None
+    if every is not None and items and not timed:
+        raise InputError(f"{path}: no datagram has a time of day: its passes cannot be "
+                         "moved on (replay it once, or without moving the times)",
+                         file=str(path))
+    # every datagram's time items found before the clock starts (module docstring)
+    layout = [time_layout(p) for p, _ in items] if every is not None else []
+    socks = [socket.socket(e.family, socket.SOCK_DGRAM) for e in eps]
     try:
         start = clock()
         plan = damaged(_passes(schedule(times, 1.0, loops, every), last, stats),
@@ -157,9 +189,9 @@ def replay(path: str | Path, to: str | Endpoint | Sequence[str | Endpoint], *,
                     break
             data = items[i][0]
             if every is not None and n:
-                if i not in fields:
-                    fields[i] = time_fields(data)
-                data = patch_times(data, fields[i], n * every, near=items[i][1])
+                fields, unmoved = layout[i]
+                data = patch_times(data, fields, n * every, near=items[i][1])
+                stats.unmoved += unmoved
             socks[k].sendto(data, addrs[k])
             stats.datagrams += 1
             stats.bytes += len(data)

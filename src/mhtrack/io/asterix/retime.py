@@ -11,8 +11,9 @@ nearest to a time of day given with the datagram — its capture time in a repla
 ``128 · ((t + s) mod 86 400) mod 2¹⁶``: a day of 86 400 s is no whole number of 512 s,
 so adding to the truncated value alone would be wrong after midnight). A whole number
 of seconds keeps every fraction of a second as it was, with I021/074 and 076 (the
-fractions of 073 and 075) left alone. Blocks of other categories, and a block whose
-records do not fill it, are sent unchanged.
+fractions of 073 and 075) left alone. Blocks of other categories are sent unchanged; a
+block of one of these categories that libasterix cannot parse, or whose records do not
+fill it, is sent unchanged too and counted (:func:`time_layout`).
 """
 
 from __future__ import annotations
@@ -61,13 +62,21 @@ def time_fields(payload: bytes) -> tuple[tuple[int, int, int], ...]:
     """``(byte offset, octets, modulus)`` of every time item in ``payload`` (module
     docstring), found with libasterix: each record is unparsed with the item as it is
     and with all its bits flipped; the octets that differ are the item's."""
+    return time_layout(payload)[0]
+
+
+def time_layout(payload: bytes) -> tuple[tuple[tuple[int, int, int], ...], int]:
+    """:func:`time_fields` of ``payload`` and the number of its blocks of a retimed
+    category left unmoved (unparsable, or records not filling the block)."""
     found: list[tuple[int, int, int]] = []
+    unmoved = 0
     for at, cat, raw in blocks(payload, 0, Problems()):
         items = TIME_ITEMS.get(cat)
         if items is None:
             continue
         records = _records(cat, raw)
         if isinstance(records, ValueError) or not records:
+            unmoved += 1
             continue
         pos, mine = at + 3, []
         for rec in records:
@@ -85,7 +94,9 @@ def time_fields(payload: bytes) -> tuple[tuple[int, int, int], ...]:
             pos += len(octets)
         if pos == at + 3 + len(raw):  # the records fill the block: else left alone
             found.extend(mine)
-    return tuple(found)
+        else:
+            unmoved += 1
+    return tuple(found), unmoved
 
 
 def patch_times(payload: bytes, fields: tuple[tuple[int, int, int], ...],

@@ -57,8 +57,12 @@ CASES = {
     # small caps: clusters solved greedily, the cap on trees cutting (scope marked dirty)
     "caps": MHTConfig(new_target_density=1e-10, max_cluster_size=3, scale_caps=False,
                       max_trees=150, max_births_per_scan=40, max_leaves=2_000),
-    # tentative trees left uncommitted by N-scan (the scope takes their rows' rule too)
-    "defer": MHTConfig(new_target_density=1e-10, defer_tentative=True),
+    # tentative trees left uncommitted by N-scan for at least six of their own looks
+    # (confirmed later than at their second plot): a tree confirmed at a frame and not
+    # stepped at the next is pruned by rule 1 only if solved again — the scope does not
+    # apply (``FrameScope.applies``), the full solve does
+    "defer": MHTConfig(new_target_density=1e-10, defer_tentative=True,
+                       confirm_min_plots=7),
 }
 
 
@@ -75,7 +79,10 @@ def test_scope_gives_the_full_solve_row_for_row(name):
     assert all(a == b for a, b in n_full)  # the full solve takes the store
     # ... the scope mostly much less of it
     share = np.array([a / max(b, 1) for a, b in n_part[20:]])
-    assert np.median(share) < 0.5
+    if name == "defer":  # every frame solved whole (FrameScope.applies)
+        assert np.all(share == 1.0)
+    else:
+        assert np.median(share) < 0.5
     if name == "caps":
         caps = {k for s in s_full for k in s.caps}
         assert {"max_cluster_size", "max_trees"} <= caps

@@ -25,8 +25,11 @@ The result — chosen leaves, pruning and the step's statistics (clusters, large
 cluster, the caps' counts) — is the full solve's, row for row
 (``tests/mht/test_frame_scope.py``); only the work differs. Used with per-tree looks
 (:attr:`~mhtrack.mht.coverage.Coverage.per_tree_looks`), one best hypothesis and
-neither probability pruning nor merging; otherwise, and after a restart (nothing cached),
-every leaf is in the scope.
+neither probability pruning, merging nor ``defer_tentative``; otherwise, and after a
+restart (nothing cached), every leaf is in the scope. ``defer_tentative`` is left out
+because confirmation runs after :meth:`FrameScope.pruned` has marked the groups clean: a
+tree confirmed at frame ``k`` and not stepped at ``k + 1`` would be skipped there, where
+the full solve prunes it with N-scan's rule 1 now applying to it.
 """
 
 from __future__ import annotations
@@ -82,7 +85,8 @@ class FrameScope:
         """Whether the configuration allows a scope smaller than the store."""
         cfg = self.config
         return (self.enabled and self.by_id and cfg.n_best == 1
-                and cfg.prune_probability <= 0 and cfg.merge_frames <= 0)
+                and cfg.prune_probability <= 0 and cfg.merge_frames <= 0
+                and not cfg.defer_tentative)
 
     def solve(self, frame: FrameContext, leaves: Leaves, first_node: int,
               ) -> tuple[GlobalHypothesis, Scope]:

@@ -25,7 +25,8 @@ def _scene():
 
 
 def _run(cfg: MHTConfig, scoped: bool, stop: int | None = None):
-    """Rows, statistics, final store and the sizes (scope, store) of each frame's solve."""
+    """Rows, statistics, final store and each frame's solve: the sizes (scope, store) and
+    the best hypothesis' total score."""
     sc, plots = _scene()
     trk = make_tracker("mht", cfg, clutter_density=2e-10, sensors=sc.sensor_set())
     trk.scope.enabled = scoped
@@ -34,7 +35,8 @@ def _run(cfg: MHTConfig, scoped: bool, stop: int | None = None):
 
     def spy(frame, leaves, first_node):
         hyp, scope = solve(frame, leaves, first_node)
-        sizes.append((len(leaves) if scope.rows is None else scope.rows.size, len(leaves)))
+        sizes.append((len(leaves) if scope.rows is None else scope.rows.size, len(leaves),
+                      hyp.total))
         return hyp, scope
 
     trk.scope.solve = spy
@@ -76,9 +78,10 @@ def test_scope_gives_the_full_solve_row_for_row(name):
     _same(lv_full, lv_part)
     assert [dataclasses.replace(s, time_s=0.0) for s in s_full] == \
         [dataclasses.replace(s, time_s=0.0) for s in s_part]
-    assert all(a == b for a, b in n_full)  # the full solve takes the store
+    assert all(a == b for a, b, _ in n_full)  # the full solve takes the store
+    assert [t for *_, t in n_full] == [t for *_, t in n_part]  # same total, bit for bit
     # ... the scope mostly much less of it
-    share = np.array([a / max(b, 1) for a, b in n_part[20:]])
+    share = np.array([a / max(b, 1) for a, b, _ in n_part[20:]])
     if name == "defer":  # every frame solved whole (FrameScope.applies)
         assert np.all(share == 1.0)
     else:

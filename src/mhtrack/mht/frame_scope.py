@@ -92,7 +92,12 @@ class FrameScope:
               ) -> tuple[GlobalHypothesis, Scope]:
         """The best global hypothesis over ``leaves`` (the store after the frame's births;
         leaves with ``node ≥ first_node`` are new) and the scope pruning takes; clusters
-        solved greedily or stopped by the node limit count as caps in ``frame``."""
+        solved greedily or stopped by the node limit count as caps in ``frame``. Its
+        ``leaves``, ``total`` (summed over the chosen leaves in store order, as the full
+        solve sums), ``probability``, ``n_clusters`` and ``largest_cluster`` are the full
+        solve's; with a scope smaller than the store, ``n_searched``, ``n_greedy`` and
+        ``n_node_limited`` count the scope's clusters only, and ``leaf_cluster`` and
+        ``cut_clusters`` are empty (nothing downstream reads them)."""
         self._pending = None
         idle = leaves.node < first_node
         if not self.applies or not idle.any():
@@ -152,7 +157,8 @@ class FrameScope:
                 np.concatenate((np.zeros(clean_g.size, bool), capped)))
         probability = np.zeros(len(leaves))
         probability[chosen] = 1.0
-        hyp = replace(hyp, leaves=chosen, n_clusters=n_clusters, largest_cluster=big,
+        hyp = replace(hyp, leaves=chosen, total=float(leaves.score[chosen].sum()),
+                      n_clusters=n_clusters, largest_cluster=big,
                       probability=probability, leaf_cluster=np.zeros(0, np.int64),
                       cut_clusters=np.zeros(0, np.int64))
         return hyp, Scope(rows, local)

@@ -139,3 +139,21 @@ def test_a_replaced_config_gives_its_own_limits():
     trk.config = MHTConfig(max_trees=7, scale_caps=False)
     trk.step(Scan.from_positions(1, 1.0, z))
     assert trk.last_stats.limits["max_trees"] == 7
+
+
+def test_the_tree_floor_counts_only_rotating_sensors():
+    """Only sensors with a rotation period give sector frames; one without a period (or
+    none at all) looks at everything each frame and counts as the single scan's one."""
+    from mhtrack.mht.coverage import RadarCoverage
+    from mhtrack.models.radars import RadarSensor, SensorSet
+
+    def radar(i: int, period: float | None) -> RadarSensor:
+        return RadarSensor(i, "polar", lat=51.0 + 0.1 * i, lon=0.0, sigma_range=50.0,
+                           sigma_bearing_deg=0.1, pd=0.9, period=period)
+
+    mixed = SensorSet(None, (radar(1, 4.0), radar(2, None), radar(3, 6.0), radar(4, None)))
+    assert RadarCoverage(mixed).n_sensors == 2
+    still = SensorSet(None, (radar(1, None), radar(2, None)))
+    assert RadarCoverage(still).n_sensors == 1
+    assert scaled_limits(DEFAULT, 70, 400, n_sensors=RadarCoverage(mixed).n_sensors)[
+        "max_trees"] == 2 * DEFAULT.max_trees

@@ -14,8 +14,9 @@ with the confirmed tracks ``t`` carried into it. With ``n' = min(n, BURST_PLOTS)
 
 the floors being the configured values (``MHTConfig``), so that nothing changes up to
 ~900 plots and 100 tracks per scan, and a burst of more than ``BURST_PLOTS`` plots gets
-the limits of ``BURST_PLOTS``. ``max_trees``' floor is per sensor: with frames of several
-sensors (each one radar's sector, :attr:`~mhtrack.mht.coverage.Coverage.n_sensors`) the
+the limits of ``BURST_PLOTS``. ``max_trees``' floor is per rotating sensor: with frames of
+several sensors (each one radar's sector, :attr:`~mhtrack.mht.coverage.Coverage.n_sensors`,
+which counts the sensors with a rotation period) the
 store holds the trees of every radar's last rotations while ``n`` counts one sector's
 plots, so the floor is the configured value times the sensors (issue 30: 30 radars and
 4 000 aircraft hold ~20 000 trees, which a floor of 5 000 cut at nearly every frame).

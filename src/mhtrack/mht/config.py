@@ -116,8 +116,10 @@ class MHTConfig:
     max_leaves : hard cap on all leaves (confirmed trees' leaves first, then best scores).
         Default 20 000 (≈ 7× the leaves of the crossing scenario); scaled (``scale_caps``).
     max_trees : hard cap on trees (trees in the best hypothesis and confirmed trees first,
-        then highest best-leaf score). Default 5 000 per sensor of the coverage (frames
-        of several radars: the store holds every radar's trees); scaled (``scale_caps``).
+        then highest best-leaf score). Default 5 000; with ``scale_caps`` on, 5 000 per
+        rotating sensor of the coverage (sector frames of several radars: the store holds
+        every radar's trees; sensors without a period and fused scans count as one) and
+        scaled (``scale_caps``); off: 5 000 whatever the sensors.
     max_gated_pairs : at most this many leaf–plot pairs are tested in the gates per scan;
         beyond it, leaves of confirmed trees and then the best-scoring leaves are gated
         first and the rest only get a miss child. Default 300 000; scaled (``scale_caps``).

@@ -70,8 +70,9 @@ class Coverage(ABC):
     #: :func:`~mhtrack.mht.hypothesis.best_hypothesis`; ids unique over the window, as a
     #: :class:`~mhtrack.records.PlotTable`'s rows are).
     per_tree_looks: bool = False
-    #: The sensors whose frames the tracker's store holds (``max_trees``' floor is per
-    #: sensor, :func:`mhtrack.mht.caps.scaled_limits`); 1: one scan holds the scene.
+    #: The rotating sensors whose sector frames the tracker's store holds (``max_trees``'
+    #: floor is per such sensor, :func:`mhtrack.mht.caps.scaled_limits`); 1: one scan
+    #: holds the scene (also a fused scan, or sensors without a rotation period).
     n_sensors: int = 1
 
     @abstractmethod
@@ -158,7 +159,8 @@ class RadarCoverage(Coverage):
     def __init__(self, sensors: SensorSet, *, max_pd: float = MAX_COVERAGE_PD,
                  learn_reach: bool = True) -> None:
         self.sensors = sensors
-        self.n_sensors = len(sensors.sensors)
+        # sector frames only: a sensor without a period looks at everything each frame
+        self.n_sensors = max(sum(s.period is not None for s in sensors.sensors), 1)
         self.max_pd = float(max_pd)
         #: Whether a radar without ``max_range`` has its reach learned (else it sees to
         #: infinity, the former rule; kept for comparisons).

@@ -25,8 +25,11 @@ The result — chosen leaves, pruning and the step's statistics (clusters, large
 cluster, the caps' counts) — is the full solve's, row for row
 (``tests/mht/test_frame_scope.py``); only the work differs. Used with per-tree looks
 (:attr:`~mhtrack.mht.coverage.Coverage.per_tree_looks`), one best hypothesis and
-neither probability pruning nor merging; otherwise, and after a restart (nothing cached),
-every leaf is in the scope.
+neither probability pruning, merging nor ``defer_tentative``; otherwise, and after a
+restart (nothing cached), every leaf is in the scope. ``defer_tentative`` is left out
+because confirmation runs after :meth:`FrameScope.pruned` has marked the groups clean: a
+tree confirmed at frame ``k`` and not stepped at ``k + 1`` would be skipped there, where
+the full solve prunes it with N-scan's rule 1 now applying to it.
 """
 
 from __future__ import annotations
@@ -82,13 +85,19 @@ class FrameScope:
         """Whether the configuration allows a scope smaller than the store."""
         cfg = self.config
         return (self.enabled and self.by_id and cfg.n_best == 1
-                and cfg.prune_probability <= 0 and cfg.merge_frames <= 0)
+                and cfg.prune_probability <= 0 and cfg.merge_frames <= 0
+                and not cfg.defer_tentative)
 
     def solve(self, frame: FrameContext, leaves: Leaves, first_node: int,
               ) -> tuple[GlobalHypothesis, Scope]:
         """The best global hypothesis over ``leaves`` (the store after the frame's births;
         leaves with ``node ≥ first_node`` are new) and the scope pruning takes; clusters
-        solved greedily or stopped by the node limit count as caps in ``frame``."""
+        solved greedily or stopped by the node limit count as caps in ``frame``. Its
+        ``leaves``, ``total`` (summed over the chosen leaves in store order, as the full
+        solve sums), ``probability``, ``n_clusters`` and ``largest_cluster`` are the full
+        solve's; with a scope smaller than the store, ``n_searched``, ``n_greedy`` and
+        ``n_node_limited`` count the scope's clusters only, and ``leaf_cluster`` and
+        ``cut_clusters`` are empty (nothing downstream reads them)."""
         self._pending = None
         idle = leaves.node < first_node
         if not self.applies or not idle.any():
@@ -148,7 +157,8 @@ class FrameScope:
                 np.concatenate((np.zeros(clean_g.size, bool), capped)))
         probability = np.zeros(len(leaves))
         probability[chosen] = 1.0
-        hyp = replace(hyp, leaves=chosen, n_clusters=n_clusters, largest_cluster=big,
+        hyp = replace(hyp, leaves=chosen, total=float(leaves.score[chosen].sum()),
+                      n_clusters=n_clusters, largest_cluster=big,
                       probability=probability, leaf_cluster=np.zeros(0, np.int64),
                       cut_clusters=np.zeros(0, np.int64))
         return hyp, Scope(rows, local)

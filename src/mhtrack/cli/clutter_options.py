@@ -29,8 +29,8 @@ def clutter_estimator_options(f: Callable[..., Any]) -> Callable[..., Any]:
         click.option("--clutter-forgetting", type=click.FloatRange(0, 1, min_open=True),
                      default=None, help="A constant forgetting factor γ per rotation or "
                      "scan of the clutter estimate (mht-map, mht-fgmm, mht-mapgmm) instead "
-                     "of the half-life (not both); 1: no forgetting [map, mapgmm: none, the half-life's; "
-                     "fgmm: 0.7]."),
+                     "of the half-life (not both); 1: no forgetting [map, mapgmm: none, the "
+                     "half-life's; fgmm: 0.7]."),
         click.option("--birth-scaling", type=click.FloatRange(0, 10), default=None,
                      help="mht-map, mht-mapgmm: β of the birth density the clutter map "
                      "drives, s(z) = min(1, ρ̄/κ̂(z))^β; 0: none [0]."),

@@ -135,3 +135,22 @@ def test_scan_plots_with_attributes_and_cartesian_nan_rows(tmp_path: Path) -> No
     assert np.isnan(a.polar_range[0]) and np.isnan(a.polar_bearing[0])
     assert a.polar_range[1] == pytest.approx(np.hypot(4000.0, 3048.0), rel=1e-12)
     assert a.polar_bearing[1] == 0.0
+
+
+def test_a_clutter_scene_keeps_the_opensky_identities() -> None:
+    """``--clutter-scene`` renames the scenario (``opensky-radars+storm``); its targets
+    are still the OpenSky data's aircraft, with their own addresses."""
+    from mhtrack.scenario import preset, simulate
+    from mhtrack.scenario.identity import with_attributes
+    from mhtrack.scenario.opensky import load_opensky
+    from mhtrack.scenario.scenes import with_clutter_scene
+
+    sc = with_clutter_scene(preset("opensky-radars", scans=3), "storm")
+    assert sc.name == "opensky-radars+storm"
+    sim = with_attributes(simulate(sc, seed=3))
+    a = sim.plots.attrs
+    target = (sim.plots.origin >= 0) & (a.address >= 0)
+    assert target.any()
+    icao = load_opensky().icao24
+    assert a.address[target].tolist() == [int(icao[o - 1], 16)
+                                          for o in sim.plots.origin[target].tolist()]

@@ -58,3 +58,26 @@ def test_bad_values_are_usage_errors(tmp_path, args, where):
     res = CliRunner().invoke(run, ["crossing", "--scans", "3", *args,
                                    "--out", str(tmp_path / "r")])
     assert res.exit_code == 2 and where in res.output, res.output
+
+
+def test_forgetting_and_half_life_not_both(tmp_path):
+    with pytest.raises(click.UsageError, match="not both"):
+        clutter_params("mht-map", 0.8, None, None, None, clutter_half_life=30.0)
+    res = CliRunner().invoke(run, ["crossing", "--scans", "3", "--tracker", "mht-fgmm",
+                                   "--clutter-forgetting", "0.9", "--clutter-half-life", "20",
+                                   "--out", str(tmp_path / "r")])
+    assert res.exit_code == 2 and "not both" in res.output, res.output
+
+
+def test_help_gives_the_estimators_defaults():
+    """The defaults the help states are the estimators' own (clutter.radar_map.HALF_LIFE
+    for map and mapgmm, clutter.forgetting.FORGETTING for fgmm)."""
+    import inspect
+
+    from mhtrack.clutter.forgetting import FORGETTING, ForgettingGMMClutter
+    from mhtrack.clutter.radar_map import HALF_LIFE
+
+    assert inspect.signature(ForgettingGMMClutter).parameters["half_life"].default is None
+    text = " ".join(CliRunner().invoke(run, ["--help"], terminal_width=200).output.split())
+    assert f"[map, mapgmm: {HALF_LIFE:g} s; fgmm: none, γ = {FORGETTING:g} per scan]" in text
+    assert f"fgmm: {FORGETTING:g}]" in text

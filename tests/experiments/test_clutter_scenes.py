@@ -165,3 +165,25 @@ def test_html_page_holds_every_comparison_and_verdict(tiny):
         assert c.sentence in text
     for line in pair_summary(tiny.paired["storm"]):
         assert line in text
+
+
+def test_html_without_plotly_fails_before_the_study(tmp_path, monkeypatch):
+    """``--html`` without Plotly: the one line and exit 1 of ``report``, before any job
+    runs (nothing written under OUT)."""
+    import sys
+
+    import mhtrack.experiments.clutter_scenes as cs
+    from mhtrack.cli.reproduce_commands import reproduce
+
+    monkeypatch.setitem(sys.modules, "plotly", None)
+    ran = []
+    monkeypatch.setattr(cs, "clutter_scenes", lambda *a, **k: ran.append(1))
+    out = tmp_path / "cs"
+    res = CliRunner().invoke(reproduce, ["clutter-scenes", "--runs", "1", "--scans", "10",
+                                         "--scene", "weather", "--method", "known",
+                                         "--html", "--out", str(out)])
+    assert res.exit_code == 1, res.output
+    assert res.output.strip().splitlines() == [
+        'Error: the HTML report needs Plotly: pip install "mhtrack[report]" '
+        "(or pip install plotly)"]
+    assert ran == [] and not out.exists()

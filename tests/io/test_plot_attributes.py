@@ -115,3 +115,42 @@ def test_simulated_attributes_keep_the_plots() -> None:
                        strict=True):
         assert addr == int(icao[o - 1], 16)  # the data's own address of the aircraft
     assert np.isnan(a.flight_level[a.plot_type == 1]).all()  # primary plots: no reply
+
+
+def test_scan_plots_with_attributes_and_cartesian_nan_rows(tmp_path: Path) -> None:
+    """A Cartesian sensor's row may write ``nan`` range/bearing (docs/file-formats.md) also
+    when the file has attribute columns; the polar row's measured position is the SLANT
+    range of its ground range at its flight level (a scenario's flat frame: by hand
+    √(4000² + (100 FL · 30.48 m)²) = 5000.6 m), the Cartesian row's NaN."""
+    from mhtrack.models.sensors import CartesianSensor, PolarRadar
+
+    p = tmp_path / "plots.csv"
+    p.write_text("scan,time,sensor,x,y,range,bearing,mode_3a,flight_level\n"
+                 "1,0,0,10,20,nan,nan,1234,\n"
+                 "1,0,1,0,4000,4000,0,7000,100\n")
+    t = read_plots(p, {0: CartesianSensor(0), 1: PolarRadar(1)})
+    a = t.attrs
+    assert t.sensor.tolist() == [0, 1]
+    assert a.mode_3a.tolist() == [code_value("1234"), code_value("7000")]
+    assert np.isnan(a.polar_range[0]) and np.isnan(a.polar_bearing[0])
+    assert a.polar_range[1] == pytest.approx(np.hypot(4000.0, 3048.0), rel=1e-12)
+    assert a.polar_bearing[1] == 0.0
+
+
+def test_a_clutter_scene_keeps_the_opensky_identities() -> None:
+    """``--clutter-scene`` renames the scenario (``opensky-radars+storm``); its targets
+    are still the OpenSky data's aircraft, with their own addresses."""
+    from mhtrack.scenario import preset, simulate
+    from mhtrack.scenario.identity import with_attributes
+    from mhtrack.scenario.opensky import load_opensky
+    from mhtrack.scenario.scenes import with_clutter_scene
+
+    sc = with_clutter_scene(preset("opensky-radars", scans=3), "storm")
+    assert sc.name == "opensky-radars+storm"
+    sim = with_attributes(simulate(sc, seed=3))
+    a = sim.plots.attrs
+    target = (sim.plots.origin >= 0) & (a.address >= 0)
+    assert target.any()
+    icao = load_opensky().icao24
+    assert a.address[target].tolist() == [int(icao[o - 1], 16)
+                                          for o in sim.plots.origin[target].tolist()]

@@ -111,3 +111,23 @@ def test_a_bad_cell_is_located(tmp_path, column, value, message):
     text = str(e.value)
     assert "line 2" in text and message in text, text
     assert column in text or column == "sensors", text
+
+
+def test_a_plot_bearing_of_360_reads_back(tmp_path):
+    """A plot at bearing 360° (accepted by the timed plots reader; ``np.mod(-1e-17, 360)``
+    gives it) is carried as 0° (north), so the tracks file written reads back."""
+    from mhtrack.attributes import PlotAttributes
+    from mhtrack.mht.track_attributes import measured
+
+    assert np.mod(-1e-17, 360.0) == 360.0
+    plots = PlotAttributes.absent(3)
+    plots = PlotAttributes.from_columns({**plots.columns(polar=True),
+                                         "polar_range": np.array([1e4, 2e4, 3e4]),
+                                         "polar_bearing": np.array([360.0, 359.5, 0.0])}, 3)
+    m = measured(plots, np.array([0, 1, 2, -1]), np.array([1, 1, 1]))
+    assert m["meas_bearing"][:3].tolist() == [0.0, 359.5, 0.0]
+    t = _table()
+    t.attrs.meas_bearing[:] = m["meas_bearing"]
+    write_tracks(t, tmp_path / "t.csv")
+    np.testing.assert_array_equal(read_tracks(tmp_path / "t.csv").attrs.meas_bearing,
+                                  m["meas_bearing"])

@@ -38,11 +38,13 @@ def test_accuracy_of_axis_aligned_ellipses_by_hand():
     np.testing.assert_allclose(orient, [90.0, 0.0])
 
 
-def _climber(n=40, rate_fl_s=0.25, callsign_every=5, drop=(), past=False, config=None):
+def _climber(n=40, rate_fl_s=0.25, callsign_every=5, drop=(), past=False, config=None,
+             primary=False):
     """One aircraft east at 200 m/s climbing from FL 200 at ``rate_fl_s``, replying
     code 4321 and address 0x3C4591 on every plot, its callsign BOX413 only on every
     ``callsign_every``-th; no clutter; scans ``drop`` without a plot. ``past``: the
-    rows of the track's tentative past (the history output) too."""
+    rows of the track's tentative past (the history output) too. ``primary``: primary
+    plots instead (no reply: a type and nothing else)."""
     rng = np.random.default_rng(3)
     trk, outs = MHTTracker(config), []
     row = 0
@@ -52,7 +54,8 @@ def _climber(n=40, rate_fl_s=0.25, callsign_every=5, drop=(), past=False, config
             attrs = PlotAttributes.absent(0)
         else:
             z = np.array([[200.0 * k, 0.0]]) + rng.normal(scale=50.0, size=(1, 2))
-            attrs = PlotAttributes.from_columns({
+            attrs = PlotAttributes.from_columns({"plot_type": np.array([1])}, 1) \
+                if primary else PlotAttributes.from_columns({
                 "flight_level": np.array([200.0 + rate_fl_s * k]),
                 "mode_3a": np.array([0o4321]), "address": np.array([0x3C4591]),
                 "callsign": np.array(["BOX413" if k % callsign_every == 0 else ""],
@@ -117,6 +120,38 @@ def test_the_tentative_past_says_what_its_plots_measured():
     assert set(a.sensors[back].tolist()) == {"0"}
     ages = np.array([float(v) for v in a.sensor_ages[back].tolist()])
     np.testing.assert_allclose(ages, np.where(tt.plot[back] >= 0, 0.0, 1.0))  # 1 s scans
+
+
+def test_a_primary_track_past_says_what_its_plots_measured():
+    """A primary-only aircraft (no identity on any tentative leaf) starting while one
+    that replied until scan 10 (its track keeps the identity) is tracked 50 km away:
+    its backfilled rows still carry their plot's sensor and type, and the existence
+    probability of their score, as its online rows."""
+    rng = np.random.default_rng(4)
+    trk, outs, row = MHTTracker(MHTConfig(alpha=1e-9)), [], 0
+    for k in range(34):
+        z = [[200.0 * k, 0.0]] + ([[200.0 * k, 50_000.0]] if k >= 20 else [])
+        z = np.array(z) + rng.normal(scale=50.0, size=(len(z), 2))
+        m = len(z)
+        attrs = PlotAttributes.from_columns({
+            "plot_type": np.array([4 if k < 10 else 1, 1][:m]),
+            "mode_3a": np.array([0o4321 if k < 10 else -1, -1][:m]),
+            "address": np.array([0x3C4591 if k < 10 else -1, -1][:m]),
+            "flight_level": np.array([200.0 if k < 10 else np.nan, np.nan][:m])}, m)
+        outs.append(trk.step(Scan(k, float(k), z, np.zeros(m, np.int64),
+                                  np.arange(row, row + m), attrs=attrs)))
+        outs.append(trk.last_backfill)
+        row += m
+    tt = TrackTable.concat(outs)
+    a = tt.attrs
+    primary = np.isin(tt.track_id, tt.track_id[(a.address < 0) & (tt.scan >= 25)])
+    back = tt.tentative.astype(bool) & primary
+    hit = back & (tt.plot >= 0)
+    assert hit.sum() >= 2
+    assert (a.meas_sensor[hit] == 0).all() and (a.meas_type[hit] == 1).all()
+    assert (a.mode_3a[back] == -1).all() and np.isnan(a.flight_level[back]).all()
+    np.testing.assert_allclose(a.existence_probability, 1.0 / (1.0 + np.exp(-tt.score)),
+                               rtol=1e-12)
 
 
 def test_a_miss_reports_the_predicted_level():

@@ -29,7 +29,8 @@ def clutter_estimator_options(f: Callable[..., Any]) -> Callable[..., Any]:
         click.option("--clutter-forgetting", type=click.FloatRange(0, 1, min_open=True),
                      default=None, help="A constant forgetting factor γ per rotation or "
                      "scan of the clutter estimate (mht-map, mht-fgmm, mht-mapgmm) instead "
-                     "of the half-life; 1: no forgetting."),
+                     "of the half-life (not both); 1: no forgetting [map, mapgmm: none, the "
+                     "half-life's; fgmm: 0.7]."),
         click.option("--birth-scaling", type=click.FloatRange(0, 10), default=None,
                      help="mht-map, mht-mapgmm: β of the birth density the clutter map "
                      "drives, s(z) = min(1, ρ̄/κ̂(z))^β; 0: none [0]."),
@@ -41,8 +42,8 @@ def clutter_estimator_options(f: Callable[..., Any]) -> Callable[..., Any]:
                      "(map) or 32 (mapgmm) with a reach, else 64]."),
         click.option("--clutter-half-life", type=click.FloatRange(0, None, min_open=True),
                      default=None, help="Half-life (s of data time) of the clutter "
-                     "estimate's memory (mht-map, mht-fgmm, mht-mapgmm) [map 40, mapgmm 40; "
-                     "fgmm none: γ = 0.7 per scan]."),
+                     "estimate's memory (mht-map, mht-fgmm, mht-mapgmm) instead of the forgetting "
+                     "factor (not both) [map, mapgmm: 40 s; fgmm: none, γ = 0.7 per scan]."),
     ]
     for opt in reversed(opts):
         f = opt(f)
@@ -54,12 +55,16 @@ def clutter_params(tracker: str, clutter_forgetting: float | None,
                    map_sectors: int | None, clutter_half_life: float | None = None
                    ) -> dict[str, Any] | None:
     """The ``clutter_params`` of the options given (``None`` when none is); a usage error
-    naming the option when ``tracker``'s estimator does not take it."""
+    naming the option when ``tracker``'s estimator does not take it, or when both the
+    forgetting factor and the half-life are given."""
     from mhtrack.build import TRACKER_ESTIMATORS
 
     estimator = TRACKER_ESTIMATORS.get(tracker)
     given = dict(zip(TAKES, (clutter_forgetting, birth_scaling, map_range_cell,
                              map_sectors, clutter_half_life), strict=True))
+    if clutter_forgetting is not None and clutter_half_life is not None:
+        raise click.UsageError("--clutter-forgetting or --clutter-half-life, not both (a "
+                               "constant factor per scan, or a memory in data time)")
     out: dict[str, Any] = {}
     for flag, value in given.items():
         if value is None:

@@ -194,6 +194,13 @@ def clutter_scenes(runs: int, out: Path, seed: int, scenes: tuple[str, ...],
     from mhtrack.experiments import clutter_scenes as cs
     from mhtrack.reports.clutter_scenes import pair_summary, write_clutter_scenes_report
 
+    if html:  # before the study, not after it: as ``report``, one line and exit 1
+        from mhtrack.reports.html_page import require_plotly
+
+        try:
+            require_plotly()
+        except ImportError as e:
+            raise click.ClickException(str(e)) from None
     run_on = executor_kwargs(workers, dask_scheduler)
     try:
         from mhtrack.scenario import preset
@@ -211,7 +218,7 @@ def clutter_scenes(runs: int, out: Path, seed: int, scenes: tuple[str, ...],
         try:
             rep.paths.insert(2, write_clutter_scenes_html(study))
         except ImportError as e:
-            raise InputProblem(str(e)) from None
+            raise click.ClickException(str(e)) from None
     for line in pair_summary(study.paired.get(cs.POOLED, next(iter(study.paired.values()),
                                                               []))):
         say(f"* {line}")

@@ -26,6 +26,7 @@ from mhtrack.attributes import (
     code_value,
 )
 from mhtrack.io._frame import FLOAT, INT, TIME, Frame, float_array, int_array
+from mhtrack.io.asterix.earth import slant_range
 
 #: Column kinds for :func:`~mhtrack.io._frame.read_frame` (TIME: read as text).
 KINDS = {"plot_type": TIME, "mode_3a": TIME, "mode_3a_v": INT, "mode_3a_g": INT,
@@ -33,13 +34,24 @@ KINDS = {"plot_type": TIME, "mode_3a": TIME, "mode_3a_v": INT, "mode_3a_g": INT,
          "address": TIME, "callsign": TIME, "amplitude": FLOAT}
 #: Flight levels a file may give (I048/090 holds −12 to 1 270 FL).
 FL_RANGE = (-12.0, 1270.0)
+#: Metres per flight level (100 ft).
+FL_M = 30.48
 _TYPE_CODE = {name: code for code, name in PLOT_TYPES.items()}
 
 
-def read_attributes(f: Frame, order: np.ndarray | None = None) -> PlotAttributes | None:
+def read_attributes(f: Frame, order: np.ndarray | None = None,
+                    polar: tuple[np.ndarray, np.ndarray] | None = None,
+                    site: tuple[np.ndarray, np.ndarray] | None = None
+                    ) -> PlotAttributes | None:
     """The attribute columns of ``f`` (rows in file order, then taken in ``order`` when
     given), ``None`` when the file has none. Raises a located
-    :class:`~mhtrack.errors.InputError` for the first bad cell."""
+    :class:`~mhtrack.errors.InputError` for the first bad cell.
+
+    ``polar``: the file's checked ``(range, bearing)`` columns (ground range, NaN on
+    Cartesian rows). The measured position kept (:data:`~mhtrack.attributes.POLAR`, as
+    ASTERIX I048/040 gives it) is the SLANT range: :func:`slant_of_ground` of the row's
+    flight level and ``site`` (per-row latitude and altitude, NaN where unknown); NaN
+    without a flight level."""
     if not any(f.has(c) for c in COLUMNS):
         return None
     cols: dict[str, np.ndarray] = {}
@@ -62,11 +74,33 @@ def read_attributes(f: Frame, order: np.ndarray | None = None) -> PlotAttributes
             cols[name] = _parsed(f, name, parse)
     if f.has("callsign"):
         cols["callsign"] = np.array([s or "" for s in _text(f, "callsign")], object)
-    if f.has("range") and f.has("bearing"):  # polar plots: their measured position
-        cols["polar_range"] = f.floats("range", nullable=True)
-        cols["polar_bearing"] = f.floats("bearing", nullable=True)
+    if polar is not None:  # polar plots: their measured position (slant, as I048/040)
+        ground, bearing = (np.asarray(v, float) for v in polar)
+        level = cols.get("flight_level", np.full(f.n, np.nan))
+        cols["polar_range"] = slant_of_ground(ground, bearing, level, *(
+            site if site is not None else (np.full(f.n, np.nan), np.zeros(f.n))))
+        cols["polar_bearing"] = bearing
     out = PlotAttributes.from_columns(cols, f.n)
     return out if order is None else out.take(order)
+
+
+def slant_of_ground(ground: np.ndarray, bearing: np.ndarray, flight_level: np.ndarray,
+                    site_lat: np.ndarray, site_alt: np.ndarray) -> np.ndarray:
+    """Slant range (m) of ground ranges to targets at ``flight_level`` (FL, 30.48 m each)
+    from sites at ``site_lat`` (°) and ``site_alt`` (m, NaN taken as 0):
+    :func:`mhtrack.io.asterix.earth.slant_range` on the ellipsoid where the latitude is
+    known, else in the plane ``ρ = √(s² + Δh²)`` (a scenario's flat frame); NaN where the
+    flight level is unknown."""
+    g = np.asarray(ground, float)
+    h = np.asarray(flight_level, float) * FL_M
+    lat = np.broadcast_to(np.asarray(site_lat, float), g.shape)
+    alt = np.nan_to_num(np.broadcast_to(np.asarray(site_alt, float), g.shape))
+    out = np.hypot(g, h - alt)
+    geo = np.isfinite(lat)
+    if geo.any():
+        out[geo] = slant_range(g[geo], np.asarray(bearing, float)[geo], h[geo], lat[geo],
+                               alt[geo])
+    return out
 
 
 def _text(f: Frame, name: str) -> list[str]:

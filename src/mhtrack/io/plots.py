@@ -144,7 +144,8 @@ def read_plots(
         )
     return PlotTable(
         scan=scan, time=time, sensor=sensor, x=x, y=y,
-        range=rng, bearing=bearing, origin=origin, R=R, attrs=read_attributes(f),
+        range=rng, bearing=bearing, origin=origin, R=R,
+        attrs=read_attributes(f, polar=None if rng is None else (rng, bearing)),
     )  # fmt: skip
 
 

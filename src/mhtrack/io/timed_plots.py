@@ -121,7 +121,8 @@ def read_timed_columns(path: PathArg, sensors: SensorSet | None = None
                 "target id >= 0, or -1 for clutter)")
     rng, bearing = _range_bearing(f)
     lat, lon = _lat_lon(f)
-    attrs = read_attributes(f)
+    attrs = read_attributes(f, polar=None if rng is None else (rng, bearing),
+                            site=None if sensors is None else _sites(sensor, sensors))
     if sensors is None:
         x, y, R = _without_sensors(f)
     else:
@@ -189,6 +190,17 @@ def _range_bearing(f: Frame) -> tuple[np.ndarray | None, np.ndarray | None]:
         f.check(~np.isnan(a) & np.isnan(b), name, lambda r: "value is missing (range and "
                 "bearing come together)")
     return rng, bearing
+
+
+def _sites(sensor: np.ndarray, sensors: SensorSet) -> tuple[np.ndarray, np.ndarray]:
+    """Each row's site latitude (°) and altitude (m; NaN where not given, or no site)."""
+    lat, alt = np.full(sensor.size, np.nan), np.full(sensor.size, np.nan)
+    for s in sensors.sensors:
+        rows = sensor == s.id
+        if s.has_site and rows.any():
+            lat[rows] = sensors.site_latlon(s.id)[0]
+            alt[rows] = np.nan if s.alt is None else s.alt
+    return lat, alt
 
 
 def _lat_lon(f: Frame) -> tuple[np.ndarray | None, np.ndarray | None]:

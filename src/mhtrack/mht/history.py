@@ -34,7 +34,7 @@ import numpy as np
 from mhtrack.attributes import TECHNOLOGIES, TrackAttributes, existence
 from mhtrack.kernels import changes
 from mhtrack.mht.attribute_scores import positions
-from mhtrack.mht.track_attributes import identity, measured
+from mhtrack.mht.track_attributes import identity, measured, says_anything
 from mhtrack.mht.tree import Leaves
 from mhtrack.records import Scan, TrackTable
 
@@ -90,7 +90,9 @@ class _Logged:
              leaves.Pm.take(sel, axis=0)) if models else (None, None, None)
         plot = leaves.window[:, -1][sel]
         meas = callsign = None
-        if known and plots is not None and plots.attrs is not None:
+        # what the plots measured whenever the frame's tracks report attributes (the
+        # tracker's rule), whether a tentative leaf has an identity or not
+        if plots is not None and says_anything(plots.attrs, leaves):
             j = positions(plots.rows, plot) if len(plots) else np.full(plot.size, -1)
             got = measured(plots.attrs, j, plots.sensor)
             meas = np.column_stack([got[k] for k in MEASURED]).astype(float)
@@ -106,17 +108,19 @@ class _Logged:
         level and rate of their vertical state, as :mod:`mhtrack.mht.track_attributes`
         reports a track; the accuracy of their covariance and the existence probability
         of their score), ``None`` when none was
-        logged."""
-        if self.ident is None or self.level is None:
+        logged. Logged with the plots' attributes (``meas``) or an identity: each part
+        logged, the existence probability always."""
+        known = self.ident is not None and self.level is not None
+        if not known and self.meas is None:
             return None
         meas = {} if self.meas is None or self.callsign is None else {
             "callsign": np.char.strip(self.callsign[j]).astype(object),
             **{k: self.meas[j, i].astype(np.int64 if k in _INT else float)
                for i, k in enumerate(MEASURED)}}
-        return replace(TrackAttributes.absent(j.size, self.P.take(j, axis=0)),
-                       **identity(self.level.take(j, axis=0), self.ident.take(j, axis=0),
-                                  self.t[j]), existence_probability=existence(self.score[j]),
-                       **meas)
+        ident = identity(self.level.take(j, axis=0), self.ident.take(j, axis=0),  # type: ignore[union-attr]
+                         self.t[j]) if known else {}
+        return replace(TrackAttributes.absent(j.size, self.P.take(j, axis=0)), **ident,
+                       existence_probability=existence(self.score[j]), **meas)
 
 
 class TentativeHistory:

@@ -144,4 +144,10 @@ def measured(attrs: PlotAttributes, j: np.ndarray, sensor: np.ndarray
             "meas_flight_level": take(attrs.flight_level, np.nan),
             "meas_flight_level_vg": take(2 * attrs.flight_level_v + attrs.flight_level_g, 0),
             "meas_range": take(attrs.polar_range, np.nan),
-            "meas_bearing": take(attrs.polar_bearing, np.nan)}
+            "meas_bearing": _turn(take(attrs.polar_bearing, np.nan))}
+
+
+def _turn(bearing: np.ndarray) -> np.ndarray:
+    """Bearings in [0, 360): 360° (a reader accepts it; ``np.mod(-1e-17, 360)`` gives it)
+    is north, 0°, as the tracks file requires."""
+    return np.where(bearing >= 360.0, bearing - 360.0, bearing)

@@ -181,6 +181,16 @@ def add_attributes(plots: PlotTable, identities: dict[int, Identity],
     return replace(plots, attrs=PlotAttributes.from_columns(cols, n))
 
 
+#: The presets whose targets are the OpenSky data's aircraft (their own identities).
+OPENSKY_PRESETS = ("opensky", "opensky-radars")
+
+
+def base_name(name: str) -> str:
+    """The scenario's name without the ``+SCENE`` a clutter scene adds
+    (:func:`mhtrack.scenario.scenes.with_clutter_scene`): its data source."""
+    return name.split("+", 1)[0]
+
+
 def default_attributes(scenario: Scenario) -> bool:
     """Whether a simulation of ``scenario`` carries secondary-radar attributes unless told
     otherwise: with rotating radars (module docstring, "Default")."""
@@ -194,6 +204,6 @@ def with_attributes(sim: Simulation, options: AttributeOptions | None = None) ->
     (the attributes' draws have their own streams)."""
     options = AttributeOptions() if options is None else options
     ids = sorted(set(sim.truth.target_id.tolist()))
-    identities = opensky_identities() if sim.scenario.name in ("opensky", "opensky-radars") \
+    identities = opensky_identities() if base_name(sim.scenario.name) in OPENSKY_PRESETS \
         else drawn_identities(ids, sim.seed)
     return replace(sim, plots=add_attributes(sim.plots, identities, options, sim.seed))

@@ -120,5 +120,11 @@ def test_decoder_and_source_give_the_attributes_back(attributed: Path, fast: boo
     # the plot's measured position (I062/340 POS of the tracks): I048/040 as decoded —
     # the slant range, and the plots file's bearing within THETA's LSB
     assert np.array_equal(back.polar_range, rec.plots["slant_range"])
+    # ... the same slant range the plots file's ground range gives at the plot's flight
+    # level (io.plot_attributes: NaN without one), within RHO's 1/256 NM LSB
+    level = np.isfinite(want.flight_level)
+    assert level.any() and np.isnan(want.polar_range[~level]).all()
+    np.testing.assert_allclose(back.polar_range[level], want.polar_range[level],
+                               atol=1852.0 / 256 / 2 + 1e-6)
     d = (back.polar_bearing - want.polar_bearing + 180.0) % 360.0 - 180.0
     assert np.abs(d).max() <= 360.0 / 2**16 / 2 + 1e-9

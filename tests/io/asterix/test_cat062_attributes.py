@@ -222,10 +222,23 @@ def test_a_tracker_run_exports_its_attributes(tmp_path):
     upd = online & (tracks.plot >= 0)  # a row with a plot says what that plot measured
     assert (tracks.attrs.meas_sensor[upd] >= 0).all()
     assert (tracks.attrs.meas_sensor[tracks.plot < 0] < 0).all()
-    # ... and where it was, as its radar measured it: the plots file's range and bearing
+    # ... and where it was, as its radar measured it: the SLANT range of the plots file's
+    # ground range (I062/340 POS RHO, as I048/040 of a recording) at the plot's flight
+    # level, NaN without one; and the plots file's bearing
+    from mhtrack.io.asterix.earth import slant_range
+
     measured = np.genfromtxt(tmp_path / "plots.csv", delimiter=",", names=True)
     k = tracks.plot[upd]
-    np.testing.assert_allclose(tracks.attrs.meas_range[upd], measured["range"][k], rtol=1e-12)
+    ss = sc.sensor_set()
+    sid = measured["sensor"][k].astype(int)
+    lat = np.array([ss.site_latlon(int(i))[0] for i in sid])
+    alt = np.array([ss.sensor(int(i)).alt or 0.0 for i in sid])
+    fl = measured["flight_level"][k]
+    want_rho = slant_range(measured["range"][k], measured["bearing"][k], fl * 30.48, lat,
+                           alt)
+    assert np.isfinite(fl).any() and np.isnan(fl).any()
+    assert np.abs(want_rho - measured["range"][k])[np.isfinite(fl)].max() > 100.0
+    np.testing.assert_allclose(tracks.attrs.meas_range[upd], want_rho, rtol=1e-12)
     np.testing.assert_allclose(tracks.attrs.meas_bearing[upd], measured["bearing"][k],
                                rtol=1e-12)
     assert np.isnan(tracks.attrs.meas_range[tracks.plot < 0]).all()

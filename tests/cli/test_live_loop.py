@@ -94,3 +94,18 @@ def test_loops_are_one_longer_feed(looped: tuple[Path, int]) -> None:
         ref["frame"].tolist(), ref["track_id"].tolist(), strict=True))
     for col in ("x", "y", "time"):
         assert np.abs(np.array([r[col] for r in rows]) - ref[col].to_numpy()).max() <= 5e-4
+
+
+def test_loop_and_loops_not_both_is_a_usage_error(tmp_path):
+    """``--loop`` (endless) with ``--loops N``: a usage error naming both, before anything
+    is read or sent (the recording is empty: reading it would fail otherwise)."""
+    from click.testing import CliRunner
+
+    from mhtrack.cli.live_commands import replay
+
+    (tmp_path / "empty.pcap").write_bytes(b"")
+    res = CliRunner().invoke(replay, [str(tmp_path / "empty.pcap"), "--to",
+                                      "udp://127.0.0.1:9", "--loop", "--loops", "2"])
+    assert res.exit_code == 2, res.output
+    assert "--loop (endless) or --loops N, not both" in res.output
+    assert "Invalid value" not in res.output  # a usage error, as other conflicts

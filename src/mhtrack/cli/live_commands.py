@@ -97,8 +97,7 @@ def replay(recording: Path, to: tuple[str, ...], speed: float | None, loop: bool
                                  "more than 1", param_hint="--drop/--delay")
     damage = Damage(drop, p, s, Damage.seed if seed is None else seed)
     if loop and loops is not None:
-        raise click.BadParameter("--loop (endless) or --loops N, not both",
-                                 param_hint="--loop/--loops")
+        raise click.UsageError("--loop (endless) or --loops N, not both")
     with stop_on_signals(threading.Event()) as stop:
         stats = play(recording, to, loops=None if loop else (loops or 1), stop=stop,
                      damage=damage,

@@ -8,7 +8,6 @@ parameters. Everything comes from the study's records and comparisons
 from __future__ import annotations
 
 import json
-import math
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -16,6 +15,7 @@ from mhtrack.experiments.clutter_scenes import METRICS, POOLED, ClutterScenesStu
 from mhtrack.io.atomic import atomic_write
 from mhtrack.reports.clutter_scenes import TIMES, method_means, pair_summary
 from mhtrack.reports.html_page import Page, require_plotly
+from mhtrack.reports.html_study import plain
 
 if TYPE_CHECKING:
     import plotly.graph_objects as go
@@ -25,13 +25,7 @@ HTML_FILE = "report.html"
 
 def _rows(comparisons: Any) -> list[dict[str, Any]]:
     """The comparisons as plain dicts, the metric by its label (NaN as ``None``)."""
-    out = []
-    for c in comparisons:
-        d = {k: (None if isinstance(v, float) and not math.isfinite(v) else v)
-             for k, v in c.to_dict().items()}
-        d["metric"] = METRICS[c.metric][0]
-        out.append(d)
-    return out
+    return [{**plain(c), "metric": METRICS[c.metric][0]} for c in comparisons]
 
 
 def error_figure(study: ClutterScenesStudy) -> go.Figure:

@@ -53,7 +53,8 @@ def tracker_table(result: MonteCarloResult) -> tuple[list[str], list[list[str]]]
     return ["metric", *trackers], rows
 
 
-def _plain(c: Any) -> dict[str, Any]:
+def plain(c: Any) -> dict[str, Any]:
+    """A comparison (or a mapping) as a plain dict, NaN and infinities as ``None`` (JSON)."""
     d = c.to_dict() if hasattr(c, "to_dict") else dict(c)
     return {k: (None if isinstance(v, float) and not math.isfinite(v) else v)
             for k, v in d.items()}
@@ -63,7 +64,7 @@ def _valid(rows: Sequence[Any]) -> list[dict[str, Any]]:
     out = []
     for r in rows:
         if isinstance(r, Mapping) and all(f in r for f in PAIRED_FIELDS):
-            out.append(_plain(r))
+            out.append(plain(r))
     return out
 
 
@@ -90,7 +91,7 @@ def paired_rows(result: MonteCarloResult | None, directory: Path
 
         compute = getattr(montecarlo, "paired_comparisons", None)
         if compute is not None:
-            rows = _valid([_plain(c) for c in compute(result)])
+            rows = _valid([plain(c) for c in compute(result)])
             if rows:
                 return rows, "mhtrack.metrics.paired on the runs"
     return paired_from_json(directory)

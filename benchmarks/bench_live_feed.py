@@ -17,29 +17,18 @@ from __future__ import annotations
 import argparse
 import csv
 import json
-import os
 import re
 import signal
 import subprocess
-import sys
 import tempfile
 from pathlib import Path
 
-SRC = Path(__file__).resolve().parents[1] / "src"
-CLI = [sys.executable, "-c", "from mhtrack.cli.main import main; main()"]
+from cli_run import CLI
+from cli_run import echo_run as _run
+from cli_run import env as _env
+
 DENSITY = "1e-10"
 FIELDS = ("frame", "time", "track_id", "x", "y", "vx", "vy", "plot", "tentative")
-
-
-def _env() -> dict[str, str]:
-    return {**os.environ, "PYTHONPATH": str(SRC) + os.pathsep + os.environ.get(
-        "PYTHONPATH", "")}
-
-
-def _run(args: list[str]) -> str:
-    print("$ mhtrack " + " ".join(args), flush=True)
-    return subprocess.run([*CLI, *args], capture_output=True, text=True, env=_env(),
-                          check=True).stdout
 
 
 def _write(rows: list[tuple], path: Path) -> Path:

@@ -52,21 +52,12 @@ from pathlib import Path
 
 import numpy as np
 
+from cli_run import CLI
+from cli_run import echo_run as _run
+from cli_run import env as _env
+
 HERE = Path(__file__).resolve().parent
-SRC = HERE.parent / "src"
 sys.path.insert(0, str(HERE))
-CLI = [sys.executable, "-c", "from mhtrack.cli.main import main; main()"]
-
-
-def _env() -> dict[str, str]:
-    return {**os.environ, "PYTHONPATH": str(SRC) + os.pathsep + os.environ.get(
-        "PYTHONPATH", "")}
-
-
-def _run(args: list[str]) -> str:
-    print("$ mhtrack " + " ".join(args), flush=True)
-    return subprocess.run([*CLI, *args], capture_output=True, text=True, env=_env(),
-                          check=True).stdout
 
 
 # ------------------------------------------------------------------ 1. scene

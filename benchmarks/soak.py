@@ -26,7 +26,6 @@ from __future__ import annotations
 import argparse
 import csv
 import json
-import os
 import re
 import signal
 import subprocess
@@ -35,24 +34,16 @@ import tempfile
 import time
 from pathlib import Path
 
-SRC = Path(__file__).resolve().parents[1] / "src"
-CLI = [sys.executable, "-c", "from mhtrack.cli.main import main; main()"]
+from cli_run import CLI
+from cli_run import env as _env
+from cli_run import run as _run
+
 #: The first pass starts at 23:30 UTC: the data cross midnight after 30 min.
 START_S = 84_600.0
 #: Longest wait (wall s) for ``live`` to take one pass.
 PASS_TIMEOUT_S = 1800.0
 #: A pass is taken once the status stood still this many status periods (1 s).
 STILL_S = 5
-
-
-def _env() -> dict[str, str]:
-    return {**os.environ, "PYTHONPATH": str(SRC) + os.pathsep + os.environ.get(
-        "PYTHONPATH", "")}
-
-
-def _run(args: list[str]) -> str:
-    return subprocess.run([*CLI, *args], capture_output=True, text=True, env=_env(),
-                          check=True).stdout + ""
 
 
 def passes(d: Path, n: int, chunk_s: float) -> list[Path]:

@@ -12,6 +12,7 @@ import click
 
 from mhtrack.cli.asterix_commands import needs_libasterix
 from mhtrack.cli.clutter_options import clutter_estimator_options, clutter_params
+from mhtrack.cli.common import clutter_frame_option
 from mhtrack.cli.terminal import say
 from mhtrack.cli.track_commands import (
     bias_fields,
@@ -23,7 +24,6 @@ from mhtrack.cli.track_commands import (
     young_track_fields,
     young_track_options,
 )
-from mhtrack.names import CLUTTER_FRAMES, DEFAULT_CLUTTER_FRAME
 
 
 class Speed(click.ParamType):
@@ -169,9 +169,7 @@ def replay(recording: Path, to: tuple[str, ...], speed: float | None, loop: bool
               help="Load the tracker's one-time code (SciPy's solvers, the compiled IMM "
               "rows) at start, not in the frame that first needs it (docs/live.md, Soak).")
 @tracker_options("--pd")
-@click.option("--clutter-frame", type=click.Choice(CLUTTER_FRAMES),
-              default=DEFAULT_CLUTTER_FRAME, show_default=True,
-              help="Estimate each radar's clutter in the local plane or in range and bearing.")
+@clutter_frame_option
 @birth_options
 @young_track_options
 @clutter_estimator_options

@@ -276,3 +276,7 @@ def test_the_tracking_options_go_through_the_checkpoint(rec: Path, tmp_path: Pat
     old = tmp_path / "old.npz"  # the same state without its options
     CheckpointSink(old, lambda: tracker, lambda: replace(state, options=None)).save()
     assert read_checkpoint(old, other)[1].options is None
+    bad = tmp_path / "bad.npz"  # options that are no object: named, as other fields
+    CheckpointSink(bad, lambda: tracker, lambda: replace(state, options=[1])).save()  # type: ignore[arg-type]
+    with pytest.raises(InputError, match=r"field 'extra': options \[1\] are not an object"):
+        read_checkpoint(bad, YOUNG_MAP)

@@ -91,8 +91,9 @@ def birth_options(f: Callable[..., Any]) -> Callable[..., Any]:
 
 
 def young_track_options(f: Callable[..., Any]) -> Callable[..., Any]:
-    """``--startup-density`` and ``--defer-tentative``: how the MHT treats the targets a
-    run starts on and its young trees (``docs/mht.md``; issue 30's dense scene)."""
+    """``--startup-density`` and ``--defer-tentative`` (``track``, ``run``, ``live``): how
+    the MHT treats the targets a run starts on and its young trees (``docs/mht.md``;
+    issue 30's dense scene)."""
     opts = [
         click.option("--startup-density", is_flag=True, help="Score the first scans' plots "
                      "with the density of targets not yet detected, estimated from the "

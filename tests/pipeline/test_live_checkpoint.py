@@ -22,6 +22,7 @@ pytest.importorskip("asterix.generated", reason="libasterix not installed")
 
 from sim_recording import simulated_recording  # tests/helpers
 
+from mhtrack.errors import InputError
 from mhtrack.io.sensors import read_sensors
 from mhtrack.pipeline import TrackOptions
 from mhtrack.pipeline.checkpoint import CheckpointSink, read_checkpoint
@@ -235,3 +236,47 @@ def test_a_hostile_bias_state_is_refused(biased: Path, field: str, value: object
     bad_p["P"][0][0] = -1.0
     with pytest.raises(ValueError, match="not a covariance"):
         restore_state(reg, bad_p)
+
+
+def _scores(live: Live) -> list[float]:
+    return live.pipeline.tracker.leaves.score.tolist()
+
+
+YOUNG_MAP = TrackOptions(output="online", new_target_density=1e-10, tracker="mht-map",
+                         startup_density=True, defer_tentative=True,
+                         clutter_params={"half_life": 5.0, "n_azimuth": 8})
+
+
+def test_the_tracking_options_go_through_the_checkpoint(rec: Path, tmp_path: Path) -> None:
+    """Stopped and resumed with the same non-default options (young-track, clutter
+    estimator's), the rows and the final tracks' scores are those of a run never stopped
+    with them — whose scores are not those of the defaults; resumed with other options,
+    refused naming each field; a checkpoint that kept no options (written before they
+    were kept) is not checked."""
+    blocks = _blocks(rec)
+    k = len(blocks) // 2
+    whole, w = _run(rec, blocks, track=YOUNG_MAP)
+    _, p = _run(rec, blocks)
+    assert _scores(w) != _scores(p)  # (the rows are the same on this recording)
+    ck = tmp_path / "state.npz"
+    first, _ = _run(rec, blocks[:k], stop_after=k, track=YOUNG_MAP, checkpoint=ck)
+    tracker, state = read_checkpoint(ck, YOUNG_MAP)
+    assert state.options is not None and state.options["clutter_params"] == {
+        "half_life": 5.0, "n_azimuth": 8}
+    second, two = _run(rec, blocks[k:], track=YOUNG_MAP, checkpoint=ck, resume=True)
+    assert first + second == whole
+    assert _scores(two) == _scores(w)
+    other = replace(YOUNG_MAP, defer_tentative=None, clutter_params={"half_life": 5.0})
+    with pytest.raises(InputError) as e:
+        _run(rec, blocks[k:], track=other, checkpoint=ck, resume=True)
+    assert str(e.value) == (
+        f"{ck}: written with other tracking options (clutter_params {{'half_life': 5.0, "
+        f"'n_azimuth': 8}} there, {{'half_life': 5.0}} here; defer_tentative True there, "
+        "None here): resume with the same options, or start afresh without --resume")
+    old = tmp_path / "old.npz"  # the same state without its options
+    CheckpointSink(old, lambda: tracker, lambda: replace(state, options=None)).save()
+    assert read_checkpoint(old, other)[1].options is None
+    bad = tmp_path / "bad.npz"  # options that are no object: named, as other fields
+    CheckpointSink(bad, lambda: tracker, lambda: replace(state, options=[1])).save()  # type: ignore[arg-type]
+    with pytest.raises(InputError, match=r"field 'extra': options \[1\] are not an object"):
+        read_checkpoint(bad, YOUNG_MAP)

@@ -1,7 +1,7 @@
 """``--clutter-half-life``, ``--clutter-forgetting``, ``--birth-scaling``,
 ``--map-range-cell``, ``--map-sectors``: the parameters of the trackers ``mht-map``,
 ``mht-fgmm`` and ``mht-mapgmm`` (``docs/clutter.md``), for
-``mhtrack run`` and ``mhtrack track``, turned into the ``clutter_params`` of
+``mhtrack run``, ``mhtrack track`` and ``mhtrack live``, turned into the ``clutter_params`` of
 :func:`mhtrack.build.make_tracker` (each bounded here and by the estimator)."""
 
 from __future__ import annotations

@@ -10,6 +10,7 @@ import click
 
 from mhtrack import bounds as B
 from mhtrack.cli.terminal import show_progress
+from mhtrack.names import CLUTTER_FRAMES, DEFAULT_CLUTTER_FRAME
 
 
 class InputProblem(click.ClickException):
@@ -172,6 +173,16 @@ def clutter_scene_option(f: Callable[..., Any]) -> Callable[..., Any]:
         "--clutter-scene", "clutter_scene", default=None, metavar="NAME",
         help="Rotating radars: add a changing clutter scene (weather, coastal, burst, "
              "storm; docs/clutter.md, Clutter scenes), e.g. with radars-clutter.")(f)
+
+
+def clutter_frame_option(f: Callable[..., Any]) -> Callable[..., Any]:
+    """``--clutter-frame`` (:data:`mhtrack.names.CLUTTER_FRAMES`) of ``track`` and
+    ``live``."""
+    return click.option(
+        "--clutter-frame", type=click.Choice(CLUTTER_FRAMES), default=DEFAULT_CLUTTER_FRAME,
+        show_default=True, help="Timed plots (live: every plot): estimate each radar's "
+        "clutter in the local east-north plane or in the radar's own range and bearing "
+        "(docs/clutter.md).")(f)
 
 
 def attributes_options(f: Callable[..., Any]) -> Callable[..., Any]:

@@ -6,10 +6,13 @@ from __future__ import annotations
 import math
 import threading
 from pathlib import Path
+from typing import Any
 
 import click
 
 from mhtrack.cli.asterix_commands import needs_libasterix
+from mhtrack.cli.clutter_options import clutter_estimator_options, clutter_params
+from mhtrack.cli.common import clutter_frame_option
 from mhtrack.cli.terminal import say
 from mhtrack.cli.track_commands import (
     bias_fields,
@@ -18,8 +21,9 @@ from mhtrack.cli.track_commands import (
     report_biases,
     track_options,
     tracker_options,
+    young_track_fields,
+    young_track_options,
 )
-from mhtrack.names import CLUTTER_FRAMES, DEFAULT_CLUTTER_FRAME
 
 
 class Speed(click.ParamType):
@@ -165,10 +169,10 @@ def replay(recording: Path, to: tuple[str, ...], speed: float | None, loop: bool
               help="Load the tracker's one-time code (SciPy's solvers, the compiled IMM "
               "rows) at start, not in the frame that first needs it (docs/live.md, Soak).")
 @tracker_options("--pd")
-@click.option("--clutter-frame", type=click.Choice(CLUTTER_FRAMES),
-              default=DEFAULT_CLUTTER_FRAME, show_default=True,
-              help="Estimate each radar's clutter in the local plane or in range and bearing.")
+@clutter_frame_option
 @birth_options
+@young_track_options
+@clutter_estimator_options
 @bias_options
 @needs_libasterix
 def live(listen: tuple[str, ...], stdin: str | None, sensors_file: Path,
@@ -183,7 +187,8 @@ def live(listen: tuple[str, ...], stdin: str | None, sensors_file: Path,
          birth_density: float | None, nscan: int | None, clutter_frame: str, birth: str,
          birth_theta: float | None, fusion: str | None, estimate_bias: bool = False,
          bias_reference: int | None = None, bias_init: Path | None = None,
-         bias_out: Path | None = None) -> None:
+         bias_out: Path | None = None, startup_density: bool = False,
+         defer_tentative: bool = False, **estimator_opts: Any) -> None:
     """Track ASTERIX plots arriving over UDP (or stdin) until Ctrl-C or SIGTERM."""
     from mhtrack.io.sensors import read_sensors
     from mhtrack.pipeline.live import Live, LiveOptions
@@ -192,7 +197,9 @@ def live(listen: tuple[str, ...], stdin: str | None, sensors_file: Path,
     options = track_options(tracker, tracker_pd, meas_sigma, accel_sigma, imm_accel_sigma,
                             clutter_density, birth_density, nscan, birth, birth_theta,
                             fusion, "online", clutter_frame=clutter_frame,
-                            **bias_fields(estimate_bias, bias_reference, bias_init, bias_out))
+                            **bias_fields(estimate_bias, bias_reference, bias_init, bias_out),
+                            **young_track_fields(startup_density, defer_tentative, birth),
+                            clutter_params=clutter_params(tracker, **estimator_opts))
     settings = LiveOptions(listen=listen, stdin=stdin, out_udp=out_udp, out_file=out,
                            part_frames=part_frames, json=as_json,
                            period_out_s=period_out, status_every_s=status_every,

@@ -13,6 +13,7 @@ from mhtrack.cli.clutter_options import clutter_estimator_options, clutter_param
 from mhtrack.cli.common import (
     attributes_arg,
     attributes_options,
+    clutter_frame_option,
     clutter_scene_option,
     echo_json,
     load_scenario_arg,
@@ -23,8 +24,6 @@ from mhtrack.cli.report_commands import page_options
 from mhtrack.cli.terminal import say, show_progress
 from mhtrack.names import (
     BIRTHS,
-    CLUTTER_FRAMES,
-    DEFAULT_CLUTTER_FRAME,
     DEFAULT_OUTPUT,
     DEFAULT_TRACKER,
     EVERY_PLOT,
@@ -92,8 +91,9 @@ def birth_options(f: Callable[..., Any]) -> Callable[..., Any]:
 
 
 def young_track_options(f: Callable[..., Any]) -> Callable[..., Any]:
-    """``--startup-density`` and ``--defer-tentative``: how the MHT treats the targets a
-    run starts on and its young trees (``docs/mht.md``; issue 30's dense scene)."""
+    """``--startup-density`` and ``--defer-tentative`` (``track``, ``run``, ``live``): how
+    the MHT treats the targets a run starts on and its young trees (``docs/mht.md``;
+    issue 30's dense scene)."""
     opts = [
         click.option("--startup-density", is_flag=True, help="Score the first scans' plots "
                      "with the density of targets not yet detected, estimated from the "
@@ -242,10 +242,7 @@ def track_options(tracker: str, tracker_pd: float | None, meas_sigma: float | No
 @click.option("--reorder-window", "reorder_window_s", type=click.FloatRange(min=0),
               default=None, help="Timed plots may be out of time order by at most this "
               "many seconds [2].")
-@click.option("--clutter-frame", type=click.Choice(CLUTTER_FRAMES),
-              default=DEFAULT_CLUTTER_FRAME, show_default=True, help="Timed plots: estimate "
-              "each radar's clutter in the local east-north plane or in the radar's own "
-              "range and bearing (docs/clutter.md).")
+@clutter_frame_option
 @click.option("--sector-frames", is_flag=True, help="A recording: cut frames at each "
               "radar's own CAT034 sector crossings instead of eighths of its rotation "
               "(docs/real-radar.md: measured, and why it is not the default).")

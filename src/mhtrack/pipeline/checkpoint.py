@@ -6,10 +6,12 @@ the period output, the next plot's row number (the tracker's plot windows name p
 by row: numbers must not repeat), the duplicate filter's last data blocks (their
 digests: a redundant-LAN copy late across the restart is still a copy), the plots
 received but not yet tracked (in the re-order window and in open frames) and, with
-bias estimation, its state (:mod:`~mhtrack.pipeline.registration_state`) — under
+bias estimation, its state (:mod:`~mhtrack.pipeline.registration_state`) and the
+tracking options the run was started with (:func:`options_record`) — under
 ``meta["extra"]``. A run resumed from it
 therefore makes the same frames as a run never stopped, given the same datagrams after
-the checkpoint.
+the checkpoint; a run resumed with other tracking options is refused
+(:func:`check_options`: the saved tracker would silently keep the old ones).
 
 :class:`CheckpointSink` writes one every ``every_s`` seconds **of data time** (the frames'
 times: the same input checkpoints at the same frames) and a final one when the run ends
@@ -22,7 +24,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -33,6 +35,7 @@ from mhtrack.sinks.base import FrameOutput, Sink
 
 if TYPE_CHECKING:
     from mhtrack.mht import MHTTracker
+    from mhtrack.pipeline.options import TrackOptions
 
 #: Version of the ``extra`` bookkeeping.
 LIVE_FORMAT = 1
@@ -64,6 +67,39 @@ class LiveState:
     #: :func:`~mhtrack.pipeline.registration_state.encode_state`), else ``None``.
     bias: dict[str, Any] | None = None
     format: int = LIVE_FORMAT
+    #: The tracking options of the run (:func:`options_record`; ``None``: a checkpoint
+    #: written before they were kept, not checked).
+    options: dict[str, Any] | None = None
+
+
+#: :class:`~mhtrack.pipeline.TrackOptions` fields not compared on resume: the bias prior
+#: (a resumed run continues from the checkpoint's bias state, not from a prior).
+UNCHECKED_OPTIONS = ("bias_prior",)
+
+
+def options_record(options: TrackOptions) -> dict[str, Any]:
+    """``options`` as JSON (every field but :data:`UNCHECKED_OPTIONS`), as saved in a
+    checkpoint and compared by :func:`check_options`."""
+    import json
+
+    fields = {k: v for k, v in asdict(options).items() if k not in UNCHECKED_OPTIONS}
+    return dict(json.loads(json.dumps(fields, sort_keys=True, default=str)))
+
+
+def check_options(path: str | Path, state: LiveState, options: TrackOptions) -> None:
+    """An :class:`InputError` in one line naming the checkpoint and each field that
+    differs when ``options`` are not those ``state`` was saved with (a checkpoint
+    without them is not checked)."""
+    if state.options is None:
+        return
+    now = options_record(options)
+    diff = [f"{k} {state.options.get(k)!r} there, {now.get(k)!r} here"
+            for k in sorted(set(now) | set(state.options))
+            if state.options.get(k) != now.get(k)]
+    if diff:
+        raise InputError(f"{path}: written with other tracking options ({'; '.join(diff)})"
+                         ": resume with the same options, or start afresh without "
+                         "--resume", file=str(path))
 
 
 def encode_pending(pending: dict[str, Any] | None) -> dict[str, Any] | None:
@@ -124,20 +160,26 @@ def decode_pending(saved: dict[str, Any] | None) -> dict[str, Any] | None:
 class CheckpointSink(Sink):
     """The tracker (``tracker()``, the one being stepped) and ``state()`` saved to
     ``path`` every ``every_s`` s of data time (``None``: only at the end) and when the
-    run ends. :attr:`written` counts the checkpoints."""
+    run ends, with the run's tracking ``options`` (:func:`options_record`; ``None``: the
+    state's own). :attr:`written` counts the checkpoints."""
 
     def __init__(self, path: str | Path, tracker: Callable[[], MHTTracker],
-                 state: Callable[[], LiveState], every_s: float | None = None) -> None:
+                 state: Callable[[], LiveState], every_s: float | None = None,
+                 options: TrackOptions | None = None) -> None:
         if every_s is not None and not every_s > 0:
             raise ValueError(f"checkpoint period must be > 0 s, got {every_s!r}")
         self.path, self.tracker, self.state = Path(path), tracker, state
+        self.options = None if options is None else options_record(options)
         self.every_s = math.inf if every_s is None else float(every_s)
         self.written = 0
         self._last: float | None = None
 
     def save(self) -> None:
         """Write a checkpoint now."""
-        self.tracker().save(self.path, extra=asdict(self.state()))
+        state = self.state()
+        if self.options is not None:
+            state = replace(state, options=self.options)
+        self.tracker().save(self.path, extra=asdict(state))
         self.written += 1
 
     def write(self, out: FrameOutput) -> None:
@@ -152,9 +194,11 @@ class CheckpointSink(Sink):
         self.save()
 
 
-def read_checkpoint(path: str | Path) -> tuple[MHTTracker, LiveState]:
+def read_checkpoint(path: str | Path, options: TrackOptions | None = None
+                    ) -> tuple[MHTTracker, LiveState]:
     """The tracker and the live bookkeeping of a checkpoint written by
-    :class:`CheckpointSink`; an :class:`InputError` naming the file otherwise."""
+    :class:`CheckpointSink`; an :class:`InputError` naming the file otherwise, or when
+    ``options`` are not those it was written with (:func:`check_options`)."""
     from mhtrack.build import load_tracker
     from mhtrack.io.asterix.duplicates import stream_filter
     from mhtrack.mht.state import saved_meta
@@ -166,9 +210,13 @@ def read_checkpoint(path: str | Path) -> tuple[MHTTracker, LiveState]:
                          f"format {LIVE_FORMAT}): not written by mhtrack live", file=str(path))
     try:
         state = LiveState(**extra)
+        if state.options is not None and not isinstance(state.options, dict):
+            raise ValueError(f"options {state.options!r} are not an object")
         decode_pending(state.pending)  # the plots held must read back
         if state.duplicates is not None:  # and the duplicate filter's blocks
             stream_filter().restore(state.duplicates)
     except (TypeError, ValueError, KeyError, AttributeError) as e:
         raise InputError(f"{path}: member 'meta': field 'extra': {e}", file=str(path)) from None
+    if options is not None:
+        check_options(path, state, options)
     return load_tracker(path), state

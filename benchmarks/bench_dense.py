@@ -71,6 +71,7 @@ GROUPS = {
     "numbering": ("number_nodes", "merge_by_tree", "number_and_merge"),
     "clustering": ("clustering",),
     "hypothesis (assignment)": ("best_hypothesis",),
+    "attributes": ("reply_terms", "pair_increments", "MHTTracker._attributes"),
     "confirm, history, report": ("hand_over", "confirm", "newly_confirmed", "report",
                                  "confirmed_windows", "SPRT.confirms",
                                  "TentativeHistory.backfill", "TentativeHistory.record",
@@ -130,6 +131,7 @@ def run_one(n_scans: int, seed: int, held_scans: int, gate: float,
     warm = warm_up(trk.motion)
     bench_stages.install()
     _install_clustering(bench_stages)
+    _install_attributes(bench_stages)
     trk.birth.propose = bench_stages._timed("Birth.propose", trk.birth.propose)
     trk.birth.seed = bench_stages._timed("Birth.seed", trk.birth.seed)
     step, cpus = trk.step, []
@@ -175,6 +177,25 @@ def _install_clustering(bench_stages: object) -> None:
     for name in ("tree_clusters", "dense_index", "plot_keys", "raw_plot_keys"):
         if hasattr(H, name):
             setattr(H, name, bench_stages._timed("clustering", getattr(H, name)))
+    try:  # the global hypothesis called through the frame scope (not the tracker's name)
+        import mhtrack.mht.frame_scope as F
+    except ImportError:
+        return
+    if hasattr(F, "best_hypothesis"):
+        F.best_hypothesis = bench_stages._timed("best_hypothesis", F.best_hypothesis)
+
+
+def _install_attributes(bench_stages: object) -> None:
+    """Time, as ``attributes``, the attributes' likelihood ratios and the leaves'
+    vertical states, codes and addresses (the tracker's names; absent: nothing)."""
+    import mhtrack.mht.tracker as T
+
+    for name in ("reply_terms", "pair_increments"):
+        if hasattr(T, name):
+            setattr(T, name, bench_stages._timed(name, getattr(T, name)))
+    if hasattr(T.MHTTracker, "_attributes"):
+        T.MHTTracker._attributes = bench_stages._timed("MHTTracker._attributes",
+                                                       T.MHTTracker._attributes)
 
 
 def warm_up(motion: object) -> float:

@@ -11,6 +11,15 @@ scan (``output="online"``: what a live tracker sends) and the aircraft are paire
 one by a minimum-distance assignment (``scipy.optimize.linear_sum_assignment``) among the
 pairs within ``--gate`` m (300 m: 3 σ); an aircraft is held when it is paired at every one
 of those scans. ``held_one_id``: held, by the same track id at every one of those scans.
+``held_history``: the same over the **history** view (the rows back-filled when a track is
+confirmed included: ``output="history"``; the online view is its rows with ``tentative``
+false, so one run gives both).
+
+``--attributes``: the same scene and seed with secondary-radar attributes on the plots, as
+``mhtrack simulate --attributes`` draws them (:func:`mhtrack.scenario.identity.
+with_attributes`: per aircraft a Mode S address, a Mode 3/A code and a flight level; per
+detection 5 % primary only, 10 % secondary only, 2 % garbled; clutter plots primary, no
+reply); positions, times and origins unchanged.
 
 Time: ``StepStats.seconds`` (the tracker's ``step`` alone, wall), median over all scans and
 mean over the last ``--held-scans``; per stage, CPU time of the tracker's stage functions
@@ -25,7 +34,7 @@ its defaults), e.g. ``'{"startup_density": true}'`` (issue 30's start-up density
 ``--ours-config`` run as several sides of ours.
 
 Run: ``python benchmarks/bench_dense.py [--repeat 3] [--reference REV] [--scans 20]
-[--ours-config JSON ...]``.
+[--seed S] [--attributes] [--ours-config JSON ...]``.
 """
 
 from __future__ import annotations
@@ -62,6 +71,7 @@ GROUPS = {
     "numbering": ("number_nodes", "merge_by_tree", "number_and_merge"),
     "clustering": ("clustering",),
     "hypothesis (assignment)": ("best_hypothesis",),
+    "attributes": ("reply_terms", "pair_increments", "MHTTracker._attributes"),
     "confirm, history, report": ("hand_over", "confirm", "newly_confirmed", "report",
                                  "confirmed_windows", "SPRT.confirms",
                                  "TentativeHistory.backfill", "TentativeHistory.record",
@@ -96,8 +106,9 @@ def held(tracks: object, truth: object, scans: list[int], gate: float) -> tuple[
 
 
 def run_one(n_scans: int, seed: int, held_scans: int, gate: float,
-            config: dict | None = None) -> dict:
-    """The scene on the library on ``sys.path``, in this process: the figures."""
+            config: dict | None = None, attributes: bool = False) -> dict:
+    """The scene on the library on ``sys.path``, in this process: the figures
+    (``attributes``: the plots with secondary-radar attributes, module docstring)."""
     import dataclasses
     import logging
 
@@ -111,11 +122,16 @@ def run_one(n_scans: int, seed: int, held_scans: int, gate: float,
     n_targets, rate, name = SCENES["big"]
     sc = scene(n_targets, rate, n_scans)
     sim = simulate(sc, seed=seed)
+    if attributes:
+        from mhtrack.scenario.identity import with_attributes
+
+        sim = with_attributes(sim)
     cfg = dataclasses.replace(default_config(sc), scale_caps=True, **(config or {}))
     trk = make_tracker(name, cfg, clutter_density=rate / sc.region.area)
     warm = warm_up(trk.motion)
     bench_stages.install()
     _install_clustering(bench_stages)
+    _install_attributes(bench_stages)
     trk.birth.propose = bench_stages._timed("Birth.propose", trk.birth.propose)
     trk.birth.seed = bench_stages._timed("Birth.seed", trk.birth.seed)
     step, cpus = trk.step, []
@@ -130,11 +146,12 @@ def run_one(n_scans: int, seed: int, held_scans: int, gate: float,
     trk.step = timed_step
     bench_stages.ACC.clear()
     c0 = time.process_time()
-    run = track(trk, sim.plots, name=name, output="online")
+    run = track(trk, sim.plots, name=name, output="history")
     cpu = time.process_time() - c0
     sec = np.asarray(run.seconds_per_scan)
     last = sorted(np.unique(sim.truth.scan))[-held_scans:]
-    h, h1 = held(run.tracks, sim.truth, [int(s) for s in last], gate)
+    h, h1 = held(run.tracks.online(), sim.truth, [int(s) for s in last], gate)
+    hh, hh1 = held(run.tracks, sim.truth, [int(s) for s in last], gate)
     n_air = int(np.unique(sim.truth.target_id).size)
     stages = {g: sum(bench_stages.ACC.get(f, 0.0) for f in fs) / n_scans
               for g, fs in GROUPS.items()}
@@ -142,6 +159,7 @@ def run_one(n_scans: int, seed: int, held_scans: int, gate: float,
     stages["other (step CPU − stages)"] = (
         cpu / n_scans - sum(stages.values()))  # track()'s own work is in there too
     return {"held": h / n_air, "held_one_id": h1 / n_air, "aircraft": n_air,
+            "held_history": hh / n_air, "held_history_one_id": hh1 / n_air,
             "s_per_scan_median": float(np.median(sec)),
             "s_per_scan_last": float(sec[-held_scans:].mean()),
             "cpu_per_scan": cpu / n_scans,
@@ -159,6 +177,25 @@ def _install_clustering(bench_stages: object) -> None:
     for name in ("tree_clusters", "dense_index", "plot_keys", "raw_plot_keys"):
         if hasattr(H, name):
             setattr(H, name, bench_stages._timed("clustering", getattr(H, name)))
+    try:  # the global hypothesis called through the frame scope (not the tracker's name)
+        import mhtrack.mht.frame_scope as F
+    except ImportError:
+        return
+    if hasattr(F, "best_hypothesis"):
+        F.best_hypothesis = bench_stages._timed("best_hypothesis", F.best_hypothesis)
+
+
+def _install_attributes(bench_stages: object) -> None:
+    """Time, as ``attributes``, the attributes' likelihood ratios and the leaves'
+    vertical states, codes and addresses (the tracker's names; absent: nothing)."""
+    import mhtrack.mht.tracker as T
+
+    for name in ("reply_terms", "pair_increments"):
+        if hasattr(T, name):
+            setattr(T, name, bench_stages._timed(name, getattr(T, name)))
+    if hasattr(T.MHTTracker, "_attributes"):
+        T.MHTTracker._attributes = bench_stages._timed("MHTTracker._attributes",
+                                                       T.MHTTracker._attributes)
 
 
 def warm_up(motion: object) -> float:
@@ -207,7 +244,7 @@ def on_library(src: Path, a: argparse.Namespace, config: str = "{}") -> dict:
     env = {**os.environ, "PYTHONPATH": str(src)}
     cmd = [sys.executable, __file__, "--one", "--scans", str(a.scans), "--seed",
            str(a.seed), "--held-scans", str(a.held_scans), "--gate", str(a.gate),
-           "--config", config]
+           "--config", config] + (["--attributes"] if a.attributes else [])
     out = subprocess.run(cmd, env=env, capture_output=True, text=True, check=True)
     return json.loads(out.stdout.strip().splitlines()[-1])
 
@@ -222,12 +259,14 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--reference", default=REFERENCE, help="git revision (or 'none')")
     ap.add_argument("--ours-config", action="append", default=None, metavar="JSON",
                     help="MHTConfig fields changed on our side (repeatable: one side each)")
+    ap.add_argument("--attributes", action="store_true",
+                    help="plots with secondary-radar attributes (module docstring)")
     ap.add_argument("--config", default="{}", help=argparse.SUPPRESS)  # --one's
     ap.add_argument("--one", action="store_true", help="this process, JSON out")
     a = ap.parse_args(argv)
     if a.one:
         print(json.dumps(run_one(a.scans, a.seed, a.held_scans, a.gate,
-                                 json.loads(a.config))))
+                                 json.loads(a.config), a.attributes)))
         return 0
     sides = {("ours" if c == "{}" else f"ours {c}"): (ROOT / "src", c)
              for c in (a.ours_config or ["{}"])}
@@ -238,17 +277,21 @@ def main(argv: list[str] | None = None) -> int:
         for k, (src, config) in sides.items():
             runs[k].append(on_library(src, a, config))
     print(f"dense scene: 1 000 aircraft x 5 000 clutter/scan, P_D 0.9, {a.scans} scans, "
-          f"seed {a.seed}; held over the last {a.held_scans} scans within {a.gate:g} m; "
+          f"seed {a.seed}{', SSR attributes' if a.attributes else ''}; held over the last "
+          f"{a.held_scans} scans within {a.gate:g} m; "
           f"median of {a.repeat} runs each, in turn")
     med = {}
     for k, rs in runs.items():
         med[k] = m = {key: statistics.median(r[key] for r in rs) for key in
-                      ("held", "held_one_id", "s_per_scan_median", "s_per_scan_last",
+                      ("held", "held_one_id", "held_history", "held_history_one_id",
+                       "s_per_scan_median", "s_per_scan_last",
                        "cpu_per_scan", "cpu_step_median", "cpu_step_last")}
         m["stages"] = {g: statistics.median(r["stages"][g] for r in rs)
                        for g in rs[0]["stages"]}
         each = ", ".join(f"{r['s_per_scan_median']:.3f}" for r in rs)
-        print(f"  {k}\n  {'':20s} held {m['held']:.3f} (one id {m['held_one_id']:.3f}), "
+        print(f"  {k}\n  {'':20s} held {m['held']:.3f} (one id {m['held_one_id']:.3f}; "
+              f"history view {m['held_history']:.3f}, one id "
+              f"{m['held_history_one_id']:.3f}), "
               f"{m['s_per_scan_median']:.3f} s/scan median (last {a.held_scans}: "
               f"{m['s_per_scan_last']:.3f}; all runs "
               f"{each}), "

@@ -17,8 +17,12 @@ here. An aircraft is
   scan (a confirmed tree whose best leaf is ≤ 0 is left out of the global hypothesis and
   not reported).
 
+``--attributes``: the plots with secondary-radar attributes as ``bench_dense.py
+--attributes`` draws them (:func:`mhtrack.scenario.identity.with_attributes`), so that each
+branch's score also holds the attributes' likelihood ratios.
+
 Run: ``PYTHONPATH=src python benchmarks/dense_bound.py [--scans 20] [--held-scans 10]
-[--seed 1] [--config JSON]``.
+[--seed 1] [--config JSON] [--attributes]``.
 """
 
 from __future__ import annotations
@@ -41,7 +45,8 @@ THRESHOLDS = (None, 3.0, 2.0, 1.0, 0.0)
 def only(plots: object, rows: np.ndarray) -> object:
     """The :class:`~mhtrack.records.PlotTable` of ``rows`` (mask) of ``plots``."""
     n = rows.size
-    return dataclasses.replace(plots, **{
+    attrs = None if plots.attrs is None else plots.attrs.take(np.flatnonzero(rows))
+    return dataclasses.replace(plots, attrs=attrs, **{
         f.name: getattr(plots, f.name)[rows] for f in dataclasses.fields(plots)
         if isinstance(getattr(plots, f.name), np.ndarray)
         and getattr(plots, f.name).shape[:1] == (n,)})
@@ -59,11 +64,17 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--scans", type=int, default=20)
     ap.add_argument("--held-scans", type=int, default=10)
+    ap.add_argument("--attributes", action="store_true",
+                    help="plots with secondary-radar attributes (module docstring)")
     a = ap.parse_args(argv)
     logging.getLogger("mhtrack").setLevel(logging.ERROR)
     n, rate, name = SCENES["big"]
     sc = scene(n, rate, a.scans)
     sim = simulate(sc, seed=a.seed)
+    if a.attributes:
+        from mhtrack.scenario.identity import with_attributes
+
+        sim = with_attributes(sim)
     kappa = rate / sc.region.area
     cfg = dataclasses.replace(default_config(sc), scale_caps=True, **json.loads(a.config))
     trk = make_tracker(name, cfg, clutter_density=kappa)
@@ -104,6 +115,7 @@ def main(argv: list[str] | None = None) -> int:
                      "kept_over_held_scans": float(kept.mean()),
                      "confirmable_by_last_scan": float(reached[-1].mean())})
     print(json.dumps({"config": json.loads(a.config), "seed": a.seed, "scans": a.scans,
+                      "attributes": a.attributes,
                       "held_scans": a.held_scans, "aircraft": int(ids.size),
                       "bounds": rows}))
     return 0

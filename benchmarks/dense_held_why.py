@@ -5,7 +5,11 @@ into first covered after the first held scan ("late") and covered by then with a
 and at each gap where the aircraft was detected, whether its track (the id it had before)
 was reported farther than the gate or not reported at all.
 
-Run: ``PYTHONPATH=src python benchmarks/dense_held_why.py [--config JSON] [--seed 1]``.
+``--attributes``: the plots with secondary-radar attributes (``bench_dense.py
+--attributes``).
+
+Run: ``PYTHONPATH=src python benchmarks/dense_held_why.py [--config JSON] [--seed 1]
+[--attributes]``.
 """
 
 from __future__ import annotations
@@ -39,11 +43,17 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--scans", type=int, default=20)
     ap.add_argument("--held-scans", type=int, default=10)
     ap.add_argument("--gate", type=float, default=300.0)
+    ap.add_argument("--attributes", action="store_true",
+                    help="plots with secondary-radar attributes (module docstring)")
     a = ap.parse_args(argv)
     logging.getLogger("mhtrack").setLevel(logging.ERROR)
     n, rate, name = SCENES["big"]
     sc = scene(n, rate, a.scans)
     sim = simulate(sc, seed=a.seed)
+    if a.attributes:
+        from mhtrack.scenario.identity import with_attributes
+
+        sim = with_attributes(sim)
     cfg = dataclasses.replace(default_config(sc), scale_caps=True, **json.loads(a.config))
     trk = make_tracker(name, cfg, clutter_density=rate / sc.region.area)
     c0 = time.process_time()
@@ -90,7 +100,8 @@ def main(argv: list[str] | None = None) -> int:
                 gaps["reported within the gate, paired elsewhere"] += 1
     covered = (by >= 0).sum(axis=1).tolist()
     print(json.dumps({
-        "config": json.loads(a.config), "seed": a.seed, "held": float(held.mean()),
+        "config": json.loads(a.config), "seed": a.seed, "attributes": a.attributes,
+        "held": float(held.mean()),
         "cpu_per_scan": cpu, "covered_per_scan": covered,
         "unpaired_confirmed_rows_mean_held_scans": float(np.mean(unpaired[h0:])),
         "track_ids": int(np.unique(R.track_id).size), "not_held": int(bad.size),

@@ -160,6 +160,27 @@ def test_state_round_trip_and_hostile_states() -> None:
             ForgettingGMMClutter(**kw)
 
 
+def test_a_radar_scale_state_is_restored_and_huge_moments_refused() -> None:
+    """Clutter spread over a 250 km radar's reach (σ 60 km): fourth moments ~10²⁰ per
+    plot, far beyond a fixed ±1e15 bound — the saved state must restore (a checkpoint of
+    ``live --tracker mht-fgmm`` on real coordinates was refused); an infinite or absurd
+    moment is still refused."""
+    rng = np.random.default_rng(3)
+    a, b = ForgettingGMMClutter(), ForgettingGMMClutter()
+    for k in range(4):
+        a.update(_scan(k, rng.normal((120e3, -80e3), 60e3, (200, 2))))
+    good = a.get_state()
+    assert np.abs(good["moments"]).max() > 1e15
+    b.set_state(good)
+    q = rng.uniform(-250e3, 250e3, (50, 2))
+    assert np.array_equal(a.intensity(q), b.intensity(q))
+    for bad_value in (np.inf, np.nan, 1e60):
+        bad = good["moments"].copy()
+        bad[0, 10] = bad_value  # a fourth-order column
+        with pytest.raises(ValueError, match="moments"):
+            ForgettingGMMClutter().set_state({**good, "moments": bad})
+
+
 def test_forget_takes_the_tracks_plots_out_of_count_and_statistics() -> None:
     """``M̂`` after forgetting m of the last scan's n plots is ``(γC + n − m)/N``; the
     statistics lose exactly the responsibilities of those plots (total mass)."""

@@ -146,7 +146,9 @@ class FrameScope:
         self._count(frame, hyp.n_greedy, hyp.n_node_limited)
         # the store's trees: clean groups numbered first (as ranked), the scope's after
         tree_group = np.empty(tree.size, np.int64)
-        tree_group[~dirty_tree] = np.searchsorted(clean_g, group[~dirty_tree])
+        rank = np.zeros(old.dirty.size if old is not None else 0, np.int64)
+        rank[clean_g] = np.arange(clean_g.size)  # a table, not a binary search
+        tree_group[~dirty_tree] = rank[group[~dirty_tree]]
         tree_group[dirty_tree] = clean_g.size + g_new
         if old is None or rows is None:
             self._pending = _Groups(tree, tree_group, n_cl, largest, capped)
@@ -163,15 +165,21 @@ class FrameScope:
                       cut_clusters=np.zeros(0, np.int64))
         return hyp, Scope(rows, local)
 
-    def pruned(self, before: Leaves, after: Leaves) -> None:
-        """After pruning ``before`` to ``after``: the groups of the trees kept; those that
-        lost leaves (N-scan or the cap on trees) are solved again at the next frame."""
+    def pruned(self, before: Leaves, after: Leaves, kept: np.ndarray | None = None) -> None:
+        """After pruning ``before`` to ``after`` (``kept``: the rows of ``before`` kept,
+        ascending, when known; ``None``: found from the node ids): the groups of the trees
+        kept; those that lost leaves (N-scan or the cap on trees) are solved again at the
+        next frame."""
         pend, self._pending = self._pending, None
         if pend is None:
             return
         dirty = pend.dirty
         if len(after) < len(before):
-            lost = ~contains(after.node, before.node)  # node ids span the run: no table
+            if kept is None:
+                lost = ~contains(after.node, before.node)  # node ids span the run
+            else:
+                lost = np.ones(len(before), bool)
+                lost[kept] = False
             leaf_group = np.repeat(pend.group, segment_sizes(segment_starts(before.tree),
                                                              len(before)))
             dirty = dirty.copy()
@@ -230,7 +238,7 @@ def _scope_trees(leaves: Leaves, old: _Groups, tree: np.ndarray, starts: np.ndar
     plots = plots[plots != NO_PLOT]
     if plots.size and not in_scope.all():
         clean = (~in_scope).nonzero()[0]
-        hit = np.isin(w.take(clean, axis=0), plots).any(axis=1)  # a table if small
+        hit = contains(plots, w.take(clean, axis=0)).any(axis=1)  # sort the few plots
         if hit.any():
             gdirty[np.repeat(group, size)[clean[hit]]] = True
             dirty_tree = ~carried | gdirty[group]

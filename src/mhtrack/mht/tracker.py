@@ -8,6 +8,7 @@ tracks on air, the caps' counters) where it needs more than its own arrays::
                 context.FrameContext.of           scaled to its plots and tracks (caps)
     look        coverage.Coverage,              P_D of each leaf (0: sensor did not look);
                 timed.split_looked                trees the frame steps, others carried
+                                                  (rows of the store, not copied)
     predict     predict.predict_leaves          all leaves to the scan time (motion model)
     gate        timed.gate_looked               every leaf against every plot (each at
                                                   its plot's own time), ln p(z|T)
@@ -19,7 +20,8 @@ tracks on air, the caps' counters) where it needs more than its own arrays::
                                                   the (costly) update
     grow        extend.grow_children            the children's filter update
     births      births.Birth.seed,              the new trees, with tree ids; leaf ids for
-                numbering.number_and_merge        the history links; idle trees merged back
+                carry.number_frame                the history links; idle trees merged back
+                                                  (states deferred: copied once, at prune)
     hypothesis  frame_scope.FrameScope.solve    clusters → best compatible leaves (the
                                                   groups of trees the frame touched)
     prune       pruning.prune_after_solve       N-scan: decide scan k − N (in that
@@ -64,6 +66,7 @@ from mhtrack.mht.attribute_scores import (
 )
 from mhtrack.mht.births import Birth, default_birth
 from mhtrack.mht.caps import CapWarnings
+from mhtrack.mht.carry import Carried, Merged, number_frame
 from mhtrack.mht.config import MHTConfig
 from mhtrack.mht.context import FrameContext
 from mhtrack.mht.coverage import Coverage, Everywhere, Looks
@@ -73,9 +76,9 @@ from mhtrack.mht.gating import Gate, plots_in_confirmed_gates
 from mhtrack.mht.history import TentativeHistory
 from mhtrack.mht.identity import Reported, confirm, hand_over, newly_confirmed
 from mhtrack.mht.intensity import clutter_intensity
-from mhtrack.mht.numbering import Counter, number_and_merge
+from mhtrack.mht.numbering import Counter
 from mhtrack.mht.predict import predict_leaves
-from mhtrack.mht.pruning import prune_after_solve, prune_children, removed_after_solve
+from mhtrack.mht.pruning import kept_after_solve, prune_children, removed_after_solve, take_kept
 from mhtrack.mht.report import StepStats, confirmed_windows, report
 from mhtrack.mht.resume import AddressBook
 from mhtrack.mht.scoring import miss_increment, miss_increments, update_increment
@@ -216,10 +219,10 @@ class MHTTracker:
             grown, births = self._attributes(f, attrs, grown, births, children.plot)
         leaves, parts, first_node = self._number(grown, births, idle)
         hyp, scope = self.scope.solve(f, leaves, first_node)
-        solved, leaves = leaves, prune_after_solve(
-            f, leaves, hyp.leaves, by_id=self.coverage.per_tree_looks, scope=scope,
-            remove=removed_after_solve(leaves, hyp, self.config), parts=parts)
-        self.scope.pruned(solved, leaves)
+        kept = kept_after_solve(f, leaves, hyp.leaves, by_id=self.coverage.per_tree_looks,
+                                scope=scope, remove=removed_after_solve(leaves, hyp, self.config))
+        solved, leaves = leaves, take_kept(leaves, kept, hyp.leaves, parts)
+        self.scope.pruned(solved, leaves, kept)
         stepped = None if len(idle) == 0 else leaves.node >= first_node
         leaves = self._confirm(f, leaves)
         out = self._report(f, leaves, stepped)
@@ -268,15 +271,13 @@ class MHTTracker:
             births = replace(births, level=level, ident=ident)
         return grown, births
 
-    def _number(self, grown: Leaves, births: Leaves, idle: Leaves
-                ) -> tuple[Leaves, tuple[Leaves, Leaves] | None, int]:
+    def _number(self, grown: Leaves, births: Leaves, idle: Carried | Leaves
+                ) -> tuple[Leaves, tuple[Leaves, Leaves] | Merged | None, int]:
         """Node ids for the new leaves (the history's links) and the idle trees merged
-        back: ``(leaves, parts, first new node id)``; ``parts`` the two stores ``leaves``
-        defers the concatenation of (``None``: concatenated)."""
+        back: ``(leaves, parts, first new node id)``; ``parts`` what the states ``leaves``
+        defers are copied from at pruning (:func:`~mhtrack.mht.carry.number_frame`)."""
         first_node = self.nodes.next
-        parts = (grown, births) if len(idle) == 0 and len(births) else None
-        leaves = number_and_merge(grown, births, idle, self.nodes, parts is not None)
-        return leaves, parts, first_node
+        return *number_frame(grown, births, idle, self.nodes), first_node
 
     def _confirm(self, frame: FrameContext, leaves: Leaves) -> Leaves:
         """Hand over track ids that follow their plots, confirm by the SPRT (new track ids),

@@ -238,7 +238,7 @@ def _scope_trees(leaves: Leaves, old: _Groups, tree: np.ndarray, starts: np.ndar
     plots = plots[plots != NO_PLOT]
     if plots.size and not in_scope.all():
         clean = (~in_scope).nonzero()[0]
-        hit = contains(plots, w.take(clean, axis=0)).any(axis=1)  # sort the few plots
+        hit = np.isin(w.take(clean, axis=0), plots).any(axis=1)  # a table if small
         if hit.any():
             gdirty[np.repeat(group, size)[clean[hit]]] = True
             dirty_tree = ~carried | gdirty[group]

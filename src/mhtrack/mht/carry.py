@@ -71,6 +71,7 @@ class Merged:
         n_out = len(leaves) if rows is None else rows.size
         g = int(new_rows.searchsorted(len(self.grown)))
         ga, gb = new_rows[:g], new_rows[g:] - len(self.grown)
+        source = _source(n_out, at_idle, src)
         cols = {}
         for f in FIELDS:
             if f in columns:
@@ -79,14 +80,30 @@ class Merged:
                 col = getattr(leaves, f)
                 cols[f] = col if rows is None else col.take(rows, axis=0)
                 continue
-            a, b, c = getattr(self.grown, f), getattr(self.births, f), getattr(
-                self.carried.store, f)
-            out = np.empty((n_out, *c.shape[1:]), np.result_type(a, b, c))
+            a, b = getattr(self.grown, f), getattr(self.births, f)
+            out = _gather(getattr(self.carried.store, f), source, a, b)
             out[at_new[:g]] = a.take(ga, axis=0)
             out[at_new[g:]] = b.take(gb, axis=0)
-            out[at_idle] = c.take(src, axis=0)
             cols[f] = out
         return Leaves(**cols, **columns)
+
+
+def _source(n: int, at_idle: np.ndarray, src: np.ndarray) -> np.ndarray:
+    """Per row of a store of ``n`` rows: the carried store's row it reads (``src`` at
+    ``at_idle``; 0 elsewhere: a row the grown or new leaves then overwrite)."""
+    source = np.zeros(n, np.int64)
+    source[at_idle] = src
+    return source
+
+
+def _gather(c: np.ndarray, source: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """``c``'s rows ``source``, in the type of the three parts' column (one gather of
+    the carried rows, the bulk; the few other rows are written after)."""
+    dtype = np.result_type(a, b, c)
+    if c.shape[0] == 0:  # nothing carried: every row written after
+        return np.empty((source.size, *c.shape[1:]), dtype)
+    out = c.take(source, axis=0)
+    return out if out.dtype == dtype else out.astype(dtype)
 
 
 def merge_carried(grown: Leaves, births: Leaves, carried: Carried, nodes: Counter
@@ -106,16 +123,16 @@ def merge_carried(grown: Leaves, births: Leaves, carried: Carried, nodes: Counte
     at_new = np.arange(n_new) + np.searchsorted(idle_tree, new_tree, side="left")
     at_idle = np.arange(src.size) + np.searchsorted(new_tree, idle_tree, side="right")
     n = n_new + src.size
+    source = _source(n, at_idle, src)
     out = {}
     for f in FIELDS:
         a, b, c = getattr(grown, f), getattr(births, f), getattr(store, f)
         if f in STATE:
             out[f] = placeholder((n, *c.shape[1:]))
             continue
-        col = np.empty((n, *c.shape[1:]), np.result_type(a, b, c))
+        col = _gather(c, source, a, b)
         col[at_new[:len(a)]] = a
         col[at_new[len(a):]] = b
-        col[at_idle] = c.take(src, axis=0)
         out[f] = col
     out["node"][at_new] = np.arange(first, first + n_new, dtype=np.int64)
     return Leaves(**out), Merged(grown, births, carried, at_new, at_idle)

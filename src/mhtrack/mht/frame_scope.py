@@ -102,7 +102,7 @@ class FrameScope:
         idle = leaves.node < first_node
         if not self.applies or not idle.any():
             self._groups = None  # every tree stepped: nothing to carry
-            hyp = self._best(leaves)
+            hyp = self._best(leaves.score, leaves.tree, leaves.window)
             self._count(frame, hyp.n_greedy, hyp.n_node_limited)
             return hyp, Scope(None, hyp.leaves)
         starts = segment_starts(leaves.tree)
@@ -116,12 +116,14 @@ class FrameScope:
             group, dirty_tree = found
         in_scope = np.repeat(dirty_tree, size)
         rows = None if dirty_tree.all() else in_scope.nonzero()[0]
-        sub = leaves if rows is None else leaves.take(rows)
-        hyp = self._best(sub)
+        # the columns the solve reads, of the scope's rows only
+        score, tree_s, window = (leaves.score, leaves.tree, leaves.window) if rows is None \
+            else (leaves.score.take(rows), leaves.tree.take(rows), leaves.window.take(rows, 0))
+        hyp = self._best(score, tree_s, window)
         local = hyp.leaves
         # the scope's groups (components over all its leaves) and their clusters
-        t_index = dense_index(sub.tree)
-        g_new = tree_clusters(t_index, *raw_plot_keys(sub.window, by_id=True))
+        t_index = dense_index(tree_s)
+        g_new = tree_clusters(t_index, *raw_plot_keys(window, by_id=True))
         n_g = int(g_new.max()) + 1 if g_new.size else 0
         on = (hyp.leaf_cluster >= 0).nonzero()[0]
         cl = hyp.leaf_cluster[on]
@@ -194,9 +196,10 @@ class FrameScope:
                                dirty[used])
 
     # ------------------------------------------------------------------ helpers
-    def _best(self, leaves: Leaves) -> GlobalHypothesis:
+    def _best(self, score: np.ndarray, tree: np.ndarray, window: np.ndarray
+              ) -> GlobalHypothesis:
         cfg = self.config
-        return best_hypothesis(leaves.score, leaves.tree, leaves.window, cfg.max_cluster_size,
+        return best_hypothesis(score, tree, window, cfg.max_cluster_size,
                                cfg.milp_node_limit, by_id=self.by_id, n_best=cfg.n_best)
 
     @staticmethod
@@ -237,9 +240,23 @@ def _scope_trees(leaves: Leaves, old: _Groups, tree: np.ndarray, starts: np.ndar
     plots = w[in_scope].ravel()
     plots = plots[plots != NO_PLOT]
     if plots.size and not in_scope.all():
-        clean = (~in_scope).nonzero()[0]
-        hit = np.isin(w.take(clean, axis=0), plots).any(axis=1)  # a table if small
+        hit = _uses(w, plots) & ~in_scope
         if hit.any():
-            gdirty[np.repeat(group, size)[clean[hit]]] = True
+            gdirty[np.repeat(group, size)[hit]] = True
             dirty_tree = ~carried | gdirty[group]
     return group, dirty_tree
+
+
+def _uses(window: np.ndarray, plots: np.ndarray) -> np.ndarray:
+    """Mask over the rows of ``window`` (L, W): the row holds one of ``plots`` (ids ≥ 0).
+    A table over the plots' span when it is small against the window (ids outside it
+    read a ``False`` cell), else ``np.isin``."""
+    lo, hi = int(plots.min()), int(plots.max())
+    span = hi - lo + 1
+    if span > 4 * window.size + 1024:
+        return np.isin(window, plots).any(axis=1)
+    table = np.zeros(span + 1, bool)  # the last cell: every id outside the span
+    table[plots - lo] = True
+    at = window - lo
+    at[(at < 0) | (at >= span)] = span
+    return table[at].any(axis=1)

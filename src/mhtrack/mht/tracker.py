@@ -8,7 +8,6 @@ tracks on air, the caps' counters) where it needs more than its own arrays::
                 context.FrameContext.of           scaled to its plots and tracks (caps)
     look        coverage.Coverage,              P_D of each leaf (0: sensor did not look);
                 timed.split_looked                trees the frame steps, others carried
-                                                  (rows of the store, not copied)
     predict     predict.predict_leaves          all leaves to the scan time (motion model)
     gate        timed.gate_looked               every leaf against every plot (each at
                                                   its plot's own time), ln p(z|T)
@@ -21,11 +20,10 @@ tracks on air, the caps' counters) where it needs more than its own arrays::
     grow        extend.grow_children            the children's filter update
     births      births.Birth.seed,              the new trees, with tree ids; leaf ids for
                 carry.number_frame                the history links; idle trees merged back
-                                                  (states deferred: copied once, at prune)
     hypothesis  frame_scope.FrameScope.solve    clusters → best compatible leaves (the
                                                   groups of trees the frame touched)
-    prune       pruning.prune_after_solve       N-scan: decide scan k − N (in that
-                                                  scope); cap on trees
+    prune       pruning.kept_after_solve,       N-scan: decide scan k − N (in that
+                pruning.take_kept                 scope); cap on trees; states copied once
     confirm     identity.hand_over,             a track follows its plots; SPRT (or
                 sprt.SPRT.confirms,               M-of-N) confirmation → new track ids;
                 history.TentativeHistory          the tentative past of new tracks

@@ -38,8 +38,9 @@ import mhtrack.mht.tracker as T  # noqa: E402
 STAGES = ["validate_scan", "predict_leaves", "gate_looked",
           "plots_in_confirmed_gates", "clutter_intensity", "update_increment",
           "miss_increments", "propose_children", "prune_children", "grow_children",
-          "number_nodes", "merge_by_tree", "number_and_merge", "best_hypothesis",
-          "removed_after_solve", "prune_after_solve", "hand_over", "confirm",
+          "number_nodes", "merge_by_tree", "number_and_merge", "number_frame", "best_hypothesis",
+          "removed_after_solve", "prune_after_solve", "kept_after_solve", "take_kept",
+          "hand_over", "confirm",
           "newly_confirmed", "report", "confirmed_windows"]
 ACC: dict[str, float] = {}
 

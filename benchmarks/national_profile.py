@@ -73,7 +73,9 @@ STAGE_FUNCS = (
     ("  number and merge", "_number", "mht/tracker.py"),
     ("  global hypothesis", "_hypothesis", "mht/tracker.py"),  # before the frame scope
     ("  global hypothesis (frame scope)", "solve", "mht/frame_scope.py"),
-    ("  N-scan pruning", "prune_after_solve", "mht/pruning.py"),
+    ("  N-scan pruning", "prune_after_solve", "mht/pruning.py"),  # before the carried rows
+    ("  N-scan pruning (rows kept)", "kept_after_solve", "mht/pruning.py"),
+    ("  store after the frame (states copied)", "take_kept", "mht/pruning.py"),
     ("  confirm", "_confirm", "mht/tracker.py"),
     ("  report", "_report", "mht/tracker.py"),
     ("  statistics", "of", "mht/"),

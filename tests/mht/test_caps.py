@@ -8,6 +8,7 @@ import logging
 import tracemalloc
 
 import numpy as np
+import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
@@ -157,3 +158,26 @@ def test_the_tree_floor_counts_only_rotating_sensors():
     assert RadarCoverage(still).n_sensors == 1
     assert scaled_limits(DEFAULT, 70, 400, n_sensors=RadarCoverage(mixed).n_sensors)[
         "max_trees"] == 2 * DEFAULT.max_trees
+
+
+@pytest.mark.parametrize("n_plots,n_tracks,n_sensors", [(0, 0, 1), (7, 3, 1), (400, 2_000, 30),
+                                                        (10**6, 10**5, 4)])
+def test_scan_config_equals_replace(n_plots, n_tracks, n_sensors):
+    """The per-frame copy without the configuration's checks equals
+    ``dataclasses.replace`` (which runs them) field for field."""
+    from mhtrack.mht.caps import scaled_limits, scan_config
+
+    for cfg in (MHTConfig(), MHTConfig(max_trees=3, max_leaves=50, max_births_per_scan=2)):
+        got = scan_config(cfg, n_plots, n_tracks, n_sensors)
+        lim = scaled_limits(cfg, n_plots, n_tracks, n_sensors)
+        assert got == dataclasses.replace(cfg, **lim)
+        assert {k: getattr(got, k) for k in lim} == lim
+
+
+def test_scan_config_still_refuses_a_floor_out_of_range():
+    from mhtrack.bounds import MAX_INDEX
+    from mhtrack.mht.caps import scan_config
+
+    cfg = MHTConfig(max_trees=MAX_INDEX // 2, max_leaves=MAX_INDEX)
+    with pytest.raises(ValueError, match="max_trees"):
+        scan_config(cfg, 5, 0, 30)  # 30 sensors × the floor: beyond MAX_INDEX

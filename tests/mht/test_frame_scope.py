@@ -107,3 +107,19 @@ def test_a_restored_tracker_solves_all_first_and_continues_alike(tmp_path):
     out += [back.step(s) for s in scans[150:]]
     for a, b in zip(out_whole, out, strict=True):
         _same(a, b)
+
+
+@pytest.mark.parametrize("seed", range(10))
+def test_uses_is_isin_of_every_row(seed):
+    """The clean groups' check (``_uses``: a table over the plots' span, ``np.isin`` when
+    the span is wide) against ``np.isin``."""
+    from mhtrack.mht.frame_scope import _uses
+
+    rng = np.random.default_rng(seed)
+    top = [50, 5_000, 10**9][seed % 3]  # narrow, medium and wide spans
+    w = rng.integers(-1, top, (int(rng.integers(1, 300)), int(rng.integers(1, 6))))
+    w[rng.random(w.shape) < 0.3] = -1
+    plots = np.unique(rng.integers(0, top, int(rng.integers(1, 40))))
+    if seed % 2:
+        plots = np.concatenate((plots, w[w >= 0][:3]))  # some hits for sure
+    assert np.array_equal(_uses(w.copy(), plots), np.isin(w, plots).any(axis=1))

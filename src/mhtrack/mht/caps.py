@@ -56,9 +56,11 @@ Nothing here depends on time: the same input gives the same cuts on any machine.
 
 from __future__ import annotations
 
+import copy
 import dataclasses
 import logging
 
+from mhtrack.bounds import int_problem
 from mhtrack.mht.config import MHTConfig
 
 #: The tracker's logger (the name users and the Monte-Carlo runner filter on).
@@ -113,11 +115,21 @@ def _leaves_supported(n: int, t: int) -> int:
 def scan_config(cfg: MHTConfig, n_plots: int, n_tracks: int,
                 n_sensors: int = 1) -> MHTConfig:
     """``cfg`` with :func:`scaled_limits` for this scan (``cfg`` itself when they are its
-    own values)."""
+    own values). Once per frame: the copy skips :class:`MHTConfig`'s checks of the
+    fields it keeps (checked when ``cfg`` was made) when the scaled ones pass theirs
+    (integers within :data:`~mhtrack.bounds.MAX_INDEX`, ≥ the configured ones, hence
+    ≥ 1; ``max_leaves > max_births_per_scan``); else ``dataclasses.replace`` raises as
+    before."""
     lim = scaled_limits(cfg, n_plots, n_tracks, n_sensors)
     if all(lim[k] == getattr(cfg, k) for k in SCALED):
         return cfg
-    return dataclasses.replace(cfg, **lim)
+    if (any(int_problem(v) is not None or v < getattr(cfg, k) for k, v in lim.items())
+            or lim["max_leaves"] <= lim["max_births_per_scan"]):
+        return dataclasses.replace(cfg, **lim)
+    out = copy.copy(cfg)
+    for k, v in lim.items():
+        object.__setattr__(out, k, v)
+    return out
 
 
 def describe(caps: dict[str, int], limits: dict[str, int] | None = None) -> str:

@@ -228,27 +228,40 @@ class RadarCoverage(Coverage):
             inside = self._learned_reach(sid, scan, site, px, py, dist)
         else:
             inside = looked
-        if sensor.period is not None and len(scan):
-            omega = 360.0 / sensor.period
-            span = tf - t0
-            if omega * span < 360.0:
-                z = np.asarray(scan.z, float).reshape(-1, 2)
-                beam = np.radians(grid_bearing(z[:, 0] - site[0], z[:, 1] - site[1])
-                                  + omega * (tf - t_plots))
-                # the circular mean
-                a_f = math.degrees(math.atan2(mean(np.sin(beam)), mean(np.cos(beam))))
-                d0 = t0 - tf
-                q0 = grid_bearing(px + x[:, 1] * d0, py + x[:, 3] * d0)
-                phi_f = (a_f - grid_bearing(px, py)) % 360.0
-                phi_0 = (a_f - omega * span - q0) % 360.0
-                sig = np.sqrt(np.maximum(P[:, 0, 0], P[:, 2, 2])) / np.maximum(dist, 1.0)
-                band = np.minimum(3.0 * np.degrees(sig) + 3.0 * (sensor.sigma_bearing_deg
-                                                                 or 0.0), MAX_EDGE_DEG)
-                crossed = phi_f < phi_0
-                certain = crossed & (phi_f >= band) & (phi_0 <= 360.0 - band)
-                possible = crossed | (phi_f > 360.0 - band) | (phi_0 < band)
-                return Looks(np.where(looked & possible, pd, 0.0), looked & certain & inside)
-        return Looks(np.where(looked, pd, 0.0), looked & inside)
+        if sensor.period is None or not len(scan):
+            return Looks(np.where(looked, pd, 0.0), looked & inside)
+        omega = 360.0 / sensor.period
+        span = tf - t0
+        if omega * span >= 360.0:
+            return Looks(np.where(looked, pd, 0.0), looked & inside)
+        # the beam's test only where the range test passed (elementwise: the same values
+        # as over every leaf; the others are not looked at)
+        r = None if looked.all() else looked.nonzero()[0]
+        if r is not None:
+            x, P, px, py, dist = x.take(r, axis=0), P.take(r, axis=0), px.take(r), \
+                py.take(r), dist.take(r)
+        z = np.asarray(scan.z, float).reshape(-1, 2)
+        beam = np.radians(grid_bearing(z[:, 0] - site[0], z[:, 1] - site[1])
+                          + omega * (tf - t_plots))
+        # the circular mean
+        a_f = math.degrees(math.atan2(mean(np.sin(beam)), mean(np.cos(beam))))
+        d0 = t0 - tf
+        q0 = grid_bearing(px + x[:, 1] * d0, py + x[:, 3] * d0)
+        phi_f = (a_f - grid_bearing(px, py)) % 360.0
+        phi_0 = (a_f - omega * span - q0) % 360.0
+        sig = np.sqrt(np.maximum(P[:, 0, 0], P[:, 2, 2])) / np.maximum(dist, 1.0)
+        band = np.minimum(3.0 * np.degrees(sig) + 3.0 * (sensor.sigma_bearing_deg or 0.0),
+                          MAX_EDGE_DEG)
+        crossed = phi_f < phi_0
+        certain = crossed & (phi_f >= band) & (phi_0 <= 360.0 - band)
+        possible = crossed | (phi_f > 360.0 - band) | (phi_0 < band)
+        if r is None:
+            return Looks(np.where(looked & possible, pd, 0.0), looked & certain & inside)
+        out_pd = np.zeros(looked.size)
+        out_pd[r] = np.where(possible, pd, 0.0)
+        out_certain = np.zeros(looked.size, bool)
+        out_certain[r] = certain & inside.take(r)
+        return Looks(out_pd, out_certain)
 
     def _learned_reach(self, sid: int, scan: Scan, site: tuple[float, float],
                        px: np.ndarray, py: np.ndarray, dist: np.ndarray) -> np.ndarray:

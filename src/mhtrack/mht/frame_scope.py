@@ -102,7 +102,7 @@ class FrameScope:
         idle = leaves.node < first_node
         if not self.applies or not idle.any():
             self._groups = None  # every tree stepped: nothing to carry
-            hyp = self._best(leaves)
+            hyp = self._best(leaves.score, leaves.tree, leaves.window)
             self._count(frame, hyp.n_greedy, hyp.n_node_limited)
             return hyp, Scope(None, hyp.leaves)
         starts = segment_starts(leaves.tree)
@@ -116,12 +116,14 @@ class FrameScope:
             group, dirty_tree = found
         in_scope = np.repeat(dirty_tree, size)
         rows = None if dirty_tree.all() else in_scope.nonzero()[0]
-        sub = leaves if rows is None else leaves.take(rows)
-        hyp = self._best(sub)
+        # the columns the solve reads, of the scope's rows only
+        score, tree_s, window = (leaves.score, leaves.tree, leaves.window) if rows is None \
+            else (leaves.score.take(rows), leaves.tree.take(rows), leaves.window.take(rows, 0))
+        hyp = self._best(score, tree_s, window)
         local = hyp.leaves
         # the scope's groups (components over all its leaves) and their clusters
-        t_index = dense_index(sub.tree)
-        g_new = tree_clusters(t_index, *raw_plot_keys(sub.window, by_id=True))
+        t_index = dense_index(tree_s)
+        g_new = tree_clusters(t_index, *raw_plot_keys(window, by_id=True))
         n_g = int(g_new.max()) + 1 if g_new.size else 0
         on = (hyp.leaf_cluster >= 0).nonzero()[0]
         cl = hyp.leaf_cluster[on]
@@ -146,7 +148,9 @@ class FrameScope:
         self._count(frame, hyp.n_greedy, hyp.n_node_limited)
         # the store's trees: clean groups numbered first (as ranked), the scope's after
         tree_group = np.empty(tree.size, np.int64)
-        tree_group[~dirty_tree] = np.searchsorted(clean_g, group[~dirty_tree])
+        rank = np.zeros(old.dirty.size if old is not None else 0, np.int64)
+        rank[clean_g] = np.arange(clean_g.size)  # a table, not a binary search
+        tree_group[~dirty_tree] = rank[group[~dirty_tree]]
         tree_group[dirty_tree] = clean_g.size + g_new
         if old is None or rows is None:
             self._pending = _Groups(tree, tree_group, n_cl, largest, capped)
@@ -163,15 +167,21 @@ class FrameScope:
                       cut_clusters=np.zeros(0, np.int64))
         return hyp, Scope(rows, local)
 
-    def pruned(self, before: Leaves, after: Leaves) -> None:
-        """After pruning ``before`` to ``after``: the groups of the trees kept; those that
-        lost leaves (N-scan or the cap on trees) are solved again at the next frame."""
+    def pruned(self, before: Leaves, after: Leaves, kept: np.ndarray | None = None) -> None:
+        """After pruning ``before`` to ``after`` (``kept``: the rows of ``before`` kept,
+        ascending, when known; ``None``: found from the node ids): the groups of the trees
+        kept; those that lost leaves (N-scan or the cap on trees) are solved again at the
+        next frame."""
         pend, self._pending = self._pending, None
         if pend is None:
             return
         dirty = pend.dirty
         if len(after) < len(before):
-            lost = ~contains(after.node, before.node)  # node ids span the run: no table
+            if kept is None:
+                lost = ~contains(after.node, before.node)  # node ids span the run
+            else:
+                lost = np.ones(len(before), bool)
+                lost[kept] = False
             leaf_group = np.repeat(pend.group, segment_sizes(segment_starts(before.tree),
                                                              len(before)))
             dirty = dirty.copy()
@@ -186,9 +196,10 @@ class FrameScope:
                                dirty[used])
 
     # ------------------------------------------------------------------ helpers
-    def _best(self, leaves: Leaves) -> GlobalHypothesis:
+    def _best(self, score: np.ndarray, tree: np.ndarray, window: np.ndarray
+              ) -> GlobalHypothesis:
         cfg = self.config
-        return best_hypothesis(leaves.score, leaves.tree, leaves.window, cfg.max_cluster_size,
+        return best_hypothesis(score, tree, window, cfg.max_cluster_size,
                                cfg.milp_node_limit, by_id=self.by_id, n_best=cfg.n_best)
 
     @staticmethod
@@ -229,9 +240,23 @@ def _scope_trees(leaves: Leaves, old: _Groups, tree: np.ndarray, starts: np.ndar
     plots = w[in_scope].ravel()
     plots = plots[plots != NO_PLOT]
     if plots.size and not in_scope.all():
-        clean = (~in_scope).nonzero()[0]
-        hit = np.isin(w.take(clean, axis=0), plots).any(axis=1)  # a table if small
+        hit = _uses(w, plots) & ~in_scope
         if hit.any():
-            gdirty[np.repeat(group, size)[clean[hit]]] = True
+            gdirty[np.repeat(group, size)[hit]] = True
             dirty_tree = ~carried | gdirty[group]
     return group, dirty_tree
+
+
+def _uses(window: np.ndarray, plots: np.ndarray) -> np.ndarray:
+    """Mask over the rows of ``window`` (L, W): the row holds one of ``plots`` (ids ≥ 0).
+    A table over the plots' span when it is small against the window (ids outside it
+    read a ``False`` cell), else ``np.isin``."""
+    lo, hi = int(plots.min()), int(plots.max())
+    span = hi - lo + 1
+    if span > 4 * window.size + 1024:
+        return np.isin(window, plots).any(axis=1)
+    table = np.zeros(span + 1, bool)  # the last cell: every id outside the span
+    table[plots - lo] = True
+    at = window - lo
+    at[(at < 0) | (at >= span)] = span
+    return table[at].any(axis=1)

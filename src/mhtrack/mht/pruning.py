@@ -14,6 +14,7 @@ import numpy as np
 
 from mhtrack.kernels import changes, segment_sizes
 from mhtrack.mht.caps import CHILDREN_PER_PLOT, MISSES_PER_TREE
+from mhtrack.mht.carry import Merged
 from mhtrack.mht.config import MHTConfig
 from mhtrack.mht.context import FrameContext
 from mhtrack.mht.extend import Children
@@ -275,20 +276,27 @@ def removed_after_solve(leaves: Leaves, hyp: GlobalHypothesis,
 
 def prune_after_solve(frame: FrameContext, leaves: Leaves, chosen: np.ndarray, *,
                       by_id: bool = False, remove: np.ndarray | None = None,
-                      parts: tuple[Leaves, Leaves] | None = None,
+                      parts: tuple[Leaves, Leaves] | Merged | None = None,
                       scope: Scope | None = None) -> Leaves:
     """N-scan pruning around the best hypothesis (leaf indices ``chosen``), then the cap
     on trees (the frame's ``max_trees``, counted in its caps); marks the surviving chosen
-    leaves. ``by_id``: trees step on their own looks (:func:`n_scan_keep`'s ``window``).
-    ``remove``: a mask of further leaves to drop (:func:`removed_after_solve`).
-    ``parts``: ``leaves`` is their :func:`~mhtrack.mht.tree.deferred_concat`, whose
-    states are copied once for the rows kept (:func:`~mhtrack.mht.tree.take_deferred`).
-    ``scope``: N-scan pruning looks at these rows only, the others are kept
-    (:mod:`mhtrack.mht.frame_scope`: the groups a frame touched; the same keep mask)."""
+    leaves: :func:`kept_after_solve` then :func:`take_kept`."""
+    kept = kept_after_solve(frame, leaves, chosen, by_id=by_id, remove=remove, scope=scope)
+    return take_kept(leaves, kept, chosen, parts)
+
+
+def kept_after_solve(frame: FrameContext, leaves: Leaves, chosen: np.ndarray, *,
+                     by_id: bool = False, remove: np.ndarray | None = None,
+                     scope: Scope | None = None) -> np.ndarray | None:
+    """The rows of ``leaves`` N-scan pruning around the best hypothesis (leaf indices
+    ``chosen``) and then the cap on trees (the frame's ``max_trees``, counted in its
+    caps) keep, ascending (``None``: all). ``by_id``: trees step on their own looks
+    (:func:`n_scan_keep`'s ``window``). ``remove``: a mask of further leaves to drop
+    (:func:`removed_after_solve`). ``scope``: N-scan pruning looks at these rows only,
+    the others are kept (:mod:`mhtrack.mht.frame_scope`: the groups a frame touched; the
+    same keep mask)."""
     max_trees = frame.limits.max_trees
     n = len(leaves)
-    is_chosen = np.zeros(n, bool)
-    is_chosen[chosen] = True
     tentative = leaves.track < 0 if frame.limits.defer_tentative else None
     if scope is None or scope.rows is None:
         keep = n_scan_keep(leaves.tree, leaves.window[:, 0], chosen,
@@ -306,16 +314,30 @@ def prune_after_solve(frame: FrameContext, leaves: Leaves, chosen: np.ndarray, *
         kept = keep.nonzero()[0]
         tree = leaves.tree.take(kept)
         if np.count_nonzero(changes(tree)) > max_trees:  # the trees kept
-            protected = is_chosen | (leaves.track >= 0)
+            protected = leaves.track >= 0
+            protected[chosen] = True
             keep_t, cut = cap_trees(tree, leaves.score.take(kept), protected.take(kept),
                                     max_trees)
             frame.cut("max_trees", cut)
             keep[kept[~keep_t]] = False
             n_kept = int(np.count_nonzero(keep))
-    rows = None if n_kept == n else keep.nonzero()[0]  # None: nothing pruned
+    return None if n_kept == n else keep.nonzero()[0]  # None: nothing pruned
+
+
+def take_kept(leaves: Leaves, rows: np.ndarray | None, chosen: np.ndarray,
+              parts: tuple[Leaves, Leaves] | Merged | None = None) -> Leaves:
+    """Rows ``rows`` of ``leaves`` (:func:`kept_after_solve`; ``None``: all) with the
+    chosen leaves (indices ``chosen`` into ``leaves``) marked. ``parts``: ``leaves``
+    defers its states, copied once here for the rows kept — from the two stores it
+    concatenates (:func:`~mhtrack.mht.tree.take_deferred`) or from the grown, new and
+    carried leaves it merges (:meth:`~mhtrack.mht.carry.Merged.take`)."""
+    is_chosen = np.zeros(len(leaves), bool)
+    is_chosen[chosen] = True
+    mark = is_chosen if rows is None else is_chosen[rows]
+    if isinstance(parts, Merged):
+        return parts.take(leaves, rows, chosen=mark)
     if parts is not None:
-        return take_deferred(leaves, rows, parts,
-                             chosen=is_chosen if rows is None else is_chosen[rows])
+        return take_deferred(leaves, rows, parts, chosen=mark)
     if rows is None:  # the same arrays
         return replace(leaves, chosen=is_chosen)
-    return replace(leaves.take(rows), chosen=is_chosen[rows])
+    return replace(leaves.take(rows), chosen=mark)

@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from mhtrack.mht.carry import Carried
 from mhtrack.mht.context import FrameContext
 from mhtrack.mht.coverage import Looks
 from mhtrack.mht.gating import Gate, Gated
@@ -37,17 +38,19 @@ def looked_trees(tree: np.ndarray, pd: np.ndarray) -> np.ndarray:
     return contains(tree[pd > 0], tree)
 
 
-def split_looked(leaves: Leaves, looks: Looks) -> tuple[Leaves, Looks, Leaves]:
+def split_looked(leaves: Leaves, looks: Looks) -> tuple[Leaves, Looks, Carried | Leaves]:
     """``(looked, their looks, idle)``: the leaves of the trees the frame looked at
-    (``P_D > 0`` at one of their leaves) and the others (the same objects when every tree
-    was looked at, with no idle leaves)."""
+    (``P_D > 0`` at one of their leaves) and the others, as rows of ``leaves`` (not
+    copied, :class:`~mhtrack.mht.carry.Carried`); the same objects when every tree was
+    looked at, with an empty store for the idle leaves."""
     if looks.uniform is not None or (looks.pd > 0).all():  # no tree is carried
         return leaves, looks, _no_leaves(leaves)
     mask = looked_trees(leaves.tree, looks.pd)
     if mask.all():
         return leaves, looks, _no_leaves(leaves)
-    return (leaves.take(mask), Looks(looks.pd[mask], looks.certain[mask]),
-            leaves.take(~mask))
+    rows = mask.nonzero()[0]
+    return (leaves.take(rows), Looks(looks.pd.take(rows), looks.certain.take(rows)),
+            Carried(leaves, (~mask).nonzero()[0]))
 
 
 def _no_leaves(leaves: Leaves) -> Leaves:

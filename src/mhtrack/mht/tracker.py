@@ -19,11 +19,11 @@ tracks on air, the caps' counters) where it needs more than its own arrays::
                                                   the (costly) update
     grow        extend.grow_children            the children's filter update
     births      births.Birth.seed,              the new trees, with tree ids; leaf ids for
-                numbering.number_and_merge        the history links; idle trees merged back
+                carry.number_frame                the history links; idle trees merged back
     hypothesis  frame_scope.FrameScope.solve    clusters → best compatible leaves (the
                                                   groups of trees the frame touched)
-    prune       pruning.prune_after_solve       N-scan: decide scan k − N (in that
-                                                  scope); cap on trees
+    prune       pruning.kept_after_solve,       N-scan: decide scan k − N (in that
+                pruning.take_kept                 scope); cap on trees; states copied once
     confirm     identity.hand_over,             a track follows its plots; SPRT (or
                 sprt.SPRT.confirms,               M-of-N) confirmation → new track ids;
                 history.TentativeHistory          the tentative past of new tracks
@@ -64,6 +64,7 @@ from mhtrack.mht.attribute_scores import (
 )
 from mhtrack.mht.births import Birth, default_birth
 from mhtrack.mht.caps import CapWarnings
+from mhtrack.mht.carry import Carried, Merged, number_frame
 from mhtrack.mht.config import MHTConfig
 from mhtrack.mht.context import FrameContext
 from mhtrack.mht.coverage import Coverage, Everywhere, Looks
@@ -73,9 +74,9 @@ from mhtrack.mht.gating import Gate, plots_in_confirmed_gates
 from mhtrack.mht.history import TentativeHistory
 from mhtrack.mht.identity import Reported, confirm, hand_over, newly_confirmed
 from mhtrack.mht.intensity import clutter_intensity
-from mhtrack.mht.numbering import Counter, number_and_merge
+from mhtrack.mht.numbering import Counter
 from mhtrack.mht.predict import predict_leaves
-from mhtrack.mht.pruning import prune_after_solve, prune_children, removed_after_solve
+from mhtrack.mht.pruning import kept_after_solve, prune_children, removed_after_solve, take_kept
 from mhtrack.mht.report import StepStats, confirmed_windows, report
 from mhtrack.mht.resume import AddressBook
 from mhtrack.mht.scoring import miss_increment, miss_increments, update_increment
@@ -216,10 +217,10 @@ class MHTTracker:
             grown, births = self._attributes(f, attrs, grown, births, children.plot)
         leaves, parts, first_node = self._number(grown, births, idle)
         hyp, scope = self.scope.solve(f, leaves, first_node)
-        solved, leaves = leaves, prune_after_solve(
-            f, leaves, hyp.leaves, by_id=self.coverage.per_tree_looks, scope=scope,
-            remove=removed_after_solve(leaves, hyp, self.config), parts=parts)
-        self.scope.pruned(solved, leaves)
+        kept = kept_after_solve(f, leaves, hyp.leaves, by_id=self.coverage.per_tree_looks,
+                                scope=scope, remove=removed_after_solve(leaves, hyp, self.config))
+        solved, leaves = leaves, take_kept(leaves, kept, hyp.leaves, parts)
+        self.scope.pruned(solved, leaves, kept)
         stepped = None if len(idle) == 0 else leaves.node >= first_node
         leaves = self._confirm(f, leaves)
         out = self._report(f, leaves, stepped)
@@ -268,15 +269,13 @@ class MHTTracker:
             births = replace(births, level=level, ident=ident)
         return grown, births
 
-    def _number(self, grown: Leaves, births: Leaves, idle: Leaves
-                ) -> tuple[Leaves, tuple[Leaves, Leaves] | None, int]:
+    def _number(self, grown: Leaves, births: Leaves, idle: Carried | Leaves
+                ) -> tuple[Leaves, tuple[Leaves, Leaves] | Merged | None, int]:
         """Node ids for the new leaves (the history's links) and the idle trees merged
-        back: ``(leaves, parts, first new node id)``; ``parts`` the two stores ``leaves``
-        defers the concatenation of (``None``: concatenated)."""
+        back: ``(leaves, parts, first new node id)``; ``parts`` what the states ``leaves``
+        defers are copied from at pruning (:func:`~mhtrack.mht.carry.number_frame`)."""
         first_node = self.nodes.next
-        parts = (grown, births) if len(idle) == 0 and len(births) else None
-        leaves = number_and_merge(grown, births, idle, self.nodes, parts is not None)
-        return leaves, parts, first_node
+        return *number_frame(grown, births, idle, self.nodes), first_node
 
     def _confirm(self, frame: FrameContext, leaves: Leaves) -> Leaves:
         """Hand over track ids that follow their plots, confirm by the SPRT (new track ids),

@@ -158,7 +158,7 @@ def deferred_concat(a: Leaves, b: Leaves, **columns: np.ndarray) -> Leaves:
     pruning read no state)."""
     n = len(a) + len(b)
     cols = {f: (columns[f] if f in columns
-                else _placeholder((n, *getattr(a, f).shape[1:])) if f in STATE
+                else placeholder((n, *getattr(a, f).shape[1:])) if f in STATE
                 else np.concatenate((getattr(a, f), getattr(b, f))))
             for f in FIELDS}
     return Leaves(**cols)
@@ -169,7 +169,7 @@ _NAN = np.array([np.nan])
 _NAN.setflags(write=False)
 
 
-def _placeholder(shape: tuple[int, ...]) -> np.ndarray:
+def placeholder(shape: tuple[int, ...]) -> np.ndarray:
     """A read-only array of ``shape`` whose every element is the one NaN of :data:`_NAN`
     (all strides 0: ``np.broadcast_to`` without its Python set-up)."""
     return np.ndarray(shape, float, buffer=_NAN, strides=(0,) * len(shape))

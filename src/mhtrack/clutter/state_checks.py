@@ -179,16 +179,17 @@ def check_forgetting(state: Mapping[str, Any], max_components: int, gamma: float
     # row; a fixed ±MAX_MAGNITUDE bound refused every real radar's fourth moments (σ 50 km:
     # 3σ⁴ ≈ 2·10¹⁹ per unit weight).
     m = array(state["moments"], f"{f}.moments", (-1, 15), bound=np.inf).astype(float)
-    if m.size and not ((np.abs(m[:, 0]) <= MAX_MAGNITUDE).all()  # false for NaN
-                       and (np.abs(m) <= np.abs(m[:, :1]) * _OFFSET_POWER).all()):
+    if m.size and not (np.abs(m[:, 0]) <= MAX_MAGNITUDE).all():  # false for NaN
+        raise _fail(f"{f}.moments", f"a weight M_00 not finite or beyond ±{MAX_MAGNITUDE:g}")
+    if m.size and not (m[:, 0] > 0).all():
+        raise _fail(f"{f}.moments", "a component has no weight")
+    if m.size and not (np.abs(m) <= m[:, :1] * _OFFSET_POWER).all():  # false for NaN
         raise _fail(f"{f}.moments", "holds values that are not finite or beyond "
-                    "M_00·(2·MAX_COORDINATE)^(p+q) (M_00 within ±MAX_MAGNITUDE)")
+                    "M_00·(2·MAX_COORDINATE)^(p+q)")
     a = array(state["anchors"], f"{f}.anchors", (len(m), 2), bound=MAX_COORDINATE)
     if len(m) > max_components:
         raise _fail(f"{f}.moments", f"{len(m)} components, more than {max_components}")
     if len(m):
-        if not (m[:, 0] > 0).all():
-            raise _fail(f"{f}.moments", "a component has no weight")
         _, _, cov = mean_cov(m, a.astype(float), 0.0)
         det = cov[:, 0, 0] * cov[:, 1, 1] - cov[:, 0, 1] ** 2
         if not (np.isfinite(det).all() and (cov[:, 0, 0] > 0).all() and (det > 0).all()):

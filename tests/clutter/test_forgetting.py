@@ -174,7 +174,8 @@ def test_a_radar_scale_state_is_restored_and_huge_moments_refused() -> None:
     b.set_state(good)
     q = rng.uniform(-250e3, 250e3, (50, 2))
     assert np.array_equal(a.intensity(q), b.intensity(q))
-    for bad_value in (np.inf, np.nan, 1e60):
+    w = good["moments"][0, 0]
+    for bad_value in (np.inf, np.nan, 1e60, 1.01 * w * 2e9**4):  # last: beyond M_00·d_max⁴
         bad = good["moments"].copy()
         bad[0, 10] = bad_value  # a fourth-order column
         with pytest.raises(ValueError, match="moments"):

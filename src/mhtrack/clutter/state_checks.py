@@ -6,7 +6,7 @@ later ``step`` (a broadcasting error from weights of the wrong length, an overfl
 huge counter). Each function raises ``ValueError("<field>: <problem>")``, which the
 state loader reports as one :class:`~mhtrack.errors.InputError` line naming the file and
 ``clutter_state``. Checked: types; every float finite and within ``±MAX_MAGNITUDE``
-(a forgetting mixture's moment ``M_pq`` within ``MAX_MAGNITUDE·(2·MAX_COORDINATE)^(p+q)``);
+(a forgetting mixture's moment ``M_pq`` within ``M_00·(2·MAX_COORDINATE)^(p+q)``);
 counters integers in ``[0, 2^53]``; positions within ``±MAX_COORDINATE``; a mixture's
 ``K`` the same in weights, means and covariances, weights in ``[0, 1]`` summing with the
 background's to 1 (1e-6), covariances symmetric positive definite, a background box with
@@ -23,9 +23,9 @@ import numpy as np
 from mhtrack.bounds import MAX_DENSITY, MAX_INDEX, MAX_MAGNITUDE, MAX_TIME_S, clip, show
 from mhtrack.records import MAX_COORDINATE
 
-#: Bound of each forgetting-mixture moment column ``(p, q)``: a weight within
-#: ``MAX_MAGNITUDE`` times the largest offset ``2·MAX_COORDINATE`` to the power ``p + q``.
-_MOMENT_BOUND = MAX_MAGNITUDE * (2.0 * MAX_COORDINATE) ** np.array(
+#: Each forgetting-mixture moment column ``(p, q)``'s largest offset power
+#: ``(2·MAX_COORDINATE)^(p+q)``: ``|M_pq| ≤ M_00 · d_max^(p+q)`` for weights ≥ 0.
+_OFFSET_POWER = (2.0 * MAX_COORDINATE) ** np.array(
     [t for t in range(5) for _ in range(t + 1)], float)
 
 
@@ -175,19 +175,21 @@ def check_forgetting(state: Mapping[str, Any], max_components: int, gamma: float
     from mhtrack.clutter.moments import mean_cov
 
     f = "clutter_state"
-    # M_pq = Σ w dx^p dy^q: |M_pq| ≤ M_00 · d_max^(p+q), with d_max ≤ 2·MAX_COORDINATE;
-    # a fixed ±MAX_MAGNITUDE bound refused every real radar's fourth moments (σ 50 km:
+    # M_pq = Σ w dx^p dy^q: |M_pq| ≤ M_00 · d_max^(p+q), with d_max ≤ 2·MAX_COORDINATE, per
+    # row; a fixed ±MAX_MAGNITUDE bound refused every real radar's fourth moments (σ 50 km:
     # 3σ⁴ ≈ 2·10¹⁹ per unit weight).
     m = array(state["moments"], f"{f}.moments", (-1, 15), bound=np.inf).astype(float)
-    if m.size and not (np.abs(m) <= _MOMENT_BOUND).all():  # false for NaN
+    if m.size and not (np.abs(m[:, 0]) <= MAX_MAGNITUDE).all():  # false for NaN
+        raise _fail(f"{f}.moments", f"a weight M_00 not finite or beyond ±{MAX_MAGNITUDE:g}")
+    if m.size and not (m[:, 0] > 0).all():
+        raise _fail(f"{f}.moments", "a component has no weight")
+    if m.size and not (np.abs(m) <= m[:, :1] * _OFFSET_POWER).all():  # false for NaN
         raise _fail(f"{f}.moments", "holds values that are not finite or beyond "
-                    "MAX_MAGNITUDE·(2·MAX_COORDINATE)^(p+q)")
+                    "M_00·(2·MAX_COORDINATE)^(p+q)")
     a = array(state["anchors"], f"{f}.anchors", (len(m), 2), bound=MAX_COORDINATE)
     if len(m) > max_components:
         raise _fail(f"{f}.moments", f"{len(m)} components, more than {max_components}")
     if len(m):
-        if not (m[:, 0] > 0).all():
-            raise _fail(f"{f}.moments", "a component has no weight")
         _, _, cov = mean_cov(m, a.astype(float), 0.0)
         det = cov[:, 0, 0] * cov[:, 1, 1] - cov[:, 0, 1] ** 2
         if not (np.isfinite(det).all() and (cov[:, 0, 0] > 0).all() and (det > 0).all()):

@@ -1,5 +1,6 @@
-"""Hypothesis management: score-drop pruning, N-scan pruning and hard caps, and the two
-pruning stages of the tracker (:func:`prune_children`, :func:`prune_after_solve`).
+"""Hypothesis management: score-drop pruning, N-scan pruning and hard caps, and the
+pruning stages of the tracker (:func:`prune_children`; after the solve
+:func:`kept_after_solve` then :func:`take_kept`, composed in :func:`prune_after_solve`).
 
 Every rule takes arrays of leaves sorted by tree id and returns a boolean *keep* mask; the
 caps also return how many leaves (or trees) they removed, so the tracker can report every
@@ -280,7 +281,9 @@ def prune_after_solve(frame: FrameContext, leaves: Leaves, chosen: np.ndarray, *
                       scope: Scope | None = None) -> Leaves:
     """N-scan pruning around the best hypothesis (leaf indices ``chosen``), then the cap
     on trees (the frame's ``max_trees``, counted in its caps); marks the surviving chosen
-    leaves: :func:`kept_after_solve` then :func:`take_kept`."""
+    leaves: :func:`kept_after_solve` then :func:`take_kept` (the tracker calls the two
+    itself, to hand the kept rows to the frame scope; this composition is the one-call
+    form for library users and tests)."""
     kept = kept_after_solve(frame, leaves, chosen, by_id=by_id, remove=remove, scope=scope)
     return take_kept(leaves, kept, chosen, parts)
 

@@ -241,7 +241,7 @@ class MHTTracker:
         self.birth.limit(frame.limits.max_births_per_scan)
         return frame
 
-    def _look(self, scan: Scan) -> tuple[Leaves, Looks, Leaves]:
+    def _look(self, scan: Scan) -> tuple[Leaves, Looks, Carried | Leaves]:
         """Coverage: each leaf's ``P_D`` in this frame; the leaves its sensor did not look
         at are set aside (``idle``) and carried unchanged."""
         lv = self._leaves

@@ -50,7 +50,7 @@ from mhtrack.io.reorder import DEFAULT_REORDER_WINDOW_S
 from mhtrack.io.reorder import kept as kept_by_buffer
 from mhtrack.models.radars import SensorSet
 from mhtrack.records import Scan
-from mhtrack.sources.base import IDLE, Source, SourceStats, Survey
+from mhtrack.sources.base import CAUGHT_UP, IDLE, Source, SourceStats, Survey
 from mhtrack.sources.gather import Gathered
 from mhtrack.sources.positions import local_positions
 from mhtrack.sources.timed import TimedStream
@@ -81,9 +81,10 @@ class DatagramSource(Source):
         super().__init__()
         if chunk < 1:
             raise ValueError(f"chunk must be >= 1 plot, got {chunk!r}")
-        #: Plots converted and passed on together (a live feed passes each data block on
-        #: at once: ``chunk=1``; the results do not depend on it, the conversion is
-        #: element-wise).
+        #: Plots converted and passed on together at most (a live feed also passes on
+        #: what it has decoded whenever no datagram is waiting:
+        #: :data:`~mhtrack.sources.base.CAUGHT_UP`; the results do not depend on it, the
+        #: conversion is element-wise).
         self.chunk = int(chunk)
         self.name = name
         self.given = sensors
@@ -128,8 +129,8 @@ class DatagramSource(Source):
         """``(byte offset, payload, capture time)`` of each datagram."""
         offset = 0
         for d in self._input:
-            if d is IDLE:
-                yield offset, IDLE, None
+            if d is IDLE or d is CAUGHT_UP:
+                yield offset, d, None
                 continue
             payload, when = (d, None) if isinstance(d, bytes | bytearray | memoryview) else d
             yield offset, payload, when
@@ -158,13 +159,12 @@ class DatagramSource(Source):
         in_sector: list[int] = []
         n = 0
         for offset, payload, when in self._datagrams(problems):
-            if payload is IDLE:  # the feed went quiet: what is decoded, then the marker
+            if payload is IDLE or payload is CAUGHT_UP:  # what is decoded, then IDLE
                 if rows:
                     yield self._chunk(rows, times, at_rows, n, convert, in_sector)
                     n += len(rows)
-                    self.decoded = n
                     rows, times, at_rows, in_sector = [], [], [], []
-                if idle:
+                if idle and payload is IDLE:
                     yield IDLE  # type: ignore[misc]
                 continue
             for at, what, found in decoder.blocks(payload, offset, problems, when):
@@ -176,6 +176,7 @@ class DatagramSource(Source):
                         sector[r[1]] = sector.get(r[1], 0) + 1
                     continue
                 rows.extend(found)
+                self.decoded = n + len(rows)
                 times.extend(t)
                 at_rows.extend([at] * len(found))
                 if self.sectors:
@@ -183,11 +184,9 @@ class DatagramSource(Source):
                 if len(rows) >= self.chunk:
                     yield self._chunk(rows, times, at_rows, n, convert, in_sector)
                     n += len(rows)
-                    self.decoded = n
                     rows, times, at_rows, in_sector = [], [], [], []
         if rows:
             yield self._chunk(rows, times, at_rows, n, convert, in_sector)
-            self.decoded = n + len(rows)
 
     def _chunk(self, rows: list[tuple[Any, ...]], times: list[float], at: list[int],
                n0: int, convert: bool, in_sector: list[int]) -> dict[str, np.ndarray]:

@@ -148,8 +148,8 @@ def live_run(stream: Path, sensors: Path, opts, window: float, port: int) -> dic
             stdin="len32", day_from="stream", preload=False, reorder_window_s=window,
             out_udp=(f"udp://127.0.0.1:{port}",)), stdin=fh)
         res = live.run()
-    return {"plots": live.source.stats.plots_out, "frames": live.source.stats.frames, "rows": res.sent_rows,
-            "cat062": res.sent_datagrams}
+    return {"plots": live.source.stats.plots_out, "frames": live.source.stats.frames,
+            "rows": res.sent_rows, "cat062": res.sent_datagrams}
 
 
 def main() -> None:
@@ -160,10 +160,9 @@ def main() -> None:
     ap.add_argument("--no-cprofile", action="store_true")
     ap.add_argument("--json", type=Path, default=None, help="write the figures here")
     a = ap.parse_args()
-    from national import first_seconds
-
     from mhtrack.pipeline import TrackOptions
     from mhtrack.sources.replay import recording_datagrams
+    from national import first_seconds
 
     d = a.dir
     meta = json.loads((d / "meta.json").read_text())

@@ -77,7 +77,8 @@ class DatagramSource(Source):
                  not_before: float | None = None,
                  pending: Mapping[str, Any] | None = None,
                  hold: Callable[[], bool] | None = None,
-                 recent: str | None = None, keep_rows: int | None = None) -> None:
+                 recent: str | None = None, keep_rows: int | None = None,
+                 release: str = "time") -> None:
         super().__init__()
         if chunk < 1:
             raise ValueError(f"chunk must be >= 1 plot, got {chunk!r}")
@@ -115,6 +116,9 @@ class DatagramSource(Source):
         #: :meth:`file_rows` knows the last ``keep_rows`` plots only (``None``: all; a
         #: live stream without end keeps its memory flat).
         self.keep_rows = keep_rows
+        #: When a closed frame goes out (:mod:`~mhtrack.sources.framer`: ``"time"``,
+        #: the order of ``track``; ``"radar"``, as soon as its own plots are in).
+        self.release = release
         self.held: dict[str, Any] | None = None
         #: Plots decoded so far: the next plot's decoding-order number (its ``file_row``).
         self.decoded = 0
@@ -261,7 +265,7 @@ class DatagramSource(Source):
             self.name, self.stats, self._frame_lengths(), self.window_s,
             lambda first: f"byte {first['offset']} (plot {first['file_row']})",
             first_frame=self.first_frame, first_row=self.first_row,
-            not_before=self.not_before, keep_rows=self.keep_rows)
+            not_before=self.not_before, keep_rows=self.keep_rows, release=self.release)
         if self.restore is not None:
             yield from stream.restore(self.restore)
         for cols in self._decoded(problems, idle=True):

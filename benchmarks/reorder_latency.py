@@ -1,12 +1,14 @@
 """Issue 30, item 3: ``live``'s latency and late drops against the re-order window.
 
     python benchmarks/reorder_latency.py DIR OUT [--seconds 120] [--window 0.2 0.1 0.05]
+        [--release time radar]
 
 ``DIR`` holds a simulation and its recording (``plots.csv``, ``sensors.toml``,
 ``radar.pcap``: ``mhtrack simulate opensky-radars --seed 1`` then ``mhtrack export``);
 for each window the recording's first ``--seconds`` are replayed at real time into
 ``live`` (:func:`national.live_run`: loopback only, every wait bounded) and its last
-status line's figures printed: plots, frames, late drops, latency p50/p99, live's CPU.
+status line's figures printed: plots, frames, late drops, latency p50/p99, live's CPU;
+for each ``--release`` of ``live`` given (``docs/live.md``, *Latency*).
 """
 
 from __future__ import annotations
@@ -26,6 +28,7 @@ def main() -> None:
     ap.add_argument("out", type=Path)
     ap.add_argument("--seconds", type=float, default=120.0)
     ap.add_argument("--window", type=float, nargs="+", default=[0.2, 0.1, 0.05])
+    ap.add_argument("--release", nargs="+", choices=("time", "radar"), default=["time"])
     a = ap.parse_args()
     import national
     from mhtrack.build.radar_defaults import radar_rule
@@ -41,12 +44,13 @@ def main() -> None:
     p = read_plots(a.dir / "plots.csv", sensors)
     rule = radar_rule(sensors, p.sensor, p.time, p.x, p.y, v_max=MHTConfig().v_max)
     meta = {"birth_density": rule.new_target_density}  # track's radar rule
-    for w in a.window:
+    for release, w in ((r, w) for r in a.release for w in a.window):
         run = national.live_run(a.out, meta, argparse.Namespace(
-            reorder_window=w, stop_timeout=60.0, live_s=a.seconds))
+            reorder_window=w, stop_timeout=60.0, live_s=a.seconds, release=release))
         st = run["status"]
         lat = st["latency_s"]
-        print(f"window {w:g} s: {st['plots']} plots, {st['frames']} frames, late drops "
+        print(f"release {release}, window {w:g} s: {st['plots']} plots, {st['frames']} "
+              f"frames, late drops "
               f"{st['late_drops']}, latency p50 {1e3 * lat['p50']:.0f} ms p99 "
               f"{1e3 * lat['p99']:.0f} ms ({lat['count']} timed); live's CPU "
               f"{run['cpu_s']:.1f} s; p99 per 10 s line (ms) "

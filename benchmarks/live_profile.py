@@ -138,8 +138,11 @@ def file_run(rec: Path, sensors: Path, opts, window: float) -> int:
     return pipe.source.stats.plots_out
 
 
-def live_run(stream: Path, sensors: Path, opts, window: float, port: int) -> dict:
-    """``live`` on the ``len32`` stream, CAT062 to ``127.0.0.1:port``; its figures."""
+def live_run(stream: Path, sensors: Path, opts, window: float, port: int,
+             one_by_one: bool = False) -> dict:
+    """``live`` on the ``len32`` stream, CAT062 to ``127.0.0.1:port``; its figures.
+    ``one_by_one``: as if no datagram ever waited (each decoded and passed on alone: a
+    feed the tracker keeps up with, datagram by datagram — the dearest case per plot)."""
     from mhtrack.io.sensors import read_sensors
     from mhtrack.pipeline.live import Live, LiveOptions
 
@@ -147,6 +150,8 @@ def live_run(stream: Path, sensors: Path, opts, window: float, port: int) -> dic
         live = Live(read_sensors(sensors), opts, LiveOptions(
             stdin="len32", day_from="stream", preload=False, reorder_window_s=window,
             out_udp=(f"udp://127.0.0.1:{port}",)), stdin=fh)
+        if one_by_one:
+            live.reader.waiting = lambda: 0  # type: ignore[method-assign]
         res = live.run()
     return {"plots": live.source.stats.plots_out, "frames": live.source.stats.frames,
             "rows": res.sent_rows, "cat062": res.sent_datagrams}
@@ -159,6 +164,8 @@ def main() -> None:
     ap.add_argument("--reorder-window", type=float, default=0.2)
     ap.add_argument("--no-cprofile", action="store_true")
     ap.add_argument("--json", type=Path, default=None, help="write the figures here")
+    ap.add_argument("--one-by-one", action="store_true",
+                    help="live passes each datagram on alone (live_run)")
     a = ap.parse_args()
     from mhtrack.pipeline import TrackOptions
     from mhtrack.sources.replay import recording_datagrams
@@ -181,8 +188,8 @@ def main() -> None:
                                             a.reorder_window), prof)
     got: dict = {}
     res["live"] = _measure(lambda: got.update(live_run(
-        stream, d / "sensors.toml", opts, a.reorder_window, sink.getsockname()[1]))
-        or got["plots"], prof)
+        stream, d / "sensors.toml", opts, a.reorder_window, sink.getsockname()[1],
+        a.one_by_one)) or got["plots"], prof)
     res["live"].update(got)
     sink.close()
     for k in ("file", "live"):

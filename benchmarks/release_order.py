@@ -17,6 +17,7 @@ import argparse
 import csv
 import subprocess
 import tempfile
+from collections import Counter
 from pathlib import Path
 
 from bench_live_feed import DENSITY, json_as_tracks, online_as_tracks, score
@@ -61,7 +62,7 @@ def main() -> None:
     for k, p in runs.items():
         s = score(p, d / "truth.csv")
         same = "(other rounding)" if k.startswith("track") else \
-            f"{len(set(rows[k]) & set(base))}"
+            f"{sum((Counter(rows[k]) & Counter(base)).values())}"
         print(f"| {k} | {len(rows[k])} | {same} | {s['ospa_mean']:.2f} | "
               f"{s['coverage']:.4f} | {s['n_track_ids']} | {s['id_switches']} |")
 

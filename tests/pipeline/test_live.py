@@ -255,7 +255,7 @@ def test_release_by_radar_tracks_the_same_frames(rec: Path) -> None:
             live.run()
             writer.join()
         seen[release] = sink.got
-        assert live.source._stream.framer.release == release  # noqa: SLF001
+        assert live.source._stream.framer.release == release
     times = [t for t, _ in seen["radar"]]
     assert times == sorted(times)
     assert sorted(p for _, p in seen["radar"]) == sorted(p for _, p in seen["time"])

@@ -2,7 +2,7 @@
 file path's, on the same recording in one run.
 
     python benchmarks/live_profile.py DIR [--seconds 60] [--reorder-window 0.2]
-        [--no-cprofile] [--repeat 1]
+        [--no-cprofile] [--one-by-one] [--json FILE]
 
 ``DIR`` is a ``benchmarks/national.py`` scene (``radar.pcap``, ``sensors.toml``,
 ``meta.json``: ``national.py --out DIR --skip-live --skip-profile --skip-stonesoup``).
@@ -14,7 +14,9 @@ The recording's first ``--seconds`` of capture time are tracked twice in this pr
   ``len32`` stream (a regular file as its stdin: the receiving thread reads it, one
   datagram at a time onto the queue, as it would from a socket), ``--day-from stream``,
   CAT062 out over UDP to a loopback socket nobody reads (the kernel drops them, the
-  encoding and ``sendto`` are paid), the health's latency bookkeeping on.
+  encoding and ``sendto`` are paid), the health's latency bookkeeping on; it decodes what
+  has queued up as one chunk (here: the whole queue, the reader being ahead), or with
+  ``--one-by-one`` each datagram alone (a feed the tracker keeps up with).
 
 Both use the national benchmark's options (its birth density, the re-order window). CPU
 is measured, not wall time (the machine is shared): the process's CPU

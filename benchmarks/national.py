@@ -127,7 +127,8 @@ def _take(s, keep: np.ndarray):
 def live_options(d: Path, meta: dict, a: argparse.Namespace) -> list[str]:
     """The tracker options ``live`` and the profile share."""
     return ["--sensors", str(d / "sensors.toml"), "--birth-density",
-            f"{meta['birth_density']:.6g}", "--reorder-window", str(a.reorder_window)]
+            f"{meta['birth_density']:.6g}", "--reorder-window", str(a.reorder_window),
+            *(["--release", a.release] if getattr(a, "release", "time") != "time" else [])]
 
 
 # ------------------------------------------------------------------ 2. live
@@ -302,6 +303,8 @@ def main() -> None:
     ap.add_argument("--seed", type=int, default=1, help="simulation seed")
     ap.add_argument("--scene-seed", type=int, default=0)
     ap.add_argument("--reorder-window", type=float, default=0.2)
+    ap.add_argument("--release", choices=("time", "radar"), default="time",
+                    help="live's --release (docs/live.md, Latency)")
     ap.add_argument("--live-s", type=float, default=None,
                     help="replay only the recording's first seconds into live")
     ap.add_argument("--stop-timeout", type=float, default=300.0,

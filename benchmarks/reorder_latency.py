@@ -1,12 +1,18 @@
 """Issue 30, item 3: ``live``'s latency and late drops against the re-order window.
 
     python benchmarks/reorder_latency.py DIR OUT [--seconds 120] [--window 0.2 0.1 0.05]
+        [--release time radar]
 
 ``DIR`` holds a simulation and its recording (``plots.csv``, ``sensors.toml``,
 ``radar.pcap``: ``mhtrack simulate opensky-radars --seed 1`` then ``mhtrack export``);
 for each window the recording's first ``--seconds`` are replayed at real time into
 ``live`` (:func:`national.live_run`: loopback only, every wait bounded) and its last
-status line's figures printed: plots, frames, late drops, latency p50/p99, live's CPU.
+status line's figures printed: plots, frames, late drops, latency p50/p99, live's CPU;
+for each ``--release`` of ``live`` given (``docs/live.md``, *Latency*). First, from the
+plots alone (no ``live``): each frame's own closing wait — from its last plot to the
+first plot that closes it (its radar's next plot, or the first plot of any radar past
+the frame's start plus its length: ``sources/framer.py``) — p50/p99 over the same
+seconds: the part of the latency that no release order removes.
 """
 
 from __future__ import annotations
@@ -15,6 +21,8 @@ import argparse
 import shutil
 import sys
 from pathlib import Path
+
+import numpy as np
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
@@ -26,6 +34,7 @@ def main() -> None:
     ap.add_argument("out", type=Path)
     ap.add_argument("--seconds", type=float, default=120.0)
     ap.add_argument("--window", type=float, nargs="+", default=[0.2, 0.1, 0.05])
+    ap.add_argument("--release", nargs="+", choices=("time", "radar"), default=["time"])
     a = ap.parse_args()
     import national
     from mhtrack.build.radar_defaults import radar_rule
@@ -41,16 +50,45 @@ def main() -> None:
     p = read_plots(a.dir / "plots.csv", sensors)
     rule = radar_rule(sensors, p.sensor, p.time, p.x, p.y, v_max=MHTConfig().v_max)
     meta = {"birth_density": rule.new_target_density}  # track's radar rule
-    for w in a.window:
+    wait = own_close_wait(p.time, p.sensor, sensors, a.seconds)
+    print(f"own closing wait after a frame's last plot (first {a.seconds:g} s, "
+          f"{wait.size} frames): p50 {1e3 * np.percentile(wait, 50):.0f} ms, p99 "
+          f"{1e3 * np.percentile(wait, 99):.0f} ms", flush=True)
+    for release, w in ((r, w) for r in a.release for w in a.window):
         run = national.live_run(a.out, meta, argparse.Namespace(
-            reorder_window=w, stop_timeout=60.0, live_s=a.seconds))
+            reorder_window=w, stop_timeout=60.0, live_s=a.seconds, release=release))
         st = run["status"]
         lat = st["latency_s"]
-        print(f"window {w:g} s: {st['plots']} plots, {st['frames']} frames, late drops "
+        print(f"release {release}, window {w:g} s: {st['plots']} plots, {st['frames']} "
+              f"frames, late drops "
               f"{st['late_drops']}, latency p50 {1e3 * lat['p50']:.0f} ms p99 "
               f"{1e3 * lat['p99']:.0f} ms ({lat['count']} timed); live's CPU "
               f"{run['cpu_s']:.1f} s; p99 per 10 s line (ms) "
               f"{[round(x[2]) for x in run['lines']]}", flush=True)
+
+
+def own_close_wait(time, sensor, sensors, seconds: float) -> np.ndarray:
+    """Each frame's wait from its last plot to the plot that closes it (module
+    docstring), frames of the first ``seconds`` (s; frames the data never closes left
+    out)."""
+    from mhtrack.frames import frame_lengths, make_frames
+
+    order = np.argsort(np.asarray(time, float), kind="stable")
+    t, s = np.asarray(time, float)[order], np.asarray(sensor, np.int64)[order]
+    keep = t < t[0] + seconds
+    t, s = t[keep], s[keep]
+    lengths = frame_lengths({x.id: x.period for x in sensors.sensors})
+    frame, _ = make_frames(t, s, lengths)
+    out = []
+    for k in range(int(frame.max()) + 1):
+        idx = np.flatnonzero(frame == k)
+        sid, start, end = int(s[idx[0]]), t[idx].min(), t[idx].max()
+        mine = np.flatnonzero((s == sid) & (t > end))
+        past = np.flatnonzero(t > start + lengths.get(sid, np.inf))
+        close = min(t[mine[0]] if mine.size else np.inf, t[past[0]] if past.size else np.inf)
+        if np.isfinite(close):
+            out.append(close - end)
+    return np.asarray(out)
 
 
 if __name__ == "__main__":

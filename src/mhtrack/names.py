@@ -44,3 +44,7 @@ DEFAULT_OUTPUT = OUTPUTS[0]
 RADAR_OUTPUT = OUTPUTS[2]
 #: What ``mhtrack export`` writes: ASTERIX CAT048 plots (the default) or CAT062 tracks.
 EXPORT_CATEGORIES: tuple[str, ...] = ("048", "062")
+#: When ``live`` gives a closed frame (a sector) to the tracker
+#: (:mod:`mhtrack.sources.framer`): in ``track``'s time order, or as soon as its own
+#: plots are in.
+RELEASES: tuple[str, ...] = ("time", "radar")

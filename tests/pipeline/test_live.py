@@ -224,3 +224,39 @@ def test_a_quiet_feed_closes_its_frames_on_the_idle_clock(rec: Path) -> None:
     assert idle_wait(sensors, LiveOptions(stdin="raw")) == 2.0 + max(
         s.period for s in sensors.sensors)
     assert idle_wait(sensors, LiveOptions(stdin="raw", idle_close_s=0.0)) is None
+
+
+def test_release_by_radar_tracks_the_same_frames(rec: Path) -> None:
+    """``release="radar"``: the frames the tracker gets are those of the default (each
+    frame's plots by row, the same set; another order), their times never go back, and
+    every plot is tracked."""
+    from mhtrack.sinks.base import Sink
+
+    class Frames(Sink):
+        def __init__(self) -> None:
+            self.got: list[tuple[float, tuple[int, ...]]] = []
+
+        def write(self, out) -> None:
+            self.got.append((float(out.frame.time),
+                             tuple(sorted(live.source.file_rows(out.frame.rows).tolist()))))
+
+    sensors = read_sensors(rec / "sensors.toml")
+    data = (rec / "radar.ast").read_bytes()
+    seen = {}
+    for release in ("time", "radar"):
+        rf, writer = _pipe(data)
+        with rf:
+            live = Live(sensors, OPTIONS, LiveOptions(preload=False, stdin="raw",
+                                                      day_from="stream", release=release),
+                        stdin=rf)
+            sink = Frames()
+            live.sinks.append(sink)
+            writer.start()
+            live.run()
+            writer.join()
+        seen[release] = sink.got
+        assert live.source._stream.framer.release == release
+    times = [t for t, _ in seen["radar"]]
+    assert times == sorted(times)
+    assert sorted(p for _, p in seen["radar"]) == sorted(p for _, p in seen["time"])
+    assert len(seen["time"]) > 10

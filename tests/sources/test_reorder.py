@@ -102,3 +102,38 @@ def test_properties(times, window) -> None:
     assert len(out) + buf.late.n == len(times)
     if not buf.late.n and t.size and np.all(t >= before - window):
         assert out == np.argsort(t, kind="stable").tolist()
+
+
+@settings(max_examples=200, deadline=None)
+@given(times_st, st.sampled_from([0.0, 0.25, 1.0]), st.lists(st.integers(0, 60), max_size=8))
+def test_holds_what_the_rule_holds_and_no_late_plot(times, window, cuts) -> None:
+    """After every batch the buffer holds exactly the plots the plain rule still holds
+    (by arrival number, in leaving order), and keeps no column of a dropped plot."""
+    buf = ReorderBuffer(window)
+    t = np.asarray(times, float)
+    bounds = [0, *sorted(set(c for c in cuts if 0 < c < t.size)), t.size]
+    for a, b in itertools.pairwise(bounds):
+        buf.push({"time": t[a:b], "tag": np.arange(a, b)})
+        _, dropped = _reference(times[:b], window)
+        held = buf.held()
+        want = sorted(set(range(b)) - set(dropped) - set(_released(times[:b], window)),
+                      key=lambda i: (times[i], i))
+        assert (held["tag"].tolist() if held is not None else []) == want
+        assert buf._held_seq.size == len(want)
+
+
+def _released(times: list[float], window: float) -> list[int]:
+    """The arrival numbers the plain rule has released after ``times`` (no flush)."""
+    held: list[tuple[float, int]] = []
+    out: list[int] = []
+    latest = released = -np.inf
+    for i, t in enumerate(times):
+        if t < released:
+            continue
+        latest = max(latest, t)
+        held.append((t, i))
+        for h in sorted(h for h in held if latest - h[0] > window):
+            out.append(h[1])
+            held.remove(h)
+            released = h[0]
+    return out

@@ -85,6 +85,7 @@ class ReorderBuffer:
         seq0 = self.n_in
         self.n_in += t.size
         out: list[int] = []
+        dropped: list[int] = []
         heap, window = self._heap, self.window_s
         latest, released = self.latest, self.released
         for i, ti in enumerate(t.tolist()):
@@ -92,6 +93,7 @@ class ReorderBuffer:
                 self.late.add(latest - ti, lambda i=i: {  # type: ignore[misc]
                     k: _scalar(np.asarray(v)[i]) for k, v in cols.items()
                     if np.ndim(v) == 1})
+                dropped.append(seq0 + i)
                 continue
             if ti < latest:
                 self.reordered += 1
@@ -103,7 +105,7 @@ class ReorderBuffer:
                 released, s = heapq.heappop(heap)
                 out.append(s)
         self.latest, self.released = latest, released
-        return self._move(cols, seq0, out)
+        return self._move(cols, seq0, out, dropped)
 
     def flush(self) -> dict[str, np.ndarray]:
         """Release every held plot (the input has ended)."""
@@ -111,7 +113,7 @@ class ReorderBuffer:
         self._heap = []
         if out:
             self.released = max(self.released, self._time_of(out[-1]))
-        return self._move(None, self.n_in, out)
+        return self._move(None, self.n_in, out, [])
 
     def held(self) -> dict[str, np.ndarray] | None:
         """The columns of the plots held, in the order they would leave (time, then
@@ -126,9 +128,11 @@ class ReorderBuffer:
         assert self._held is not None
         return float(self._held["time"][np.searchsorted(self._held_seq, seq)])
 
-    def _move(self, cols: Columns | None, seq0: int, out: list[int]) -> dict[str, np.ndarray]:
+    def _move(self, cols: Columns | None, seq0: int, out: list[int], dropped: list[int]
+              ) -> dict[str, np.ndarray]:
         """Gather the released plots (by ``seq``) from the held ones and the batch; keep
-        the rest held."""
+        the rest held (those neither released nor ``dropped``: the heap's, in ``seq``
+        order, found by a mask rather than a pass over the heap)."""
         if cols is not None and len(cols["time"]):
             new_seq = np.arange(seq0, seq0 + len(cols["time"]), dtype=np.int64)
             batch = {k: np.asarray(v) for k, v in cols.items()}
@@ -143,10 +147,12 @@ class ReorderBuffer:
         pos = np.searchsorted(self._held_seq, seq)
         result = {k: v[pos] for k, v in self._held.items()}
         result["seq"] = seq
-        keep = np.sort(np.fromiter((s for _, s in self._heap), np.int64, len(self._heap)))
-        kpos = np.searchsorted(self._held_seq, keep)
-        self._held = {k: v[kpos] for k, v in self._held.items()}
-        self._held_seq = keep
+        stay = np.ones(self._held_seq.size, bool)
+        stay[pos] = False
+        if dropped:
+            stay[np.searchsorted(self._held_seq, np.asarray(dropped, np.int64))] = False
+        self._held = {k: v[stay] for k, v in self._held.items()}
+        self._held_seq = self._held_seq[stay]
         return result
 
 

@@ -52,7 +52,7 @@ from mhtrack.pipeline.run import Pipeline, RunResult
 from mhtrack.pipeline.view import ViewServer, ViewSink, radar_list
 from mhtrack.pipeline.warmup import Warmup, warm_up
 from mhtrack.sinks.base import FrameOutput, Sink
-from mhtrack.sources.base import IDLE
+from mhtrack.sources.base import CAUGHT_UP, IDLE
 
 if TYPE_CHECKING:
     from mhtrack.models.radars import SensorSet
@@ -158,13 +158,14 @@ class Live:
                               if s.kind == "polar" and s.period is not None}, clock)
         self.source = DatagramSource(
             self._arrived(incoming), sensors=sensors, name=name,
-            reorder_window_s=live.reorder_window_s, chunk=1,  # each data block on at once
+            reorder_window_s=live.reorder_window_s,  # what has queued up: one chunk
             axis=axis, first_frame=0 if st is None else st.next_frame,
             first_row=0 if st is None else st.next_row,
             not_before=None if st is None else st.last_time,
             pending=None if st is None else decode_pending(st.pending),
             recent=None if st is None else st.duplicates,
             keep_rows=KEEP_ROWS,  # the health looks up the frame just made
+            release=live.release,
             # stopped with a checkpoint: the plots held go into it, tracked on resume
             hold=lambda: self.stop.is_set() and live.checkpoint is not None)
         try:
@@ -274,8 +275,11 @@ class Live:
 
     # -- what the health, period output and checkpoints read --------------------------
     def _arrived(self, reader: Iterable[tuple[bytes, float]]) -> Iterator[Any]:
-        """The reader's datagrams, each receive time noted for the latency first."""
+        """The reader's datagrams, each receive time noted for the latency first, and
+        :data:`~mhtrack.sources.base.CAUGHT_UP` after one when no other is waiting (the
+        source decodes what has queued up as one chunk, and passes it on then)."""
         stream = self.live.day_from == "stream"
+        waiting = self.reader.waiting
         for item in reader:
             if item is IDLE:
                 yield item
@@ -283,6 +287,8 @@ class Live:
             data, when = item
             self.health.arrivals.add(self.source.decoded, when)
             yield data if stream else (data, when)
+            if not waiting():
+                yield CAUGHT_UP
         self.health.input_ended = True
 
     def _counts(self) -> dict[str, int | None]:

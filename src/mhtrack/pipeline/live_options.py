@@ -63,6 +63,10 @@ class LiveOptions:
     sac: int | None = None
     sic: int | None = None
     reorder_window_s: float | None = None
+    #: When a closed frame goes to the tracker (:mod:`~mhtrack.sources.framer`):
+    #: ``"time"``, in ``track``'s order (the output equals ``track``'s online view);
+    #: ``"radar"``, as soon as its own plots are in (lower latency, another output).
+    release: str = "time"
     #: A quiet feed: after this many wall-clock seconds without a datagram the frames
     #: held are closed (``None``: the re-order window plus the longest rotation period;
     #: ``0``: never) — *A silent feed* in ``docs/live.md``.

@@ -156,12 +156,14 @@ def cat062_blocks(tracks: TrackTable, frame: LocalFrame, name: str, *,
                   sac: int | None = None, sic: int | None = None
                   ) -> Iterator[tuple[float, int, bytes]]:
     """``(time, data source, CAT062 data block)`` of tracker rows ``tracks``: the one
-    encoding path of every CAT062 sink (:func:`~mhtrack.io.asterix.cat062.table_messages`
-    then :func:`~mhtrack.io.asterix.encode.encode_blocks`, at most 40 records a block)."""
-    from mhtrack.io.asterix.cat062 import table_messages
-    from mhtrack.io.asterix.encode import encode_blocks
+    encoding path of every CAT062 sink — the octets libasterix writes of
+    :func:`~mhtrack.io.asterix.cat062.table_messages`
+    (:func:`~mhtrack.io.asterix.encode.encode_blocks`, at most 40 records a block),
+    encoded with NumPy for rows without attributes
+    (:func:`~mhtrack.io.asterix.cat062_fast.blocks062`)."""
+    from mhtrack.io.asterix.cat062_fast import blocks062
 
-    return encode_blocks(table_messages(tracks, frame, name, sac=sac, sic=sic))
+    return blocks062(tracks, frame, name, sac=sac, sic=sic)
 
 
 class Cat062Sink(_Rows):

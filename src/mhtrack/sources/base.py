@@ -45,6 +45,20 @@ class _Idle:
 IDLE = _Idle()
 
 
+class _CaughtUp:
+    """The type of :data:`CAUGHT_UP`."""
+
+    def __repr__(self) -> str:
+        return "CAUGHT_UP"
+
+
+#: In a live stream of datagrams, after one: no other datagram is waiting now; a
+#: :class:`~mhtrack.sources.datagrams.DatagramSource` passes on the plots it has decoded
+#: (a live feed decodes what has queued up as one chunk, not datagram by datagram; the
+#: frames do not depend on the chunks, only when they are given out).
+CAUGHT_UP = _CaughtUp()
+
+
 @dataclass
 class SourceStats:
     """What a source did to its input so far (counters only grow while it is read)."""

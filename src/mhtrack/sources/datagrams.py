@@ -50,7 +50,7 @@ from mhtrack.io.reorder import DEFAULT_REORDER_WINDOW_S
 from mhtrack.io.reorder import kept as kept_by_buffer
 from mhtrack.models.radars import SensorSet
 from mhtrack.records import Scan
-from mhtrack.sources.base import IDLE, Source, SourceStats, Survey
+from mhtrack.sources.base import CAUGHT_UP, IDLE, Source, SourceStats, Survey
 from mhtrack.sources.gather import Gathered
 from mhtrack.sources.positions import local_positions
 from mhtrack.sources.timed import TimedStream
@@ -77,13 +77,15 @@ class DatagramSource(Source):
                  not_before: float | None = None,
                  pending: Mapping[str, Any] | None = None,
                  hold: Callable[[], bool] | None = None,
-                 recent: str | None = None, keep_rows: int | None = None) -> None:
+                 recent: str | None = None, keep_rows: int | None = None,
+                 release: str = "time") -> None:
         super().__init__()
         if chunk < 1:
             raise ValueError(f"chunk must be >= 1 plot, got {chunk!r}")
-        #: Plots converted and passed on together (a live feed passes each data block on
-        #: at once: ``chunk=1``; the results do not depend on it, the conversion is
-        #: element-wise).
+        #: Plots converted and passed on together at most (a live feed also passes on
+        #: what it has decoded whenever no datagram is waiting:
+        #: :data:`~mhtrack.sources.base.CAUGHT_UP`; the results do not depend on it, the
+        #: conversion is element-wise).
         self.chunk = int(chunk)
         self.name = name
         self.given = sensors
@@ -114,6 +116,9 @@ class DatagramSource(Source):
         #: :meth:`file_rows` knows the last ``keep_rows`` plots only (``None``: all; a
         #: live stream without end keeps its memory flat).
         self.keep_rows = keep_rows
+        #: When a closed frame goes out (:mod:`~mhtrack.sources.framer`: ``"time"``,
+        #: the order of ``track``; ``"radar"``, as soon as its own plots are in).
+        self.release = release
         self.held: dict[str, Any] | None = None
         #: Plots decoded so far: the next plot's decoding-order number (its ``file_row``).
         self.decoded = 0
@@ -128,8 +133,8 @@ class DatagramSource(Source):
         """``(byte offset, payload, capture time)`` of each datagram."""
         offset = 0
         for d in self._input:
-            if d is IDLE:
-                yield offset, IDLE, None
+            if d is IDLE or d is CAUGHT_UP:
+                yield offset, d, None
                 continue
             payload, when = (d, None) if isinstance(d, bytes | bytearray | memoryview) else d
             yield offset, payload, when
@@ -158,13 +163,12 @@ class DatagramSource(Source):
         in_sector: list[int] = []
         n = 0
         for offset, payload, when in self._datagrams(problems):
-            if payload is IDLE:  # the feed went quiet: what is decoded, then the marker
+            if payload is IDLE or payload is CAUGHT_UP:  # what is decoded, then IDLE
                 if rows:
                     yield self._chunk(rows, times, at_rows, n, convert, in_sector)
                     n += len(rows)
-                    self.decoded = n
                     rows, times, at_rows, in_sector = [], [], [], []
-                if idle:
+                if idle and payload is IDLE:
                     yield IDLE  # type: ignore[misc]
                 continue
             for at, what, found in decoder.blocks(payload, offset, problems, when):
@@ -176,6 +180,7 @@ class DatagramSource(Source):
                         sector[r[1]] = sector.get(r[1], 0) + 1
                     continue
                 rows.extend(found)
+                self.decoded = n + len(rows)
                 times.extend(t)
                 at_rows.extend([at] * len(found))
                 if self.sectors:
@@ -183,11 +188,9 @@ class DatagramSource(Source):
                 if len(rows) >= self.chunk:
                     yield self._chunk(rows, times, at_rows, n, convert, in_sector)
                     n += len(rows)
-                    self.decoded = n
                     rows, times, at_rows, in_sector = [], [], [], []
         if rows:
             yield self._chunk(rows, times, at_rows, n, convert, in_sector)
-            self.decoded = n + len(rows)
 
     def _chunk(self, rows: list[tuple[Any, ...]], times: list[float], at: list[int],
                n0: int, convert: bool, in_sector: list[int]) -> dict[str, np.ndarray]:
@@ -262,7 +265,7 @@ class DatagramSource(Source):
             self.name, self.stats, self._frame_lengths(), self.window_s,
             lambda first: f"byte {first['offset']} (plot {first['file_row']})",
             first_frame=self.first_frame, first_row=self.first_row,
-            not_before=self.not_before, keep_rows=self.keep_rows)
+            not_before=self.not_before, keep_rows=self.keep_rows, release=self.release)
         if self.restore is not None:
             yield from stream.restore(self.restore)
         for cols in self._decoded(problems, idle=True):

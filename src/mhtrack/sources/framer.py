@@ -18,6 +18,16 @@ goes out once
 and closed frames go out in ``(end, sensor)`` order. Frames of one sensor have distinct
 ends, so make_frames' last tie-break (first row) never decides. Within a frame plots keep
 their input order, which is time order.
+
+**Release by radar** (``release="radar"``, an option of ``live``, off by default): a
+closed frame goes out once ``end_F < T`` alone — its own plots are all in — without
+waiting for the open frames of other radars that might still end before it (the wait of
+the global order is up to one frame length of the slowest radar). Frames then go out in
+the order they are complete, not make_frames' order; a frame that closes with its end
+before that of a frame already given out gets the latter's time as its reference time
+(its plots keep their own times), so that frame times never go back. The tracker then
+sees another order of the same frames than ``track`` on the file: its output differs
+(``docs/live.md``, *Latency*).
 """
 
 from __future__ import annotations
@@ -28,6 +38,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from mhtrack.frames import DEFAULT_FRAME_S
+from mhtrack.names import RELEASES
 
 
 @dataclass
@@ -55,9 +66,16 @@ class Framer:
     """Cuts time-ordered batches of plots into one-sensor frames (module docstring).
 
     ``frame_s`` gives the longest frame per sensor id (s) or one length for all; a sensor
-    missing from the mapping gets :data:`~mhtrack.frames.DEFAULT_FRAME_S`."""
+    missing from the mapping gets :data:`~mhtrack.frames.DEFAULT_FRAME_S`; ``release``
+    ``"time"`` (make_frames' order) or ``"radar"`` (module docstring)."""
 
-    def __init__(self, frame_s: Mapping[int, float] | float = DEFAULT_FRAME_S) -> None:
+    def __init__(self, frame_s: Mapping[int, float] | float = DEFAULT_FRAME_S, *,
+                 release: str = "time") -> None:
+        if release not in RELEASES:
+            raise ValueError(f"unknown release {release!r} (expected "
+                             f"{', '.join(RELEASES)})")
+        self.release = release
+        self.last_time = -np.inf  # the reference time of the last frame given out
         self.frame_s = frame_s
         self.now = -np.inf
         self.n_frames = 0
@@ -150,7 +168,8 @@ class Framer:
             if not final:
                 if not end < self.now:
                     break
-                if any((g.end, gs) < (end, s) for gs, g in self._open.items()):
+                if self.release == "time" and any(
+                        (g.end, gs) < (end, s) for gs, g in self._open.items()):
                     break
             self._closed.pop(0)
             yield self._emit(s, fr)
@@ -164,6 +183,9 @@ class Framer:
             if self._uses[b] == 0:
                 del self._batches[b], self._uses[b]
         cols = {k: v[0] if len(v) == 1 else np.concatenate(v) for k, v in pieces.items()}
-        out = Frame(self.n_frames, sensor, fr.end, cols)
+        if self.release == "radar":  # frame times never go back
+            self.last_time = max(self.last_time, fr.end)
+        out = Frame(self.n_frames, sensor, fr.end if self.release == "time"
+                    else self.last_time, cols)
         self.n_frames += 1
         return out

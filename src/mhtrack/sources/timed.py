@@ -30,12 +30,13 @@ class TimedStream:
     def __init__(self, name: str, stats: SourceStats, frame_s: Mapping[int, float] | float,
                  window_s: float, where: Callable[[dict[str, object]], str], *,
                  first_frame: int = 0, first_row: int = 0,
-                 not_before: float | None = None, keep_rows: int | None = None) -> None:
+                 not_before: float | None = None, keep_rows: int | None = None,
+                 release: str = "time") -> None:
         self.name = name
         self.stats = stats
         self.where = where
         self.buffer = ReorderBuffer(window_s)
-        self.framer = Framer(frame_s)
+        self.framer = Framer(frame_s, release=release)  # when frames go out
         self.framer.n_frames = int(first_frame)  # frames numbered on from here
         if not_before is not None:  # as if plots up to it had gone: earlier ones are late
             self.buffer.latest = self.buffer.released = float(not_before)

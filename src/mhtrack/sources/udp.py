@@ -205,6 +205,11 @@ class _Threaded(ABC):
         s.bytes += len(data)
         s.per_input[where] = s.per_input.get(where, 0) + 1
 
+    def waiting(self) -> int:
+        """Datagrams received and not yet taken (approximately: the receiving thread
+        goes on)."""
+        return self._queue.qsize()
+
     @abstractmethod
     def _receive(self) -> None:
         """Put what the input delivers on the queue (:meth:`_put`) until stop or its end."""

@@ -14,6 +14,7 @@ identification and 290 update ages per technology (PSR, SSR, Mode S;
 from __future__ import annotations
 
 from collections.abc import Callable
+from functools import cache
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -45,6 +46,7 @@ TRACK_COLUMNS = ("time", "sac", "sic", "track_number", "lat", "lon", "vx", "vy",
                  "tentative", "coasting")
 
 
+@cache
 def lsb062() -> dict[str, float]:
     """LSBs of the CAT062 items written, from libasterix (raw 1 read back)."""
     rec = _lib.cat062().cv_record
@@ -114,6 +116,13 @@ def table_messages(tracks: TrackTable, frame: LocalFrame, name: str, *,
     a miss is coasting, a ``tentative`` row tentative) — the same messages
     :func:`export_tracks` makes of the tracks file written from ``tracks``. Problems
     raise :class:`ValueError` naming ``name``, the track and its time."""
+    return track_messages(*table_values(tracks, frame, name), sac=sac, sic=sic,
+                          attrs=tracks.attrs)
+
+
+def table_values(tracks: TrackTable, frame: LocalFrame, name: str) -> tuple[Any, ...]:
+    """The arguments of :func:`track_messages` (and :func:`core_raw`) for tracker
+    output ``tracks`` (:func:`table_messages`), up to ``check``."""
     x, y = tracks.x, tracks.y
     lat, lon = frame.to_geodetic(x, y)
     ve, vn = frame.velocity_to_geodetic(x, y, tracks.vx, tracks.vy)
@@ -127,8 +136,8 @@ def table_messages(tracks: TrackTable, frame: LocalFrame, name: str, *,
             raise ValueError(f"{name}: track {int(tracks.track_id[r])} at time "
                              f"{float(tracks.time[r]):g} s, {column}: {text(r)}")
 
-    return track_messages(np.asarray(tracks.time, float), tracks.track_id, lat, lon, ve, vn,
-                          coasting, tentative, check, sac=sac, sic=sic, attrs=tracks.attrs)
+    return (np.asarray(tracks.time, float), tracks.track_id, lat, lon, ve, vn, coasting,
+            tentative, check)
 
 
 def track_messages(time: np.ndarray, track_id: np.ndarray, lat: np.ndarray,
@@ -140,6 +149,26 @@ def track_messages(time: np.ndarray, track_id: np.ndarray, lat: np.ndarray,
     ``attrs`` the items of :func:`~mhtrack.io.asterix.cat062_items.attribute_items` where
     known), values rounded to the items' LSBs (:func:`lsb062`); ``check`` reports rows
     that do not fit."""
+    r = core_raw(time, track_id, lat, lon, ve, vn, coasting, tentative, check, sac=sac,
+                 sic=sic)
+    sac, sic = r["sac"], r["sic"]
+    extra = attribute_items(attrs, check) if attrs is not None else None
+    return [Message(float(time[i]), r["sid"], 62, {
+        "010": (("SAC", sac), ("SIC", sic)), "070": int(r["tod"][i]),
+        "105": (("LAT", int(r["lat"][i])), ("LON", int(r["lon"][i]))),
+        "185": (("VX", int(r["vx"][i])), ("VY", int(r["vy"][i]))),
+        "040": int(r["track"][i]), "080": _status(int(tentative[i]), int(coasting[i])),
+        **({} if extra is None else extra(i)),
+    }) for i in range(len(time))]
+
+
+def core_raw(time: np.ndarray, track_id: np.ndarray, lat: np.ndarray, lon: np.ndarray,
+             ve: np.ndarray, vn: np.ndarray, coasting: np.ndarray, tentative: np.ndarray,
+             check: Check, *, sac: int | None = None, sic: int | None = None
+             ) -> dict[str, Any]:
+    """The raw values (LSBs of :func:`lsb062`) of the items every row has — ``tod``
+    (070), ``lat, lon`` (105), ``vx, vy`` (185), ``track`` (040) — and ``sac, sic,
+    sid``; ``check`` reports rows that do not fit."""
     sac = DEFAULT_SAC if sac is None else sac
     sic = DEFAULT_SIC if sic is None else sic
     check(time < 0, "time", lambda r: f"time {time[r]:g} s is negative (ASTERIX times "
@@ -154,16 +183,8 @@ def track_messages(time: np.ndarray, track_id: np.ndarray, lat: np.ndarray,
             f"velocity {k} beyond I062/185's ±8192 m/s"))
     lat_raw = np.round(lat / L["deg"]).astype(np.int64)
     lon_raw = np.round(((lon + 180.0) % 360.0 - 180.0) / L["deg"]).astype(np.int64)
-    tod = raw_tod(time)
-    sid = (sac << 8) | sic
-    extra = attribute_items(attrs, check) if attrs is not None else None
-    return [Message(float(time[i]), sid, 62, {
-        "010": (("SAC", sac), ("SIC", sic)), "070": int(tod[i]),
-        "105": (("LAT", int(lat_raw[i])), ("LON", int(lon_raw[i]))),
-        "185": (("VX", int(raw["vx"][i])), ("VY", int(raw["vy"][i]))),
-        "040": int(tn[i]), "080": _status(int(tentative[i]), int(coasting[i])),
-        **({} if extra is None else extra(i)),
-    }) for i in range(len(time))]
+    return {"tod": raw_tod(time), "lat": lat_raw, "lon": lon_raw, "vx": raw["vx"],
+            "vy": raw["vy"], "track": tn, "sac": sac, "sic": sic, "sid": (sac << 8) | sic}
 
 
 def read_system_tracks(path: str | Path) -> tuple[dict[str, np.ndarray], Problems]:

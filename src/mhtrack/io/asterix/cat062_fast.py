@@ -1,0 +1,81 @@
+"""CAT062 data blocks of track rows without attributes, encoded with NumPy: the octets
+libasterix writes for the messages of :func:`~mhtrack.io.asterix.cat062.track_messages`
+(``encode_blocks``), without building a Python object per item — a live run sends every
+frame's rows, and libasterix's per-record objects cost more CPU than the tracking.
+
+A record (EUROCONTROL ASTERIX CAT062 edition 1.18, user application profile) holds, in
+FRN order, I062/010 (SAC, SIC), 070 (time of day, 1/128 s, 3 octets), 105 (latitude,
+longitude: two's complement, 4 octets each, 180/2²⁵°), 185 (VX, VY: 2 octets each, ¼
+m/s), 040 (track number, 2 octets) and 080 (track status, four octets: CNF the second
+lowest bit of the first, CST the highest of the fourth; FX set on the first three). Its
+FSPEC is two octets: FRN 1, 4, 5, 7 and FX, then FRN 12 and 13. Values big-endian.
+Data blocks: category 62, their length (2 octets), at most
+:data:`~mhtrack.io.asterix.encode.MAX_RECORDS` records, rows in time order (stable) —
+``encode_blocks``' rule for one data source. Rows with attributes (I062/060, 136, 220,
+245, 290, 340, 380, 500) are not encoded here: :func:`blocks062` falls back to
+libasterix for them.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from mhtrack.io.asterix.encode import MAX_RECORDS
+
+if TYPE_CHECKING:
+    from mhtrack.models.geodesy import LocalFrame
+    from mhtrack.records import TrackTable
+
+#: The FSPEC of a record with items 010, 070, 105, 185 | 040, 080.
+FSPEC = (0x9B, 0x0C)
+#: Octets of one record: FSPEC 2, 010 2, 070 3, 105 8, 185 4, 040 2, 080 4.
+RECORD = 25
+
+
+def records062(raw: dict[str, np.ndarray | int], tentative: np.ndarray,
+               coasting: np.ndarray) -> np.ndarray:
+    """The records of the rows (``raw``: :func:`~mhtrack.io.asterix.cat062.core_raw`)
+    as an ``(n, RECORD)`` array of octets (module docstring)."""
+    n = len(raw["tod"])  # type: ignore[arg-type]
+    out = np.zeros((n, RECORD), np.uint8)
+    out[:, 0], out[:, 1] = FSPEC
+    out[:, 2], out[:, 3] = int(raw["sac"]), int(raw["sic"])  # type: ignore[call-overload]
+    at = 4
+    for key, size in (("tod", 3), ("lat", 4), ("lon", 4), ("vx", 2), ("vy", 2),
+                      ("track", 2)):
+        v = np.asarray(raw[key], np.int64) & ((1 << (8 * size)) - 1)  # two's complement
+        for k in range(size):
+            out[:, at + k] = (v >> (8 * (size - 1 - k))) & 0xFF
+        at += size
+    out[:, at] = 0x01 | (np.asarray(tentative) != 0).astype(np.uint8) << 1
+    out[:, at + 1] = out[:, at + 2] = 0x01
+    out[:, at + 3] = (np.asarray(coasting) != 0).astype(np.uint8) << 7
+    return out
+
+
+def blocks062(tracks: TrackTable, frame: LocalFrame, name: str, *,
+              sac: int | None = None, sic: int | None = None
+              ) -> Iterator[tuple[float, int, bytes]]:
+    """``(time, data source, CAT062 data block)`` of tracker rows ``tracks``: the
+    blocks of :func:`~mhtrack.sinks.files.cat062_blocks`, octet for octet, encoded with
+    NumPy when the rows have no attributes (module docstring), else by libasterix."""
+    from mhtrack.io.asterix.cat062 import core_raw, table_messages, table_values
+    from mhtrack.io.asterix.encode import encode_blocks
+
+    if tracks.attrs is not None:
+        yield from encode_blocks(table_messages(tracks, frame, name, sac=sac, sic=sic))
+        return
+    values = table_values(tracks, frame, name)
+    time, coasting, tentative = values[0], values[6], values[7]
+    raw = core_raw(*values, sac=sac, sic=sic)
+    order = np.argsort(time, kind="stable")
+    recs = records062(raw, tentative, coasting)[order]
+    sid = int(raw["sid"])
+    for i in range(0, len(order), MAX_RECORDS):
+        part = recs[i:i + MAX_RECORDS]
+        size = 3 + part.size
+        yield (float(time[order[i]]), sid,
+               bytes((62, size >> 8, size & 0xFF)) + part.tobytes())

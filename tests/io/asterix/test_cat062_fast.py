@@ -1,8 +1,9 @@
 """The NumPy CAT062 encoder (:mod:`mhtrack.io.asterix.cat062_fast`) against libasterix:
 the same data blocks, octet for octet, for random rows (any time of day, positions over
 the globe from one frame, velocities up to I062/185's range, track numbers 0–65535,
-tentative and coasting rows, ties in time), and the libasterix path kept for rows with
-attributes (any mix present/absent, with a hand-worked record)."""
+tentative and coasting rows, ties in time), and with attributes (any mix present and
+absent, a hand-worked record, values beyond an item: the same refusal or, where the NumPy
+encoder falls back, libasterix's own answer)."""
 
 from __future__ import annotations
 

@@ -12,8 +12,8 @@ FSPEC is two octets: FRN 1, 4, 5, 7 and FX, then FRN 12 and 13. Values big-endia
 Data blocks: category 62, their length (2 octets), at most
 :data:`~mhtrack.io.asterix.encode.MAX_RECORDS` records, rows in time order (stable) —
 ``encode_blocks``' rule for one data source. Rows with attributes (I062/060, 136, 220,
-245, 290, 340, 380, 500) are not encoded here: :func:`blocks062` falls back to
-libasterix for them.
+245, 290, 340, 380, 500) are encoded by :mod:`.cat062_attr_octets`, and by libasterix
+where that module does not cover them (codes beyond 12 bits, …: its docstring).
 """
 
 from __future__ import annotations
@@ -61,21 +61,34 @@ def blocks062(tracks: TrackTable, frame: LocalFrame, name: str, *,
               ) -> Iterator[tuple[float, int, bytes]]:
     """``(time, data source, CAT062 data block)`` of tracker rows ``tracks``: the
     blocks of :func:`~mhtrack.sinks.files.cat062_blocks`, octet for octet, encoded with
-    NumPy when the rows have no attributes (module docstring), else by libasterix."""
+    NumPy: rows without attributes here (module docstring), rows with attributes by
+    :mod:`.cat062_attr_octets`; by libasterix when that module does not cover the
+    attributes (its ``covered``). Values that do not fit are refused as
+    :func:`~mhtrack.io.asterix.cat062.track_messages` refuses them (the same checks)."""
     from mhtrack.io.asterix.cat062 import core_raw, table_messages, table_values
+    from mhtrack.io.asterix.cat062_attr_octets import covered, record_segments
+    from mhtrack.io.asterix.cat062_items import attribute_raw
     from mhtrack.io.asterix.encode import encode_blocks
+    from mhtrack.io.asterix.octets import assemble
 
-    if tracks.attrs is not None:
-        yield from encode_blocks(table_messages(tracks, frame, name, sac=sac, sic=sic))
-        return
     values = table_values(tracks, frame, name)
-    time, coasting, tentative = values[0], values[6], values[7]
+    time, coasting, tentative, check = values[0], values[6], values[7], values[8]
     raw = core_raw(*values, sac=sac, sic=sic)
     order = np.argsort(time, kind="stable")
-    recs = records062(raw, tentative, coasting)[order]
     sid = int(raw["sid"])
+    if tracks.attrs is None:
+        recs = records062(raw, tentative, coasting)[order]
+        data, sizes = recs.reshape(-1), np.full(len(order), RECORD)
+    else:
+        attrs = attribute_raw(tracks.attrs, check)
+        if not covered(tracks.attrs, attrs):
+            yield from encode_blocks(table_messages(tracks, frame, name, sac=sac, sic=sic))
+            return
+        data, sizes = assemble(record_segments(raw, tentative, coasting, tracks.attrs,
+                                               attrs), order)
+    ends = np.concatenate([[0], np.cumsum(sizes)])
     for i in range(0, len(order), MAX_RECORDS):
-        part = recs[i:i + MAX_RECORDS]
-        size = 3 + part.size
+        j = min(i + MAX_RECORDS, len(order))
+        size = 3 + int(ends[j] - ends[i])
         yield (float(time[order[i]]), sid,
-               bytes((62, size >> 8, size & 0xFF)) + part.tobytes())
+               bytes((62, size >> 8, size & 0xFF)) + data[ends[i]:ends[j]].tobytes())

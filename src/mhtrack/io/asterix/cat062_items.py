@@ -25,6 +25,7 @@ written as the largest value (saturated).
 from __future__ import annotations
 
 from collections.abc import Callable
+from functools import cache
 from typing import Any
 
 import numpy as np
@@ -40,6 +41,7 @@ TYP340 = {PRIMARY: 1, SECONDARY: 2, COMBINED: 3, MODE_S: 5}
 ID_CHARS = frozenset("ABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789 ")
 
 
+@cache
 def lsb_attributes() -> dict[str, float]:
     """LSBs of the items written, from libasterix (raw 1 read back)."""
     rec = _lib.cat062().cv_record
@@ -70,12 +72,14 @@ def cartesian(a: TrackAttributes) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         (M2 - m2) * s * c
 
 
-def attribute_items(a: TrackAttributes, check: Callable[..., None]
-                    ) -> Callable[[int], dict[str, Any]]:
-    """A function of a row giving its items (module docstring) for libasterix's
-    ``create``; ``check(bad rows, column, message)`` reports values an item cannot
-    hold (a flight level beyond −15…1 500 FL, a rate beyond ±204 793 ft/min, a
-    callsign of other characters)."""
+def attribute_raw(a: TrackAttributes, check: Callable[..., None]) -> dict[str, Any]:
+    """The raw values (LSBs of :func:`lsb_attributes`) of the items of ``a`` (module
+    docstring), computed for every row, with the rows' presence masks: ``fl`` (136),
+    ``roc`` (220), ``names`` (380 ID, 245 CHR: upper case), ``ax, ay, cov, known`` (500),
+    ``mfl, rho, theta, pos`` (340 MDC, POS) and ``ages`` (290: name → (known, raw));
+    ``check(bad rows, column, message)`` reports values an item cannot hold (a flight
+    level beyond −15…1 500 FL, a rate beyond ±204 793 ft/min, a callsign of other
+    characters, a measured level beyond MDC, a sensor beyond SID), in that order."""
     L = lsb_attributes()
     fl = np.round(np.nan_to_num(a.flight_level) / L["fl"]).astype(np.int64)
     check(np.isfinite(a.flight_level) & ((fl < -60) | (fl > 6000)), "flight_level",
@@ -89,14 +93,11 @@ def attribute_items(a: TrackAttributes, check: Callable[..., None]
           "callsign", lambda r: f"callsign {names[r]!r} is not up to eight of A-Z, 0-9, "
           "space (I062/380 ID)")
     sx, sy, cxy = cartesian(a)
-    known = np.isfinite(sx) & np.isfinite(sy)
     top = 0xFFFF
 
     def raw(v: np.ndarray, lo: int, hi: int) -> np.ndarray:
         return np.clip(np.round(np.nan_to_num(v) / L["m"]), lo, hi).astype(np.int64)
 
-    ax, ay = raw(sx, 0, top), raw(sy, 0, top)
-    cov = raw(np.sign(cxy) * np.sqrt(np.abs(cxy)), -0x8000, 0x7FFF)
     mfl = np.round(np.nan_to_num(a.meas_flight_level) * 4).astype(np.int64)
     check(np.isfinite(a.meas_flight_level) & (np.abs(mfl) >= 1 << 13), "meas_flight_level",
           lambda r: f"measured flight level {a.meas_flight_level[r]:g} beyond I062/340 MDC")
@@ -104,10 +105,26 @@ def attribute_items(a: TrackAttributes, check: Callable[..., None]
           "is not SAC·256 + SIC (I062/340 SID)")
     rho = np.round(np.nan_to_num(a.meas_range) / L["rho_m"]).astype(np.int64)
     theta = np.round(np.nan_to_num(a.meas_bearing) / L["theta_deg"]).astype(np.int64) % 65536
-    pos = np.isfinite(a.meas_range) & np.isfinite(a.meas_bearing) & (rho <= 0xFFFF)
-    ages = {k: (np.isfinite(v), np.clip(np.round(np.nan_to_num(v) / L["age"]), 0, 0xFF)
-                .astype(np.int64))
-            for k, v in (("PSR", a.age_psr), ("SSR", a.age_ssr), ("MDS", a.age_mds))}
+    return {"fl": fl, "roc": roc, "names": names, "ax": raw(sx, 0, top),
+            "ay": raw(sy, 0, top),
+            "cov": raw(np.sign(cxy) * np.sqrt(np.abs(cxy)), -0x8000, 0x7FFF),
+            "known": np.isfinite(sx) & np.isfinite(sy), "mfl": mfl, "rho": rho,
+            "theta": theta,
+            "pos": np.isfinite(a.meas_range) & np.isfinite(a.meas_bearing) & (rho <= 0xFFFF),
+            "ages": {k: (np.isfinite(v), np.clip(np.round(np.nan_to_num(v) / L["age"]), 0,
+                                                 0xFF).astype(np.int64))
+                     for k, v in (("PSR", a.age_psr), ("SSR", a.age_ssr),
+                                  ("MDS", a.age_mds))}}
+
+
+def attribute_items(a: TrackAttributes, check: Callable[..., None]
+                    ) -> Callable[[int], dict[str, Any]]:
+    """A function of a row giving its items (module docstring) for libasterix's
+    ``create``, from :func:`attribute_raw` (which ``check`` s the values)."""
+    v = attribute_raw(a, check)
+    fl, roc, names, ages = v["fl"], v["roc"], v["names"], v["ages"]
+    ax, ay, cov, known = v["ax"], v["ay"], v["cov"], v["known"]
+    mfl, rho, theta, pos = v["mfl"], v["rho"], v["theta"], v["pos"]
 
     def items(i: int) -> dict[str, Any]:
         out: dict[str, Any] = {}

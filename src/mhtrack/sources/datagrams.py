@@ -20,10 +20,10 @@ known site are skipped, and one warning line at the end lists those radars.
 With ``sectors=True`` a radar's frames are also cut at its own sectors: each plot is in
 the sector its radar's last CAT034/CAT002 north marker or sector crossing received
 before it opened (arrival order: a radar sends a sector's message before the next
-sector's plots), and a frame holds one sector's plots (still at most ``frame_s``: radars
-without sector messages keep today's rule). Off by default: the recordings ``mhtrack
-export`` writes carry sector crossings every 45°, and cutting there changes their frames
-(and tracks) from those of the plots table they came from.
+sector's plots), a frame holds one sector's plots (at most ``frame_s``: radars without
+sector messages keep today's rule), the marks close it (:mod:`~mhtrack.sources.marks`).
+Off by default: ``mhtrack export``'s recordings carry crossings every 45°, and cutting
+there changes their frames (and tracks) from those of their plots table.
 
 A plot's file row is its 0-based number in decoding order (the row ``mhtrack convert``
 gives it, skipped radars included). Frame lengths come from the sensors' periods

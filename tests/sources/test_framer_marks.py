@@ -5,6 +5,8 @@ marks change *when* frames go out, never which frames, nor their order (``releas
 
 from __future__ import annotations
 
+from itertools import pairwise
+
 import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
@@ -41,7 +43,7 @@ def _run(rows, cuts, lengths, marks: bool):
     fr = Framer(lengths)
     out = []
     edges = [0, *cuts, len(rows)]
-    for k, (a, b) in enumerate(zip(edges[:-1], edges[1:], strict=True)):
+    for k, (a, b) in enumerate(pairwise(edges)):
         sel = (pos >= a) & (pos < b)
         for f in fr.push({c: v[sel] for c, v in cols.items()}):
             out.append((f.sensor, f.time, [int(pos[i]) for i in f.cols["id"]], k))

@@ -128,7 +128,8 @@ def live_options(d: Path, meta: dict, a: argparse.Namespace) -> list[str]:
     """The tracker options ``live`` and the profile share."""
     return ["--sensors", str(d / "sensors.toml"), "--birth-density",
             f"{meta['birth_density']:.6g}", "--reorder-window", str(a.reorder_window),
-            *(["--release", a.release] if getattr(a, "release", "time") != "time" else [])]
+            *(["--release", a.release] if getattr(a, "release", "time") != "time" else []),
+            *(["--sector-frames"] if getattr(a, "frames", "eighth") == "sector" else [])]
 
 
 # ------------------------------------------------------------------ 2. live

@@ -1,11 +1,12 @@
-"""Issue 30, item 5: what ``live --release radar`` changes (``docs/live.md``,
-*Latency*) — rows and quality on ``opensky-radars`` seed 1 against the default
-(``--release time``, whose rows equal ``track --output online`` on the recording).
+"""Issue 30, item 5: what ``live --release radar`` and ``live --sector-frames`` change
+(``docs/live.md``, *Latency*) — rows and quality on ``opensky-radars`` seed 1 against the
+default (``--release time``, whose rows equal ``track --output online`` on the
+recording).
 
-    python benchmarks/release_order.py [--out DIR] [--scans N]
+    python benchmarks/release_order.py [--out DIR] [--scans N] [--frames eighth sector]
 
 The scene is simulated and exported as a raw ``.ast`` recording, then fed to ``mhtrack
-live --stdin raw --day-from stream --json`` once per release (a file as stdin: no wall
+live --stdin raw --day-from stream --json`` once per release and framing (a file as stdin: no wall
 clock enters, the same rows every run); ``track --output online`` on the same recording
 beside them. Each output goes through :mod:`bench_live_feed`'s conversion to a tracks
 file and ``mhtrack evaluate --json``: rows, OSPA (mean), coverage, track ids, id switches.
@@ -26,22 +27,25 @@ from cli_run import echo_run as _run
 from cli_run import env as _env
 
 
-def live_rows(d: Path, release: str) -> Path:
-    """``live --release RELEASE`` on ``d/radar.ast`` as a tracks file."""
+def live_rows(d: Path, release: str, frames: str = "eighth") -> Path:
+    """``live --release RELEASE`` (``frames`` ``sector``: ``--sector-frames``) on
+    ``d/radar.ast`` as a tracks file."""
     args = ["live", "--stdin", "raw", "--sensors", str(d / "sensors.toml"), "--day-from",
             "stream", "--birth-density", DENSITY, "--json", "--no-preload", "--release",
-            release]
+            release, *(["--sector-frames"] if frames == "sector" else [])]
     print(f"$ mhtrack {' '.join(args)} < {d / 'radar.ast'}", flush=True)
     with (d / "radar.ast").open("rb") as fh:
         out = subprocess.run([*CLI, *args], stdin=fh, capture_output=True, text=True,
                              env=_env(), check=True).stdout
-    return json_as_tracks(out, d / f"live_{release}.csv")
+    return json_as_tracks(out, d / f"live_{frames}_{release}.csv")
 
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", type=Path, default=None)
     ap.add_argument("--scans", type=int, default=None)
+    ap.add_argument("--frames", nargs="+", choices=("eighth", "sector"),
+                    default=["eighth"])
     a = ap.parse_args()
     d = a.out or Path(tempfile.mkdtemp(prefix="release_order_"))
     d.mkdir(parents=True, exist_ok=True)
@@ -53,8 +57,16 @@ def main() -> None:
           "--output", "online", "--birth-density", DENSITY, "--out",
           str(d / "online.csv"), "-q"])
     runs = {"track --output online": online_as_tracks(d / "online.csv", d / "track.csv")}
-    for release in ("time", "radar"):
-        runs[f"live --release {release}"] = live_rows(d, release)
+    for frames in a.frames:
+        if frames == "sector":  # track's rows with the option, beside live's
+            _run(["track", str(d / "radar.ast"), "--sensors", str(d / "sensors.toml"),
+                  "--output", "online", "--birth-density", DENSITY, "--sector-frames",
+                  "--out", str(d / "online_sector.csv"), "-q"])
+            runs["track --output online --sector-frames"] = online_as_tracks(
+                d / "online_sector.csv", d / "track_sector.csv")
+        for release in ("time", "radar"):
+            opt = " --sector-frames" if frames == "sector" else ""
+            runs[f"live --release {release}{opt}"] = live_rows(d, release, frames)
     rows = {k: _rows(p) for k, p in runs.items()}
     base = rows["live --release time"]
     print("\n| run | rows | rows equal to --release time's (time, id, x, y, vx, vy) | "

@@ -186,3 +186,15 @@ def test_a_restart_with_other_options_is_refused(rec: Path, tmp_path: Path) -> N
         lines = err.strip().splitlines()
         assert len(lines) == 1 and str(ck) in lines[0] and field in lines[0], err
         assert "resume with the same options" in lines[0]
+
+
+def test_sector_frames_as_track(rec: Path, tmp_path: Path) -> None:
+    """``live --sector-frames`` gives ``track --sector-frames``'s online rows, not those
+    without the flag."""
+    ref = _track(rec, tmp_path / "sectors.csv", "--sector-frames")
+    code, rows, err = _live(rec, "--sector-frames")
+    assert code == 0, err
+    assert len(rows) > 100
+    _same(rows, ref)
+    plain = _track(rec, tmp_path / "plain.csv")
+    assert [r["frame"] for r in plain] != [r["frame"] for r in ref]

@@ -166,6 +166,9 @@ def replay(recording: Path, to: tuple[str, ...], speed: float | None, loop: bool
               help="A sector to the tracker in track's time order (time: the output equals "
               "track's) or as soon as its own plots are in (radar: lower latency, another "
               "output; docs/live.md, Release by radar) [time].")
+@click.option("--sector-frames", is_flag=True, help="Cut a radar's frames at its own CAT034 "
+              "sector crossings and close each when the next crossing comes (as track "
+              "--sector-frames; docs/live.md, Frames at the radar's sectors).")
 @click.option("--idle-close", "idle_close_s", type=click.FloatRange(min=0), default=None,
               help="Close the frames held after this many wall-clock seconds without a "
               "datagram (a feed gone quiet); 0: never [the re-order window plus the "
@@ -186,7 +189,8 @@ def live(listen: tuple[str, ...], stdin: str | None, sensors_file: Path,
          status_every: float | None, status_json: Path | None, prometheus: Path | None,
          metrics_http: str | None, view: str | None, checkpoint: Path | None,
          checkpoint_every: float | None, resume: bool, reorder_window_s: float | None,
-         release: str | None, idle_close_s: float | None, preload: bool, tracker: str,
+         release: str | None, sector_frames: bool, idle_close_s: float | None,
+         preload: bool, tracker: str,
          tracker_pd: float | None, meas_sigma: float | None, accel_sigma: float | None,
          imm_accel_sigma: float | None, clutter_density: float | None,
          birth_density: float | None, nscan: int | None, clutter_frame: str, birth: str,
@@ -214,6 +218,7 @@ def live(listen: tuple[str, ...], stdin: str | None, sensors_file: Path,
                                                else 60.0 * checkpoint_every),
                            resume=resume, reorder_window_s=reorder_window_s,
                            idle_close_s=idle_close_s, preload=preload,
+                           sectors=sector_frames,
                            **({} if day_from is None else {"day_from": day_from}),
                            **({} if release is None else {"release": release}))
     with stop_on_signals(threading.Event()) as stop:

@@ -165,7 +165,7 @@ class Live:
             pending=None if st is None else decode_pending(st.pending),
             recent=None if st is None else st.duplicates,
             keep_rows=KEEP_ROWS,  # the health looks up the frame just made
-            release=live.release,
+            release=live.release, sectors=live.sectors,
             # stopped with a checkpoint: the plots held go into it, tracked on resume
             hold=lambda: self.stop.is_set() and live.checkpoint is not None)
         try:

@@ -67,6 +67,9 @@ class LiveOptions:
     #: ``"time"``, in ``track``'s order (the output equals ``track``'s online view);
     #: ``"radar"``, as soon as its own plots are in (lower latency, another output).
     release: str = "time"
+    #: Frames cut and closed at each radar's own CAT034 sector crossings
+    #: (``track --sector-frames``; :mod:`~mhtrack.sources.framer`).
+    sectors: bool = False
     #: A quiet feed: after this many wall-clock seconds without a datagram the frames
     #: held are closed (``None``: the re-order window plus the longest rotation period;
     #: ``0``: never) — *A silent feed* in ``docs/live.md``.

@@ -20,10 +20,10 @@ known site are skipped, and one warning line at the end lists those radars.
 With ``sectors=True`` a radar's frames are also cut at its own sectors: each plot is in
 the sector its radar's last CAT034/CAT002 north marker or sector crossing received
 before it opened (arrival order: a radar sends a sector's message before the next
-sector's plots), and a frame holds one sector's plots (still at most ``frame_s``: radars
-without sector messages keep today's rule). Off by default: the recordings ``mhtrack
-export`` writes carry sector crossings every 45°, and cutting there changes their frames
-(and tracks) from those of the plots table they came from.
+sector's plots), a frame holds one sector's plots (at most ``frame_s``: radars without
+sector messages keep today's rule), the marks close it (:mod:`~mhtrack.sources.marks`).
+Off by default: ``mhtrack export``'s recordings carry crossings every 45°, and cutting
+there changes their frames (and tracks) from those of their plots table.
 
 A plot's file row is its 0-based number in decoding order (the row ``mhtrack convert``
 gives it, skipped radars included). Frame lengths come from the sensors' periods
@@ -52,6 +52,7 @@ from mhtrack.models.radars import SensorSet
 from mhtrack.records import Scan
 from mhtrack.sources.base import CAUGHT_UP, IDLE, Source, SourceStats, Survey
 from mhtrack.sources.gather import Gathered
+from mhtrack.sources.marks import with_marks
 from mhtrack.sources.positions import local_positions
 from mhtrack.sources.timed import TimedStream
 
@@ -128,6 +129,8 @@ class DatagramSource(Source):
         self._decoder: Decoder | None = None
         self._seen: set[int] = set()  # radars whose site was settled (kept or skipped)
         self._skipped: dict[int, list[int]] = {}  # radar -> [plots, first byte]
+        #: Columns of the last converted plots: a sweep mark's row has them (``sectors``)
+        self._template: dict[str, tuple[np.dtype, tuple[int, ...]]] | None = None
 
     def _datagrams(self, problems: Problems) -> Iterator[tuple[int, Any, float | None]]:
         """``(byte offset, payload, capture time)`` of each datagram."""
@@ -161,13 +164,15 @@ class DatagramSource(Source):
         at_rows: list[int] = []
         sector: dict[int, int] = {}  # sweep marks received so far, per radar
         in_sector: list[int] = []
+        marks: list[tuple[float, int, int, int]] = []  # (time, radar, sector, place)
+        closing = self.sectors and convert  # marks go on with the plots: they close frames
         n = 0
         for offset, payload, when in self._datagrams(problems):
             if payload is IDLE or payload is CAUGHT_UP:  # what is decoded, then IDLE
-                if rows:
-                    yield self._chunk(rows, times, at_rows, n, convert, in_sector)
+                if rows or marks:
+                    yield self._chunk(rows, times, at_rows, n, convert, in_sector, marks)
                     n += len(rows)
-                    rows, times, at_rows, in_sector = [], [], [], []
+                    rows, times, at_rows, in_sector, marks = [], [], [], [], []
                 if idle and payload is IDLE:
                     yield IDLE  # type: ignore[misc]
                 continue
@@ -176,8 +181,10 @@ class DatagramSource(Source):
                 if what == MARKS:
                     if sweeps is not None:
                         sweeps.extend((ti, *r[1:]) for ti, r in zip(t, found, strict=True))
-                    for r in found:
+                    for ti, r in zip(t, found, strict=True):
                         sector[r[1]] = sector.get(r[1], 0) + 1
+                        if closing:
+                            marks.append((ti, r[1], sector[r[1]], len(rows)))
                     continue
                 rows.extend(found)
                 self.decoded = n + len(rows)
@@ -186,21 +193,30 @@ class DatagramSource(Source):
                 if self.sectors:
                     in_sector.extend(sector.get(r[1], 0) for r in found)
                 if len(rows) >= self.chunk:
-                    yield self._chunk(rows, times, at_rows, n, convert, in_sector)
+                    yield self._chunk(rows, times, at_rows, n, convert, in_sector, marks)
                     n += len(rows)
-                    rows, times, at_rows, in_sector = [], [], [], []
-        if rows:
-            yield self._chunk(rows, times, at_rows, n, convert, in_sector)
+                    rows, times, at_rows, in_sector, marks = [], [], [], [], []
+        if rows or marks:
+            yield self._chunk(rows, times, at_rows, n, convert, in_sector, marks)
 
     def _chunk(self, rows: list[tuple[Any, ...]], times: list[float], at: list[int],
-               n0: int, convert: bool, in_sector: list[int]) -> dict[str, np.ndarray]:
+               n0: int, convert: bool, in_sector: list[int],
+               marks: list[tuple[float, int, int, int]] | None = None
+               ) -> dict[str, np.ndarray]:
         p = plot_columns(rows)  # ADS-B reports add lat, lon, sigma; I048/130 its columns
         p["time"] = np.array(times, float)
         p["offset"] = np.asarray(at, np.int64)
         p["file_row"] = np.arange(n0, n0 + len(rows), dtype=np.int64)
         if self.sectors:
             p["sector"] = np.asarray(in_sector, np.int64)
-        return self._convert(p) if convert else p
+        out = self._convert(p) if rows and convert else None
+        if not (convert and self.sectors):
+            return out if convert else p  # type: ignore[return-value]
+        if out is not None:
+            out["mark"] = np.zeros(out["time"].size, bool)
+            if out["time"].size:
+                self._template = {k: (v.dtype, v.shape[1:]) for k, v in out.items()}
+        return with_marks(out, marks or [], n0, self._template)
 
     def _convert(self, p: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
         """Plots of radars with a known site and ADS-B reports with an accuracy, in the
@@ -381,3 +397,4 @@ class DatagramSource(Source):
         return sweep_periods(marks), Survey(int(x.size), tuple(sorted(kept)), x[on_time],
                                             y[on_time], sensor=sensor[on_time],
                                             time=t[on_time])
+

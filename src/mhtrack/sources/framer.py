@@ -6,8 +6,13 @@ Input: plots in time order (ties in input order), as batches of columns (``time`
 sensor's plots while ``t − start ≤ frame_s`` — and, where the batches carry a ``sector``
 column (the radar's own sectors, counted from its CAT034 sector crossings), while their
 sector is the frame's first plot's; it is *closed* once a plot of that sensor
-falls beyond (it starts the next frame) or the stream's time ``T`` passes
-``start + frame_s`` (every later plot has ``t ≥ T``). :func:`~mhtrack.frames.make_frames`
+falls beyond (it starts the next frame), the stream's time ``T`` passes
+``start + frame_s`` (every later plot has ``t ≥ T``), or — rows with ``mark`` true: the
+radar's CAT034/CAT002 north marker or sector crossing, its ``sector`` the radar's count
+of them with it, in time order among the plots — a mark of that sensor with a sector
+after the frame's comes (the antenna has left the frame's sector: every plot of it is
+in). A mark is no plot: it joins no frame. A radar that sends no marks, or whose mark
+is lost, keeps the ``frame_s`` rule. :func:`~mhtrack.frames.make_frames`
 numbers frames by (latest plot time ``end``, sensor id); a closed frame ``F`` therefore
 goes out once
 
@@ -104,35 +109,67 @@ class Framer:
         self._batches[b] = {k: np.asarray(v) for k, v in cols.items()}
         sensor = np.asarray(cols["sensor"], np.int64)
         sector = np.asarray(cols["sector"], np.int64) if "sector" in cols else None
+        mark = np.asarray(cols["mark"], bool) if "mark" in cols else None
         uses = 0
         for s in np.unique(sensor).tolist():
             rows = np.flatnonzero(sensor == s)
-            ts = t[rows]
-            sec = sector[rows] if sector is not None else None
-            fr = self._open.get(s)
-            length = self._length(s)
-            cut = 0
-            while cut < rows.size:
-                if fr is None:
-                    fr = self._open[s] = _Open(float(ts[cut]), float(ts[cut]),
-                                               0 if sec is None else int(sec[cut]))
-                # plots of this frame: t − start ≤ length, computed as make_frames does
-                # (the difference of sorted times is sorted)
-                stop = cut + int(np.searchsorted(ts[cut:] - fr.start, length, side="right"))
-                if sec is not None:  # and of the frame's sector
-                    other = np.flatnonzero(sec[cut:stop] != fr.sector)
-                    stop = cut + int(other[0]) if other.size else stop
-                if stop > cut:
-                    fr.parts.append((b, rows[cut:stop]))
-                    fr.end = float(ts[stop - 1])
-                    uses += 1
-                if stop < rows.size:  # a later plot starts the next frame
-                    self._close(s)
-                    fr = None
-                cut = stop
+            if mark is not None and mark[rows].any():  # plots between marks, in turn
+                uses += self._with_marks(b, s, rows, t, sector, mark)
+                continue
+            uses += self._plots(b, s, rows, t, sector)
         self._uses[b] = uses
         self.now = float(t[-1])
         yield from self._ready(final=False)
+
+    def _with_marks(self, b: int, s: int, rows: np.ndarray, t: np.ndarray,
+                    sector: np.ndarray | None, mark: np.ndarray) -> int:
+        """Sensor ``s``'s rows of batch ``b`` with marks among them: the plots before
+        each mark, then the mark closes the open frame if its sector is later."""
+        assert sector is not None
+        uses = 0
+        at = rows[mark[rows]]
+        cut = 0
+        for m in at.tolist():
+            upto = int(np.searchsorted(rows, m))
+            if upto > cut:
+                uses += self._plots(b, s, rows[cut:upto], t, sector)
+            fr = self._open.get(s)
+            if fr is not None and fr.sector < int(sector[m]):
+                self._close(s)
+            cut = upto + 1
+        if cut < rows.size:
+            uses += self._plots(b, s, rows[cut:], t, sector)
+        return uses
+
+    def _plots(self, b: int, s: int, rows: np.ndarray, t: np.ndarray,
+               sector: np.ndarray | None) -> int:
+        """Sensor ``s``'s plots ``rows`` of batch ``b`` into its frames; the number of
+        frame parts made."""
+        uses = 0
+        ts = t[rows]
+        sec = sector[rows] if sector is not None else None
+        fr = self._open.get(s)
+        length = self._length(s)
+        cut = 0
+        while cut < rows.size:
+            if fr is None:
+                fr = self._open[s] = _Open(float(ts[cut]), float(ts[cut]),
+                                           0 if sec is None else int(sec[cut]))
+            # plots of this frame: t − start ≤ length, computed as make_frames does
+            # (the difference of sorted times is sorted)
+            stop = cut + int(np.searchsorted(ts[cut:] - fr.start, length, side="right"))
+            if sec is not None:  # and of the frame's sector
+                other = np.flatnonzero(sec[cut:stop] != fr.sector)
+                stop = cut + int(other[0]) if other.size else stop
+            if stop > cut:
+                fr.parts.append((b, rows[cut:stop]))
+                fr.end = float(ts[stop - 1])
+                uses += 1
+            if stop < rows.size:  # a later plot starts the next frame
+                self._close(s)
+                fr = None
+            cut = stop
+        return uses
 
     def flush(self) -> Iterator[Frame]:
         """Every remaining frame (the input has ended)."""

@@ -57,8 +57,13 @@ class TimedStream:
         self.first_row = int(first_row)
 
     def push(self, cols: Mapping[str, np.ndarray]) -> Iterator[Scan]:
-        """Frames completed by one more batch of plots."""
-        self.stats.plots_in += len(cols["time"])
+        """Frames completed by one more batch of plots (and sweep marks: rows with
+        ``mark`` true, :mod:`~mhtrack.sources.marks`)."""
+        if not cols:
+            return
+        n = len(cols["time"])
+        self.stats.plots_in += n - int(np.count_nonzero(cols["mark"])) if "mark" in cols \
+            else n
         released = self.buffer.push(cols)
         self._count()
         if released and len(released["time"]):

@@ -1,0 +1,47 @@
+"""Sweep marks among the plots (``sectors=True``, ``docs/sources.md``, *Frames*): a
+radar's CAT034/CAT002 north markers and sector crossings go through the re-order buffer
+with its plots, as rows with ``mark`` true, so that the framer closes the radar's frame
+when the antenna leaves its sector (:mod:`~mhtrack.sources.framer`)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+#: A chunk's columns: dtype and trailing shape of each.
+Template = dict[str, tuple[np.dtype, tuple[int, ...]]]
+
+
+def with_marks(out: dict[str, np.ndarray] | None, marks: list[tuple[float, int, int, int]],
+               n0: int, template: Template | None) -> dict[str, np.ndarray]:
+    """The converted plots ``out`` (``file_row`` from ``n0`` on, some left out) with the
+    chunk's marks ``(time, radar, sector, j)`` among them in arrival order — a mark
+    decoded when the chunk held ``j`` plots goes before plot ``n0 + j``: rows with
+    ``mark`` true, their ``time``, ``sensor`` and ``sector`` (the radar's count of marks
+    with this one), ``file_row`` -1, the other columns of ``template`` blank (NaN, -1,
+    empty). Without a template (no plot converted yet) the marks are left out: there is
+    no frame they could close."""
+    if template is None or not marks:
+        return out if out is not None else {}
+    m = len(marks)
+    rows = {k: _blank(dt, (m, *shape)) for k, (dt, shape) in template.items()}
+    rows["time"] = np.array([x[0] for x in marks], float)
+    rows["sensor"] = np.array([x[1] for x in marks], np.int64)
+    rows["sector"] = np.array([x[2] for x in marks], np.int64)
+    rows["mark"] = np.ones(m, bool)
+    rows["file_row"] = np.full(m, -1, np.int64)
+    if out is None or not out["time"].size:
+        return rows
+    key = np.concatenate((2 * out["file_row"] + 1,
+                          2 * (n0 + np.array([x[3] for x in marks], np.int64))))
+    order = np.argsort(key, kind="stable")
+    return {k: np.concatenate((out[k], rows[k]))[order] for k in out}
+
+
+def _blank(dtype: np.dtype, shape: tuple[int, ...]) -> np.ndarray:
+    """An array of ``shape`` meaning "none": NaN (floats), -1 (integers), else zeros
+    (False, "")."""
+    if dtype.kind == "f":
+        return np.full(shape, np.nan, dtype)
+    if dtype.kind in "iu":
+        return np.full(shape, -1, dtype)
+    return np.zeros(shape, dtype)

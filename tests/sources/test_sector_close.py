@@ -1,0 +1,122 @@
+"""Frames closed at the radar's own sector crossings (``sectors=True``,
+:mod:`mhtrack.sources.framer`, :mod:`mhtrack.sources.marks`): a hand-built recording —
+CAT048 plots and CAT034 north markers / sector crossings, one datagram per message — whose
+frames and the datagram after which each frame leaves are worked out by hand; a radar
+without CAT034 keeps the eighth-of-a-turn rule; lost crossings do not hold a frame past
+that rule."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+pytest.importorskip("asterix.generated", reason="libasterix not installed")
+
+from mhtrack.io.asterix.encode import Message, encode_blocks, lsb, plot_messages, raw_tod
+from mhtrack.io.sensors import read_sensors
+from mhtrack.sources.datagrams import DatagramSource
+
+SENSORS = """[origin]
+lat = 52.0
+lon = -1.0
+
+[[sensors]]
+id = 1
+kind = "polar"
+pd = 0.9
+lat = 52.0
+lon = -1.0
+sigma_range = 30.0
+sigma_bearing_deg = 0.08
+period = 8.0
+
+[[sensors]]
+id = 2
+kind = "polar"
+pd = 0.9
+lat = 52.2
+lon = -1.2
+sigma_range = 30.0
+sigma_bearing_deg = 0.08
+period = 8.0
+"""
+T0 = 36000.0  # 10:00:00; every time below a multiple of 1/8 s (exact in I048/140's LSB)
+
+
+def _plot(t: float, sensor: int) -> bytes:
+    m = plot_messages(np.array([T0 + t]), np.array([sensor]), np.array([40e3]),
+                      np.array([90.0]), {})
+    return next(encode_blocks(m))[2]
+
+
+def _mark(t: float, sensor: int, north: bool) -> bytes:
+    items = {"000": 1 if north else 2, "010": (("SAC", 0), ("SIC", sensor)),
+             "030": int(raw_tod(np.array([T0 + t]))[0])}
+    if not north:
+        items["020"] = round(22.5 / lsb()["azimuth_deg"])
+    return next(encode_blocks([Message(T0 + t, sensor, 34, items)]))[2]
+
+
+def _frames(feed: list[tuple[str, float, int]], tmp: Path, sectors: bool,
+            release: str = "time") -> list[tuple[int, list[float], int]]:
+    """``(sensor, plot times − T0, datagrams read when it left)`` of each frame of the
+    feed (``("p"|"n"|"s", time, sensor)``: plot, north marker, sector crossing)."""
+    (tmp / "sensors.toml").write_text(SENSORS)
+    grams = [_plot(t, s) if k == "p" else _mark(t, s, k == "n") for k, t, s in feed]
+    read = [0]
+
+    def datagrams():
+        for g in grams:
+            read[0] += 1
+            yield g
+
+    src = DatagramSource(datagrams(), sensors=read_sensors(tmp / "sensors.toml"),
+                         reorder_window_s=0.0, sectors=sectors, chunk=1,
+                         release=release)
+    return [(int(f.sensor[0]), [round(x - T0, 3) for x in f.t.tolist()], read[0])
+            for f in src]
+
+
+# radar 1 sends a north marker and a crossing every 0.5 s (1/16 turn; its frame length is
+# 8 s / 8 = 1 s); radar 2 sends no CAT034 at all
+FEED = [("n", 0.0, 1), ("p", 0.125, 1), ("p", 0.25, 2), ("p", 0.375, 1),
+        ("s", 0.5, 1),                                    # 5th: radar 1's sector 1 done
+        ("p", 0.625, 2),                                  # 6th: releases the crossing
+        ("p", 0.75, 1), ("p", 0.875, 1), ("s", 1.0, 1), ("p", 1.125, 2),   # 7th–10th
+        ("p", 1.25, 1), ("p", 1.5, 2)]                    # 11th, 12th
+
+
+def test_hand_built_recording_frames_close_at_the_crossing(tmp_path: Path) -> None:
+    # radar 1: one frame per sector, closed by the crossing after it once the crossing
+    # has passed the re-order window (window 0: the next datagram with a later time);
+    # radar 2 (no CAT034): eighths, [0.25, 1.25] s from its first plot
+    frames = [[0.125, 0.375], [0.75, 0.875], [0.25, 0.625, 1.125], [1.25], [1.5]]
+    by_radar = _frames(FEED, tmp_path, sectors=True, release="radar")
+    assert by_radar == [(1, frames[0], 6),   # the crossing at 0.5 s, released by 0.625
+                        (1, frames[1], 10),  # the crossing at 1.0 s, released by 1.125
+                        (2, frames[2], 12),  # the end of the input (1.5 − 0.25 > 1)
+                        (1, frames[3], 12), (2, frames[4], 12)]
+    # in track's order a closed frame also waits for radar 2's open frame while that
+    # frame's end (0.25, then 0.625) is before its own: one datagram later here
+    assert _frames(FEED, tmp_path, sectors=True) == [
+        (1, frames[0], 7), (1, frames[1], 11), *by_radar[2:]]
+    # without the option: eighths for both; radar 1's first frame is closed by its plot
+    # at 1.25 > 0.125 + 1, released by the 12th datagram
+    assert _frames(FEED, tmp_path, sectors=False) == [
+        (1, [0.125, 0.375, 0.75, 0.875], 12), (2, frames[2], 12),
+        (1, [1.25], 12), (2, [1.5], 12)]
+
+
+def test_lost_crossings_fall_back_to_the_eighth(tmp_path: Path) -> None:
+    # radar 1's crossings after 0.5 s are lost: its frame of sector 2 keeps its plots up
+    # to its first plot + 1 s (the eighth-of-a-turn rule), then the next starts
+    feed = [("n", 0.0, 1), ("p", 0.125, 1), ("s", 0.5, 1), ("p", 0.625, 1),
+            ("p", 0.875, 1), ("p", 1.25, 1), ("p", 1.625, 1), ("p", 1.75, 1),
+            ("p", 2.0, 2), ("p", 2.875, 2)]
+    got = _frames(feed, tmp_path, sectors=True)
+    assert got == [(1, [0.125], 4),  # the crossing at 0.5 s, released by 0.625
+                   # 1.75 > 0.625 + 1 closes it, released by the 9th datagram (2.0)
+                   (1, [0.625, 0.875, 1.25, 1.625], 9),
+                   (1, [1.75], 10), (2, [2.0, 2.875], 10)]  # the end of the input

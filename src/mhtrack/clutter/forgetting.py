@@ -48,7 +48,6 @@ from typing import Any
 import numpy as np
 
 from mhtrack.clutter.base import ClutterEstimator
-from mhtrack.clutter.discount import check_discount, discount
 from mhtrack.clutter.density import (
     Mixture,
     log_pdf_t,
@@ -60,6 +59,7 @@ from mhtrack.clutter.density import (
     responsibilities_t,
     weighted_t,
 )
+from mhtrack.clutter.discount import check_discount, discount
 from mhtrack.clutter.moments import I00, mean_cov, plot_moments
 from mhtrack.clutter.seeding import kmeanspp_centres
 from mhtrack.clutter.split_merge import merge, reanchor, split

@@ -40,7 +40,7 @@ def _gauss(x: np.ndarray, y: np.ndarray, mean, cov) -> np.ndarray:
 
 def _mass(cells: cell_mass.Cells, w, means, covs) -> np.ndarray:
     w, means, covs = (np.asarray(a, float) for a in (w, means, covs))
-    out = cell_mass.mixture_mass(cells, cell_mass.cell_nodes(cells), w, means, covs)
+    out = cell_mass.mixture_mass(cells, w, means, covs)
     return out.reshape(cells.n_rings, cells.n_azimuth)
 
 

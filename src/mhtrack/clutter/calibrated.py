@@ -35,9 +35,9 @@ the base's expectation of clutter, and the base drops them from its next fits it
 The cells' reference level ``ρ̄`` (:meth:`reference_intensity`) is the map's mean, so that
 the map can drive the birth density too (``birth_scaling``).
 
-Cost per rotation: the base's update, the quadrature (2 × 2 nodes per cell for the broad
-Gaussians, recomputed only when the base's mixture or count changes), one pass over the
-cells.
+Cost per rotation: the base's update, the quadrature (one vectorised pass over the
+Gaussians' boxes, again only when the base's mixture or count changed), one pass over
+the cells.
 """
 
 from __future__ import annotations
@@ -193,7 +193,7 @@ class MapCalibratedClutter(ClutterEstimator):
                 and last[2] == c.n_rings):
             return last[3]
         cells, nodes = self._cells()
-        out = cell_mass.mixture_mass(cells, nodes, mix.weights, mix.means, mix.covariances)
+        out = cell_mass.mixture_mass(cells, mix.weights, mix.means, mix.covariances)
         if mix.background_box is not None and mix.background_weight > 0:
             out += mix.background_weight * cell_mass.background_mass(
                 cells, nodes, mix.background_box)
@@ -216,7 +216,7 @@ class MapCalibratedClutter(ClutterEstimator):
             p, b = self.smoothing, self.prior()
             s, e = self.counts.sums_, self.expected_
             if p and np.isfinite(b):
-                s, e = smooth_cells(s, p), smooth_cells(e, p)
+                s, e = smooth_cells(np.stack([s, e]), p)
             self._ratio = shrunk_ratio(s, e, b)
         return self._ratio
 

@@ -87,7 +87,7 @@ def cell_areas(n_rings: int, n_azimuth: int, range_cell: float) -> np.ndarray:
 
 
 def smooth_cells(a: np.ndarray, passes: int) -> np.ndarray:
-    """``a`` (rings, sectors) convolved ``passes`` times with the binomial kernel
+    """``a`` (..., rings, sectors) convolved ``passes`` times with the binomial kernel
     ``[1, 2, 1]/4`` along the rings (the first and last ring reflected) and along the
     sectors (circular). The map's smoothed density is the ratio of the smoothed counts to
     the smoothed cell areas, ``Σ w S / (N Σ w A)``: a kernel-smoothed histogram (the
@@ -96,10 +96,10 @@ def smooth_cells(a: np.ndarray, passes: int) -> np.ndarray:
     cells' Poisson variance."""
     out = np.asarray(a, float)
     for _ in range(int(passes)):
-        out = 0.5 * out + 0.25 * (np.roll(out, 1, axis=1) + np.roll(out, -1, axis=1))
-        if out.shape[0] > 1:
-            up = np.vstack([out[:1], out[:-1]])
-            down = np.vstack([out[1:], out[-1:]])
+        out = 0.5 * out + 0.25 * (np.roll(out, 1, axis=-1) + np.roll(out, -1, axis=-1))
+        if out.shape[-2] > 1:
+            up = np.concatenate([out[..., :1, :], out[..., :-1, :]], axis=-2)
+            down = np.concatenate([out[..., 1:, :], out[..., -1:, :]], axis=-2)
             out = 0.5 * out + 0.25 * (up + down)
     return out
 

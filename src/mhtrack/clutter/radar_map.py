@@ -96,10 +96,14 @@ def smooth_cells(a: np.ndarray, passes: int) -> np.ndarray:
     cells' Poisson variance."""
     out = np.asarray(a, float)
     for _ in range(int(passes)):
-        out = 0.5 * out + 0.25 * (np.roll(out, 1, axis=-1) + np.roll(out, -1, axis=-1))
+        left, right = np.empty_like(out), np.empty_like(out)  # np.roll by ±1 sector
+        left[..., 1:], left[..., :1] = out[..., :-1], out[..., -1:]
+        right[..., :-1], right[..., -1:] = out[..., 1:], out[..., :1]
+        out = 0.5 * out + 0.25 * (left + right)
         if out.shape[-2] > 1:
-            up = np.concatenate([out[..., :1, :], out[..., :-1, :]], axis=-2)
-            down = np.concatenate([out[..., 1:, :], out[..., -1:, :]], axis=-2)
+            up, down = np.empty_like(out), np.empty_like(out)  # the end rings reflected
+            up[..., 1:, :], up[..., :1, :] = out[..., :-1, :], out[..., :1, :]
+            down[..., :-1, :], down[..., -1:, :] = out[..., 1:, :], out[..., -1:, :]
             out = 0.5 * out + 0.25 * (up + down)
     return out
 

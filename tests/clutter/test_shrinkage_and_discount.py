@@ -110,3 +110,28 @@ def test_forget_takes_used_plots_out_of_the_counts_not_the_expected() -> None:
     est.forget(np.arange(120) < 10)
     assert est.counts.sums_.sum() == s0 - 10
     np.testing.assert_array_equal(est.expected_, e0)
+
+
+def _smooth_with_roll(a: np.ndarray, passes: int) -> np.ndarray:
+    """The former ``smooth_cells`` (np.roll and np.vstack), the reference."""
+    out = np.asarray(a, float)
+    for _ in range(passes):
+        out = 0.5 * out + 0.25 * (np.roll(out, 1, axis=1) + np.roll(out, -1, axis=1))
+        if out.shape[0] > 1:
+            up, down = np.vstack([out[:1], out[:-1]]), np.vstack([out[1:], out[-1:]])
+            out = 0.5 * out + 0.25 * (up + down)
+    return out
+
+
+@pytest.mark.parametrize("shape", [(1, 1), (1, 5), (3, 1), (7, 9), (24, 64)])
+def test_smooth_cells_gives_the_former_floats_also_stacked(shape: tuple[int, int]) -> None:
+    from mhtrack.clutter.radar_map import smooth_cells
+
+    rng = np.random.default_rng(sum(shape))
+    a = rng.random(shape) * 10.0 ** rng.integers(-5, 5, shape)
+    for p in (0, 1, 2, 3):
+        ref = _smooth_with_roll(a, p)
+        assert smooth_cells(a, p).tobytes() == ref.tobytes()
+        both = smooth_cells(np.stack([a, 2 * a]), p)
+        assert both[0].tobytes() == ref.tobytes()
+        assert both[1].tobytes() == _smooth_with_roll(2 * a, p).tobytes()

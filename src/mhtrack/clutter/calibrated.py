@@ -48,9 +48,12 @@ import numpy as np
 
 from mhtrack.clutter import cell_mass
 from mhtrack.clutter.base import ClutterEstimator
+from mhtrack.clutter.mixture import MixtureClutter
+from mhtrack.clutter.polar import PolarClutter
 from mhtrack.clutter.radar_map import ClutterMap, smooth_cells
 from mhtrack.clutter.shrinkage import prior_count as estimated_prior_count
 from mhtrack.clutter.shrinkage import shrunk_ratio
+from mhtrack.kernels import same_floats
 from mhtrack.records import Scan
 
 #: Smoothing passes over the cells (measured: docs/clutter.md).
@@ -121,6 +124,7 @@ class MapCalibratedClutter(ClutterEstimator):
         self._nodes: tuple[cell_mass.Cells, tuple[np.ndarray, ...]] | None = None
         self._last: tuple[Any, float, int, np.ndarray] | None = None  # mixture, M̂, rings, E
         self._background: tuple[Any, np.ndarray] | None = None  # (box, rings), ∫_c u
+        self._scan_cells: tuple[np.ndarray, np.ndarray] | None = None  # last plots, cells
 
     @property
     def site(self) -> tuple[float, float]:
@@ -161,6 +165,7 @@ class MapCalibratedClutter(ClutterEstimator):
         c = self.counts
         looks = c.looks_
         c.update(scan, in_track_gates)
+        self._scan_cells = (np.asarray(scan.z, float).reshape(-1, 2), c._last.copy())
         g = (c.looks_ - 1.0) / looks if looks > 0 else 1.0  # the map's γ_k
         self.looks2_ = g * g * self.looks2_ + 1.0
         grow = c.n_rings - self.expected_.shape[0]
@@ -172,8 +177,6 @@ class MapCalibratedClutter(ClutterEstimator):
     def _cells(self) -> tuple[cell_mass.Cells, tuple[np.ndarray, ...]]:
         """The map's geometry in the base's coordinates and its cells' quadrature nodes
         (made again only when rings are added)."""
-        from mhtrack.clutter.polar import PolarClutter
-
         c, base = self.counts, self.base
         if self._nodes is None or self._nodes[0].n_rings != c.n_rings:
             polar = ((base.r0, base.min_range, float(base.cut))
@@ -186,9 +189,6 @@ class MapCalibratedClutter(ClutterEstimator):
         """(n_rings, n_azimuth) ``∫_c κ̂_base`` now, the plots the base expects per cell
         (module docstring); the last result again while the base's mixture, count and the
         rings are unchanged."""
-        from mhtrack.clutter.mixture import MixtureClutter
-        from mhtrack.clutter.polar import PolarClutter
-
         c, base = self.counts, self.base
         inner = base.inner if isinstance(base, PolarClutter) else base
         mix = getattr(inner, "mixture_", None)
@@ -237,6 +237,12 @@ class MapCalibratedClutter(ClutterEstimator):
         c = self.counts
         if c.looks_ == 0.0 or not c.n_rings:
             return out
+        last = self._scan_cells
+        if last is not None and same_floats(last[0], z):  # the scan's own plots: cells known
+            flat = last[1]
+            inside = flat >= 0
+            out[inside] *= self.ratio().reshape(-1)[flat[inside]]
+            return out
         ring, sector = c.cells(z)
         inside = ring < c.n_rings
         out[inside] *= self.ratio()[ring[inside], sector[inside]]
@@ -270,4 +276,4 @@ class MapCalibratedClutter(ClutterEstimator):
             raise ValueError("field clutter_state.looks2: expected a finite Σγ^2m in "
                              f"[0, looks], got {looks2!r}")
         self.expected_, self._ratio = np.ascontiguousarray(e), None
-        self.looks2_, self._last = looks2, None
+        self.looks2_, self._last, self._scan_cells = looks2, None, None

@@ -32,7 +32,7 @@ def test_prior_count_by_hand() -> None:
     assert shrunk_ratio(s, e, b)[0] == pytest.approx(0.23529, rel=1e-4)
     assert prior_count(s, e, phi=2.0) == np.inf
     np.testing.assert_array_equal(shrunk_ratio(s, e, np.inf), np.ones(4))
-    assert Z_OVERDISPERSED == pytest.approx(1.6448536, rel=1e-7)
+    assert pytest.approx(1.6448536, rel=1e-7) == Z_OVERDISPERSED
 
 
 @settings(max_examples=60, deadline=None)

@@ -36,7 +36,7 @@ import numpy as np
 
 #: Gauss–Legendre nodes per segment and axis.
 NODES = 2
-#: Half-width, in σ, of the box a narrow Gaussian is integrated over (mass outside < 1e-4).
+#: Half-width, in σ, of the box a Gaussian is integrated over (mass outside < 1e-3).
 REACH_SIGMA = 3.5
 
 #: Steps of a narrow Gaussian's box, in its conditional σ.

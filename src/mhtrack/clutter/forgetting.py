@@ -59,6 +59,7 @@ from mhtrack.clutter.density import (
     responsibilities_t,
     weighted_t,
 )
+from mhtrack.clutter.discount import check_discount, discount
 from mhtrack.clutter.moments import I00, mean_cov, plot_moments
 from mhtrack.clutter.seeding import kmeanspp_centres
 from mhtrack.clutter.split_merge import merge, reanchor, split
@@ -78,9 +79,10 @@ class ForgettingGMMClutter(ClutterEstimator):
     Parameters
     ----------
     forgetting : ``γ`` in (0, 1] per scan (memory ``1/(1 − γ)`` scans). Default
-        :data:`FORGETTING`.
-    half_life : ``h`` (s of data time, ``inf``: no forgetting): when given, the statistics
-        are discounted by ``γ_k = 2^(−Δt_k/h)`` instead. Default ``None``.
+        :data:`FORGETTING` unless ``half_life`` is given.
+    half_life : ``h`` (s of data time, ``inf``: no forgetting): the statistics are
+        discounted by ``γ_k = 2^(−Δt_k/h)`` instead (:mod:`mhtrack.clutter.discount`; not
+        with ``forgetting``). Default ``None``.
     n_components : most Gaussians. Default 8.
     background : a uniform component over ``region`` or the box of the plots seen so far
         (padded 5 %, at least ``min_extent`` wide). Default True.
@@ -97,7 +99,7 @@ class ForgettingGMMClutter(ClutterEstimator):
 
     name = "fgmm"
 
-    def __init__(self, *, forgetting: float = FORGETTING, half_life: float | None = None,
+    def __init__(self, *, forgetting: float | None = None, half_life: float | None = None,
                  n_components: int = 8,
                  background: bool = True, background_floor: float = 0.01,
                  region: Region | tuple[float, float, float, float] | None = None,
@@ -105,10 +107,9 @@ class ForgettingGMMClutter(ClutterEstimator):
                  min_points: float = 3.0, min_contrast: float = 5.0,
                  min_extent: float = 1000.0, merge_distance: float = 1.0,
                  split_kurtosis: float = 2.0, seed: int = 0) -> None:
-        if not (np.isfinite(forgetting) and 0 < forgetting <= 1):
-            raise ValueError(f"forgetting must be in (0, 1], got {forgetting!r}")
-        if half_life is not None and not half_life > 0:
-            raise ValueError(f"half_life must be > 0 s, got {half_life!r}")
+        check_discount(forgetting, half_life)
+        if forgetting is None and half_life is None:
+            forgetting = FORGETTING
         if not (isinstance(n_components, int | np.integer) and 1 <= n_components <= 256):
             raise ValueError(f"n_components must be an integer in [1, 256], got "
                              f"{n_components!r}")
@@ -127,7 +128,7 @@ class ForgettingGMMClutter(ClutterEstimator):
             raise ValueError(f"split_kurtosis must be in [0, 3), got {split_kurtosis!r}")
         if region is not None and not isinstance(region, Region):
             region = Region(*(float(v) for v in region))
-        self.forgetting = float(forgetting)
+        self.forgetting = None if forgetting is None else float(forgetting)
         self.half_life = None if half_life is None else float(half_life)
         self.n_components = int(n_components)
         self.background = bool(background)
@@ -259,12 +260,9 @@ class ForgettingGMMClutter(ClutterEstimator):
         self._finish()
 
     def _discount(self, t: float) -> float:
-        """``γ_k``: ``2^(−Δt/h)`` since the last scan (1 at the first) with a half-life,
-        else ``forgetting``."""
+        """``γ_k`` (:func:`mhtrack.clutter.discount.discount`)."""
         last, self.time_ = self.time_, t
-        if self.half_life is None:
-            return self.forgetting
-        return 1.0 if last is None else float(2.0 ** (-max(t - last, 0.0) / self.half_life))
+        return discount(last, t, forgetting=self.forgetting, half_life=self.half_life)
 
     def _finish(self) -> None:
         self.mixture_ = (None if len(self.moments_) == 0 and self.box_ is None
@@ -361,7 +359,7 @@ class ForgettingGMMClutter(ClutterEstimator):
         from mhtrack.clutter.state_checks import MAX_COORDINATE, array, check_forgetting, number
 
         m, a, box, extent = check_forgetting(
-            state, self.n_components, 1.0 if self.half_life else self.forgetting)
+            state, self.n_components, self.forgetting or 1.0)
         self.moments_, self.anchors_, self.box_, self.extent_ = m, a, box, extent
         self.bg_mass_ = float(state["bg_mass"])
         self.count_sum_, self.looks_ = float(state["count_sum"]), float(state["looks"])

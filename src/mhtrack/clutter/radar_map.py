@@ -61,6 +61,7 @@ from typing import Any, Literal
 import numpy as np
 
 from mhtrack.clutter.base import ClutterEstimator
+from mhtrack.clutter.discount import check_discount, discount
 from mhtrack.records import Scan
 
 #: Rings over the reach and sectors of a map placed with a ``max_range`` and no
@@ -86,7 +87,7 @@ def cell_areas(n_rings: int, n_azimuth: int, range_cell: float) -> np.ndarray:
 
 
 def smooth_cells(a: np.ndarray, passes: int) -> np.ndarray:
-    """``a`` (rings, sectors) convolved ``passes`` times with the binomial kernel
+    """``a`` (..., rings, sectors) convolved ``passes`` times with the binomial kernel
     ``[1, 2, 1]/4`` along the rings (the first and last ring reflected) and along the
     sectors (circular). The map's smoothed density is the ratio of the smoothed counts to
     the smoothed cell areas, ``Σ w S / (N Σ w A)``: a kernel-smoothed histogram (the
@@ -95,10 +96,14 @@ def smooth_cells(a: np.ndarray, passes: int) -> np.ndarray:
     cells' Poisson variance."""
     out = np.asarray(a, float)
     for _ in range(int(passes)):
-        out = 0.5 * out + 0.25 * (np.roll(out, 1, axis=1) + np.roll(out, -1, axis=1))
-        if out.shape[0] > 1:
-            up = np.vstack([out[:1], out[:-1]])
-            down = np.vstack([out[1:], out[-1:]])
+        left, right = np.empty_like(out), np.empty_like(out)  # np.roll by ±1 sector
+        left[..., 1:], left[..., :1] = out[..., :-1], out[..., -1:]
+        right[..., :-1], right[..., -1:] = out[..., 1:], out[..., :1]
+        out = 0.5 * out + 0.25 * (left + right)
+        if out.shape[-2] > 1:
+            up, down = np.empty_like(out), np.empty_like(out)  # the end rings reflected
+            up[..., 1:, :], up[..., :1, :] = out[..., :-1, :], out[..., :1, :]
+            down[..., :-1, :], down[..., -1:, :] = out[..., 1:, :], out[..., -1:, :]
             out = 0.5 * out + 0.25 * (up + down)
     return out
 
@@ -123,9 +128,11 @@ class ClutterMap(ClutterEstimator):
         with a ``max_range``, else 64 (5.6°).
     half_life : ``h`` (s of data time, ``inf``: no forgetting): each rotation discounts
         the sums by ``γ_k = 2^(−Δt_k/h)``, ``Δt_k`` the time since the previous one, so
-        the memory is the same whatever the radar's period. Default :data:`HALF_LIFE`.
+        the memory is the same whatever the radar's period
+        (:mod:`mhtrack.clutter.discount`). Default :data:`HALF_LIFE` unless ``forgetting``
+        is given.
     forgetting : a constant ``γ`` in (0, 1] per rotation instead (memory ``1/(1 − γ)``
-        rotations); default ``None``: ``half_life``.
+        rotations; not with ``half_life``). Default ``None``.
     prior_weight : ``b₀`` (rotations) of the shrinkage toward the map's mean. Default 1.
     smoothing : passes ``p`` of the binomial kernel over neighbouring cells (0: none;
         :func:`smooth_cells`). Default :data:`SMOOTHING`.
@@ -164,11 +171,9 @@ class ClutterMap(ClutterEstimator):
             raise ValueError(f"range_cell must be finite and > 0 m, got {range_cell!r}")
         if not (isinstance(n_azimuth, int | np.integer) and 1 <= n_azimuth <= 65536):
             raise ValueError(f"n_azimuth must be an integer in [1, 65536], got {n_azimuth!r}")
-        if forgetting is not None and not (np.isfinite(forgetting) and 0 < forgetting <= 1):
-            raise ValueError(f"forgetting must be in (0, 1], got {forgetting!r}")
-        half_life = HALF_LIFE if half_life is None else half_life
-        if not half_life > 0:
-            raise ValueError(f"half_life must be > 0 s, got {half_life!r}")
+        check_discount(forgetting, half_life)
+        if forgetting is None and half_life is None:
+            half_life = HALF_LIFE
         if not (np.isfinite(prior_weight) and prior_weight >= 0):
             raise ValueError(f"prior_weight must be finite and >= 0, got {prior_weight!r}")
         if not (isinstance(smoothing, int | np.integer) and 0 <= smoothing <= 64):
@@ -183,7 +188,7 @@ class ClutterMap(ClutterEstimator):
         self.range_cell = float(range_cell)
         self.n_azimuth = int(n_azimuth)
         self.forgetting = None if forgetting is None else float(forgetting)
-        self.half_life = float(half_life)
+        self.half_life = None if half_life is None else float(half_life)
         self.prior_weight = float(prior_weight)
         self.smoothing = int(smoothing)
         self.max_range = None if max_range is None else float(max_range)
@@ -264,12 +269,9 @@ class ClutterMap(ClutterEstimator):
         self._map = None
 
     def _discount(self, t: float) -> float:
-        """``γ_k``: ``forgetting``, else ``2^(−Δt/h)`` since the last rotation (1 at the
-        first)."""
+        """``γ_k`` (:func:`mhtrack.clutter.discount.discount`)."""
         last, self.time_ = self.time_, t
-        if self.forgetting is not None:
-            return self.forgetting
-        return 1.0 if last is None else float(2.0 ** (-max(t - last, 0.0) / self.half_life))
+        return discount(last, t, forgetting=self.forgetting, half_life=self.half_life)
 
     def forget(self, used: np.ndarray) -> None:
         """Take the last rotation's plots that confirmed tracks used out of their cells."""

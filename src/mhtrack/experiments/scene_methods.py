@@ -41,6 +41,8 @@ VARIANTS: dict[str, tuple[str, dict[str, Any]]] = {
     "mapgmm-birth": ("mapgmm", {"birth_scaling": 1.0}),
     "map-no-shrinkage": ("map", {"prior_weight": 0.0}),
     "map-keeps-track-plots": ("map", {"forget_used": False}),
+    "mapgmm-fixed-shrinkage": ("mapgmm", {"prior_count": 5.0}),
+    "mapgmm-no-smoothing": ("mapgmm", {"smoothing": 0}),
     "fgmm-no-forgetting": ("fgmm", {"forgetting": 1.0}),
     "fgmm-no-split-merge": ("fgmm", {"merge_distance": 0.0, "split_kurtosis": 0.0}),
 }
@@ -54,6 +56,8 @@ DESCRIPTIONS = {
     "mapgmm-birth": "map-calibrated GMM, its map driving the birth density (β = 1)",
     "map-no-shrinkage": "clutter map without the shrinkage toward its mean (b₀ = 0)",
     "map-keeps-track-plots": "clutter map that keeps the plots confirmed tracks used",
+    "mapgmm-fixed-shrinkage": "map-calibrated GMM with the former fixed shrinkage, φb = 5 plots",
+    "mapgmm-no-smoothing": "map-calibrated GMM without smoothing the counts (0 passes)",
     "fgmm-no-forgetting": "forgetting mixture with γ = 1 (no forgetting)",
     "fgmm-no-split-merge": "forgetting mixture without split and merge",
 }

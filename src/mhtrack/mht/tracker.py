@@ -211,8 +211,7 @@ class MHTTracker:
         children = prune_children(f, leaves, children, self.sprt,
                                   n_births=len(cand) + len(idle))
         if attrs is not None and not self.attributes.birth_on_tracked_address:
-            children, cand = untracked(children, cand, f.rows, attrs.address,
-                                       leaves.ident[:, 1], leaves.track)
+            children, cand = untracked(children, cand, f.rows, attrs.address, leaves)
         grown = grow_children(f, leaves, pred, children, motion=self.motion,
                               pair_pred=pair_pred, posterior=gated.posterior)
         births = self.birth.seed(f, cand, grown.window, self.trees)

@@ -1,8 +1,9 @@
 """No new target on a Mode S reply that a tree with the same address already takes.
 
-**Rule.** Call a plot with Mode S address ``A`` *tracked* when a leaf whose address is
-``A`` (:attr:`~mhtrack.mht.tree.Leaves.ident`: the first address its plots gave) has a
-child that takes the plot and survived this frame's pruning
+**Rule.** Call a plot with Mode S address ``A`` *tracked* when a *witness* — a leaf of a
+confirmed track whose address is ``A`` (:attr:`~mhtrack.mht.tree.Leaves.ident`: the
+first address its plots gave) and whose branch holds at least :data:`MIN_PLOTS` plots —
+has a child that takes the plot and survived this frame's pruning
 (:func:`~mhtrack.mht.pruning.prune_children`). Then
 
 1. a tracked plot starts no new tree (the birth process's candidate on it is dropped);
@@ -10,7 +11,7 @@ child that takes the plot and survived this frame's pruning
    (that child is dropped before its Kalman update; the leaf's other children stay).
 
 Every other plot and child is as before: a plot without an address, with another
-address, outside every such leaf's gate, or whose only such child was pruned starts its
+address, outside every witness's gate, or whose only witness child was pruned starts its
 tree; confirmed tracks and leaves with an address keep all their children
 (``docs/mht.md``, *No new target on a tracked address*).
 
@@ -18,7 +19,7 @@ tree; confirmed tracks and leaves with an address keep all their children
 tree, and a tentative tree takes plots, so that the hypotheses cover "a target no tree
 follows yet". An ICAO 24-bit address belongs to one airframe (ICAO Annex 10 vol. III,
 the aircraft addressing system; Mode S replies carry it under a 24-bit parity), so a new
-target with address ``A`` while a tree with ``A`` has a branch on the plot is that
+target with address ``A`` while a track with ``A`` has a branch on the plot is that
 aircraft again. A new tree on the plot (1) copies the branch; a tentative tree without
 an address (started on a clutter plot, or on the aircraft's own primary-only plot) that
 takes the reply (2) becomes a copy with a made-up start. Both gain the reply's ~20 nats
@@ -30,11 +31,20 @@ attributes*). The hypotheses they stand for are the branch's already; only the c
 Attribute (IFF/SSR) data in association and initiation: Blackman & Popoli (1999),
 *Design and Analysis of Modern Tracking Systems*, ch. 11; this form of the rule is ours.
 
-**Garbled addresses.** Only an exact match with a leaf that takes the plot acts: a
+**Witness.** A new tree on a reply is not only a copy: it restarts from the plot with
+the one-point state (velocity unknown, :func:`~mhtrack.mht.tree.one_point_state`). A
+branch whose velocity rests on two plots is wrong when the aircraft turned or slowed
+between them, and then the restart is what follows it: with any leaf with the address as
+witness, a landing aircraft of ``opensky-radars`` seed 2 lost its track and took a second
+id (fragmentations 13 → 15, identity switches 1 → 2), seed 3 likewise (14 → 15). A
+confirmed track's branch with three plots or more keeps those seeds' figures exactly and
+removes the copies as well (``docs/performance.md``).
+
+**Garbled addresses.** Only an exact match with a witness that takes the plot acts: a
 garbled address (another value) is scored and starts its tree as before, and a real new
 aircraft loses its tree (or a tentative tree its reply) only if its address was decoded
-as exactly that of an aircraft whose gate the plot lies in (about ``ε_S`` times the
-chance of that one value among 2²⁴); its next reply starts its tree then. A Mode A/C
+as exactly that of a tracked aircraft whose gate the plot lies in (about ``ε_S`` times
+the chance of that one value among 2²⁴); its next reply starts its tree then. A Mode A/C
 aircraft (no address) keeps every plot without an address. Without addresses nothing
 changes: the tracker calls this only for frames with attributes
 (``AttributeModel.birth_on_tracked_address`` = True switches it off).
@@ -47,15 +57,27 @@ import numpy as np
 from mhtrack.mht.attribute_scores import positions
 from mhtrack.mht.births.base import BirthCandidates
 from mhtrack.mht.extend import Children
+from mhtrack.mht.tree import Leaves
+
+#: Plots (the root included) a confirmed track's branch must rest on to stand for its
+#: aircraft: its velocity then comes from three plots or more, not from two that a turn
+#: between them makes wrong (module docstring, *Witness*).
+MIN_PLOTS = 3
+
+
+def witnesses(leaves: Leaves) -> np.ndarray:
+    """Mask over ``leaves``: a confirmed track's leaf (``track >= 0``) with an address and
+    at least :data:`MIN_PLOTS` plots (module docstring)."""
+    return (leaves.track >= 0) & (leaves.n_updates >= MIN_PLOTS) & (leaves.ident[:, 1] >= 0)
 
 
 def tracked_replies(address: np.ndarray, leaf_address: np.ndarray, parent: np.ndarray,
-                    plot: np.ndarray) -> np.ndarray:
+                    plot: np.ndarray, witness: np.ndarray) -> np.ndarray:
     """Mask over a frame's plots (``address`` (n,), ``-1`` none): a child (``parent``
-    leaf, ``plot`` index, ``-1`` a miss) takes the plot and its parent's address
-    ``leaf_address[parent]`` equals the plot's (module docstring)."""
+    leaf, ``plot`` index, ``-1`` a miss) of a ``witness`` (mask over leaves) takes the
+    plot, and its parent's address ``leaf_address[parent]`` equals the plot's."""
     out = np.zeros(address.size, bool)
-    took = plot >= 0
+    took = (plot >= 0) & witness[parent]
     j = plot[took]
     a = leaf_address[parent[took]]
     out[j[(a >= 0) & (a == address[j])]] = True
@@ -75,17 +97,18 @@ def untracked_births(cand: BirthCandidates, rows: np.ndarray,
 
 
 def untracked(children: Children, cand: BirthCandidates, rows: np.ndarray,
-              address: np.ndarray, leaf_address: np.ndarray, leaf_track: np.ndarray
-              ) -> tuple[Children, BirthCandidates]:
+              address: np.ndarray, leaves: Leaves) -> tuple[Children, BirthCandidates]:
     """Both parts of the rule (module docstring) on the children that survived pruning
-    (parents' ``leaf_address`` and ``leaf_track``, ``-1`` none / tentative) and on the
-    birth candidates: ``(children, candidates)`` without those that copy a tracked reply."""
-    tracked = tracked_replies(address, leaf_address, children.parent, children.plot)
+    (their parents ``leaves``) and on the birth candidates: ``(children, candidates)``
+    without those that copy a tracked reply."""
+    ident = leaves.ident[:, 1]
+    tracked = tracked_replies(address, ident, children.parent, children.plot,
+                              witnesses(leaves))
     if not tracked.any():
         return children, cand
-    j = children.plot
-    copy = (j >= 0) & tracked[np.maximum(j, 0)] & (leaf_address[children.parent] < 0) & \
-        (leaf_track[children.parent] < 0)
+    j, parent = children.plot, children.parent
+    copy = (j >= 0) & tracked[np.maximum(j, 0)] & (ident[parent] < 0) & \
+        (leaves.track[parent] < 0)
     if copy.any():
         children = children.take(np.flatnonzero(~copy))
     return children, untracked_births(cand, rows, tracked)

@@ -105,6 +105,9 @@ class AttributeModel:
     #: A new track on the address of a track that ended at most this long ago (s) takes
     #: its id (:mod:`mhtrack.mht.resume`; the OpenSky data's longest gap is 660 s).
     resume_s: float = 900.0
+    #: A reply whose address a tree that takes it already carries also starts a new tree
+    #: (True: as before issue 30; default False, :mod:`mhtrack.mht.births.same_address`).
+    birth_on_tracked_address: bool = False
 
     def __post_init__(self) -> None:
         for name in ("address_error", "address_share", "code_error", "code_error_garbled",

@@ -63,6 +63,7 @@ from mhtrack.mht.attribute_scores import (
     seed_attributes,
 )
 from mhtrack.mht.births import Birth, default_birth
+from mhtrack.mht.births.same_address import untracked
 from mhtrack.mht.caps import CapWarnings
 from mhtrack.mht.carry import Carried, Merged, number_frame
 from mhtrack.mht.config import MHTConfig
@@ -210,6 +211,8 @@ class MHTTracker:
             cand = replace(cand, score=cand.score + gain, peak=cand.peak + gain)
         children = prune_children(f, leaves, children, self.sprt,
                                   n_births=len(cand) + len(idle))
+        if attrs is not None and not self.attributes.birth_on_tracked_address:
+            children, cand = untracked(children, cand, f.rows, attrs.address, leaves)
         grown = grow_children(f, leaves, pred, children, motion=self.motion,
                               pair_pred=pair_pred, posterior=gated.posterior)
         births = self.birth.seed(f, cand, grown.window, self.trees)

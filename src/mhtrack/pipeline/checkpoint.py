@@ -153,6 +153,8 @@ def decode_pending(saved: dict[str, Any] | None) -> dict[str, Any] | None:
         if "R" in arrays:
             arrays["R"] = arrays["R"].reshape(-1, 2, 2)
         arrays["file_row"] = np.full(len(arrays["time"]), -1, np.int64)
+        if "mark" in arrays and "offset" in arrays:  # bytes of the earlier run's input
+            arrays["offset"] = np.where(arrays["mark"], -1, arrays["offset"])
         out[part] = arrays
     return out
 

@@ -139,7 +139,9 @@ def _column(values: Any) -> dict[str, Any]:
 
 def decode_pending(saved: dict[str, Any] | None) -> dict[str, Any] | None:
     """The plots held, back as columns for ``DatagramSource(pending=...)``; their
-    ``file_row`` is ``-1`` (numbers of the earlier run, not of this one's input)."""
+    ``file_row`` is ``-1`` (numbers of the earlier run, not of this one's input), and so
+    is a sweep mark's ``offset`` (no datagram of this run: a frame it closes is timed
+    from its last plot)."""
     if saved is None:
         return None
     out: dict[str, Any] = {k: -math.inf if saved[k] is None else float(saved[k])

@@ -11,9 +11,10 @@ last datagram — and ``t_out`` the time its output had gone to every sink (the 
 datagrams sent, the JSON lines written). It includes the wait for the re-order window
 and, for a frame closed otherwise, for the next plot that closes it (``docs/sources.md``):
 what a consumer sees. The former measure — from the last plot's datagram alone — is
-kept beside it (``last_plot`` in :meth:`Health.snapshot`). Frames made by the end of the input (a stop:
-the window and the open frames flushed) are timed by the stop, not by the data: they
-are counted apart (``after_end``) and left out. Receive times come from the reader thread
+kept beside it (``last_plot`` in :meth:`Health.snapshot`). Frames made by the end of
+the input (a stop: the window and the open frames flushed) are timed by the stop, not
+by the data: they are counted apart (``after_end``) and left out. A frame whose
+datagram (or crossing's) is forgotten is counted in ``untimed``. Receive times come from the reader thread
 (``time.time()`` when ``recv`` returned); :class:`Arrivals` maps each plot's
 decoding-order number to its datagram's receive time over a bounded horizon.
 

@@ -14,9 +14,10 @@ what a consumer sees. The former measure — from the last plot's datagram alone
 kept beside it (``last_plot`` in :meth:`Health.snapshot`). Frames made by the end of
 the input (a stop: the window and the open frames flushed) are timed by the stop, not
 by the data: they are counted apart (``after_end``) and left out. A frame whose
-datagram (or crossing's) is forgotten is counted in ``untimed``. Receive times come from the reader thread
-(``time.time()`` when ``recv`` returned); :class:`Arrivals` maps each plot's
-decoding-order number to its datagram's receive time over a bounded horizon.
+datagram (or crossing's) is forgotten is counted in ``untimed``. Receive times come
+from the reader thread (``time.time()`` when ``recv`` returned); :class:`Arrivals` maps
+each plot's decoding-order number, and each byte offset of the input, to its datagram's
+receive time over a bounded horizon.
 
 The **percentiles** p50/p99 are numpy's ``percentile`` (linear interpolation between
 order statistics, Hyndman & Fan's definition 7) of the latencies of the frames since the

@@ -7,7 +7,9 @@
 ``radar.pcap``: ``mhtrack simulate opensky-radars --seed 1`` then ``mhtrack export``);
 for each window the recording's first ``--seconds`` are replayed at real time into
 ``live`` (:func:`national.live_run`: loopback only, every wait bounded) and its last
-status line's figures printed: plots, frames, late drops, latency p50/p99, live's CPU;
+status line's figures printed: plots, frames, late drops, latency p50/p99 (a sector
+frame timed from its closing crossing's datagram, the former measure from its last
+plot's beside it: ``docs/live.md``), live's CPU;
 for each ``--release`` and ``--frames`` of ``live`` given (``docs/live.md``, *Latency*;
 ``sector``: ``live --sector-frames``, frames closed at the radars' CAT034 crossings).
 First, from the plots alone (no ``live``): each frame's own closing wait — from its last
@@ -83,7 +85,10 @@ def main() -> None:
               f"{st['frames']} "
               f"frames, late drops "
               f"{st['late_drops']}, latency p50 {1e3 * lat['p50']:.0f} ms p99 "
-              f"{1e3 * lat['p99']:.0f} ms ({lat['count']} timed); live's CPU "
+              f"{1e3 * lat['p99']:.0f} ms ({lat['count']} timed, "
+              f"{lat.get('by_crossing', 0)} from the closing crossing; from the last "
+              f"plot: p50 {1e3 * lat['last_plot']['p50']:.0f} ms p99 "
+              f"{1e3 * lat['last_plot']['p99']:.0f} ms); live's CPU "
               f"{run['cpu_s']:.1f} s; p99 per 10 s line (ms) "
               f"{[round(x[2]) for x in run['lines']]}", flush=True)
 

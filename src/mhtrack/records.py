@@ -74,6 +74,9 @@ class Scan:
         ``time`` is the frame's reference time, the latest plot time.
     attrs : what each plot says besides its position (:class:`~mhtrack.attributes.
         PlotAttributes`: code, flight level, address, ...); ``None`` when nothing.
+    closing : the byte offset in the input of the radar's sweep mark (CAT034 sector
+        crossing) whose arrival closed the frame (``sectors`` frames,
+        :mod:`~mhtrack.sources.framer`); ``None`` when something else closed it.
     """
 
     index: int
@@ -85,6 +88,7 @@ class Scan:
     origin: np.ndarray | None = None
     t: np.ndarray | None = None
     attrs: PlotAttributes | None = None
+    closing: int | None = None
 
     def plot_times(self) -> np.ndarray:
         """(n,) the time of each plot: ``t``, or the scan's ``time`` for every plot."""

@@ -44,6 +44,23 @@ def test_arrivals_against_brute_force(plots_per_datagram: list[int], keep: int) 
         assert arr.time_of(plot) == want, (plot, i)
 
 
+@settings(max_examples=60, deadline=None)
+@given(st.lists(st.integers(0, 7), min_size=1, max_size=60), st.integers(1, 20))
+def test_arrivals_by_byte_against_brute_force(sizes: list[int], keep: int) -> None:
+    """Datagram ``i`` (received at time ``i``) holds the next ``sizes[i]`` bytes (some
+    none): :meth:`Arrivals.time_at` of every byte is its datagram's time while that is
+    among the last ``keep``, else ``None``; a byte not yet received has none."""
+    arr = Arrivals(keep)
+    owner: list[int] = []
+    for i, n in enumerate(sizes):
+        arr.add(0, float(i), n)
+        owner += [i] * n
+    last = len(sizes) - 1
+    for byte, i in enumerate(owner):
+        assert arr.time_at(byte) == (float(i) if i > last - keep else None), (byte, i)
+    assert arr.time_at(len(owner)) is None and arr.time_at(-1) is None
+
+
 def _health(clock_values: list[float], arrivals: Arrivals | None = None) -> Health:
     clock = iter(clock_values)
     return Health(lambda: {"datagrams": 5, "queue_drops": 0, "plots": 9, "duplicates": 1,

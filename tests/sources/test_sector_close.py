@@ -120,3 +120,64 @@ def test_lost_crossings_fall_back_to_the_eighth(tmp_path: Path) -> None:
                    # 1.75 > 0.625 + 1 closes it, released by the 9th datagram (2.0)
                    (1, [0.625, 0.875, 1.25, 1.625], 9),
                    (1, [1.75], 10), (2, [2.0, 2.875], 10)]  # the end of the input
+
+
+def _timed(feed: list[tuple[str, float, int]], tmp: Path) -> tuple[list, object]:
+    """The feed through ``DatagramSource`` into a live run's health bookkeeping
+    (:class:`~mhtrack.pipeline.health.Health`), datagram ``i`` received at stamp
+    ``1000 + i`` and every frame out at stamp 10 000 (as ``live``'s reader does:
+    :meth:`Arrivals.add` as each datagram is taken): the frames and the health."""
+    from types import SimpleNamespace
+
+    from mhtrack.pipeline.health import Health
+
+    (tmp / "sensors.toml").write_text(SENSORS)
+    grams = [_plot(t, s) if k == "p" else _mark(t, s, k == "n") for k, t, s in feed]
+    health = Health(lambda: {}, lambda: 0, lambda o: src.file_rows(o.frame.rows),
+                    {1: 8.0, 2: 8.0}, lambda: 10_000.0)
+
+    def datagrams():
+        for i, g in enumerate(grams):
+            health.arrivals.add(src.decoded, 1000.0 + i, len(g))
+            yield g
+        health.input_ended = True
+
+    src = DatagramSource(datagrams(), sensors=read_sensors(tmp / "sensors.toml"),
+                         reorder_window_s=0.0, sectors=True, chunk=1, release="radar")
+    frames = []
+    for f in src:
+        frames.append(f)
+        health.write(SimpleNamespace(frame=f))  # type: ignore[arg-type]
+    starts = np.cumsum([0, *map(len, grams)])  # each datagram's first byte
+    return [(int(f.sensor[0]), None if f.closing is None else
+             int(np.searchsorted(starts, f.closing, side="right")) - 1) for f in frames], \
+        health
+
+
+def test_latency_of_a_sector_is_timed_from_its_closing_crossing(tmp_path: Path) -> None:
+    # FEED's frames (above): radar 1's [0.125, 0.375] closed by the crossing at 0.5 s
+    # (datagram 4; its last plot in datagram 3), [0.75, 0.875] by the crossing at 1.0 s
+    # (datagram 8; last plot in 7); the last three by the end of the input (not timed)
+    closing, health = _timed(FEED, tmp_path)
+    assert closing == [(1, 4), (1, 8), (2, None), (1, None), (2, None)]
+    k = health.latency_count
+    assert k == 2 and health.after_end == 3 and health.by_crossing == 2
+    assert (10_000.0 - health.recent[:k]).tolist() == [1004.0, 1008.0]
+    assert (10_000.0 - health.recent_last_plot[:k]).tolist() == [1003.0, 1007.0]
+    lat = health.snapshot()["latency_s"]
+    assert (lat["p50"], lat["last_plot"]["p50"]) == (8994.0, 8995.0)
+
+
+def test_a_fallback_frame_keeps_its_last_plot_s_datagram(tmp_path: Path) -> None:
+    # the lost crossings' feed: the first frame is closed by the crossing at 0.5 s
+    # (datagram 2, its plot in 1); the next by radar 1's plot at 1.75 s past the eighth
+    # (its last plot at 1.625 s in datagram 6), whatever came before
+    feed = [("n", 0.0, 1), ("p", 0.125, 1), ("s", 0.5, 1), ("p", 0.625, 1),
+            ("p", 0.875, 1), ("p", 1.25, 1), ("p", 1.625, 1), ("p", 1.75, 1),
+            ("p", 2.0, 2), ("p", 2.875, 2)]
+    closing, health = _timed(feed, tmp_path)
+    assert closing[:2] == [(1, 2), (1, None)]
+    k = health.latency_count
+    assert k == 2 and health.by_crossing == 1
+    assert (10_000.0 - health.recent[:k]).tolist() == [1002.0, 1006.0]
+    assert (10_000.0 - health.recent_last_plot[:k]).tolist() == [1001.0, 1006.0]

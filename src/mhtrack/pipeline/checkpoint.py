@@ -139,7 +139,9 @@ def _column(values: Any) -> dict[str, Any]:
 
 def decode_pending(saved: dict[str, Any] | None) -> dict[str, Any] | None:
     """The plots held, back as columns for ``DatagramSource(pending=...)``; their
-    ``file_row`` is ``-1`` (numbers of the earlier run, not of this one's input)."""
+    ``file_row`` is ``-1`` (numbers of the earlier run, not of this one's input), and so
+    is a sweep mark's ``offset`` (no datagram of this run: a frame it closes is timed
+    from its last plot)."""
     if saved is None:
         return None
     out: dict[str, Any] = {k: -math.inf if saved[k] is None else float(saved[k])
@@ -153,6 +155,8 @@ def decode_pending(saved: dict[str, Any] | None) -> dict[str, Any] | None:
         if "R" in arrays:
             arrays["R"] = arrays["R"].reshape(-1, 2, 2)
         arrays["file_row"] = np.full(len(arrays["time"]), -1, np.int64)
+        if "mark" in arrays and "offset" in arrays:  # bytes of the earlier run's input
+            arrays["offset"] = np.where(arrays["mark"], -1, arrays["offset"])
         out[part] = arrays
     return out
 

@@ -3,15 +3,21 @@ rates, tracks, silent radars and the latency of each sector, as one status line,
 object and Prometheus text.
 
 **Latency** of a frame (a sector: one radar's plots over at most an eighth of its
-rotation) is ``t_out − t_in``: ``t_in`` the receive time of the frame's **last
-datagram** — the one carrying the frame's plot decoded last — and ``t_out`` the time its
-output had gone to every sink (the CAT062 datagrams sent, the JSON lines written). It
-includes the wait for the re-order window and for the next plot that closes the frame
-(``docs/sources.md``): what a consumer sees. Frames made by the end of the input (a stop:
-the window and the open frames flushed) are timed by the stop, not by the data: they
-are counted apart (``after_end``) and left out. Receive times come from the reader thread
-(``time.time()`` when ``recv`` returned); :class:`Arrivals` maps each plot's
-decoding-order number to its datagram's receive time over a bounded horizon.
+rotation, or between two of its CAT034 crossings) is ``t_out − t_in``: ``t_in`` the
+receive time of the frame's **last datagram** — the one carrying the frame's plot
+decoded last, or, for a frame closed by its radar's sector crossing (``Scan.closing``,
+``live --sector-frames``), the one carrying that crossing if it came later: the sector's
+last datagram — and ``t_out`` the time its output had gone to every sink (the CAT062
+datagrams sent, the JSON lines written). It includes the wait for the re-order window
+and, for a frame closed otherwise, for the next plot that closes it (``docs/sources.md``):
+what a consumer sees. The former measure — from the last plot's datagram alone — is
+kept beside it (``last_plot`` in :meth:`Health.snapshot`). Frames made by the end of
+the input (a stop: the window and the open frames flushed) are timed by the stop, not
+by the data: they are counted apart (``after_end``) and left out. A frame whose
+datagram (or crossing's) is forgotten is counted in ``untimed``. Receive times come
+from the reader thread (``time.time()`` when ``recv`` returned); :class:`Arrivals` maps
+each plot's decoding-order number, and each byte offset of the input, to its datagram's
+receive time over a bounded horizon.
 
 The **percentiles** p50/p99 are numpy's ``percentile`` (linear interpolation between
 order statistics, Hyndman & Fan's definition 7) of the latencies of the frames since the
@@ -48,11 +54,12 @@ SILENT_PERIODS = 3.0
 
 class Arrivals:
     """Receive time of the datagram of each plot, by the plot's decoding-order number:
-    :meth:`add` ``(first plot number of the datagram, receive time)`` as each datagram
-    is taken (plots of earlier datagrams all numbered below it); :meth:`time_of` a
-    plot. The last ``keep`` datagrams are remembered, in two NumPy rings allocated (and
-    written) whole at the start — memory flat from the first datagram; older plots have
-    no time."""
+    :meth:`add` ``(first plot number of the datagram, receive time, its size)`` as each
+    datagram is taken (plots of earlier datagrams all numbered below it); :meth:`time_of`
+    a plot, :meth:`time_at` a byte offset in the input (the datagrams' bytes end to end,
+    as the source counts them: a sweep mark's ``offset``). The last ``keep`` datagrams
+    are remembered, in NumPy rings allocated (and written) whole at the start — memory
+    flat from the first datagram; older plots have no time."""
 
     def __init__(self, keep: int = MAX_ARRIVALS) -> None:
         if keep < 1:
@@ -60,13 +67,27 @@ class Arrivals:
         self.keep = int(keep)
         self._first = np.full(self.keep, -1, np.int64)
         self._time = np.full(self.keep, np.nan)
+        self._start = np.full(self.keep, -1, np.int64)  # each datagram's first byte
         self.n = 0  # datagrams added
+        self.bytes = 0  # their sizes' sum
 
-    def add(self, first_plot: int, when: float) -> None:
+    def add(self, first_plot: int, when: float, size: int = 0) -> None:
         i = self.n % self.keep
         self._first[i] = first_plot
         self._time[i] = when
+        self._start[i] = self.bytes
         self.n += 1
+        self.bytes += int(size)
+
+    def time_at(self, offset: int) -> float | None:
+        """The receive time of the datagram holding byte ``offset`` (the last datagram
+        taken that starts at or before it); ``None`` if forgotten or not yet taken."""
+        lo, keep, start = max(0, self.n - self.keep), self.keep, self._start
+        if offset < 0 or offset >= self.bytes:
+            return None
+        i = bisect.bisect_right(range(lo, self.n), int(offset),
+                                key=lambda j: int(start[j % keep])) - 1
+        return None if i < 0 else float(self._time[(lo + i) % keep])
 
     def time_of(self, plot: int) -> float | None:
         """The receive time of the datagram holding plot ``plot`` (the last datagram
@@ -114,11 +135,13 @@ class Health(Sink):
         self.after_end = 0
         self._lock = threading.Lock()  # write (stepping) against snapshot (status thread)
         self.untimed = 0  # frames whose last datagram was forgotten
+        self.by_crossing = 0  # frames timed from their closing crossing's datagram
         self.latency_sum = 0.0
         self.latency_count = 0
         #: The last ``window`` latencies: a ring allocated (and written) whole at the
         #: start, so the memory does not grow with the frames.
         self.recent = np.full(int(window), np.nan)
+        self.recent_last_plot = np.full(int(window), np.nan)  # the former measure
         self._n_recent = 0
         self._interval: list[float] = []
         self._last_frame: dict[int, float] = {}  # radar -> time of its last frame
@@ -146,21 +169,27 @@ class Health(Sink):
             return
         if plots.size == 0:
             return
-        t_in = self.arrivals.time_of(int(plots.max()))
-        if t_in is None:
+        t_plot = self.arrivals.time_of(int(plots.max()))
+        closing = getattr(out.frame, "closing", None)  # a Scan; a test may pass less
+        t_mark = None if closing is None else self.arrivals.time_at(closing)
+        if t_plot is None or (closing is not None and t_mark is None):
             self.untimed += 1
             return
-        self._observe(now - t_in)
+        t_in = t_plot if t_mark is None else max(t_plot, t_mark)
+        self.by_crossing += t_mark is not None and t_mark >= t_plot
+        self._observe(now - t_in, now - t_plot)
 
     def observe(self, latency_s: float) -> None:
         """One frame's latency (s)."""
         with self._lock:
             self._observe(latency_s)
 
-    def _observe(self, latency_s: float) -> None:
+    def _observe(self, latency_s: float, last_plot_s: float | None = None) -> None:
         self.latency_sum += latency_s
         self.latency_count += 1
-        self.recent[self._n_recent % self.recent.size] = latency_s
+        i = self._n_recent % self.recent.size
+        self.recent[i] = latency_s
+        self.recent_last_plot[i] = latency_s if last_plot_s is None else last_plot_s
         self._n_recent += 1
         self._interval.append(latency_s)
 
@@ -175,15 +204,21 @@ class Health(Sink):
     def snapshot(self, now: float | None = None) -> dict[str, Any]:
         """Every figure now, JSON-able: the totals, ``frames, tracks, radars_silent``
         (ids), ``latency_s`` — ``p50, p99`` of the last :data:`WINDOW` frames, ``sum``
-        and ``count`` of all — and ``time`` (the clock)."""
+        and ``count`` of all, ``by_crossing`` (frames timed from their closing crossing)
+        and ``last_plot`` (``p50, p99`` of the same frames timed from their last plot's
+        datagram, the former measure) — and ``time`` (the clock)."""
         with self._lock:
-            p50, p99 = percentiles(self.recent[:min(self._n_recent, self.recent.size)])
+            k = min(self._n_recent, self.recent.size)
+            p50, p99 = percentiles(self.recent[:k])
+            old = percentiles(self.recent_last_plot[:k])
             return {"time": self.clock() if now is None else now, **dict(self.counts()),
                     "frames": self.frames, "tracks": self.n_tracks,
                     "radars_silent": self.silent(),
                     "latency_s": {"p50": p50, "p99": p99, "sum": self.latency_sum,
                                   "count": self.latency_count, "untimed": self.untimed,
-                                  "after_end": self.after_end}}
+                                  "after_end": self.after_end,
+                                  "by_crossing": self.by_crossing,
+                                  "last_plot": {"p50": old[0], "p99": old[1]}}}
 
     def line(self, snap: Mapping[str, Any] | None = None) -> str:
         """The status line: rates since the last line (none at the first), totals, and

@@ -285,7 +285,7 @@ class Live:
                 yield item
                 continue
             data, when = item
-            self.health.arrivals.add(self.source.decoded, when)
+            self.health.arrivals.add(self.source.decoded, when, len(data))
             yield data if stream else (data, when)
             if not waiting():
                 yield CAUGHT_UP

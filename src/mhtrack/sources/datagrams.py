@@ -164,7 +164,7 @@ class DatagramSource(Source):
         at_rows: list[int] = []
         sector: dict[int, int] = {}  # sweep marks received so far, per radar
         in_sector: list[int] = []
-        marks: list[tuple[float, int, int, int]] = []  # (time, radar, sector, place)
+        marks: list[tuple[float, int, int, int, int]] = []  # (time, radar, sector, place, byte)
         closing = self.sectors and convert  # marks go on with the plots: they close frames
         n = 0
         for offset, payload, when in self._datagrams(problems):
@@ -184,7 +184,7 @@ class DatagramSource(Source):
                     for ti, r in zip(t, found, strict=True):
                         sector[r[1]] = sector.get(r[1], 0) + 1
                         if closing:
-                            marks.append((ti, r[1], sector[r[1]], len(rows)))
+                            marks.append((ti, r[1], sector[r[1]], len(rows), at))
                     continue
                 rows.extend(found)
                 self.decoded = n + len(rows)
@@ -201,7 +201,7 @@ class DatagramSource(Source):
 
     def _chunk(self, rows: list[tuple[Any, ...]], times: list[float], at: list[int],
                n0: int, convert: bool, in_sector: list[int],
-               marks: list[tuple[float, int, int, int]] | None = None
+               marks: list[tuple[float, int, int, int, int]] | None = None
                ) -> dict[str, np.ndarray]:
         p = plot_columns(rows)  # ADS-B reports add lat, lon, sigma; I048/130 its columns
         p["time"] = np.array(times, float)

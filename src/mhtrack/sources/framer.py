@@ -54,17 +54,20 @@ class _Open:
     end: float
     sector: int = 0
     parts: list[tuple[int, np.ndarray]] = field(default_factory=list)  # (batch id, rows)
+    mark: dict[str, object] | None = None  # the mark that closed it (its row's values)
 
 
 @dataclass(frozen=True)
 class Frame:
-    """A finished frame: its number, sensor, reference time (its latest plot's) and the
-    columns of its plots in time order."""
+    """A finished frame: its number, sensor, reference time (its latest plot's), the
+    columns of its plots in time order and ``mark``, the values of the row of the sweep
+    mark that closed it (``None``: closed by a plot, the stream's time or the end)."""
 
     index: int
     sensor: int
     time: float
     cols: dict[str, np.ndarray]
+    mark: dict[str, object] | None = None
 
 
 class Framer:
@@ -135,6 +138,7 @@ class Framer:
                 uses += self._plots(b, s, rows[cut:upto], t, sector)
             fr = self._open.get(s)
             if fr is not None and fr.sector < int(sector[m]):
+                fr.mark = {k: v[m] for k, v in self._batches[b].items()}
                 self._close(s)
             cut = upto + 1
         if cut < rows.size:
@@ -223,6 +227,6 @@ class Framer:
         if self.release == "radar":  # frame times never go back
             self.last_time = max(self.last_time, fr.end)
         out = Frame(self.n_frames, sensor, fr.end if self.release == "time"
-                    else self.last_time, cols)
+                    else self.last_time, cols, fr.mark)
         self.n_frames += 1
         return out

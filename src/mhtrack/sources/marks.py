@@ -11,13 +11,16 @@ import numpy as np
 Template = dict[str, tuple[np.dtype, tuple[int, ...]]]
 
 
-def with_marks(out: dict[str, np.ndarray] | None, marks: list[tuple[float, int, int, int]],
+def with_marks(out: dict[str, np.ndarray] | None,
+               marks: list[tuple[float, int, int, int, int]],
                n0: int, template: Template | None) -> dict[str, np.ndarray]:
     """The converted plots ``out`` (``file_row`` from ``n0`` on, some left out) with the
-    chunk's marks ``(time, radar, sector, j)`` among them in arrival order — a mark
-    decoded when the chunk held ``j`` plots goes before plot ``n0 + j``: rows with
-    ``mark`` true, their ``time``, ``sensor`` and ``sector`` (the radar's count of marks
-    with this one), ``file_row`` -1, the other columns of ``template`` blank (NaN, -1,
+    chunk's marks ``(time, radar, sector, j, offset)`` among them in arrival order — a
+    mark decoded when the chunk held ``j`` plots goes before plot ``n0 + j``: rows with
+    ``mark`` true, their ``time``, ``sensor``, ``sector`` (the radar's count of marks
+    with this one) and ``offset`` (its data block's byte offset in the input: the
+    datagram it came in, whose receive time the live status uses), ``file_row`` -1, the
+    other columns of ``template`` blank (NaN, -1,
     empty). Without a template (no plot converted yet) the marks are left out: there is
     no frame they could close."""
     if template is None or not marks:
@@ -29,6 +32,8 @@ def with_marks(out: dict[str, np.ndarray] | None, marks: list[tuple[float, int, 
     rows["sector"] = np.array([x[2] for x in marks], np.int64)
     rows["mark"] = np.ones(m, bool)
     rows["file_row"] = np.full(m, -1, np.int64)
+    if "offset" in rows:
+        rows["offset"] = np.array([x[4] for x in marks], rows["offset"].dtype)
     if out is None or not out["time"].size:
         return rows
     key = np.concatenate((2 * out["file_row"] + 1,

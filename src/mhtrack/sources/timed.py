@@ -143,7 +143,7 @@ class TimedStream:
         return Scan(index=fr.index, time=fr.time, z=np.column_stack((c["x"], c["y"])),
                     sensor=np.asarray(c["sensor"], np.int64), rows=rows, R=c.get("R"),
                     origin=c.get("origin"), t=np.asarray(c["time"], float),
-                    attrs=of_columns(c))
+                    attrs=of_columns(c), closing=_closing(fr))
 
     @property
     def next_row(self) -> int:
@@ -163,3 +163,10 @@ class TimedStream:
             ok = (rows >= max(0, self._n_out - self.keep_rows)) & (rows < self._n_out)
             out[ok] = self._rows[rows[ok] % self.keep_rows]
         return out
+
+
+def _closing(fr: Frame) -> int | None:
+    """The byte offset of the sweep mark that closed ``fr`` (``Scan.closing``); ``None``
+    if none did or its offset is unknown (a mark restored from a checkpoint)."""
+    at = -1 if fr.mark is None else int(fr.mark.get("offset", -1))  # type: ignore[call-overload]
+    return at if at >= 0 else None

@@ -129,7 +129,7 @@ def live_options(d: Path, meta: dict, a: argparse.Namespace) -> list[str]:
     return ["--sensors", str(d / "sensors.toml"), "--birth-density",
             f"{meta['birth_density']:.6g}", "--reorder-window", str(a.reorder_window),
             *(["--release", a.release] if getattr(a, "release", "time") != "time" else []),
-            *(["--sector-frames"] if getattr(a, "frames", "eighth") == "sector" else [])]
+            *(["--sector-frames"] if a.frames == "sector" else [])]
 
 
 # ------------------------------------------------------------------ 2. live
@@ -304,6 +304,9 @@ def main() -> None:
     ap.add_argument("--seed", type=int, default=1, help="simulation seed")
     ap.add_argument("--scene-seed", type=int, default=0)
     ap.add_argument("--reorder-window", type=float, default=0.2)
+    ap.add_argument("--frames", choices=("eighth", "sector"), default="eighth",
+                    help="live's framing: eighths of a turn (default) or --sector-frames "
+                    "(closed at the radar's CAT034 crossings; docs/live.md)")
     ap.add_argument("--release", choices=("time", "radar"), default="time",
                     help="live's --release (docs/live.md, Latency)")
     ap.add_argument("--live-s", type=float, default=None,
@@ -344,6 +347,12 @@ def main() -> None:
               f"({lat['count']} timed, {lat['after_end']} made "
               f"by the stop); {st['queue_drops']} queue drops, {st['late_drops']} late drops; "
               f"{r['cat062_datagrams']} CAT062 datagrams out; {st['tracks']} tracks at the end")
+        old = lat.get("last_plot") or {}
+        if lat.get("by_crossing"):
+            print(f"  {lat['by_crossing']} frames timed from their closing crossing's datagram;"
+                  f" the same frames from their last plot's: p50 "
+                  f"{1e3 * old.get('p50', math.nan):.0f} ms, p99 "
+                  f"{1e3 * old.get('p99', math.nan):.0f} ms")
         print(f"  latency p50 {1e3 * lat['p50']:.0f} ms, p99 {1e3 * lat['p99']:.0f} ms "
               f"(whole run); per 10 s line p99: first {lines[0][2] if lines else 0:.0f} ms, "
               f"median {_pct([x[2] for x in lines], 50):.0f} ms, last "

@@ -11,7 +11,7 @@ import itertools
 import numpy as np
 import pytest
 from hypothesis import given, settings
-from hypothesis import strategies as st
+from tests.sources.test_framer import streams  # the same random streams
 
 from mhtrack.frames import make_frames
 from mhtrack.sources.framer import Framer
@@ -28,18 +28,6 @@ def _run(t, s, lengths, cuts, release):
     for f in fr.flush():
         out.append((f.sensor, f.time, f.cols["pos"].tolist(), len(bounds), t.size))
     return out
-
-
-@st.composite
-def streams(draw):
-    n = draw(st.integers(0, 80))
-    steps = draw(st.lists(st.sampled_from([0.0, 0.0, 0.125, 0.25, 0.5, 1.0, 3.0]),
-                          min_size=n, max_size=n))
-    t = np.cumsum(np.asarray(steps, float))
-    s = np.asarray(draw(st.lists(st.integers(1, 4), min_size=n, max_size=n)), np.int64)
-    lengths = {k: draw(st.sampled_from([0.25, 0.5, 1.0, 1.5, 2.0])) for k in range(1, 5)}
-    cuts = draw(st.lists(st.integers(0, max(n, 1)), max_size=10))
-    return t, s, lengths, cuts
 
 
 @settings(max_examples=300, deadline=None)

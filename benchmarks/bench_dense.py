@@ -106,17 +106,17 @@ def held(tracks: object, truth: object, scans: list[int], gate: float) -> tuple[
     return int(ok.sum()), int(one_id.sum())
 
 
-def run_one(n_scans: int, seed: int, held_scans: int, gate: float,
-            config: dict | None = None, attributes: bool = False) -> dict:
-    """The scene on the library on ``sys.path``, in this process: the figures
-    (``attributes``: the plots with secondary-radar attributes, module docstring)."""
+def dense_scene(n_scans: int, seed: int, attributes: bool = False,
+                config: dict | None = None) -> tuple[object, object, str, float]:
+    """``(simulation, MHTConfig, tracker name, true κ per m²)`` of the dense scene (module
+    docstring) on the library on ``sys.path``; ``config``: ``MHTConfig`` fields changed;
+    ``attributes``: the plots with secondary-radar attributes. Shared by
+    ``dense_bound.py`` and ``dense_held_why.py``."""
     import dataclasses
     import logging
 
-    import bench_stages
     from bench_scale import SCENES, scene
-    from mhtrack.build import default_config, make_tracker
-    from mhtrack.experiments import track
+    from mhtrack.build import default_config
     from mhtrack.scenario import simulate
 
     logging.getLogger("mhtrack").setLevel(logging.ERROR)
@@ -128,7 +128,19 @@ def run_one(n_scans: int, seed: int, held_scans: int, gate: float,
 
         sim = with_attributes(sim)
     cfg = dataclasses.replace(default_config(sc), scale_caps=True, **(config or {}))
-    trk = make_tracker(name, cfg, clutter_density=rate / sc.region.area)
+    return sim, cfg, name, rate / sc.region.area
+
+
+def run_one(n_scans: int, seed: int, held_scans: int, gate: float,
+            config: dict | None = None, attributes: bool = False) -> dict:
+    """The scene on the library on ``sys.path``, in this process: the figures
+    (``attributes``: the plots with secondary-radar attributes, module docstring)."""
+    import bench_stages
+    from mhtrack.build import make_tracker
+    from mhtrack.experiments import track
+
+    sim, cfg, name, kappa = dense_scene(n_scans, seed, attributes, config)
+    trk = make_tracker(name, cfg, clutter_density=kappa)
     warm = warm_up(trk.motion)
     bench_stages.install()
     _install_clustering(bench_stages)

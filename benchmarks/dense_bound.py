@@ -30,7 +30,6 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import json
-import logging
 import math
 import sys
 from pathlib import Path
@@ -53,10 +52,9 @@ def only(plots: object, rows: np.ndarray) -> object:
 
 
 def main(argv: list[str] | None = None) -> int:
-    from bench_scale import SCENES, scene
-    from mhtrack.build import default_config, make_tracker
+    from bench_dense import dense_scene
+    from mhtrack.build import make_tracker
     from mhtrack.mht.undetected import UndetectedDensity
-    from mhtrack.scenario import simulate
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--config", default='{"startup_density": true}',
@@ -67,16 +65,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--attributes", action="store_true",
                     help="plots with secondary-radar attributes (module docstring)")
     a = ap.parse_args(argv)
-    logging.getLogger("mhtrack").setLevel(logging.ERROR)
-    n, rate, name = SCENES["big"]
-    sc = scene(n, rate, a.scans)
-    sim = simulate(sc, seed=a.seed)
-    if a.attributes:
-        from mhtrack.scenario.identity import with_attributes
-
-        sim = with_attributes(sim)
-    kappa = rate / sc.region.area
-    cfg = dataclasses.replace(default_config(sc), scale_caps=True, **json.loads(a.config))
+    sim, cfg, name, kappa = dense_scene(a.scans, a.seed, a.attributes,
+                                        json.loads(a.config))
     trk = make_tracker(name, cfg, clutter_density=kappa)
     if cfg.startup_density:  # the full scene's densities, scan by scan
         u = UndetectedDensity(cfg.new_target_density)

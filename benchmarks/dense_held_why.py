@@ -16,9 +16,7 @@ from __future__ import annotations
 
 import argparse
 import collections
-import dataclasses
 import json
-import logging
 import sys
 import time
 from pathlib import Path
@@ -32,10 +30,9 @@ def main(argv: list[str] | None = None) -> int:
     from scipy.optimize import linear_sum_assignment
     from scipy.spatial.distance import cdist
 
-    from bench_scale import SCENES, scene
-    from mhtrack.build import default_config, make_tracker
+    from bench_dense import dense_scene
+    from mhtrack.build import make_tracker
     from mhtrack.experiments import track
-    from mhtrack.scenario import simulate
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--config", default="{}", help="MHTConfig fields to change (JSON)")
@@ -46,16 +43,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--attributes", action="store_true",
                     help="plots with secondary-radar attributes (module docstring)")
     a = ap.parse_args(argv)
-    logging.getLogger("mhtrack").setLevel(logging.ERROR)
-    n, rate, name = SCENES["big"]
-    sc = scene(n, rate, a.scans)
-    sim = simulate(sc, seed=a.seed)
-    if a.attributes:
-        from mhtrack.scenario.identity import with_attributes
-
-        sim = with_attributes(sim)
-    cfg = dataclasses.replace(default_config(sc), scale_caps=True, **json.loads(a.config))
-    trk = make_tracker(name, cfg, clutter_density=rate / sc.region.area)
+    sim, cfg, name, kappa = dense_scene(a.scans, a.seed, a.attributes,
+                                        json.loads(a.config))
+    trk = make_tracker(name, cfg, clutter_density=kappa)
     c0 = time.process_time()
     run = track(trk, sim.plots, name=name, output="online")
     cpu = (time.process_time() - c0) / a.scans

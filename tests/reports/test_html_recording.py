@@ -72,12 +72,12 @@ def test_histogram_counts_every_track_once(recording_dir):
     assert int(np.sum(fig.data[0].y)) == len(ids) == len(d)
 
 
-def test_hover_details_speed_heading_and_plot_fields(tmp_path):
-    """Speed and heading of a hand-made track (due south at 10 m/s: 180°; east at 5 m/s:
-    90°); flight level and code from the plot each row used."""
+def _details(tmp_path, plot_rows: str):
+    """A hand-made track 4 (due south at 10 m/s for two scans, then east at 5 m/s,
+    coasting) over the plots ``plot_rows`` (scan,time,sensor,x,y,flight_level,mode_3a),
+    both written as files: ``(tracks, track_details)``."""
     (tmp_path / "plots.csv").write_text(
-        "scan,time,sensor,x,y,flight_level,mode_3a\n"
-        "0,0.0,7,0,0,350,7000\n1,1.0,7,0,-10,351.25,7000\n2,2.0,7,5,-10,,\n")
+        "scan,time,sensor,x,y,flight_level,mode_3a\n" + plot_rows)
     (tmp_path / "tracks.csv").write_text(
         "scan,time,track_id,x,y,vx,vy,plot,score\n"
         "0,0.0,4,0,0,0,-10,0,1.5\n1,1.0,4,0,-10,0,-10,1,2.5\n2,2.0,4,5,-10,5,0,,3.5\n")
@@ -85,7 +85,15 @@ def test_hover_details_speed_heading_and_plot_fields(tmp_path):
 
     plots = read_plots(tmp_path / "plots.csv")
     tracks = read_tracks(tmp_path / "tracks.csv")
-    d = track_details(tracks, tmp_path / "tracks.csv", plots, tmp_path / "plots.csv")
+    return tracks, track_details(tracks, tmp_path / "tracks.csv", plots,
+                                 tmp_path / "plots.csv")
+
+
+def test_hover_details_speed_heading_and_plot_fields(tmp_path):
+    """Speed and heading of a hand-made track (due south at 10 m/s: 180°; east at 5 m/s:
+    90°); flight level and code from the plot each row used."""
+    _, d = _details(tmp_path, "0,0.0,7,0,0,350,7000\n1,1.0,7,0,-10,351.25,7000\n"
+                    "2,2.0,7,5,-10,,\n")
     assert d["speed"].tolist() == [10.0, 10.0, 5.0]
     assert d["heading"].tolist() == [180.0, 180.0, 90.0]
     assert d["score"].tolist() == [1.5, 2.5, 3.5]
@@ -121,17 +129,7 @@ def test_hover_leaves_out_what_a_row_does_not_know(tmp_path):
     """A coasting row (no plot) and a primary-only plot (no flight level): their hover
     names no flight level and no sensor — no ``NaN``, no ``-1`` — while the rows that
     know them show them; hand-written labels."""
-    (tmp_path / "plots.csv").write_text(
-        "scan,time,sensor,x,y,flight_level,mode_3a\n"
-        "0,0.0,7,0,0,350,7000\n1,1.0,2,0,-10,,\n")
-    (tmp_path / "tracks.csv").write_text(
-        "scan,time,track_id,x,y,vx,vy,plot,score\n"
-        "0,0.0,4,0,0,0,-10,0,1.5\n1,1.0,4,0,-10,0,-10,1,2.5\n2,2.0,4,5,-10,5,0,,3.5\n")
-    from mhtrack.io import read_plots
-
-    plots = read_plots(tmp_path / "plots.csv")
-    tracks = read_tracks(tmp_path / "tracks.csv")
-    d = track_details(tracks, tmp_path / "tracks.csv", plots, tmp_path / "plots.csv")
+    tracks, d = _details(tmp_path, "0,0.0,7,0,0,350,7000\n1,1.0,2,0,-10,,\n")
     [trace, _labels] = html_scene.track_traces(tracks, 1.0, d)
     head = "track 4, scan {}, t = {}.0 s<br>speed {} m/s, heading {}°, score {}"
     assert _hovered(trace) == [

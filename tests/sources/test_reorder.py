@@ -28,8 +28,9 @@ def _run(times: list[float], window: float, cuts: list[int] | None = None
     return out, buf
 
 
-def _reference(times: list[float], window: float) -> tuple[list[int], list[int]]:
-    """The rule, written plainly: (released arrival numbers, dropped ones)."""
+def _plain(times: list[float], window: float) -> tuple[list[int], list[int], list[int]]:
+    """The rule, written plainly, after ``times`` (no flush): arrival numbers released,
+    still held (in time order), dropped."""
     held: list[tuple[float, int]] = []
     out, dropped = [], []
     latest = released = -np.inf
@@ -43,7 +44,13 @@ def _reference(times: list[float], window: float) -> tuple[list[int], list[int]]
             out.append(h[1])
             held.remove(h)
             released = h[0]
-    return out + [i for _, i in sorted(held)], dropped
+    return out, [i for _, i in sorted(held)], dropped
+
+
+def _reference(times: list[float], window: float) -> tuple[list[int], list[int]]:
+    """The plain rule with the flush at the end: (released arrival numbers, dropped ones)."""
+    out, held, dropped = _plain(times, window)
+    return out + held, dropped
 
 
 def test_hand_worked() -> None:
@@ -114,26 +121,8 @@ def test_holds_what_the_rule_holds_and_no_late_plot(times, window, cuts) -> None
     bounds = [0, *sorted(set(c for c in cuts if 0 < c < t.size)), t.size]
     for a, b in itertools.pairwise(bounds):
         buf.push({"time": t[a:b], "tag": np.arange(a, b)})
-        _, dropped = _reference(times[:b], window)
         held = buf.held()
-        want = sorted(set(range(b)) - set(dropped) - set(_released(times[:b], window)),
-                      key=lambda i: (times[i], i))
+        _, want, _ = _plain(times[:b], window)  # still held, in (time, arrival) order
         assert (held["tag"].tolist() if held is not None else []) == want
         assert buf._held_seq.size == len(want)
 
-
-def _released(times: list[float], window: float) -> list[int]:
-    """The arrival numbers the plain rule has released after ``times`` (no flush)."""
-    held: list[tuple[float, int]] = []
-    out: list[int] = []
-    latest = released = -np.inf
-    for i, t in enumerate(times):
-        if t < released:
-            continue
-        latest = max(latest, t)
-        held.append((t, i))
-        for h in sorted(h for h in held if latest - h[0] > window):
-            out.append(h[1])
-            held.remove(h)
-            released = h[0]
-    return out

@@ -4,7 +4,10 @@ a map) beside the GMM's, in one run.
 
 Run: ``python benchmarks/bench_clutter_map.py [--seeds N] [--figure PATH] [--clock cpu]``
 (``--clock cpu``: the thread's CPU time, ``time.thread_time``, instead of the wall clock —
-on a shared, loaded machine the wall clock also counts the time other processes ran).
+on a shared, loaded machine the wall clock also counts the time other processes ran;
+``--path``: the scan path with the cell-mass quadrature's NumPy path, its compiled loops
+(:mod:`mhtrack.clutter.cell_mass_rows`, numba), or both, one after the other; the same
+floats either way, so the same IAE).
 
 * scan path, ``crossing-changing`` (one sensor, 90 scans): each estimator fed every scan
   (``update`` + ``intensity`` at the scan's plots: the tracker's clutter stage), the
@@ -28,6 +31,7 @@ from collections.abc import Callable
 import numpy as np
 
 from mhtrack.build import make_clutter_estimator, make_tracker
+from mhtrack.clutter import cell_mass, cell_mass_rows
 from mhtrack.clutter.base import ClutterEstimator
 from mhtrack.clutter.radar_map import map_snapshots
 from mhtrack.experiments.pipeline import scenario_source
@@ -134,10 +138,19 @@ def main() -> int:
     ap.add_argument("--figure", default=None)
     ap.add_argument("--skip-timed", action="store_true")
     ap.add_argument("--clock", choices=("wall", "cpu"), default="wall")
+    ap.add_argument("--path", choices=("both", "numpy", "compiled"), default="both",
+                    help="the cell-mass quadrature's NumPy path, its compiled loops "
+                    "(numba, extra [fast]), or one after the other (default)")
     a = ap.parse_args()
     CLOCK[0] = time.thread_time if a.clock == "cpu" else time.perf_counter
     print(f"clock: {a.clock}")
-    scan_path(a.seeds)
+    for path in (("numpy", "compiled") if a.path == "both" else (a.path,)):
+        on = cell_mass_rows.use(path == "compiled") and cell_mass.preload()
+        if path == "compiled" and not on:
+            print("compiled loops: numba not installed (or MHTRACK_COMPILED=0)")
+            continue
+        print(f"cell-mass quadrature: {path} path")
+        scan_path(a.seeds)
     if not a.skip_timed:
         timed_path(a.figure)
         timed_path(None, "storm")

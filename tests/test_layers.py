@@ -12,6 +12,7 @@ SRC = Path(__file__).resolve().parents[1] / "src" / "mhtrack"
 #: First component under mhtrack → layer (docs/architecture.md, "Layers").
 LAYER = {
     "records": 1, "attributes": 1, "names": 1, "errors": 1, "bounds": 1, "kernels": 1,
+    "compiled": 1,
     "progress": 1,
     "models": 2, "frames": 2,
     "io": 3, "clutter": 3, "initiation": 3,

@@ -70,6 +70,18 @@ def _polar_kappa(w, means, covs, r0, rmin, cut):
     return kappa
 
 
+@pytest.mark.parametrize("sigma", [400.0, 2500.0])
+def test_plane_clump_centred_on_the_site_matches_the_fine_grid(sigma: float) -> None:
+    """A plane Gaussian whose mean is the site itself (no bearing of its own: the whole
+    circle), correlated: every cell within :data:`TOL` of the fine grid, no warning."""
+    cells = cell_mass.Cells((250.0, 400.0), 500.0, 12, 16)
+    cov = np.array([[sigma**2, 0.5 * sigma**2], [0.5 * sigma**2, 1.5 * sigma**2]])
+    got = _mass(cells, [1.0], [cells.site], [cov])
+    ref = _fine(cells, lambda x, y, r, t: _gauss(x, y, cells.site, cov))
+    assert np.abs(got - ref).max() < TOL * ref.sum()
+    assert got.sum() == pytest.approx(ref.sum(), rel=TOL)
+
+
 @pytest.mark.parametrize("mu_r", [300.0, 1500.0, 6000.0])
 def test_polar_mixture_near_the_site_keeps_min_range_and_no_negative_ranges(mu_r: float
                                                                              ) -> None:

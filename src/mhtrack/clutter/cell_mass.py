@@ -34,6 +34,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from mhtrack.clutter import cell_mass_rows
+
 #: Gauss–Legendre nodes per segment and axis.
 NODES = 2
 #: Half-width, in σ, of the box a Gaussian is integrated over (mass outside < 1e-3).
@@ -172,7 +174,8 @@ def _gauss_mass(cells: Cells, weights: np.ndarray, means: np.ndarray, cov: np.nd
     else:  # along (u) and across (v) the bearing of each mean
         d = means - np.asarray(cells.site)
         dist = np.hypot(d[:, 0], d[:, 1])
-        u = d / np.maximum(dist, 1e-9)[:, None]
+        u = np.divide(d, np.maximum(dist, 1e-9)[:, None], out=np.tile([0.0, 1.0], (n, 1)),
+                      where=(dist > 0)[:, None])  # at the site: any unit vector
         c00, c01, c11 = cov[:, 0, 0], cov[:, 0, 1], cov[:, 1, 1]
         uu = u[:, 0] * u[:, 0] * c00 + 2.0 * u[:, 0] * u[:, 1] * c01 + u[:, 1] * u[:, 1] * c11
         vv = c00 + c11 - uu  # the trace is invariant
@@ -187,10 +190,16 @@ def _gauss_mass(cells: Cells, weights: np.ndarray, means: np.ndarray, cov: np.nd
         r_step, t_step = ca, cb / np.maximum(np.where(away, dist, r_hi), 1e-9)
         r_extra = r_lo
     unit = np.repeat([cells.dr, cells.dtheta], n)
-    x, w, idx = _batch_segments(np.concatenate([r_lo, t_lo]) / unit,
-                                np.concatenate([r_hi, t_hi]) / unit,
-                                STEP_SIGMA * np.concatenate([r_step, t_step]) / unit,
-                                np.concatenate([r_extra, t_lo]) / unit)
+    lo, hi = np.concatenate([r_lo, t_lo]) / unit, np.concatenate([r_hi, t_hi]) / unit
+    step = STEP_SIGMA * np.concatenate([r_step, t_step]) / unit
+    extra = np.concatenate([r_extra, t_lo]) / unit
+    rows = cell_mass_rows.kernels()
+    if rows is not None:  # the same floats, compiled (cell_mass_rows)
+        x, w, idx, ok = rows["segments"](lo, hi, step, extra, unit, _X, _W, MAX_STEPS)
+        if ok:
+            _compiled_products(rows, cells, x, w, idx, weights, means, cov, det, out)
+            return
+    x, w, idx = _batch_segments(lo, hi, step, extra)
     x, w = x * unit[:, None], w * unit[:, None]
     rr, wr, ir, tt, wt, it = x[:n], w[:n], idx[:n], x[n:], w[n:], idx[n:]
     w_r = wr * rr
@@ -217,6 +226,29 @@ def _gauss_mass(cells: Cells, weights: np.ndarray, means: np.ndarray, cov: np.nd
                          + c[:, 0, 0] * dy * dy))
     val *= (weights / (TWO_PI * np.sqrt(det)))[comp] * w_r[jr, pr][a] * wt[jt, pt][b]
     flat = ir[jr, pr][a] * cells.n_azimuth + np.mod(it[jt, pt], cells.n_azimuth)[b]
+    out += np.bincount(flat, val, minlength=out.size)
+
+
+def _compiled_products(rows: dict, cells: Cells, x: np.ndarray, w: np.ndarray,
+                       idx: np.ndarray, weights: np.ndarray, means: np.ndarray,
+                       cov: np.ndarray, det: np.ndarray, out: np.ndarray) -> None:
+    """:func:`_gauss_mass`'s node products by the compiled loop, the exponential, sines and
+    cosines by NumPy (:mod:`mhtrack.clutter.cell_mass_rows`)."""
+    n = len(weights)
+    tt = x[n:]
+    if cells.polar is not None:
+        r0, rmin, cut = cells.polar
+        ta, tb = r0 * np.mod(tt - cut, TWO_PI), tt
+    else:
+        r0, rmin = 1.0, 0.0
+        ta, tb = np.sin(tt), np.cos(tt)
+    arg, coef, flat = rows["products"](
+        x[:n], w[:n], idx[:n], ta, tb, w[n:], idx[n:], cells.polar is not None, r0, rmin,
+        float(cells.site[0]), float(cells.site[1]), np.ascontiguousarray(weights, float),
+        np.ascontiguousarray(means, float), np.ascontiguousarray(cov, float), det,
+        cells.n_rings, cells.n_azimuth)
+    val = np.exp(arg)
+    val *= coef
     out += np.bincount(flat, val, minlength=out.size)
 
 
@@ -252,3 +284,16 @@ def mixture_mass(cells: Cells, weights: np.ndarray, means: np.ndarray, cov: np.n
         return out
     _gauss_mass(cells, weights, means, cov, out)
     return out
+
+
+def preload() -> bool:
+    """Load the compiled loops of the quadrature now (:func:`cell_mass_rows.load`) and
+    compile them on a small mixture, in the plane and in range and bearing, rather than in
+    the middle of a run; whether they are in use. The floats of later calls do not depend
+    on it."""
+    if not cell_mass_rows.load():
+        return False
+    one, mean, cov = np.ones(1), np.array([[1500.0, 1500.0]]), 1e6 * np.eye(2)[None]
+    for polar in (None, (1e4, 100.0, 0.0)):
+        mixture_mass(Cells((0.0, 0.0), 1000.0, 4, 8, polar), one, mean, cov)
+    return True

@@ -19,12 +19,13 @@ on disk (numba's ``cache=True``) beside this module when it is writable.
 
 from __future__ import annotations
 
-import os
 import types
 from collections.abc import Callable
 from typing import Any
 
 import numpy as np
+
+from mhtrack.compiled import jit, numba_module
 
 #: Rows (leaves, or gated pairs) from which the compiled loops are used.
 MIN_ROWS = 4096
@@ -41,33 +42,24 @@ def kernels(n_rows: int) -> dict[str, Callable[..., Any]] | None:
         return None
     if not _TRIED:
         _TRIED = True
-        if os.environ.get("MHTRACK_COMPILED", "1") != "0":
-            _KERNELS = _compile()
+        _KERNELS = _compile()
     return _KERNELS
 
 
 def _compile() -> dict[str, Callable[..., Any]] | None:
-    """numba's ``njit`` of the loops below (``None`` when numba is absent)."""
-    try:
-        import numba
-    except ImportError:
+    """numba's ``njit`` of the loops below (``None``: numba absent or turned off,
+    :func:`mhtrack.compiled.numba_module`)."""
+    numba = numba_module()
+    if numba is None:
         return None
-    combine = _jit(numba, _combine_row)
+    combine = jit(numba, _combine_row)
     out = {}
     for name, fn in (("predict", predict_rows), ("update", update_rows),
                      ("grow", grow_rows)):
         # the loop's own copy, whose global ``_combine_row`` is the compiled one
         glob = {**fn.__globals__, "_combine_row": combine}
-        out[name] = _jit(numba, types.FunctionType(fn.__code__, glob, fn.__name__))
+        out[name] = jit(numba, types.FunctionType(fn.__code__, glob, fn.__name__))
     return out
-
-
-def _jit(numba: Any, fn: Callable[..., Any]) -> Callable[..., Any]:
-    """``numba.njit`` with the on-disk cache, or without where it cannot be written."""
-    try:
-        return numba.njit(cache=True, nogil=True)(fn)
-    except RuntimeError:  # numba: "cannot cache function …: no locator available"
-        return numba.njit(nogil=True)(fn)
 
 
 def predict_rows(xm: np.ndarray, Pm: np.ndarray, mu: np.ndarray, mubar: np.ndarray,

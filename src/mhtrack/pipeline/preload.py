@@ -23,13 +23,16 @@ LAZY_MODULES = ("scipy.optimize", "scipy.sparse", "scipy.sparse.csgraph",
 
 
 def preload() -> tuple[int, bool]:
-    """Import :data:`LAZY_MODULES` and load the compiled IMM rows
-    (:func:`mhtrack.models.imm_preload.preload`); the number of modules this added and
+    """Import :data:`LAZY_MODULES`, load the compiled IMM rows
+    (:func:`mhtrack.models.imm_preload.preload`) and the clutter map's compiled quadrature
+    (:func:`mhtrack.clutter.cell_mass.preload`); the number of modules this added and
     whether the compiled rows are in use."""
+    from mhtrack.clutter.cell_mass import preload as quadrature
     from mhtrack.models.imm_preload import preload as compiled
 
     before = len(sys.modules)
     for name in LAZY_MODULES:
         importlib.import_module(name)
     used = compiled()
+    quadrature()
     return len(sys.modules) - before, used

@@ -151,9 +151,9 @@ def main() -> int:
             continue
         print(f"cell-mass quadrature: {path} path")
         scan_path(a.seeds)
-    if not a.skip_timed:
-        timed_path(a.figure)
-        timed_path(None, "storm")
+        if not a.skip_timed:
+            timed_path(a.figure)
+            timed_path(None, "storm")
     return 0
 
 

@@ -2,8 +2,9 @@
 fresh interpreter, after :func:`preload` the lazily imported modules are there, and the
 compiled IMM rows (numba, when installed) are compiled for the signatures the tracker
 uses — tracker-sized predict, update and children_states calls afterwards with another
-model set compile nothing more, and the prediction gives the NumPy path's floats; with
-``MHTRACK_COMPILED=0`` nothing is compiled."""
+model set compile nothing more, and the prediction gives the NumPy path's floats; so is
+the clutter map's quadrature (``mapgmm`` on a scan path and on rotating radars compiles
+nothing more); with ``MHTRACK_COMPILED=0`` nothing is compiled."""
 
 from __future__ import annotations
 
@@ -60,6 +61,24 @@ if used:
     ref = model.predict(s, dt)
     for f in ("x", "P", "xm", "Pm", "mu"):
         assert np.array_equal(getattr(got, f), getattr(ref, f)), f
+from mhtrack.clutter import cell_mass_rows
+assert (cell_mass_rows._PATH["kernels"] is not None) == used
+if used:  # the clutter map's quadrature: a scan path and rotating radars (polar bases)
+    from mhtrack.build import make_clutter_estimator, make_tracker
+    from mhtrack.experiments.pipeline import scenario_source
+    from mhtrack.scenario import preset, simulate
+    q = cell_mass_rows._COMPILED
+    before = {{n: len(f.signatures) for n, f in q.items()}}
+    assert all(v >= 1 for v in before.values()), before
+    est = make_clutter_estimator("mapgmm")
+    for scan in simulate(preset("crossing-changing", scans=4), seed=1).plots.scans():
+        est.update(scan, None)
+    sc = preset("radars-clutter", scans=20)  # 41 frames, 5 quadratures
+    src = scenario_source(sc, simulate(sc, seed=1).plots)
+    clutter = make_tracker("mht-mapgmm", sensors=src.sensors).clutter
+    for frame in scenario_source(sc, simulate(sc, seed=1).plots):
+        clutter.update(frame, None)
+    assert {{n: len(f.signatures) for n, f in q.items()}} == before, "quadrature compiled again"
 print("ok", added, used)
 """
 

@@ -28,9 +28,11 @@ def numba_module() -> Any | None:
 
 
 def jit(numba: Any, fn: Callable[..., Any]) -> Callable[..., Any]:
-    """``numba.njit`` with the on-disk cache (beside the module when it is writable), or
-    without where it cannot be written."""
+    """``numba.njit`` with NumPy's error model (a division by zero gives ``inf`` or
+    ``nan``, as NumPy's does, instead of raising ``ZeroDivisionError``) and the on-disk
+    cache (beside the module when it is writable), or without the cache where it cannot be
+    written."""
     try:
-        return numba.njit(cache=True, nogil=True)(fn)
+        return numba.njit(cache=True, nogil=True, error_model="numpy")(fn)
     except RuntimeError:  # numba: "cannot cache function …: no locator available"
-        return numba.njit(nogil=True)(fn)
+        return numba.njit(nogil=True, error_model="numpy")(fn)

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import subprocess
 import sys
+import warnings
 
 import numpy as np
 import pytest
@@ -132,3 +133,48 @@ def test_a_short_run_does_not_import_numba() -> None:
             "    est.update(s, None); est.intensity(s.z)\n"
             "assert 'numba' not in sys.modules, 'numba imported'\n")
     subprocess.run([sys.executable, "-c", code], check=True)
+
+
+def _quiet_both(cells: cell_mass.Cells, mix: tuple, kernels: dict) -> tuple:
+    """:func:`_both` with NumPy's warnings silenced; an exception is returned as its type."""
+    out = []
+    for k in (None, kernels):
+        with pytest.MonkeyPatch.context() as mp, np.errstate(all="ignore"), \
+                warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            _path(mp, k)
+            try:
+                out.append(cell_mass.mixture_mass(cells, *mix))
+            except Exception as exc:  # compared between the paths
+                out.append(type(exc))
+    return tuple(out)
+
+
+@pytest.mark.parametrize("kind", ["plain", "compiled"])
+def test_singular_covariance_as_numpy(kind: str) -> None:
+    """A covariance of determinant exactly 0 (a line): NaNs in the plane, zeros in range
+    and bearing, NumPy's own error for a mean far outside — the loops give the same, not
+    a ``ZeroDivisionError`` (the compiled loops use NumPy's error model)."""
+    kernels = PLAIN if kind == "plain" else _compiled()
+    line = np.array([[[1e6, 1e6], [1e6, 1e6]]])
+    cases = [(cell_mass.Cells((0.0, 0.0), 1000.0, 5, 8), [[1500.0, 2000.0]]),
+             (cell_mass.Cells((0.0, 0.0), 1000.0, 5, 8, (5000.0, 100.0, 0.0)),
+              [[1500.0, 2000.0]]),
+             (cell_mass.Cells((0.0, 0.0), 1000.0, 5, 8, (5000.0, 100.0, 0.0)), [[1e7, 1e7]])]
+    for cells, mean in cases:
+        ref, got = _quiet_both(cells, (np.ones(1), np.array(mean), line), kernels)
+        if isinstance(ref, type):
+            assert got is ref
+        else:
+            assert isinstance(got, np.ndarray) and np.array_equal(got, ref, equal_nan=True)
+
+
+def test_float32_mixture_is_read_as_float64() -> None:
+    """A float32 mixture gives the float64 mixture's masses on both paths."""
+    cells, (w, means, cov) = _mixture(11, 4, False)
+    ref = _both(cells, (w, means, cov), PLAIN)[0]
+    f32 = tuple(a.astype(np.float32).astype(float) for a in (w, means, cov))
+    ref32 = _both(cells, f32, PLAIN)[0]
+    for got in _both(cells, tuple(a.astype(np.float32) for a in (w, means, cov)), PLAIN):
+        assert np.array_equal(got, ref32)
+    assert np.allclose(ref32, ref, rtol=1e-5, atol=1e-12)

@@ -244,8 +244,7 @@ def _compiled_products(rows: dict, cells: Cells, x: np.ndarray, w: np.ndarray,
         ta, tb = np.sin(tt), np.cos(tt)
     arg, coef, flat = rows["products"](
         x[:n], w[:n], idx[:n], ta, tb, w[n:], idx[n:], cells.polar is not None, r0, rmin,
-        float(cells.site[0]), float(cells.site[1]), np.ascontiguousarray(weights, float),
-        np.ascontiguousarray(means, float), np.ascontiguousarray(cov, float), det,
+        float(cells.site[0]), float(cells.site[1]), weights, means, cov, det,
         cells.n_rings, cells.n_azimuth)
     val = np.exp(arg)
     val *= coef
@@ -282,7 +281,8 @@ def mixture_mass(cells: Cells, weights: np.ndarray, means: np.ndarray, cov: np.n
     out = np.zeros(cells.n_rings * cells.n_azimuth)
     if not len(weights):
         return out
-    _gauss_mass(cells, weights, means, cov, out)
+    weights, means, cov = (np.ascontiguousarray(a, float) for a in (weights, means, cov))
+    _gauss_mass(cells, weights, means.reshape(-1, 2), cov.reshape(-1, 2, 2), out)
     return out
 
 

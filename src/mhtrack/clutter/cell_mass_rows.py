@@ -45,7 +45,9 @@ def kernels() -> dict[str, Callable[..., Any]] | None:
 
 
 def load() -> bool:
-    """Compile (or load from numba's cache) the loops now; whether they are in use."""
+    """Make numba's functions of the loops now (each compiles, or loads from numba's cache,
+    at its first call: :func:`mhtrack.clutter.cell_mass.preload` makes those calls);
+    whether they are in use."""
     if not _PATH["decided"]:
         _PATH["decided"] = True
         numba = numba_module()

@@ -115,7 +115,8 @@ def test_own_tracks_as_cat062_reference_score_as_themselves(
     themselves: every reference state matched, none false, no identity switch, one
     reference target per track, and positions within the I062/105 LSB (180/2²⁵°)."""
     from mhtrack.io import read_tracks
-    from mhtrack.io.asterix.cat062 import export_tracks, lsb062
+    from mhtrack.io.asterix.cat062 import lsb062
+    from mhtrack.io.asterix.cat062_export import export_tracks
     from mhtrack.io.reference import read_reference
 
     csv, ast = tmp_path / "tracks.csv", tmp_path / "ref.ast"

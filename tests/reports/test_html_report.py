@@ -205,7 +205,11 @@ def test_study_paired_from_a_json_file(study_dir, tmp_path, monkeypatch):
     page = report_page(d).render()
     assert "Paired comparisons</h2>" in page and "Source: results.json." in page
     assert ("<td>ospa_mean ↓</td><td>mht-agmm</td><td>mht-gmm</td><td class=\"num\">3</td>"
-            "<td class=\"num\">-4</td><td>[-7.5, -0.5]</td><td>better</td>") in page
+            "<td class=\"num\">-4.0</td><td>[-7.5, -0.5]</td><td>better</td>") in page
+    # the text reports' format (metrics.paired.difference_texts): ospa_mean with 1
+    # decimal, rcc with 4 (montecarlo.PAIRED_METRICS); no interval: a dash
+    assert ("<td class=\"num\">+0.0100</td><td>–</td>"
+            "<td>no detectable difference</td>") in page
     assert "<li>mht-agmm is better than mht-gmm</li>" in page
 
 

@@ -8,7 +8,7 @@ import pytest
 pytest.importorskip("asterix")
 
 from mhtrack.io import write_plots
-from mhtrack.io.asterix.cat062 import export_tracks
+from mhtrack.io.asterix.cat062_export import export_tracks
 from mhtrack.io.sensors import write_sensors
 from mhtrack.pipeline import Pipeline, TrackOptions
 from mhtrack.scenario import preset, simulate

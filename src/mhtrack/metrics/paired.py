@@ -98,6 +98,26 @@ def verdict_of(ci_low: float, ci_high: float, higher_better: bool) -> str:
     return NO_DIFFERENCE
 
 
+def interval_decimals(ci_low: float, ci_high: float, digits: int) -> int:
+    """Decimals to print a difference's mean and interval with: ``digits``, or, when the
+    interval excludes 0 (a ``better``/``worse`` verdict, :func:`verdict_of`), enough for
+    the bound nearer 0 to show its first significant digit, ``−⌊log10 min(|lo|,
+    |hi|)⌋`` (a value in ``[10^−k, 10^(1−k))`` rounds to at least ``10^−k`` at ``k``
+    decimals): the printed bounds then show the side of 0 the verdict reads, never
+    ``[-0.00, +0.00]`` beside ``worse``."""
+    if not (math.isfinite(ci_low) and math.isfinite(ci_high)) or ci_low <= 0 <= ci_high:
+        return digits
+    return max(digits, -math.floor(math.log10(min(abs(ci_low), abs(ci_high)))))
+
+
+def difference_texts(mean_diff: float, ci_low: float, ci_high: float,
+                     digits: int = 3) -> tuple[str, str, str]:
+    """The mean difference and its interval's bounds as every report prints them:
+    signed, :func:`interval_decimals` decimals (``–`` for NaN)."""
+    d = interval_decimals(ci_low, ci_high, digits)
+    return _fmt(mean_diff, d), _fmt(ci_low, d), _fmt(ci_high, d)
+
+
 def _fmt(v: float, digits: int) -> str:
     if not math.isfinite(v):
         return "–"
@@ -124,10 +144,11 @@ def verdict_sentence(c: PairedComparison, digits: int = 3, unit: str = "",
                 f"identical in all {c.n} runs.")
     head = (f"{c.a} is {c.verdict} than {c.b}" if c.verdict != NO_DIFFERENCE
             else f"{NO_DIFFERENCE} at n = {c.n}")
-    ci = (f"95 % CI [{_fmt(c.ci_low, digits)}, {_fmt(c.ci_high, digits)}]{unit}"
-          if math.isfinite(c.ci_low) else "no interval from one run")
+    mean, lo, hi = difference_texts(c.mean_diff, c.ci_low, c.ci_high, digits)
+    ci = (f"95 % CI [{lo}, {hi}]{unit}" if math.isfinite(c.ci_low)
+          else "no interval from one run")
     return (f"{c.a} vs {c.b}, {what} ({side}): {head} — mean difference "
-            f"{_fmt(c.mean_diff, digits)}{unit}, {ci}, n = {c.n} paired runs, "
+            f"{mean}{unit}, {ci}, n = {c.n} paired runs, "
             f"{c.n_identical} identical; {c.a} better in {c.n_a_better}, worse in "
             f"{c.n_b_better}; sign test p {_p(c.sign_p)}, Wilcoxon p {_p(c.wilcoxon_p)}"
             + (f" (the Wilcoxon test does not confirm it at the {1 - CONFIDENCE:.2f} level: "
@@ -203,6 +224,8 @@ __all__ = [
     "WORSE",
     "PairedComparison",
     "compare_paired",
+    "difference_texts",
+    "interval_decimals",
     "paired_by_run",
     "t_interval",
     "verdict_of",

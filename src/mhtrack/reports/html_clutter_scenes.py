@@ -67,7 +67,7 @@ def clutter_scenes_page(study: ClutterScenesStudy) -> Page:
         rows = _rows(cs)
         if rows:
             page.figure(paired_figure(rows), f"paired-{scene.replace(' ', '-')}")
-            page.table(*paired_table(rows))
+            page.table(*paired_table(rows, {lab: d for lab, _, d in METRICS.values()}))
         page.sentences(pair_summary(cs))
         page.sentences([c.sentence for c in cs])
         if scene in means:

@@ -264,6 +264,7 @@ def study_page(directory: Path) -> Page:
     """The page of a Monte-Carlo directory (module docstring)."""
     from mhtrack.experiments.montecarlo import load_results
     from mhtrack.reports.html_study import paired_figure, paired_rows, paired_table, tracker_table
+    from mhtrack.reports.montecarlo import PAIRED_METRICS
 
     result = load_results(directory)
     spec = result.spec
@@ -284,7 +285,7 @@ def study_page(directory: Path) -> Page:
                   f"its mean and 95 % t interval; the verdict is read from the interval "
                   f"(↑ higher is better, ↓ lower). Source: {source}.")
         page.figure(paired_figure(pairs), "paired")
-        page.table(*paired_table(pairs))
+        page.table(*paired_table(pairs, {k: d for k, (_, d) in PAIRED_METRICS.items()}))
         page.sentences([str(p["sentence"]) for p in pairs if p.get("sentence")])
     page.section("Metrics per tracker")
     page.note("Mean ± population std over the successful runs."

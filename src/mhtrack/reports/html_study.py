@@ -97,16 +97,26 @@ def paired_rows(result: MonteCarloResult | None, directory: Path
     return paired_from_json(directory)
 
 
-def paired_table(rows: Sequence[Mapping[str, Any]]) -> tuple[list[str], list[list[str]]]:
+def paired_table(rows: Sequence[Mapping[str, Any]], digits: Mapping[str, int] | None = None
+                 ) -> tuple[list[str], list[list[str]]]:
     """Header and rows of the paired comparisons: metric, A, B, n, mean A − B, 95 % CI,
-    verdict."""
+    verdict; the difference and its bounds as the text reports print them
+    (:func:`~mhtrack.metrics.paired.difference_texts`, ``digits`` decimals per metric,
+    default 3)."""
+    from mhtrack.metrics.paired import difference_texts
+
+    def num(v: Any) -> float:
+        return math.nan if v is None else float(v)
+
     out = []
     for r in rows:
-        ci = (f"[{fmt(r['ci_low'])}, {fmt(r['ci_high'])}]"
-              if r["ci_low"] is not None and r["ci_high"] is not None else "–")
+        mean, lo, hi = difference_texts(num(r["mean_diff"]), num(r["ci_low"]),
+                                        num(r["ci_high"]), (digits or {}).get(r["metric"], 3))
+        ci = (f"[{lo}, {hi}]" if r["ci_low"] is not None and r["ci_high"] is not None
+              else "–")
         arrow = {True: " ↑", False: " ↓"}.get(r.get("higher_better"), "")
         out.append([f"{r['metric']}{arrow}", str(r["a"]), str(r["b"]), str(r["n"]),
-                    fmt(r["mean_diff"]), ci, str(r.get("verdict", ""))])
+                    mean, ci, str(r.get("verdict", ""))])
     return ["metric", "A", "B", "runs", "mean A − B", "95 % CI", "verdict"], out
 
 

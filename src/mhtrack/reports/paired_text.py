@@ -7,13 +7,13 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 
-from mhtrack.metrics.paired import NO_DIFFERENCE, PairedComparison
+from mhtrack.metrics.paired import NO_DIFFERENCE, PairedComparison, difference_texts
 
 
-def _f(v: float, digits: int, sign: bool = False) -> str:
+def _f(v: float, digits: int) -> str:
     if not math.isfinite(v):
         return "–"
-    return f"{v:+.{digits}f}" if sign else f"{v:.{digits}f}"
+    return f"{v:.{digits}f}"
 
 
 def _p(v: float) -> str:
@@ -26,7 +26,9 @@ def paired_table(comparisons: Sequence[PairedComparison], digits: dict[str, int]
                  labels: dict[str, str] | None = None) -> str:
     """A Markdown table: A, B, metric, mean A, mean B, mean difference A − B with its 95 %
     interval, runs (identical), A better / worse, sign and Wilcoxon p, verdict.
-    ``digits``/``labels``: decimals and headings per metric key (default 3 / the key)."""
+    ``digits``/``labels``: decimals and headings per metric key (default 3 / the key);
+    the difference and its interval with more decimals where the interval excludes 0
+    (:func:`~mhtrack.metrics.paired.difference_texts`, as the verdict sentences)."""
     digits = digits or {}
     labels = labels or {}
     lines = ["| A | B | metric | mean A | mean B | A − B (95 % CI) | runs (identical) | "
@@ -36,8 +38,8 @@ def paired_table(comparisons: Sequence[PairedComparison], digits: dict[str, int]
         d = digits.get(c.metric, 3)
         side = "↑" if c.higher_better else "↓"
         verdict = f"{c.verdict} at n = {c.n}" if c.verdict == NO_DIFFERENCE else c.verdict
-        ci = (f"{_f(c.mean_diff, d, True)} [{_f(c.ci_low, d, True)}, {_f(c.ci_high, d, True)}]"
-              if math.isfinite(c.ci_low) else _f(c.mean_diff, d, True))
+        mean, lo, hi = difference_texts(c.mean_diff, c.ci_low, c.ci_high, d)
+        ci = f"{mean} [{lo}, {hi}]" if math.isfinite(c.ci_low) else mean
         lines.append(
             f"| {c.a} | {c.b} | {labels.get(c.metric, c.metric)} {side} | "
             f"{_f(c.mean_a, d)} | {_f(c.mean_b, d)} | {ci} | {c.n} ({c.n_identical}) | "

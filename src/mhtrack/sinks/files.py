@@ -155,12 +155,12 @@ class TracksFileSink(_Rows):
 def cat062_blocks(tracks: TrackTable, frame: LocalFrame, name: str, *,
                   sac: int | None = None, sic: int | None = None
                   ) -> Iterator[tuple[float, int, bytes]]:
-    """``(time, data source, CAT062 data block)`` of tracker rows ``tracks``: the one
+    """``(time, data source, CAT062 data block)`` of tracker rows ``tracks``: the
     encoding path of every CAT062 sink — the octets libasterix writes of
     :func:`~mhtrack.io.asterix.cat062.table_messages`
     (:func:`~mhtrack.io.asterix.encode.encode_blocks`, at most 40 records a block),
-    encoded with NumPy for rows without attributes
-    (:func:`~mhtrack.io.asterix.cat062_fast.blocks062`)."""
+    encoded with NumPy (:func:`~mhtrack.io.asterix.cat062_fast.blocks062`, through
+    ``row_blocks``, which ``export --category 062`` uses too)."""
     from mhtrack.io.asterix.cat062_fast import blocks062
 
     return blocks062(tracks, frame, name, sac=sac, sic=sic)

@@ -8,7 +8,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from mhtrack.io.asterix.cat062 import export_tracks, lsb062, read_system_tracks
+from mhtrack.io.asterix.cat062 import lsb062, read_system_tracks
+from mhtrack.io.asterix.cat062_export import export_tracks
 from mhtrack.io.sensors import read_sensors
 
 

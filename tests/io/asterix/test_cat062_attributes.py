@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from mhtrack.attributes import TrackAttributes, address_text, code_text
-from mhtrack.io.asterix.cat062 import export_tracks
+from mhtrack.io.asterix.cat062_export import export_tracks
 from mhtrack.io.asterix.cat062_items import cartesian
 from mhtrack.io.tracks import read_tracks, write_tracks
 from mhtrack.models.geodesy import LocalFrame

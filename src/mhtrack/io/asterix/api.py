@@ -223,9 +223,10 @@ def export_file(path: str | Path, sensors: SensorSet | None, out: str | Path, *,
     """``mhtrack export`` (:data:`~mhtrack.names.EXPORT_CATEGORIES`, the first the
     default): timed plots as CAT048 target reports with CAT034 sweeps (:func:`export`;
     needs ``sensors``), or with ``category "062"`` a tracks file as CAT062 system tracks
-    from data source ``sac``/``sic`` (:func:`~mhtrack.io.asterix.cat062.export_tracks`).
-    ``progress``: a bar of the rows encoded."""
-    from mhtrack.io.asterix.cat062 import export_tracks
+    from data source ``sac``/``sic``
+    (:func:`~mhtrack.io.asterix.cat062_export.export_tracks`). ``progress``: a bar of
+    the rows encoded."""
+    from mhtrack.io.asterix.cat062_export import export_tracks
 
     category = EXPORT_CATEGORIES[0] if category is None else category
     if category not in EXPORT_CATEGORIES:

@@ -22,25 +22,17 @@ import numpy as np
 
 import mhtrack.io.asterix._lib as _lib
 from mhtrack.errors import InputError
-from mhtrack.io._frame import FLOAT, INT, TIME, read_frame
-from mhtrack.io._times import seconds
 from mhtrack.io.asterix.cat062_items import attribute_items
 from mhtrack.io.asterix.category_file import category_rows
-from mhtrack.io.asterix.encode import Message, encode_blocks, raw_tod
+from mhtrack.io.asterix.encode import Message, raw_tod
 from mhtrack.io.asterix.problems import Problems
 from mhtrack.io.asterix.timeaxis import DAY_S, unwrap_days
-from mhtrack.io.asterix.writer import write_blocks
-from mhtrack.io.track_attributes import KINDS, read_track_attributes
-from mhtrack.models.radars import SensorSet
-from mhtrack.progress import Count
 from mhtrack.records import TrackTable
 
 if TYPE_CHECKING:
     from mhtrack.attributes import TrackAttributes
     from mhtrack.models.geodesy import LocalFrame
 
-_TRACKS = {"time": TIME, "track_id": INT, "lat": FLOAT, "lon": FLOAT, "x": FLOAT,
-           "y": FLOAT, "vx": FLOAT, "vy": FLOAT, "plot": INT, "tentative": INT} | KINDS
 #: Columns of :func:`read_system_tracks`.
 TRACK_COLUMNS = ("time", "sac", "sic", "track_number", "lat", "lon", "vx", "vy",
                  "tentative", "coasting")
@@ -72,50 +64,14 @@ DEFAULT_SIC = 1
 Check = Callable[[np.ndarray, str, Callable[[int], str]], None]
 
 
-def export_tracks(tracks: str | Path, sensors: SensorSet | None, out: str | Path, *,
-                  sac: int | None = None, sic: int | None = None,
-                  progress: bool = False) -> tuple[int, int]:
-    """Encode a tracks file as CAT062 system tracks from data source ``sac``/``sic``
-    (default :data:`DEFAULT_SAC`/:data:`DEFAULT_SIC`); positions from ``lat, lon`` (else
-    ``x, y`` through the sensors file's frame), velocities east/north. Returns
-    ``(track rows, data blocks)``. ``progress``: a bar of the rows encoded."""
-    _lib.modules()
-    f = read_frame(tracks, _TRACKS, ("time", "track_id"), "tracks")
-    if f.n == 0:
-        f.fail("no rows (nothing to export)")
-    time = seconds(f)
-    tn = f.ints("track_id")
-    if f.has("lat") and f.has("lon"):
-        lat, lon = f.floats("lat"), f.floats("lon")
-        ve = f.floats("vx") if f.has("vx") else np.zeros(f.n)
-        vn = f.floats("vy") if f.has("vy") else np.zeros(f.n)
-    else:
-        if sensors is None or sensors.reference is None:
-            f.fail("no lat/lon columns: give the sensors file whose frame the x, y are in")
-        frame = sensors.frame()  # type: ignore[union-attr]
-        x, y = f.floats("x"), f.floats("y")
-        lat, lon = frame.to_geodetic(x, y)
-        vx = f.floats("vx") if f.has("vx") else np.zeros(f.n)
-        vy = f.floats("vy") if f.has("vy") else np.zeros(f.n)
-        ve, vn = frame.velocity_to_geodetic(x, y, vx, vy)
-    coasting = (f.ints("plot", nullable=True) < 0).astype(int) if f.has("plot") \
-        else np.zeros(f.n, int)
-    tentative = (f.ints("tentative", nullable=True, fill=0) != 0).astype(int) \
-        if f.has("tentative") else np.zeros(f.n, int)
-    messages = track_messages(time, tn, lat, lon, ve, vn, coasting, tentative, f.check,
-                              sac=sac, sic=sic, attrs=read_track_attributes(f))
-    with Count(f.n, "export", "row", progress) as bar:
-        n = write_blocks(out, encode_blocks(messages, bar))
-    return f.n, n
-
-
 def table_messages(tracks: TrackTable, frame: LocalFrame, name: str, *,
                    sac: int | None = None, sic: int | None = None) -> list[Message]:
     """The CAT062 messages of tracker output ``tracks`` (local ``x, y, vx, vy`` turned
     into WGS-84 and east/north by ``frame``, as a tracks file's ``lat, lon, vx, vy``;
-    a miss is coasting, a ``tentative`` row tentative) — the same messages
-    :func:`export_tracks` makes of the tracks file written from ``tracks``. Problems
-    raise :class:`ValueError` naming ``name``, the track and its time."""
+    a miss is coasting, a ``tentative`` row tentative) — the same messages as of the
+    tracks file written from ``tracks``
+    (:func:`~mhtrack.io.asterix.cat062_export.export_tracks`). Problems raise
+    :class:`ValueError` naming ``name``, the track and its time."""
     return track_messages(*table_values(tracks, frame, name), sac=sac, sic=sic,
                           attrs=tracks.attrs)
 

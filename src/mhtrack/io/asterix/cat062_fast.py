@@ -1,7 +1,9 @@
-"""CAT062 data blocks of track rows without attributes, encoded with NumPy: the octets
-libasterix writes for the messages of :func:`~mhtrack.io.asterix.cat062.track_messages`
+"""CAT062 data blocks of track rows, encoded with NumPy: the octets libasterix writes
+for the messages of :func:`~mhtrack.io.asterix.cat062.track_messages`
 (``encode_blocks``), without building a Python object per item — a live run sends every
-frame's rows, and libasterix's per-record objects cost more CPU than the tracking.
+frame's rows, and libasterix's per-record objects cost more CPU than the tracking (and
+``export --category 062`` of a tracks file ~15× the time). :func:`row_blocks` is the
+one path of every CAT062 writer: the sinks (:func:`blocks062`) and the export.
 
 A record (EUROCONTROL ASTERIX CAT062 edition 1.18, user application profile) holds, in
 FRN order, I062/010 (SAC, SIC), 070 (time of day, 1/128 s, 3 octets), 105 (latitude,
@@ -19,14 +21,16 @@ where that module does not cover them (codes beyond 12 bits, …: its docstring)
 from __future__ import annotations
 
 from collections.abc import Iterator
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from mhtrack.io.asterix.encode import MAX_RECORDS
 
 if TYPE_CHECKING:
+    from mhtrack.attributes import TrackAttributes
     from mhtrack.models.geodesy import LocalFrame
+    from mhtrack.progress import Count
     from mhtrack.records import TrackTable
 
 #: The FSPEC of a record with items 010, 070, 105, 185 | 040, 080.
@@ -60,35 +64,50 @@ def blocks062(tracks: TrackTable, frame: LocalFrame, name: str, *,
               sac: int | None = None, sic: int | None = None
               ) -> Iterator[tuple[float, int, bytes]]:
     """``(time, data source, CAT062 data block)`` of tracker rows ``tracks``: the
-    blocks of :func:`~mhtrack.sinks.files.cat062_blocks`, octet for octet, encoded with
-    NumPy: rows without attributes here (module docstring), rows with attributes by
-    :mod:`.cat062_attr_octets`; by libasterix when that module does not cover the
-    attributes (its ``covered``). Values that do not fit are refused as
-    :func:`~mhtrack.io.asterix.cat062.track_messages` refuses them (the same checks)."""
-    from mhtrack.io.asterix.cat062 import core_raw, table_messages, table_values
+    blocks of :func:`~mhtrack.sinks.files.cat062_blocks`, octet for octet — those of
+    :func:`row_blocks` of the rows' :func:`~mhtrack.io.asterix.cat062.table_values`."""
+    from mhtrack.io.asterix.cat062 import table_values
+
+    return row_blocks(table_values(tracks, frame, name), tracks.attrs, sac=sac, sic=sic)
+
+
+def row_blocks(values: tuple[Any, ...], attrs: TrackAttributes | None, *,
+               sac: int | None = None, sic: int | None = None, bar: Count | None = None
+               ) -> Iterator[tuple[float, int, bytes]]:
+    """``(time, data source, CAT062 data block)`` of rows ``values`` (the arguments of
+    :func:`~mhtrack.io.asterix.cat062.track_messages` up to ``check``) with attributes
+    ``attrs``: the one place that decides how rows become CAT062 (the sinks'
+    :func:`blocks062`, ``export --category 062``). The octets libasterix writes of
+    ``encode_blocks(track_messages(...))``, encoded with NumPy: rows without attributes
+    here (module docstring), rows with attributes by :mod:`.cat062_attr_octets`; by
+    libasterix when that module does not cover the attributes (its ``covered``). Values
+    that do not fit are refused as ``track_messages`` refuses them (the same checks).
+    ``bar`` counts the rows encoded."""
+    from mhtrack.io.asterix.cat062 import core_raw, track_messages
     from mhtrack.io.asterix.cat062_attr_octets import covered, record_segments
     from mhtrack.io.asterix.cat062_items import attribute_raw
     from mhtrack.io.asterix.encode import encode_blocks
     from mhtrack.io.asterix.octets import assemble
 
-    values = table_values(tracks, frame, name)
     time, coasting, tentative, check = values[0], values[6], values[7], values[8]
     raw = core_raw(*values, sac=sac, sic=sic)
     order = np.argsort(time, kind="stable")
     sid = int(raw["sid"])
-    if tracks.attrs is None:
+    if attrs is None:
         recs = records062(raw, tentative, coasting)[order]
         data, sizes = recs.reshape(-1), np.full(len(order), RECORD)
     else:
-        attrs = attribute_raw(tracks.attrs, check)
-        if not covered(tracks.attrs, attrs):
-            yield from encode_blocks(table_messages(tracks, frame, name, sac=sac, sic=sic))
+        v = attribute_raw(attrs, check)
+        if not covered(attrs, v):
+            yield from encode_blocks(track_messages(*values, sac=sac, sic=sic,
+                                                    attrs=attrs), bar)
             return
-        data, sizes = assemble(record_segments(raw, tentative, coasting, tracks.attrs,
-                                               attrs), order)
+        data, sizes = assemble(record_segments(raw, tentative, coasting, attrs, v), order)
     ends = np.concatenate([[0], np.cumsum(sizes)])
     for i in range(0, len(order), MAX_RECORDS):
         j = min(i + MAX_RECORDS, len(order))
         size = 3 + int(ends[j] - ends[i])
+        if bar is not None:
+            bar.update(j - i)
         yield (float(time[order[i]]), sid,
                bytes((62, size >> 8, size & 0xFF)) + data[ends[i]:ends[j]].tobytes())

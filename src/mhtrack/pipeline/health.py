@@ -112,8 +112,8 @@ class Health(Sink):
     *after* the output sinks, so its ``write`` comes once the frame has gone out.
 
     ``counts()`` → the running totals ``datagrams, queue_drops, kernel_drops, plots,
-    duplicates, late_drops`` (``kernel_drops`` ``None`` where not counted; callables of
-    the reader and source); ``tracks()`` → confirmed tracks
+    duplicates, late_drops, late_crossings`` (``kernel_drops`` ``None`` where not
+    counted; callables of the reader and source); ``tracks()`` → confirmed tracks
     after a frame (called in :meth:`write`, the stepping thread); ``plot_numbers(out)``
     → the frame's plots' decoding-order numbers; ``periods``
     — each radar's rotation period (s); ``clock`` → now (s, the receive times' clock)."""
@@ -239,8 +239,10 @@ class Health(Sink):
         silent = s["radars_silent"]
         kernel = s.get("kernel_drops")  # None: not counted (SO_RXQ_OVFL is Linux's)
         kernel = "kernel drops n/a" if kernel is None else f"{kernel} kernel drops"
+        crossings = s.get("late_crossings")  # sector frames: sweep marks too late
+        late_crossings = f"{crossings} late crossings, " if crossings else ""
         return (f"live: {rates}{d} datagrams, {p} plots, {s['duplicates']} duplicates, "
-                f"{s['late_drops']} late drops, {s['queue_drops']} queue drops, "
+                f"{s['late_drops']} late drops, {late_crossings}{s['queue_drops']} queue drops, "
                 f"{kernel}, "
                 f"{s['frames']} frames, {s['tracks']} tracks, {len(silent)} radars silent"
                 f"{' (' + ', '.join(map(str, silent)) + ')' if silent else ''}{lat}")

@@ -52,7 +52,7 @@ from mhtrack.models.radars import SensorSet
 from mhtrack.records import Scan
 from mhtrack.sources.base import CAUGHT_UP, IDLE, Source, SourceStats, Survey
 from mhtrack.sources.gather import Gathered
-from mhtrack.sources.marks import with_marks
+from mhtrack.sources.marks import row_place, with_marks
 from mhtrack.sources.positions import local_positions
 from mhtrack.sources.timed import TimedStream
 
@@ -279,7 +279,7 @@ class DatagramSource(Source):
         self._skipped = {}
         self._stream = stream = TimedStream(
             self.name, self.stats, self._frame_lengths(), self.window_s,
-            lambda first: f"byte {first['offset']} (plot {first['file_row']})",
+            row_place,
             first_frame=self.first_frame, first_row=self.first_row,
             not_before=self.not_before, keep_rows=self.keep_rows, release=self.release)
         if self.restore is not None:

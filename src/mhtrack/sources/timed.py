@@ -80,10 +80,11 @@ class TimedStream:
     def finish(self) -> Iterator[Scan]:
         """The remaining frames (end of input); warns about dropped plots."""
         yield from self._release_all()
-        late = self.buffer.late
-        if late.n:
-            logging.getLogger("mhtrack").warning("%s", late.line(self.name,
-                                                                 self.where(late.first)))
+        log = logging.getLogger("mhtrack")
+        for late, what in ((self.buffer.late, "plot"),
+                           (self.buffer.late_marks, "sector crossing")):
+            if late.n:
+                log.warning("%s", late.line(self.name, self.where(late.first), what))
 
     def idle(self) -> Iterator[Scan]:
         """The input went quiet (a live feed: :data:`~mhtrack.sources.base.IDLE`): the
@@ -122,6 +123,7 @@ class TimedStream:
     def _count(self) -> None:
         b, s = self.buffer, self.stats
         s.reordered, s.late_dropped, s.max_late_s = b.reordered, b.late.n, b.late.max_late_s
+        s.late_crossings = b.late_marks.n
 
     def _scan(self, fr: Frame) -> Scan:
         c = fr.cols

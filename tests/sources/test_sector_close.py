@@ -144,7 +144,8 @@ def test_a_fallback_frame_keeps_its_last_plot_s_datagram(tmp_path: Path) -> None
     assert (10_000.0 - health.recent_last_plot[:k]).tolist() == [1001.0, 1006.0]
 
 
-def test_a_late_crossing_is_counted_as_one_not_as_a_late_plot(tmp_path: Path) -> None:
+def test_a_late_crossing_is_counted_as_one_not_as_a_late_plot(
+        tmp_path: Path, caplog: pytest.LogCaptureFixture) -> None:
     # radar 1's crossing at 0.5 s comes after its plots at 0.625 and 0.75 s (datagram 6):
     # with window 0 the plot at 0.75 s had released 0.625 s, so the crossing (0.5 s) can
     # no longer be put in order: dropped, counted as a late crossing, not a late plot.
@@ -165,6 +166,11 @@ def test_a_late_crossing_is_counted_as_one_not_as_a_late_plot(tmp_path: Path) ->
     st = src.stats
     assert (st.late_dropped, st.late_crossings) == (0, 1)
     assert st.plots_in == st.plots_out == 7  # every plot tracked, none dropped
+    # one warning line of its own: late by M − t = 0.75 − 0.5 s, at its datagram's byte
+    at = sum(map(len, grams[:5]))
+    assert [r.getMessage() for r in caplog.records if "dropped" in r.getMessage()] == [
+        f"datagrams: 1 sector crossing dropped, late by 0.25 s (after later plots had gone "
+        f"to the tracker, beyond the reorder window; first at byte {at})"]
     # the same stream with the crossing lost instead: no plot counts sector 2, so the
     # eighth alone cuts radar 1's frame (1.0 − 0.125 ≤ 1 s: one frame to the end)
     lost = [g for i, g in enumerate(grams) if i != 5]

@@ -345,7 +345,8 @@ def main() -> None:
               f"{st['plots'] / r['replay_s']:.0f} plots/s sustained over the replay; "
               f"{st['frames']} of the recording's {meta['frames']} frames tracked "
               f"({lat['count']} timed, {lat['after_end']} made "
-              f"by the stop); {st['queue_drops']} queue drops, {st['late_drops']} late drops; "
+              f"by the stop); {st['queue_drops']} queue drops, {st['late_drops']} late drops "
+              f"({st.get('late_crossings', 0)} late crossings); "
               f"{r['cat062_datagrams']} CAT062 datagrams out; {st['tracks']} tracks at the end")
         old = lat.get("last_plot") or {}
         if lat.get("by_crossing"):

@@ -186,3 +186,21 @@ def test_frames_made_by_the_end_are_not_timed() -> None:
     lat = h.snapshot()["latency_s"]
     assert (lat["count"], lat["after_end"], h.frames) == (1, 1, 2)
     assert lat["p99"] == pytest.approx(0.6)
+
+
+def test_late_crossings_have_their_own_figure() -> None:
+    """Sector crossings too late for the re-order window are counted apart from late
+    plots: their own word in the line (when there are any) and their own counter in the
+    Prometheus text, beside ``late_drops``."""
+    counts = {"datagrams": 5, "queue_drops": 0, "plots": 9, "duplicates": 1,
+              "late_drops": 2, "late_crossings": 3}
+    h = Health(lambda: counts, lambda: 4, lambda out: np.asarray(out.frame.rows), {},
+               lambda: 1.0)
+    snap = h.snapshot()
+    assert (snap["late_drops"], snap["late_crossings"]) == (2, 3)
+    assert "2 late drops, 3 late crossings, 0 queue drops" in h.line(snap)
+    text = prometheus_text(snap).splitlines()
+    assert "mhtrack_live_late_crossings_total 3" in text
+    assert "mhtrack_live_late_drops_total 2" in text
+    counts["late_crossings"] = 0  # none: the line as without sector frames
+    assert "2 late drops, 0 queue drops" in h.line(h.snapshot())

@@ -93,6 +93,29 @@ def test_stop_and_resume_equals_one_run(rec: Path, tmp_path: Path, period: float
     assert two.source.stats.late_dropped == 0
 
 
+@pytest.mark.parametrize("cut", [0.3, 0.45])
+def test_stop_and_resume_with_sector_frames(rec: Path, tmp_path: Path, cut: float) -> None:
+    """``--sector-frames``: the checkpoint keeps the crossings held and each radar's count
+    of crossings (a plot's sector), so the resumed run cuts and closes the frames of the
+    run never stopped (before, reading it back failed on a held crossing's blank callsign,
+    and the sectors numbered from 0 again cut other frames); the resumed run's crossings
+    are counted as such, none as a late plot."""
+    blocks = _blocks(rec)
+    k = int(cut * len(blocks))
+    whole, w = _run(rec, blocks, sectors=True)
+    ck = tmp_path / "state.npz"
+    first, one = _run(rec, blocks[:k], stop_after=k, checkpoint=ck, sectors=True)
+    held = one.source.held
+    assert held is not None and held["held"] is not None and held["held"]["mark"].any()
+    second, two = _run(rec, blocks[k:], checkpoint=ck, resume=True, sectors=True)
+    assert len(first) > 0 and len(second) > 0 and first + second == whole
+    assert two.source.stats.late_dropped == two.source.stats.late_crossings == 0
+    frames = one.health.frames + two.health.frames
+    assert frames == w.health.frames
+    lat = two.health.snapshot()["latency_s"]
+    assert lat["by_crossing"] > 0  # the resumed run's sectors timed by their crossings
+
+
 def test_a_copy_late_across_the_restart_is_a_copy(rec: Path, tmp_path: Path) -> None:
     """Redundant LANs: copies of the last blocks received before the stop arrive after
     the restart (the second LAN behind). The checkpoint keeps the duplicate filter's

@@ -92,3 +92,38 @@ def test_sector_frames_do_not_depend_on_the_chunks(rec: Path) -> None:
 
     one = frames(1)
     assert len(one) > 10 and frames(7) == one and frames(1024) == one
+
+
+def test_sector_frames_are_never_fused(rec: Path) -> None:
+    """A sector frame is one radar's plots with their own times: ``live`` (as ``track``
+    on a recording) refuses ``--fusion adaptive-kmeans`` — it fuses plots of several
+    radars at one scan time — in one line, before any datagram is read; with the
+    default (``none``) each frame goes to the tracker as it was cut, its closing crossing
+    (``Scan.closing``) with it. So no fused frame ever holds sector frames whose
+    crossings it could lose (``docs/live.md``, *Health and latency*)."""
+    import dataclasses
+    import io
+
+    from mhtrack.pipeline.run import fused
+    from mhtrack.sources.datagrams import DatagramSource
+    from mhtrack.sources.replay import recording_datagrams
+
+    with pytest.raises(ValueError, match="one sensor per frame: use fusion 'none'"):
+        Live(read_sensors(rec / "sensors.toml"),
+             dataclasses.replace(OPTIONS, fusion="adaptive-kmeans"),
+             LiveOptions(preload=False, stdin="raw", day_from="stream", sectors=True),
+             stdin=io.BytesIO(b""))
+    grams = [d for d, _ in recording_datagrams(rec / "radar.ast")]
+    frames = list(DatagramSource(grams, sensors=read_sensors(rec / "sensors.toml"),
+                                 sectors=True))
+    out = list(fused(frames, "none"))
+    assert [f.closing for f in out] == [f.closing for f in frames]
+    assert sum(f.closing is not None for f in out) > len(out) // 2  # most by a crossing
+
+
+def test_track_refuses_to_fuse_sector_frames(rec: Path) -> None:
+    r = CliRunner().invoke(cli, ["track", str(rec / "radar.ast"), "--sensors",
+                                 str(rec / "sensors.toml"), "--sector-frames", "--fusion",
+                                 "adaptive-kmeans", "--out", str(rec / "fused.csv"), "-q"])
+    assert r.exit_code != 0 and not (rec / "fused.csv").exists()
+    assert "one sensor per frame: use fusion 'none'" in r.output.strip().splitlines()[-1]

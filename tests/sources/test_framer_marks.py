@@ -61,3 +61,76 @@ def test_marks_change_when_not_which(stream) -> None:
     assert [f[:3] for f in with_marks] == [f[:3] for f in plain]
     assert all(a[3] <= b[3] for a, b in zip(with_marks, plain, strict=True))
     assert all(not rows[i][3] for f in with_marks for i in f[2])  # no mark in a frame
+
+
+def _frames_out(fr: Framer, batches, k0: int, out: list) -> None:
+    """Push ``batches`` (numbered from ``k0``) into ``fr``, then flush; each frame out as
+    ``(sensor, time, ids, the closing mark's id or None, batch number)``."""
+    for k, b in enumerate(batches, k0):
+        for f in fr.push(b):
+            out.append((f.sensor, f.time, f.cols["id"].tolist(),
+                        None if f.mark is None else int(f.mark["id"]), k))
+    for f in fr.flush():
+        out.append((f.sensor, f.time, f.cols["id"].tolist(),
+                    None if f.mark is None else int(f.mark["id"]), -1))
+
+
+@settings(max_examples=150, deadline=None)
+@given(streams(), st.integers(0, 8), st.sampled_from(["time", "radar"]))
+def test_pending_with_marks_continues_in_a_fresh_framer(stream, stop, release) -> None:
+    """Stopped after any batch, the rows a framer holds (:meth:`Framer.pending`: the
+    plots of open and of closed frames not yet out, and the mark that closed each of the
+    latter) pushed into a fresh framer (numbered on, frame times on from the last one
+    out), then the batches after the stop: the frames of the framer never stopped, each
+    closed by the same mark and out after the same batch — what a resumed live run
+    relies on. (Without the marks a closed frame came back open: its mark lost, it waited
+    for the next plot or the eighth.)"""
+    rows, cuts, lengths = stream
+    cols = {"time": np.array([r[0] for r in rows]), "sensor": np.array([r[1] for r in rows]),
+            "sector": np.array([r[2] for r in rows]), "mark": np.array([r[3] for r in rows]),
+            "id": np.arange(len(rows))}
+    edges = [0, *cuts, len(rows)]
+    batches = [{c: v[a:b] for c, v in cols.items()} for a, b in pairwise(edges)]
+    stop = min(stop, len(batches))
+    want: list = []
+    _frames_out(Framer(lengths, release=release), batches, 0, want)
+    first, got = Framer(lengths, release=release), []
+    for k, b in enumerate(batches[:stop]):
+        got += [(f.sensor, f.time, f.cols["id"].tolist(),
+                 None if f.mark is None else int(f.mark["id"]), k) for f in first.push(b)]
+    second = Framer(lengths, release=release)
+    second.n_frames, second.last_time = first.n_frames, first.last_time
+    held = first.pending()
+    if held is not None:  # nothing comes out of the held rows alone
+        assert not list(second.push(held))
+        assert [k for k, v in held.items()] == list(cols)
+        assert np.all(np.diff(held["id"]) > 0)  # in the order pushed
+    _frames_out(second, batches[stop:], stop, got)
+    assert got == want
+
+
+def test_a_closed_frame_held_keeps_its_mark() -> None:
+    # lengths: radar 1 3 s, radar 2 1 s. Batch 0: radar 2's plot at 0 s, radar 1's at
+    # 0.25 s, radar 1's crossing into sector 1 at 0.5 s: it closes radar 1's frame {0.25},
+    # which (in track's order) waits for radar 2's open frame {0}, whose end is earlier.
+    # Batch 1: radar 2's plot at 1.5 s closes {0} (more than 1 s after it); both go out.
+    # Stopped after batch 0 and restored, the held rows must hold the crossing: without
+    # it radar 1's frame came back open, went out only at the end (1.5 − 0.25 < 3 s) and
+    # without its mark — a frame other than the run never stopped
+    b0 = {"time": np.array([0.0, 0.25, 0.5]), "sensor": np.array([2, 1, 1]),
+          "sector": np.array([0, 0, 1]), "mark": np.array([False, False, True]),
+          "id": np.array([0, 1, 2])}
+    b1 = {"time": np.array([1.5]), "sensor": np.array([2]), "sector": np.array([0]),
+          "mark": np.array([False]), "id": np.array([3])}
+    lengths = {1: 3.0, 2: 1.0}
+    want: list = []
+    _frames_out(Framer(lengths), [b0, b1], 0, want)
+    assert want == [(2, 0.0, [0], None, 1), (1, 0.25, [1], 2, 1), (2, 1.5, [3], None, -1)]
+    first = Framer(lengths)
+    assert not list(first.push(b0))
+    held = first.pending()
+    assert held is not None and held["id"].tolist() == [0, 1, 2]  # the crossing too
+    second, got = Framer(lengths), []
+    assert not list(second.push(held))
+    _frames_out(second, [b1], 1, got)
+    assert got == want

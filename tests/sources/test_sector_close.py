@@ -14,49 +14,10 @@ import pytest
 
 pytest.importorskip("asterix.generated", reason="libasterix not installed")
 
-from mhtrack.io.asterix.encode import Message, encode_blocks, lsb, plot_messages, raw_tod
+from sector_feed import SENSORS, T0, datagrams  # tests/helpers
+
 from mhtrack.io.sensors import read_sensors
 from mhtrack.sources.datagrams import DatagramSource
-
-SENSORS = """[origin]
-lat = 52.0
-lon = -1.0
-
-[[sensors]]
-id = 1
-kind = "polar"
-pd = 0.9
-lat = 52.0
-lon = -1.0
-sigma_range = 30.0
-sigma_bearing_deg = 0.08
-period = 8.0
-
-[[sensors]]
-id = 2
-kind = "polar"
-pd = 0.9
-lat = 52.2
-lon = -1.2
-sigma_range = 30.0
-sigma_bearing_deg = 0.08
-period = 8.0
-"""
-T0 = 36000.0  # 10:00:00; every time below a multiple of 1/8 s (exact in I048/140's LSB)
-
-
-def _plot(t: float, sensor: int) -> bytes:
-    m = plot_messages(np.array([T0 + t]), np.array([sensor]), np.array([40e3]),
-                      np.array([90.0]), {})
-    return next(encode_blocks(m))[2]
-
-
-def _mark(t: float, sensor: int, north: bool) -> bytes:
-    items = {"000": 1 if north else 2, "010": (("SAC", 0), ("SIC", sensor)),
-             "030": int(raw_tod(np.array([T0 + t]))[0])}
-    if not north:
-        items["020"] = round(22.5 / lsb()["azimuth_deg"])
-    return next(encode_blocks([Message(T0 + t, sensor, 34, items)]))[2]
 
 
 def _frames(feed: list[tuple[str, float, int]], tmp: Path, sectors: bool,
@@ -64,15 +25,15 @@ def _frames(feed: list[tuple[str, float, int]], tmp: Path, sectors: bool,
     """``(sensor, plot times − T0, datagrams read when it left)`` of each frame of the
     feed (``("p"|"n"|"s", time, sensor)``: plot, north marker, sector crossing)."""
     (tmp / "sensors.toml").write_text(SENSORS)
-    grams = [_plot(t, s) if k == "p" else _mark(t, s, k == "n") for k, t, s in feed]
+    grams = datagrams(feed)
     read = [0]
 
-    def datagrams():
+    def counted():
         for g in grams:
             read[0] += 1
             yield g
 
-    src = DatagramSource(datagrams(), sensors=read_sensors(tmp / "sensors.toml"),
+    src = DatagramSource(counted(), sensors=read_sensors(tmp / "sensors.toml"),
                          reorder_window_s=0.0, sectors=sectors, chunk=1,
                          release=release)
     return [(int(f.sensor[0]), [round(x - T0, 3) for x in f.t.tolist()], read[0])
@@ -132,17 +93,17 @@ def _timed(feed: list[tuple[str, float, int]], tmp: Path) -> tuple[list, object]
     from mhtrack.pipeline.health import Health
 
     (tmp / "sensors.toml").write_text(SENSORS)
-    grams = [_plot(t, s) if k == "p" else _mark(t, s, k == "n") for k, t, s in feed]
+    grams = datagrams(feed)
     health = Health(lambda: {}, lambda: 0, lambda o: src.file_rows(o.frame.rows),
                     {1: 8.0, 2: 8.0}, lambda: 10_000.0)
 
-    def datagrams():
+    def noted():
         for i, g in enumerate(grams):
             health.arrivals.add(src.decoded, 1000.0 + i, len(g))
             yield g
         health.input_ended = True
 
-    src = DatagramSource(datagrams(), sensors=read_sensors(tmp / "sensors.toml"),
+    src = DatagramSource(noted(), sensors=read_sensors(tmp / "sensors.toml"),
                          reorder_window_s=0.0, sectors=True, chunk=1, release="radar")
     frames = []
     for f in src:
@@ -181,3 +142,40 @@ def test_a_fallback_frame_keeps_its_last_plot_s_datagram(tmp_path: Path) -> None
     assert k == 2 and health.by_crossing == 1
     assert (10_000.0 - health.recent[:k]).tolist() == [1002.0, 1006.0]
     assert (10_000.0 - health.recent_last_plot[:k]).tolist() == [1001.0, 1006.0]
+
+
+def test_a_late_crossing_is_counted_as_one_not_as_a_late_plot(
+        tmp_path: Path, caplog: pytest.LogCaptureFixture) -> None:
+    # radar 1's crossing at 0.5 s comes after its plots at 0.625 and 0.75 s (datagram 6):
+    # with window 0 the plot at 0.75 s had released 0.625 s, so the crossing (0.5 s) can
+    # no longer be put in order: dropped, counted as a late crossing, not a late plot.
+    # The plots decoded before it still count sector 1 (they join the open frame, which
+    # stays within its eighth: 0.75 − 0.125 ≤ 1 s); those decoded after it count sector
+    # 2, so radar 1's next plot (0.875 s) closes the frame, released by 1.0 s (8th)
+    feed = [("n", 0.0, 1), ("p", 0.125, 1), ("p", 0.375, 1), ("p", 0.625, 1),
+            ("p", 0.75, 1), ("s", 0.5, 1), ("p", 0.875, 1), ("p", 1.0, 1),
+            ("p", 1.25, 2)]
+    (tmp_path / "sensors.toml").write_text(SENSORS)
+    grams = datagrams(feed)
+    src = DatagramSource(grams, sensors=read_sensors(tmp_path / "sensors.toml"),
+                         reorder_window_s=0.0, sectors=True, chunk=1)
+    frames = [(int(f.sensor[0]), [round(x - T0, 3) for x in f.t.tolist()], f.closing)
+              for f in src]
+    assert frames == [(1, [0.125, 0.375, 0.625, 0.75], None), (1, [0.875, 1.0], None),
+                      (2, [1.25], None)]
+    st = src.stats
+    assert (st.late_dropped, st.late_crossings) == (0, 1)
+    assert st.plots_in == st.plots_out == 7  # every plot tracked, none dropped
+    # one warning line of its own: late by M − t = 0.75 − 0.5 s, at its datagram's byte
+    at = sum(map(len, grams[:5]))
+    assert [r.getMessage() for r in caplog.records if "dropped" in r.getMessage()] == [
+        f"datagrams: 1 sector crossing dropped, late by 0.25 s (after later plots had gone "
+        f"to the tracker, beyond the reorder window; first at byte {at})"]
+    # the same stream with the crossing lost instead: no plot counts sector 2, so the
+    # eighth alone cuts radar 1's frame (1.0 − 0.125 ≤ 1 s: one frame to the end)
+    lost = [g for i, g in enumerate(grams) if i != 5]
+    src2 = DatagramSource(lost, sensors=read_sensors(tmp_path / "sensors.toml"),
+                          reorder_window_s=0.0, sectors=True, chunk=1)
+    assert [[round(x - T0, 3) for x in f.t.tolist()] for f in src2] == \
+        [[0.125, 0.375, 0.625, 0.75, 0.875, 1.0], [1.25]]
+    assert (src2.stats.late_dropped, src2.stats.late_crossings) == (0, 0)

@@ -5,7 +5,10 @@ Rule (``docs/sources.md``, *Ordering*): with ``M`` the latest plot time seen so 
 ``W`` the window (s), a plot is held until ``M − t > W``, then released; held plots leave
 in time order, ties in arrival order. A plot whose time is before the last time already
 released cannot be put in order: it is dropped, counted, and its lateness ``M − t``
-recorded. A plot at most ``W`` older than ``M`` is therefore never dropped.
+recorded. A plot at most ``W`` older than ``M`` is therefore never dropped. Rows with
+``mark`` true (a radar's sweep marks — CAT034/CAT002 north markers and sector crossings,
+:mod:`mhtrack.sources.marks`) follow the same rule but are no plots: a late one is
+dropped and counted apart (:attr:`ReorderBuffer.late_marks`), never as a late plot.
 
 This is the one rule for every reader of timed plots: the sources (``track``, ``live``)
 push their plots through the buffer as they come, and
@@ -48,10 +51,11 @@ class Late:
         self.n += 1
         self.max_late_s = max(self.max_late_s, late_s)
 
-    def line(self, name: str, where: str) -> str:
+    def line(self, name: str, where: str, what: str = "plot") -> str:
         """The one warning line: ``NAME: 1 plot dropped, late by 40 s (...)``; ``where``
-        names the first dropped plot's place in the input."""
-        plural = "plot" if self.n == 1 else "plots"
+        names the first dropped row's place in the input, ``what`` the rows (``"plot"``,
+        ``"sweep mark"``)."""
+        plural = what if self.n == 1 else f"{what}s"
         by = (f"late by {self.max_late_s:.3g} s" if self.n == 1
               else f"late by up to {self.max_late_s:.3g} s")
         first = "" if self.n == 1 else f", the first late by {self.first_late_s:.3g} s"
@@ -64,7 +68,8 @@ class ReorderBuffer:
 
     :meth:`push` takes a batch in arrival order and returns the columns of the plots it
     releases, in time order, plus ``seq`` (each plot's 0-based arrival number);
-    :meth:`flush` releases the rest at the end of the input."""
+    :meth:`flush` releases the rest at the end of the input. :attr:`late` records the
+    plots dropped, :attr:`late_marks` the sweep marks (rows with ``mark`` true)."""
 
     def __init__(self, window_s: float = DEFAULT_REORDER_WINDOW_S) -> None:
         if not window_s >= 0:
@@ -73,6 +78,7 @@ class ReorderBuffer:
         self.latest = -np.inf
         self.released = -np.inf
         self.late = Late()
+        self.late_marks = Late()  # rows with ``mark`` true: no plots
         self.n_in = 0
         self.reordered = 0
         self._heap: list[tuple[float, int]] = []  # (time, seq) of the held plots
@@ -88,9 +94,11 @@ class ReorderBuffer:
         dropped: list[int] = []
         heap, window = self._heap, self.window_s
         latest, released = self.latest, self.released
+        mark = cols.get("mark")
         for i, ti in enumerate(t.tolist()):
             if ti < released:
-                self.late.add(latest - ti, lambda i=i: {  # type: ignore[misc]
+                late = self.late_marks if mark is not None and mark[i] else self.late
+                late.add(latest - ti, lambda i=i: {  # type: ignore[misc]
                     k: _scalar(np.asarray(v)[i]) for k, v in cols.items()
                     if np.ndim(v) == 1})
                 dropped.append(seq0 + i)

@@ -5,7 +5,9 @@ what the live run needs to continue — the next frame's number, the time axis (
 the period output, the next plot's row number (the tracker's plot windows name plots
 by row: numbers must not repeat), the duplicate filter's last data blocks (their
 digests: a redundant-LAN copy late across the restart is still a copy), the plots
-received but not yet tracked (in the re-order window and in open frames) and, with
+received but not yet tracked (in the re-order window and in frames not yet tracked,
+with the sweep marks among them and each radar's count of marks: ``--sector-frames``
+numbers sectors on after the restart) and, with
 bias estimation, its state (:mod:`~mhtrack.pipeline.registration_state`) and the
 tracking options the run was started with (:func:`options_record`) — under
 ``meta["extra"]``. A run resumed from it
@@ -113,7 +115,19 @@ def encode_pending(pending: dict[str, Any] | None) -> dict[str, Any] | None:
     for part in ("framed", "held"):
         cols = pending[part]
         out[part] = None if cols is None else {k: _column(v) for k, v in cols.items()}
+    out["marks"] = {str(k): int(v) for k, v in sorted(pending.get("marks", {}).items())}
     return out
+
+
+def _marks(saved: Any) -> dict[int, int]:
+    """Each radar's count of sweep marks, by radar id, from ``{"id": count}``; a
+    ``ValueError`` naming an entry that is no integer id with an integer count ≥ 0."""
+    if not isinstance(saved, dict):
+        raise ValueError(f"marks {saved!r} are not an object")
+    for k, v in saved.items():
+        if not (k.lstrip("-").isdigit() and type(v) is int and v >= 0):
+            raise ValueError(f"marks: {k!r}: {v!r} is no radar id with a count >= 0")
+    return {int(k): v for k, v in saved.items()}
 
 
 def _array(saved: dict[str, Any]) -> np.ndarray:
@@ -140,12 +154,14 @@ def _column(values: Any) -> dict[str, Any]:
 def decode_pending(saved: dict[str, Any] | None) -> dict[str, Any] | None:
     """The plots held, back as columns for ``DatagramSource(pending=...)``; their
     ``file_row`` is ``-1`` (numbers of the earlier run, not of this one's input), and so
-    is a sweep mark's ``offset`` (no datagram of this run: a frame it closes is timed
-    from its last plot)."""
+    is a sweep mark's ``offset`` (no datagram of this run: ``docs/live.md``, *Health and
+    latency*); ``marks``, each radar's count of sweep marks, by radar id (none in a
+    checkpoint written before they were kept)."""
     if saved is None:
         return None
     out: dict[str, Any] = {k: -math.inf if saved[k] is None else float(saved[k])
                            for k in ("latest", "released")}
+    out["marks"] = _marks(saved.get("marks", {}))
     for part in ("framed", "held"):
         cols = saved[part]
         if cols is None:

@@ -14,7 +14,12 @@ what a consumer sees. The former measure — from the last plot's datagram alone
 kept beside it (``last_plot`` in :meth:`Health.snapshot`). Frames made by the end of
 the input (a stop: the window and the open frames flushed) are timed by the stop, not
 by the data: they are counted apart (``after_end``) and left out. A frame whose
-datagram (or crossing's) is forgotten is counted in ``untimed``. Receive times come
+datagram (or crossing's) is forgotten is counted in ``untimed``. The plots a resumed
+run took back from its checkpoint (``file_row`` -1) came before the restart, earlier
+than any datagram since: a frame of them alone is timed from its closing crossing if
+that came since (the sector's last datagram), else — closed by a crossing held in the
+checkpoint too, or by anything else — it is timed by the restart, not by the data, and
+counted apart (``restored``), as ``after_end``. Receive times come
 from the reader thread (``time.time()`` when ``recv`` returned); :class:`Arrivals` maps
 each plot's decoding-order number, and each byte offset of the input, to its datagram's
 receive time over a bounded horizon.
@@ -112,8 +117,8 @@ class Health(Sink):
     *after* the output sinks, so its ``write`` comes once the frame has gone out.
 
     ``counts()`` → the running totals ``datagrams, queue_drops, kernel_drops, plots,
-    duplicates, late_drops`` (``kernel_drops`` ``None`` where not counted; callables of
-    the reader and source); ``tracks()`` → confirmed tracks
+    duplicates, late_drops, late_crossings`` (``kernel_drops`` ``None`` where not
+    counted; callables of the reader and source); ``tracks()`` → confirmed tracks
     after a frame (called in :meth:`write`, the stepping thread); ``plot_numbers(out)``
     → the frame's plots' decoding-order numbers; ``periods``
     — each radar's rotation period (s); ``clock`` → now (s, the receive times' clock)."""
@@ -135,6 +140,9 @@ class Health(Sink):
         self.after_end = 0
         self._lock = threading.Lock()  # write (stepping) against snapshot (status thread)
         self.untimed = 0  # frames whose last datagram was forgotten
+        #: Frames all of whose datagrams came before a restart (plots held in the
+        #: checkpoint resumed from, no closing crossing received since): left out.
+        self.restored = 0
         self.by_crossing = 0  # frames timed from their closing crossing's datagram
         self.latency_sum = 0.0
         self.latency_count = 0
@@ -169,15 +177,24 @@ class Health(Sink):
             return
         if plots.size == 0:
             return
-        t_plot = self.arrivals.time_of(int(plots.max()))
         closing = getattr(out.frame, "closing", None)  # a Scan; a test may pass less
         t_mark = None if closing is None else self.arrivals.time_at(closing)
-        if t_plot is None or (closing is not None and t_mark is None):
+        if plots.max() < 0:  # every plot held in a checkpoint: came before the restart
+            if closing is None:
+                self.restored += 1  # timed by the restart, not by the data
+                return
+            t_plot = None  # earlier than the closing crossing, received since
+        else:
+            t_plot = self.arrivals.time_of(int(plots.max()))
+            if t_plot is None:
+                self.untimed += 1
+                return
+        if closing is not None and t_mark is None:
             self.untimed += 1
             return
-        t_in = t_plot if t_mark is None else max(t_plot, t_mark)
-        self.by_crossing += t_mark is not None and t_mark >= t_plot
-        self._observe(now - t_in, now - t_plot)
+        t_in = t_plot if t_mark is None else t_mark if t_plot is None else max(t_plot, t_mark)
+        self.by_crossing += t_mark is not None and t_mark == t_in
+        self._observe(now - t_in, None if t_plot is None else now - t_plot)
 
     def observe(self, latency_s: float) -> None:
         """One frame's latency (s)."""
@@ -204,9 +221,11 @@ class Health(Sink):
     def snapshot(self, now: float | None = None) -> dict[str, Any]:
         """Every figure now, JSON-able: the totals, ``frames, tracks, radars_silent``
         (ids), ``latency_s`` — ``p50, p99`` of the last :data:`WINDOW` frames, ``sum``
-        and ``count`` of all, ``by_crossing`` (frames timed from their closing crossing)
+        and ``count`` of all, ``untimed``, ``after_end``, ``restored`` (frames left out:
+        module docstring), ``by_crossing`` (frames timed from their closing crossing)
         and ``last_plot`` (``p50, p99`` of the same frames timed from their last plot's
-        datagram, the former measure) — and ``time`` (the clock)."""
+        datagram, the former measure; a frame of restored plots alone: from its
+        crossing) — and ``time`` (the clock)."""
         with self._lock:
             k = min(self._n_recent, self.recent.size)
             p50, p99 = percentiles(self.recent[:k])
@@ -216,7 +235,7 @@ class Health(Sink):
                     "radars_silent": self.silent(),
                     "latency_s": {"p50": p50, "p99": p99, "sum": self.latency_sum,
                                   "count": self.latency_count, "untimed": self.untimed,
-                                  "after_end": self.after_end,
+                                  "after_end": self.after_end, "restored": self.restored,
                                   "by_crossing": self.by_crossing,
                                   "last_plot": {"p50": old[0], "p99": old[1]}}}
 
@@ -239,8 +258,10 @@ class Health(Sink):
         silent = s["radars_silent"]
         kernel = s.get("kernel_drops")  # None: not counted (SO_RXQ_OVFL is Linux's)
         kernel = "kernel drops n/a" if kernel is None else f"{kernel} kernel drops"
+        crossings = s.get("late_crossings")  # sector frames: sweep marks too late
+        late_crossings = f"{crossings} late crossings, " if crossings else ""
         return (f"live: {rates}{d} datagrams, {p} plots, {s['duplicates']} duplicates, "
-                f"{s['late_drops']} late drops, {s['queue_drops']} queue drops, "
+                f"{s['late_drops']} late drops, {late_crossings}{s['queue_drops']} queue drops, "
                 f"{kernel}, "
                 f"{s['frames']} frames, {s['tracks']} tracks, {len(silent)} radars silent"
                 f"{' (' + ', '.join(map(str, silent)) + ')' if silent else ''}{lat}")

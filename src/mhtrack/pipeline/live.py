@@ -296,7 +296,8 @@ class Live:
         return {"datagrams": r.datagrams, "queue_drops": r.queue_dropped,
                 "kernel_drops": r.kernel_dropped, "plots": s.plots_in,
                 "duplicates": self.source.problems.counts.get("duplicate", 0),
-                "late_drops": s.late_dropped, "idle_closes": self.source.idles}
+                "late_drops": s.late_dropped, "late_crossings": s.late_crossings,
+                "idle_closes": self.source.idles}
 
     def _tracks(self) -> int:
         return int(np.count_nonzero(self.pipeline.tracker.leaves.reported()))

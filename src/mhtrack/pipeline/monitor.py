@@ -40,6 +40,9 @@ _PLAIN = (
      "Data blocks received twice (redundant LANs) and dropped."),
     ("late_drops", "late_drops_total", "counter",
      "Plots dropped for arriving after the re-order window."),
+    ("late_crossings", "late_crossings_total", "counter",
+     "Sector crossings (CAT034/CAT002 sweep marks) dropped for arriving after the "
+     "re-order window (not plots; their frames closed without them)."),
     ("frames", "frames_total", "counter", "Frames (sectors) tracked."),
     ("idle_closes", "idle_closes_total", "counter",
      "Times the feed was quiet for the idle wait and the frames held were closed."),

@@ -75,6 +75,11 @@ class SourceStats:
     late_dropped: int = 0
     #: The largest lateness (s) of a dropped plot.
     max_late_s: float = 0.0
+    #: A radar's sector crossings (CAT034/CAT002 north markers and sector crossings:
+    #: sweep marks, ``sectors`` frames) dropped for arriving later than the reorder window
+    #: allows — no plots, so not in :attr:`late_dropped`; the frame they would have
+    #: closed closes by the rules without one (``docs/live.md``).
+    late_crossings: int = 0
     #: Other counts by kind (e.g. ``"duplicate datagrams"``, ``"no position"``).
     skipped: dict[str, int] = field(default_factory=dict)
 

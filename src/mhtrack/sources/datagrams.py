@@ -22,13 +22,12 @@ the sector its radar's last CAT034/CAT002 north marker or sector crossing receiv
 before it opened (arrival order: a radar sends a sector's message before the next
 sector's plots), a frame holds one sector's plots (at most ``frame_s``: radars without
 sector messages keep today's rule), the marks close it (:mod:`~mhtrack.sources.marks`).
-Off by default: ``mhtrack export``'s recordings carry crossings every 45°, and cutting
-there changes their frames (and tracks) from those of their plots table.
+Off by default: ``mhtrack export``'s recordings carry crossings every 45°: cutting there
+changes their frames (and tracks) from those of their plots table.
 
 A plot's file row is its 0-based number in decoding order (the row ``mhtrack convert``
 gives it, skipped radars included). Frame lengths come from the sensors' periods
-(``SensorSet``); a radar without one gets frames of
-:data:`~mhtrack.frames.DEFAULT_FRAME_S`.
+(``SensorSet``); a radar without one gets :data:`~mhtrack.frames.DEFAULT_FRAME_S`.
 """
 
 from __future__ import annotations
@@ -52,7 +51,7 @@ from mhtrack.models.radars import SensorSet
 from mhtrack.records import Scan
 from mhtrack.sources.base import CAUGHT_UP, IDLE, Source, SourceStats, Survey
 from mhtrack.sources.gather import Gathered
-from mhtrack.sources.marks import with_marks
+from mhtrack.sources.marks import row_place, with_marks
 from mhtrack.sources.positions import local_positions
 from mhtrack.sources.timed import TimedStream
 
@@ -106,14 +105,15 @@ class DatagramSource(Source):
         self.first_frame, self.first_row = int(first_frame), int(first_row)
         #: Plots before this time are late drops (a resumed run: its checkpoint's time).
         self.not_before = not_before
-        #: Plots held by an earlier stream (``TimedStream.pending``), taken back first;
-        #: ``hold()`` true at the end of the input: keep the plots held (:attr:`held`)
-        #: instead of making frames of them (a live run stopped to be resumed).
+        #: Plots held by an earlier stream (:meth:`pending`), taken back first (its count
+        #: of sweep marks numbers the sectors on); ``hold()`` true at the end of the
+        #: input: keep the plots held (:attr:`held`), not framed (a live run stopped).
         self.restore, self.hold = pending, hold
-        #: The duplicate filter's blocks of an earlier run
-        #: (:meth:`~mhtrack.io.asterix.duplicates.DuplicateFilter.recent`), remembered
-        #: first: a copy received before the stop and again after is taken once.
+        #: The duplicate filter's blocks of an earlier run (``DuplicateFilter.recent``),
+        #: remembered first: a copy received before the stop and again after is taken once.
         self.recent_start = recent
+        #: Each radar's count of sweep marks so far (a plot's ``sector``).
+        self.marks: dict[int, int] = dict((pending or {}).get("marks") or {})
         #: :meth:`file_rows` knows the last ``keep_rows`` plots only (``None``: all; a
         #: live stream without end keeps its memory flat).
         self.keep_rows = keep_rows
@@ -162,7 +162,7 @@ class DatagramSource(Source):
         rows: list[tuple[Any, ...]] = []
         times: list[float] = []
         at_rows: list[int] = []
-        sector: dict[int, int] = {}  # sweep marks received so far, per radar
+        self.marks = sector = dict((self.restore or {}).get("marks") or {})
         in_sector: list[int] = []
         marks: list[tuple[float, int, int, int, int]] = []  # (time, radar, sector, place, byte)
         closing = self.sectors and convert  # marks go on with the plots: they close frames
@@ -279,7 +279,7 @@ class DatagramSource(Source):
         self._skipped = {}
         self._stream = stream = TimedStream(
             self.name, self.stats, self._frame_lengths(), self.window_s,
-            lambda first: f"byte {first['offset']} (plot {first['file_row']})",
+            row_place,
             first_frame=self.first_frame, first_row=self.first_row,
             not_before=self.not_before, keep_rows=self.keep_rows, release=self.release)
         if self.restore is not None:
@@ -299,10 +299,10 @@ class DatagramSource(Source):
 
     def pending(self) -> dict[str, Any] | None:
         """The plots not yet in a frame given out (:meth:`TimedStream.pending`; after a
-        held end, those held); ``None`` before reading."""
-        if self.held is not None:
-            return self.held
-        return None if self._stream is None else self._stream.pending()
+        held end, those held) and ``marks``, each radar's count of sweep marks (the
+        sector numbers of the plots that follow); ``None`` before reading."""
+        held = self.held or (None if self._stream is None else self._stream.pending())
+        return None if held is None else {**held, "marks": dict(self.marks)}
 
     def recent_blocks(self) -> str | None:
         """The duplicate filter's recent blocks now (``DuplicateFilter.recent``: what a
@@ -312,8 +312,7 @@ class DatagramSource(Source):
 
     @property
     def idles(self) -> int:
-        """Times the input went quiet and the frames held were closed
-        (:meth:`TimedStream.idle`)."""
+        """Times the input went quiet and the held frames were closed (``TimedStream.idle``)."""
         return 0 if self._stream is None else self._stream.idles
 
     @property

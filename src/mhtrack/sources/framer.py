@@ -54,7 +54,8 @@ class _Open:
     end: float
     sector: int = 0
     parts: list[tuple[int, np.ndarray]] = field(default_factory=list)  # (batch id, rows)
-    mark: dict[str, object] | None = None  # the mark that closed it (its row's values)
+    mark: dict[str, np.ndarray] | None = None  # the mark that closed it (its row, copied)
+    mark_at: tuple[int, int] = (-1, -1)  # the mark's batch id and row in it
 
 
 @dataclass(frozen=True)
@@ -138,7 +139,8 @@ class Framer:
                 uses += self._plots(b, s, rows[cut:upto], t, sector)
             fr = self._open.get(s)
             if fr is not None and fr.sector < int(sector[m]):
-                fr.mark = {k: v[m] for k, v in self._batches[b].items()}
+                fr.mark = {k: v[m:m + 1].copy() for k, v in self._batches[b].items()}
+                fr.mark_at = (b, m)
                 self._close(s)
             cut = upto + 1
         if cut < rows.size:
@@ -182,18 +184,26 @@ class Framer:
         yield from self._ready(final=True)
 
     def pending(self) -> dict[str, np.ndarray] | None:
-        """The columns of every plot held (open frames and closed frames not yet given
-        out), in time order (ties: in the order pushed); ``None`` when none. Pushed into a
-        fresh framer (same lengths) they give the same frames as here."""
-        parts = [p for fr in (*self._open.values(), *(c[2] for c in self._closed))
-                 for p in fr.parts]
-        if not parts:
+        """The columns of every row held — the plots of open frames and of closed frames
+        not yet given out, and the mark that closed each of the latter —, in the order
+        pushed (time order); ``None`` when none. Pushed into a fresh framer (same
+        lengths) they give the same frames as here, each out at the same push."""
+        at_b: list[np.ndarray] = []
+        at_row: list[np.ndarray] = []
+        cols: list[Mapping[str, np.ndarray]] = []
+        for fr in (*self._open.values(), *(c[2] for c in self._closed)):
+            for b, rows in fr.parts:
+                at_b.append(np.full(rows.size, b))
+                at_row.append(rows)
+                cols.append({k: v[rows] for k, v in self._batches[b].items()})
+            if fr.mark is not None:
+                at_b.append(np.array([fr.mark_at[0]]))
+                at_row.append(np.array([fr.mark_at[1]]))
+                cols.append(fr.mark)
+        if not cols:
             return None
-        parts.sort(key=lambda p: p[0])  # batch order, then rows in order
-        cols = {k: np.concatenate([self._batches[b][k][rows] for b, rows in parts])
-                for k in self._batches[parts[0][0]]}
-        order = np.argsort(cols["time"], kind="stable")
-        return {k: v[order] for k, v in cols.items()}
+        order = np.lexsort((np.concatenate(at_row), np.concatenate(at_b)))
+        return {k: np.concatenate([c[k] for c in cols])[order] for k in cols[0]}
 
     def _close(self, sensor: int) -> None:
         fr = self._open.pop(sensor)
@@ -226,7 +236,8 @@ class Framer:
         cols = {k: v[0] if len(v) == 1 else np.concatenate(v) for k, v in pieces.items()}
         if self.release == "radar":  # frame times never go back
             self.last_time = max(self.last_time, fr.end)
+        mark = None if fr.mark is None else {k: v[0] for k, v in fr.mark.items()}
         out = Frame(self.n_frames, sensor, fr.end if self.release == "time"
-                    else self.last_time, cols, fr.mark)
+                    else self.last_time, cols, mark)
         self.n_frames += 1
         return out

@@ -42,11 +42,21 @@ def with_marks(out: dict[str, np.ndarray] | None,
     return {k: np.concatenate((out[k], rows[k]))[order] for k in out}
 
 
+def row_place(row: dict[str, object]) -> str:
+    """Where a row (its 1-d column values) is in the input of datagrams: ``byte N (plot
+    k)`` — its data block's byte offset and decoding-order number —, ``byte N`` for a
+    sweep mark (no plot)."""
+    plot = "" if row.get("mark") else f" (plot {row['file_row']})"
+    return f"byte {row['offset']}{plot}"
+
+
 def _blank(dtype: np.dtype, shape: tuple[int, ...]) -> np.ndarray:
-    """An array of ``shape`` meaning "none": NaN (floats), -1 (integers), else zeros
-    (False, "")."""
+    """An array of ``shape`` meaning "none": NaN (floats), -1 (integers), ``""`` (text,
+    also in an object column: the callsign's "absent"), else zeros (False)."""
     if dtype.kind == "f":
         return np.full(shape, np.nan, dtype)
     if dtype.kind in "iu":
         return np.full(shape, -1, dtype)
+    if dtype.kind in "OUS":
+        return np.full(shape, "", dtype)
     return np.zeros(shape, dtype)

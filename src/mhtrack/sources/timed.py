@@ -40,6 +40,7 @@ class TimedStream:
         self.framer.n_frames = int(first_frame)  # frames numbered on from here
         if not_before is not None:  # as if plots up to it had gone: earlier ones are late
             self.buffer.latest = self.buffer.released = float(not_before)
+            self.framer.last_time = float(not_before)  # and frame times go on from it
         # file row of each running row: one int64 array grown by doubling (8 bytes a
         # plot, no object per frame), the first ``_n_out`` entries valid; with
         # ``keep_rows`` (a stream without end: live) a ring of the last ``keep_rows``
@@ -61,9 +62,7 @@ class TimedStream:
         ``mark`` true, :mod:`~mhtrack.sources.marks`)."""
         if not cols:
             return
-        n = len(cols["time"])
-        self.stats.plots_in += n - int(np.count_nonzero(cols["mark"])) if "mark" in cols \
-            else n
+        self.stats.plots_in += _plots(cols)
         released = self.buffer.push(cols)
         self._count()
         if released and len(released["time"]):
@@ -80,10 +79,11 @@ class TimedStream:
     def finish(self) -> Iterator[Scan]:
         """The remaining frames (end of input); warns about dropped plots."""
         yield from self._release_all()
-        late = self.buffer.late
-        if late.n:
-            logging.getLogger("mhtrack").warning("%s", late.line(self.name,
-                                                                 self.where(late.first)))
+        log = logging.getLogger("mhtrack")
+        for late, what in ((self.buffer.late, "plot"),
+                           (self.buffer.late_marks, "sector crossing")):
+            if late.n:
+                log.warning("%s", late.line(self.name, self.where(late.first), what))
 
     def idle(self) -> Iterator[Scan]:
         """The input went quiet (a live feed: :data:`~mhtrack.sources.base.IDLE`): the
@@ -109,7 +109,7 @@ class TimedStream:
         b.latest, b.released = float(pending["latest"]), float(pending["released"])  # type: ignore[arg-type]
         framed, held = pending.get("framed"), pending.get("held")
         for c in (framed, held):
-            self.stats.plots_in += 0 if c is None else len(c["time"])  # type: ignore[index]
+            self.stats.plots_in += 0 if c is None else _plots(c)  # type: ignore[arg-type]
         if framed is not None:
             yield from map(self._scan, self.framer.push(framed))  # type: ignore[arg-type]
         if held is not None:  # all within the window of ``latest``: none should leave
@@ -122,6 +122,7 @@ class TimedStream:
     def _count(self) -> None:
         b, s = self.buffer, self.stats
         s.reordered, s.late_dropped, s.max_late_s = b.reordered, b.late.n, b.late.max_late_s
+        s.late_crossings = b.late_marks.n
 
     def _scan(self, fr: Frame) -> Scan:
         c = fr.cols
@@ -163,6 +164,13 @@ class TimedStream:
             ok = (rows >= max(0, self._n_out - self.keep_rows)) & (rows < self._n_out)
             out[ok] = self._rows[rows[ok] % self.keep_rows]
         return out
+
+
+def _plots(cols: Mapping[str, np.ndarray]) -> int:
+    """The number of plots among the rows ``cols`` (sweep marks, ``mark`` true, are no
+    plots)."""
+    n = len(cols["time"])
+    return n - int(np.count_nonzero(cols["mark"])) if "mark" in cols else n
 
 
 def _closing(fr: Frame) -> int | None:

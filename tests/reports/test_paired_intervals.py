@@ -93,3 +93,15 @@ def test_printed_bounds_give_the_same_verdict(lo: float, width: float, digits: i
         assert interval_decimals(lo, hi, digits) == digits
     else:
         assert float(plo) != 0 and float(phi) != 0
+
+
+@pytest.mark.parametrize("lo", [5e-324, 1e-17, 3e-9])
+def test_bounds_too_near_zero_print_short_in_scientific_notation(lo: float) -> None:
+    """A bound nearer 0 than ``MAX_DECIMALS`` shows (float noise beside a verdict): the
+    three numbers in scientific notation, short, each on its side of 0."""
+    for a, b in ((lo, 2 * lo), (-2 * lo, -lo)):
+        texts = difference_texts((a + b) / 2, a, b, 2)
+        assert all(len(t) <= 10 and "e" in t for t in texts), texts
+        assert [math.copysign(1.0, float(t)) for t in texts[1:]] == \
+            [math.copysign(1.0, a), math.copysign(1.0, b)]
+        assert float(texts[1]) != 0.0 and float(texts[2]) != 0.0

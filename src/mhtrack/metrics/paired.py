@@ -110,18 +110,22 @@ def interval_decimals(ci_low: float, ci_high: float, digits: int) -> int:
     return max(digits, -math.floor(math.log10(min(abs(ci_low), abs(ci_high)))))
 
 
+#: Most decimals a difference is printed with; a bound nearer 0 than this shows (float
+#: noise beside a verdict, say) prints the three numbers in scientific notation.
+MAX_DECIMALS = 8
+
+
 def difference_texts(mean_diff: float, ci_low: float, ci_high: float,
                      digits: int = 3) -> tuple[str, str, str]:
     """The mean difference and its interval's bounds as every report prints them:
-    signed, :func:`interval_decimals` decimals (``–`` for NaN)."""
+    signed, :func:`interval_decimals` decimals, or three significant digits in scientific
+    notation beyond :data:`MAX_DECIMALS` (``–`` for NaN)."""
     d = interval_decimals(ci_low, ci_high, digits)
-    return _fmt(mean_diff, d), _fmt(ci_low, d), _fmt(ci_high, d)
+    spec = f"+.{d}f" if d <= MAX_DECIMALS else "+.2e"
 
-
-def _fmt(v: float, digits: int) -> str:
-    if not math.isfinite(v):
-        return "–"
-    return f"{v:+.{digits}f}"
+    def show(v: float) -> str:
+        return f"{v:{spec}}" if math.isfinite(v) else "–"
+    return show(mean_diff), show(ci_low), show(ci_high)
 
 
 def _p(v: float) -> str:

@@ -27,8 +27,7 @@ there changes their frames (and tracks) from those of their plots table.
 
 A plot's file row is its 0-based number in decoding order (the row ``mhtrack convert``
 gives it, skipped radars included). Frame lengths come from the sensors' periods
-(``SensorSet``); a radar without one gets frames of
-:data:`~mhtrack.frames.DEFAULT_FRAME_S`.
+(``SensorSet``); a radar without one gets frames of :data:`~mhtrack.frames.DEFAULT_FRAME_S`.
 """
 
 from __future__ import annotations
@@ -134,8 +133,7 @@ class DatagramSource(Source):
 
     def _datagrams(self, problems: Problems, decoder: Decoder
                    ) -> Iterator[tuple[int, Any, float | None]]:
-        """``(byte offset, payload, capture time)`` of each datagram (``decoder``: the
-        pass's, which a file source reads its recording with)."""
+        """``(byte offset, payload, capture time)`` of each datagram (a file: by ``decoder``)."""
         offset = 0
         for d in self._input:
             if d is IDLE or d is CAUGHT_UP:

@@ -24,6 +24,12 @@ mutant:
 * every plot of every untouched packet is in ``convert``'s output (sensor, slant range,
   bearing, time of day compared exactly; a multiset, so that a duplicate hides nothing).
 
+The plots ``track`` decodes (:class:`~mhtrack.sources.recording.AsterixSource`, its
+decoding stage: the plots and skip lines before conversion) are compared with
+``convert``'s (``read_recording``): **paths differ** counts the mutants where the two
+readings give other plots or other skip lines, and the track path's own plots lost and
+garbage are counted as ``convert``'s are.
+
 Also counted, not failures: **garbage** plots (in ``convert``'s output, not in the
 original recording at all: damaged octets that still decode as valid ASTERIX) and the
 raw blocks lost inside a damaged length (``raw-covered``, documented).
@@ -271,6 +277,9 @@ class Outcome:
     lost: int = 0
     covered: bool = False
     garbage: int = 0
+    differ: bool = False
+    track_lost: int = 0
+    track_garbage: int = 0
     fails: list[str] = field(default_factory=list)
 
 
@@ -315,9 +324,48 @@ def check(base: Base, sensors: Path, work: Path, seed: int, kind: str, timeout: 
             res.fails.append(f"convert lost {res.lost} plot(s) of untouched packets, e.g. "
                              f"{next(iter(missing))}")
     if track:
+        _compare_paths(res, path, kept, {k for keys in base.plots for k in keys})
         _run(res, "track", ["track", str(path), "--sensors", str(sensors), "--out",
                             str(work / "t.csv")], may_refuse, timeout)
     return res
+
+
+def _keys(plots: dict[str, np.ndarray]) -> collections.Counter[tuple[float, ...]]:
+    """The plot keys (:data:`KEY`, then the time of day) of decoded plot columns."""
+    return collections.Counter(zip(*(map(float, plots[k]) for k in KEY),
+                                   (float(x) % 86400 for x in plots["time"]), strict=True))
+
+
+def _compare_paths(res: Outcome, path: Path, kept: list[tuple[float, ...]],
+                   known: set[tuple[float, ...]]) -> None:
+    """The plots and skip lines of ``track``'s reading (the source's decoding stage)
+    against ``convert``'s (``read_recording``); the track path's plots of untouched
+    packets lost, and its garbage."""
+    from mhtrack.errors import InputError
+    from mhtrack.io.asterix.decode import read_recording
+    from mhtrack.sources.recording import AsterixSource
+
+    try:
+        rec = read_recording(path)
+    except InputError as e:
+        rec, refused = None, str(e)
+    try:
+        src = AsterixSource(path)
+    except InputError as e:
+        res.differ = rec is not None or str(e) != refused
+        return
+    if rec is None:
+        res.differ = True
+        return
+    problems = Problems()
+    chunks = list(src._decoded(problems, convert=False))
+    cols = {k: np.concatenate([c[k] for c in chunks]) if chunks else np.zeros(0)
+            for k in (*KEY, "time")}
+    got = _keys(cols)
+    res.differ = got != _keys(rec.plots) or problems.lines(str(path)) != \
+        rec.problems.lines(str(path))
+    res.track_lost = sum((collections.Counter(kept) - got).values())
+    res.track_garbage = sum(c for k, c in got.items() if k not in known)
 
 
 def _tables(columns: tuple[str, ...], counts: dict[tuple[str, str], list[int]],
@@ -369,7 +417,8 @@ def main(argv: list[str] | None = None) -> int:
         k, n = map(int, args.shard.split("/"))
         jobs = [j for j in jobs[k::n] if j[0] in args.formats.split(",")]
     columns = ("mutants", "failed", "tracebacks", "hangs", "refusals", "losing",
-               "plots lost", "raw-covered", "garbage", "garbage plots")
+               "plots lost", "raw-covered", "garbage", "garbage plots", "paths differ",
+               "track losing", "track lost", "track garbage")
     counts: dict[tuple[str, str], list[int]] = collections.defaultdict(
         lambda: [0] * len(columns))
     failures: list[str] = []
@@ -378,7 +427,8 @@ def main(argv: list[str] | None = None) -> int:
         losing = o.lost > 0 and not o.covered
         for j, v in enumerate((1, bool(o.fails), o.tracebacks, o.hangs, o.refusals,
                                losing, o.lost if losing else 0, o.covered,
-                               o.garbage > 0, o.garbage)):
+                               o.garbage > 0, o.garbage, o.differ, o.track_lost > 0,
+                               o.track_lost, o.track_garbage)):
             counts[fmt, kind][j] += int(v)
         if o.fails:
             failures.append(f"{fmt}-{kind}-{seed}: " + " | ".join(o.fails))

@@ -181,8 +181,8 @@ def test_adsb_reference_is_walked_once(tmp_path: Path, monkeypatch: pytest.Monke
     """A recording with no CAT062 is read as CAT021 from the same walk of the file (the
     framing reader runs once), with the same updates and problems as a walk of its own
     for CAT021 (the former path)."""
-    import mhtrack.io.asterix.category_file as cf
     from mhtrack.io.asterix import encode_other
+    from mhtrack.io.asterix.decode import Decoder
     from mhtrack.io.reference import _adsb_reports, read_reference
     from mhtrack.models.geodesy import LocalFrame
 
@@ -196,8 +196,9 @@ def test_adsb_reference_is_walked_once(tmp_path: Path, monkeypatch: pytest.Monke
                              for _, _, b in encode_other.blocks([(t, 0x0709, 21, r)]))
                     + b"\x15\x00")  # two octets of damage at the end
     walks = []
-    real = cf.units
-    monkeypatch.setattr(cf, "units", lambda *a, **k: walks.append(1) or real(*a, **k))
+    real = Decoder.units  # the one reading path of a recording (category_file's too)
+    monkeypatch.setattr(Decoder, "units",
+                        lambda self, *a, **k: walks.append(1) or real(self, *a, **k))
     ref = read_reference(ast, frame)
     assert len(walks) == 1 and len(ref) == 10
     cols, key, problems = _adsb_reports(ast)

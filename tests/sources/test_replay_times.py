@@ -16,6 +16,7 @@ from udp_drain import drain
 
 import mhtrack.sources.replay as replay_mod
 from mhtrack.errors import InputError
+from mhtrack.io.asterix import read_recording, wrap
 from mhtrack.io.asterix.retime import time_layout
 from mhtrack.io.asterix.timeaxis import DAY_S
 from mhtrack.sources.replay import pass_seconds, recording_datagrams, replay, schedule
@@ -111,11 +112,20 @@ def test_blocks_left_unmoved_are_counted(blocks: list[bytes], tmp_path: Path) ->
     # the same block one octet longer: its records no longer fill it
     bad = good[:1] + (len(good) + 1).to_bytes(2, "big") + good[3:] + b"\xff"
     assert time_layout(bad) == ((), 1)
-    path = tmp_path / "bad.ast"
-    path.write_bytes(good + bad + good)
+    # in a pcap each datagram is sent as captured, the bad block with it
+    path = tmp_path / "bad.pcap"
+    path.write_bytes(wrap.pcap(wrap.udp_frames([good, bad, good], 258), [0.0, 1.0, 2.0]))
     stats, wire = _send(path, 3)
     assert stats.datagrams == 9 and stats.unmoved == 2  # passes 2 and 3
     assert wire[4] == bad and wire[7] == bad and wire[3] != good
+    # a raw stream is read as convert reads it: the block its records do not fill is
+    # damage, skipped (and so never sent)
+    path = tmp_path / "bad.ast"
+    path.write_bytes(good + bad + good)
+    assert [p for p, _ in recording_datagrams(path)] == [good, good]
+    rec = read_recording(path)
+    assert rec.problems.counts == {"resync": 1, "skipped_octets": len(bad), "duplicate": 1}
+    assert rec.problems.first["resync"] == len(good)
 
 
 def test_pass_length_of_a_recording_out_of_time_order() -> None:
@@ -135,8 +145,8 @@ def test_the_summary_line_counts_them(blocks: list[bytes], tmp_path: Path) -> No
 
     good = blocks[0]
     bad = good[:1] + (len(good) + 1).to_bytes(2, "big") + good[3:] + b"\xff"
-    path = tmp_path / "bad.ast"
-    path.write_bytes(good + bad)
+    path = tmp_path / "bad.pcap"
+    path.write_bytes(wrap.pcap(wrap.udp_frames([good, bad], 258), [0.0, 1.0]))
     r = CliRunner().invoke(cli, ["replay", str(path), "--to", "udp://127.0.0.1:9",
                                  "--loops", "3", "--speed", "max"])
     assert r.exit_code == 0, r.output

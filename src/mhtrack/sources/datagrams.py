@@ -132,8 +132,9 @@ class DatagramSource(Source):
         #: Columns of the last converted plots: a sweep mark's row has them (``sectors``)
         self._template: dict[str, tuple[np.dtype, tuple[int, ...]]] | None = None
 
-    def _datagrams(self, problems: Problems) -> Iterator[tuple[int, Any, float | None]]:
-        """``(byte offset, payload, capture time)`` of each datagram."""
+    def _datagrams(self, problems: Problems, decoder: Decoder
+                   ) -> Iterator[tuple[int, Any, float | None]]:
+        """``(byte offset, payload, capture time)`` of each datagram (a file: by ``decoder``)."""
         offset = 0
         for d in self._input:
             if d is IDLE or d is CAUGHT_UP:
@@ -167,7 +168,7 @@ class DatagramSource(Source):
         marks: list[tuple[float, int, int, int, int]] = []  # (time, radar, sector, place, byte)
         closing = self.sectors and convert  # marks go on with the plots: they close frames
         n = 0
-        for offset, payload, when in self._datagrams(problems):
+        for offset, payload, when in self._datagrams(problems, decoder):
             if payload is IDLE or payload is CAUGHT_UP:  # what is decoded, then IDLE
                 if rows or marks:
                     yield self._chunk(rows, times, at_rows, n, convert, in_sector, marks)

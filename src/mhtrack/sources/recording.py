@@ -1,7 +1,8 @@
 """An ASTERIX recording file as a source: its framing (pcap, pcapng, the recorder formats,
 raw data blocks: :func:`mhtrack.io.asterix.framings.recognise`, by content) is read
-through an ``mmap`` of the file (:func:`mhtrack.io.asterix.framings.units`, with each
-unit's capture time) and its units fed to
+through an ``mmap`` of the file as ``convert`` reads it
+(:meth:`mhtrack.io.asterix.decode.Decoder.units`: each unit with its capture time, a raw
+stream's blocks judged by their content) and its units fed to
 :class:`~mhtrack.sources.datagrams.DatagramSource` — decoded in memory, chunk by chunk,
 never through a temporary file.
 
@@ -23,7 +24,7 @@ from typing import Any
 from mhtrack.errors import InputError
 from mhtrack.io.asterix.api import sensors_with_periods
 from mhtrack.io.asterix.decode import Decoder
-from mhtrack.io.asterix.framings import recognise, units
+from mhtrack.io.asterix.framings import recognise
 from mhtrack.io.asterix.problems import Problems
 from mhtrack.io.asterix.sites import radar_name
 from mhtrack.io.paths import check_input_file
@@ -61,10 +62,13 @@ class AsterixSource(DatagramSource):
             with mmap.mmap(fh.fileno(), 0, access=mmap.ACCESS_READ) as data:
                 yield data
 
-    def _datagrams(self, problems: Problems) -> Iterator[tuple[int, Any, float | None]]:
+    def _datagrams(self, problems: Problems, decoder: Decoder
+                   ) -> Iterator[tuple[int, Any, float | None]]:
+        """The recording's units as ``convert`` reads them (:meth:`Decoder.units`: a raw
+        stream's blocks judged by their content, by the decoder that decodes them)."""
         with self._mapped() as data:
-            for offset, when, payload in units(data, self.container, self.name,
-                                               self.categories, problems):
+            for offset, when, payload in decoder.units(data, self.container, self.name,
+                                                       problems):
                 if self._bar is not None:
                     self._bar.to(offset)
                 yield offset, payload, when

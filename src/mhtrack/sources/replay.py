@@ -4,9 +4,10 @@
 Each datagram of a pcap or pcapng recording is sent as it was captured (its ASTERIX
 payload, one UDP datagram), at its capture time (the recorder formats: each record at its
 own time); a raw recording (data blocks back to back) is sent one data block per
-datagram, at the time of day of the block's first CAT048/CAT034 record (on one axis
-across midnight, :class:`TimeAxis`; a block without one keeps the previous time, blocks
-before the first timed one take its time). The
+datagram — the blocks ``convert`` reads (:meth:`~mhtrack.io.asterix.decode.Decoder.units`:
+in a damaged stream, judged by their content) — at the time of day of the block's first
+CAT048/CAT034 record (on one axis across midnight, :class:`TimeAxis`; a block without
+one keeps the previous time, blocks before the first timed one take its time). The
 spacing of the times is kept, divided by ``speed`` (``math.inf``: as fast as the socket
 takes them). ``loops`` plays the file that many times
 (``None``: until ``stop``), pass ``n`` ``n · S`` seconds after the first, ``S`` the
@@ -36,7 +37,7 @@ from pathlib import Path
 
 from mhtrack.errors import InputError
 from mhtrack.io.asterix.decode import Decoder
-from mhtrack.io.asterix.framings import recognise, units
+from mhtrack.io.asterix.framings import recognise
 from mhtrack.io.asterix.problems import Problems
 from mhtrack.io.asterix.retime import patch_times, time_layout
 from mhtrack.io.asterix.timeaxis import TimeAxis
@@ -66,8 +67,8 @@ def _datagrams(path: str | Path) -> tuple[list[tuple[bytes, float]], bool]:
         with (mmap.mmap(fh.fileno(), 0, access=mmap.ACCESS_READ) if size else
               _Empty()) as data:
             kind = recognise(data, name, decoder.categories)
-            raw = [(bytes(payload), when) for _, when, payload in units(
-                data, kind, name, decoder.categories, problems)]  # raw: one block each
+            raw = [(bytes(payload), when) for _, when, payload in decoder.units(
+                data, kind, name, problems)]  # raw: one block each, judged as convert does
     whens: list[float | None] = []
     axis = TimeAxis()
     for payload, when in raw:

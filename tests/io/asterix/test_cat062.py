@@ -79,3 +79,30 @@ def test_local_tracks_through_the_sensors_frame(opensky: Path, tmp_path: Path) -
     assert np.abs(back["lon"] - lon).max() <= lsb062()["deg"]
     # a grid velocity of 100 m/s east is about 100 m/s east on the ground near the origin
     assert np.abs(back["vx"] - 100.0).max() < 2.0 and np.abs(back["vy"]).max() < 3.0
+
+
+def test_raw_reference_with_a_damaged_length(tmp_path: Path) -> None:
+    """A raw CAT062 file (a reference for ``evaluate --reference``) whose block 3 has
+    its length made to cover blocks 4 and 5 exactly: read as ``convert`` reads a raw
+    stream (blocks judged by their content), every other block's tracks are kept, block
+    3 counted as damage; by framing alone blocks 4 and 5 went with it."""
+    _tracks(tmp_path / "tracks.csv")
+    export_tracks(tmp_path / "tracks.csv", None, tmp_path / "t.ast")
+    data = bytearray((tmp_path / "t.ast").read_bytes())
+    starts = [0]
+    while starts[-1] < len(data):
+        starts.append(starts[-1] + int.from_bytes(data[starts[-1] + 1:starts[-1] + 3], "big"))
+    assert len(starts) > 8 and starts[-1] == len(data)
+    (tmp_path / "b3.ast").write_bytes(bytes(data[starts[3]:starts[4]]))
+    data[starts[3] + 1:starts[3] + 3] = (starts[6] - starts[3]).to_bytes(2, "big")
+    (tmp_path / "d.ast").write_bytes(bytes(data))
+
+    def keys(path: Path) -> list[tuple[int, float]]:
+        cols, _ = read_system_tracks(path)
+        return sorted(zip(cols["track_number"].tolist(), cols["time"].tolist(), strict=True))
+
+    whole, lost = keys(tmp_path / "t.ast"), keys(tmp_path / "b3.ast")
+    got, problems = keys(tmp_path / "d.ast"), read_system_tracks(tmp_path / "d.ast")[1]
+    assert got == sorted(set(whole) - set(lost)) and len(got) == len(whole) - len(lost)
+    assert problems.counts == {"resync": 1, "skipped_octets": starts[4] - starts[3]}
+    assert problems.first["resync"] == starts[3]

@@ -4,7 +4,9 @@
 other categories and blocks whose records do not fill them are counted in the
 :class:`~mhtrack.io.asterix.problems.Problems`, never passed on. One walk of the file
 can serve several categories (:func:`category_blocks`): a reference without CAT062 is
-read as CAT021 without reading the file again."""
+read as CAT021 without reading the file again. The file is walked as ``convert`` walks a
+recording (:meth:`~mhtrack.io.asterix.decode.Decoder.units`: a raw stream's blocks
+judged by their content), so that a damaged length does not take good blocks with it."""
 
 from __future__ import annotations
 
@@ -12,9 +14,9 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
-import mhtrack.io.asterix._lib as _lib
 from mhtrack.io.asterix.container import blocks
-from mhtrack.io.asterix.framings import recognise, units
+from mhtrack.io.asterix.decode import Decoder
+from mhtrack.io.asterix.framings import recognise
 from mhtrack.io.asterix.problems import Problems
 
 #: One block's rows (``raw`` records, the block's file offset, the problems), or
@@ -26,15 +28,18 @@ Walked = tuple[list[tuple[int, int, bytes]], Problems]
 
 
 def category_blocks(path: str | Path, cats: Sequence[int]) -> Walked:
-    """Every data block of recording ``path`` in file order, recognised with ``cats``
-    among its categories, and the framing's problems."""
-    gen = _lib.modules()[1]
+    """Every data block of recording ``path`` in file order (``cats``: the categories
+    wanted, among those libasterix carries: a raw block is judged by them), and the
+    framing's problems."""
+    decoder = Decoder(duplicates=None)
+    if missing := set(cats) - decoder.categories:
+        raise ValueError(f"categories {sorted(missing)} are not read (libasterix does not "
+                         "carry them)")
     name = str(path)
     data = Path(path).read_bytes()
-    known = {int(c) for c in gen.manifest["CATS"]} | set(cats)
-    kind = recognise(data, name, known)
+    kind = recognise(data, name, decoder.categories)
     problems = Problems()
-    found = [block for offset, _, payload in units(data, kind, name, known, problems)
+    found = [block for offset, _, payload in decoder.units(data, kind, name, problems)
              for block in blocks(payload, offset, problems)]
     return found, problems
 

@@ -33,7 +33,7 @@ from mhtrack.io.asterix.container import blocks
 from mhtrack.io.asterix.duplicates import DuplicateFilter
 from mhtrack.io.asterix.fast import reader034, reader048
 from mhtrack.io.asterix.fill import fills_any_edition, whole_records
-from mhtrack.io.asterix.framings import recognise, units
+from mhtrack.io.asterix.framings import Unit, recognise, units
 from mhtrack.io.asterix.notplots import flags048, plot_type048_of, reason
 from mhtrack.io.asterix.problems import Problems
 from mhtrack.io.asterix.timeaxis import TimeAxis
@@ -107,8 +107,7 @@ def read_recording(path: str | Path, *, fast: bool = True, progress: bool = Fals
     times: list[float] = []
     axis = TimeAxis()
     bar = Count(len(data), "decode", "B", progress, scale=True)
-    for offset, when, payload in units(data, kind, name, decoder.categories, problems,
-                                      decoder.fills):
+    for offset, when, payload in decoder.units(data, kind, name, problems):
         bar.to(offset)
         for _, what, found in decoder.blocks(payload, offset, problems, when):
             into = marks if what == MARKS else rows  # ADS-B reports beside the plots
@@ -181,6 +180,15 @@ class Decoder:
                 yield at, ADSB, _plots_only(found, cat, at, problems)
             else:
                 yield at, PLOTS, _plots_only(found, cat, at, problems)
+
+    def units(self, data: bytes, kind: str, name: str, problems: Problems
+              ) -> Iterator[Unit]:
+        """The units of recording ``data`` of framing ``kind``
+        (:func:`~mhtrack.io.asterix.framings.units`) as every reader of a recording
+        takes them — ``convert``, ``track``, ``replay``, a reference file: a raw
+        stream's blocks judged by their content too (:meth:`fills`), so that a damaged
+        file reads the same through each (``docs/file-formats.md``)."""
+        return units(data, kind, name, self.categories, problems, self.fills)
 
     def fills(self, block: bytes) -> bool:
         """Whether the records of data block ``block`` (header included) fill it

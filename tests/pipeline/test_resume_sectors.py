@@ -24,8 +24,16 @@ pytest.importorskip("asterix.generated", reason="libasterix not installed")
 
 from sector_feed import SENSORS, T0, datagrams  # tests/helpers
 
+from mhtrack.errors import InputError
 from mhtrack.io.sensors import read_sensors
-from mhtrack.pipeline.checkpoint import decode_pending, encode_pending
+from mhtrack.pipeline import TrackOptions
+from mhtrack.pipeline.checkpoint import (
+    LiveState,
+    check_options,
+    decode_pending,
+    encode_pending,
+    options_record,
+)
 from mhtrack.pipeline.health import Health
 from mhtrack.sources.base import CAUGHT_UP
 from mhtrack.sources.datagrams import DatagramSource
@@ -149,3 +157,69 @@ def test_a_count_of_crossings_that_is_none_is_refused(bad: object) -> None:
     with pytest.raises(ValueError, match="marks"):
         decode_pending(saved)
     assert decode_pending({**saved, "marks": {"3": 7}})["marks"] == {3: 7}
+
+
+def _saved(stop: int, tmp: Path, sectors: bool = True) -> dict:
+    """The checkpoint's JSON of what FEED's first ``stop`` datagrams leave held."""
+    (tmp / "sensors.toml").write_text(SENSORS)
+    one = DatagramSource(datagrams(FEED)[:stop], sensors=read_sensors(tmp / "sensors.toml"),
+                         reorder_window_s=0.0, sectors=sectors, chunk=1, hold=lambda: True)
+    list(one)
+    return json.loads(json.dumps(encode_pending(one.pending())))
+
+
+def test_held_sectors_without_their_counts_are_refused(tmp_path: Path) -> None:
+    # stopped after 5 datagrams: {0.125, 0.25} went out (closed by the crossing at
+    # 0.5 s); the plot at 0.625 s is held (window 0) in radar 1's sector 2 — 2 marks so
+    # far. Without the count (the previous mhtrack wrote none) the resumed run would
+    # number the crossing at 1.0 s sector 1: it would not close {0.625, 0.75}
+    saved = _saved(5, tmp_path)
+    assert saved["held"]["sector"]["values"] == [2] and saved["marks"] == {"1": 2}
+    old = {k: v for k, v in saved.items() if k != "marks"}
+    with pytest.raises(ValueError, match=r"^pending: plots held with their sectors but no "
+                       r"'marks' .*: written before sector counts were kept: start "
+                       r"afresh without --resume$"):
+        decode_pending(old)
+    plain = _saved(5, tmp_path, sectors=False)  # no sectors held: no count needed
+    assert "sector" not in plain["held"]
+    assert decode_pending({k: v for k, v in plain.items() if k != "marks"})["marks"] == {}
+
+
+@pytest.mark.parametrize("sectors", [False, True])
+def test_rows_held_go_on_only_as_they_were_cut(tmp_path: Path, sectors: bool) -> None:
+    # held with sectors, resumed without: the crossing held became a plot of NaN; the
+    # other way round the framer failed on the missing sector column (KeyError)
+    (tmp_path / "sensors.toml").write_text(SENSORS)
+    saved = _saved(4, tmp_path, sectors)
+    was, now = ("with", "without") if sectors else ("without", "with")
+    with pytest.raises(ValueError, match=f"^pending: rows held cut {was} their sectors, "
+                       f"this stream's {now}$"):
+        DatagramSource(datagrams(FEED)[4:], sensors=read_sensors(tmp_path / "sensors.toml"),
+                       sectors=not sectors, pending=decode_pending(saved))
+
+
+def _state(pending: dict | None, options: dict | None) -> LiveState:
+    return LiveState(next_frame=1, axis_day0=None, axis_latest=None, last_time=None,
+                     next_tick=None, pending=pending, options=options)
+
+
+@pytest.mark.parametrize("sectors", [False, True])
+def test_a_resume_with_sector_frames_toggled_is_refused(tmp_path: Path,
+                                                        sectors: bool) -> None:
+    saved = _saved(4, tmp_path, sectors)
+    opts = TrackOptions()
+    line = (f"ck.npz: written with other tracking options (sector_frames {sectors} there, "
+            f"{not sectors} here): resume with the same options, or start afresh without "
+            "--resume")
+    record = options_record(opts, sectors)
+    assert record["sector_frames"] is sectors
+    older = {k: v for k, v in record.items() if k != "sector_frames"}
+    # kept with the options; else (written before) told by the held plots' columns
+    for state in (_state(saved, record), _state(None, record), _state(saved, older),
+                  _state(saved, None)):
+        check_options("ck.npz", state, opts, sectors)  # the same: fine
+        with pytest.raises(InputError) as e:
+            check_options("ck.npz", state, opts, not sectors)
+        assert str(e.value) == line
+    for state in (_state(None, older), _state(None, None)):  # nothing tells: not checked
+        check_options("ck.npz", state, opts, not sectors)

@@ -114,7 +114,7 @@ class DatagramSource(Source):
         self.recent_start = recent
         #: Each radar's count of sweep marks so far (a plot's ``sector``); the columns of
         #: the last converted plots (or restored ones): a sweep mark's row has them
-        self.marks, self._template = restored(pending)
+        self.marks, self._template = restored(pending, sectors)
         #: :meth:`file_rows` knows the last ``keep_rows`` plots only (``None``: all; a
         #: live stream without end keeps its memory flat).
         self.keep_rows = keep_rows
@@ -161,7 +161,7 @@ class DatagramSource(Source):
         rows: list[tuple[Any, ...]] = []
         times: list[float] = []
         at_rows: list[int] = []
-        self.marks, self._template = restored(self.restore)
+        self.marks, self._template = restored(self.restore, self.sectors)
         sector = self.marks
         in_sector: list[int] = []
         marks: list[tuple[float, int, int, int, int]] = []  # (time, radar, sector, place, byte)

@@ -116,6 +116,46 @@ def test_stop_and_resume_with_sector_frames(rec: Path, tmp_path: Path, cut: floa
     assert lat["by_crossing"] > 0  # the resumed run's sectors timed by their crossings
 
 
+def test_sector_frames_must_match_the_checkpoint(rec: Path, tmp_path: Path) -> None:
+    """``--sector-frames`` is kept with the checkpoint's options: a resume that toggles
+    it is refused in one line before any datagram is read (on → off, a crossing held
+    reached the tracker as a plot of NaN; off → on, a traceback in the framer); a
+    checkpoint of the previous mhtrack (no counts of crossings, no such option) holding
+    plots with their sectors is refused naming the field."""
+    blocks = _blocks(rec)
+    k = int(0.3 * len(blocks))
+    sensors = read_sensors(rec / "sensors.toml")
+
+    def resume(ck: Path, sectors: bool) -> Live:
+        return Live(sensors, OPTIONS, LiveOptions(preload=False, stdin="raw", checkpoint=ck,
+                                                  resume=True, sectors=sectors),
+                    stdin=io.BytesIO(b""))
+
+    for sectors in (True, False):
+        ck = tmp_path / f"state-{sectors}.npz"
+        _run(rec, blocks[:k], stop_after=k, checkpoint=ck, sectors=sectors)
+        with pytest.raises(InputError) as e:
+            resume(ck, not sectors)
+        assert str(e.value) == (
+            f"{ck}: written with other tracking options (sector_frames {sectors} there, "
+            f"{not sectors} here): resume with the same options, or start afresh "
+            "without --resume")
+        assert resume(ck, sectors).resumed is not None
+    tracker, state = read_checkpoint(tmp_path / "state-True.npz")
+    assert state.pending is not None and "sector" in state.pending["held"]
+    assert state.options is not None and state.options["sector_frames"] is True
+    old = tmp_path / "old.npz"  # as the previous mhtrack wrote it
+    CheckpointSink(old, lambda: tracker, lambda: replace(
+        state, pending={k: v for k, v in state.pending.items() if k != "marks"},
+        options={k: v for k, v in state.options.items() if k != "sector_frames"})).save()
+    with pytest.raises(InputError) as e:
+        resume(old, True)
+    assert str(e.value) == (
+        f"{old}: member 'meta': field 'extra': pending: plots held with their sectors but "
+        "no 'marks' (each radar's count of sector crossings): written before sector "
+        "counts were kept: start afresh without --resume")
+
+
 def test_a_copy_late_across_the_restart_is_a_copy(rec: Path, tmp_path: Path) -> None:
     """Redundant LANs: copies of the last blocks received before the stop arrive after
     the restart (the second LAN behind). The checkpoint keeps the duplicate filter's

@@ -134,3 +134,58 @@ def test_a_closed_frame_held_keeps_its_mark() -> None:
     assert not list(second.push(held))
     _frames_out(second, [b1], 1, got)
     assert got == want
+
+
+@settings(max_examples=100, deadline=None)
+@given(st.integers(0, 300))
+def test_marks_alone_hold_nothing(n: int) -> None:
+    """A radar's crossings in batches of their own (``live --sector-frames`` with each
+    crossing in its own datagram): nothing of them is kept, however many (each used to
+    be kept forever: a long run grew without bound)."""
+    fr = Framer(1.0)
+    for i in range(n):
+        out = list(fr.push({"time": np.array([i / 8]), "sensor": np.array([3]),
+                            "sector": np.array([i + 1]), "mark": np.array([True])}))
+        assert not out  # a mark is no plot: no frame
+    assert fr.batches_held == 0 and fr.pending() is None
+
+
+@settings(max_examples=100, deadline=None)
+@given(st.integers(1, 300))
+def test_crossings_of_another_radar_hold_nothing(n: int) -> None:
+    # radar 1: a plot every 1/8 s (batch 2i, time i/8); radar 3: a crossing 1/16 s after
+    # each (batch 2i + 1). Radar 1's frames (1 s) hold 9 plots, 0/8 … 8/8 s, the next
+    # 9/8 …; a frame is closed by the stream's time once a row is more than 1 s after
+    # its first plot — the crossing after its 9th plot — and then goes out (its end is
+    # earlier than the stream's time, no other frame is open). After n pairs the open
+    # frame holds n mod 9 plots, each of its own batch: those batches only are kept
+    fr, out = Framer(1.0), 0
+    for i in range(n):
+        out += len(list(fr.push({"time": np.array([i / 8]), "sensor": np.array([1]),
+                                 "sector": np.array([0]), "mark": np.array([False])})))
+        out += len(list(fr.push({"time": np.array([i / 8 + 1 / 16]),
+                                 "sensor": np.array([3]), "sector": np.array([i + 1]),
+                                 "mark": np.array([True])})))
+    assert out == n // 9
+    assert fr.batches_held == n % 9
+    held = fr.pending()
+    assert (0 if held is None else len(held["time"])) == n % 9
+
+
+@settings(max_examples=100, deadline=None)
+@given(streams())
+def test_only_batches_with_plots_held_are_kept(stream) -> None:
+    """After every push, the framer keeps exactly the batches that hold a plot of a
+    frame not yet out (:meth:`Framer.pending`'s plot rows; the mark that closed a frame
+    is copied, not kept with its batch)."""
+    rows, cuts, lengths = stream
+    cols = {"time": np.array([r[0] for r in rows]), "sensor": np.array([r[1] for r in rows]),
+            "sector": np.array([r[2] for r in rows]), "mark": np.array([r[3] for r in rows])}
+    edges = [0, *cuts, len(rows)]
+    fr = Framer(lengths)
+    for k, (a, b) in enumerate(pairwise(edges)):
+        list(fr.push({**{c: v[a:b] for c, v in cols.items()},
+                      "batch": np.full(b - a, k)}))
+        held = fr.pending()
+        plots = set() if held is None else set(held["batch"][~held["mark"]].tolist())
+        assert fr.batches_held == len(plots)

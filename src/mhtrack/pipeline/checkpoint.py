@@ -9,11 +9,14 @@ received but not yet tracked (in the re-order window and in frames not yet track
 with the sweep marks among them and each radar's count of marks: ``--sector-frames``
 numbers sectors on after the restart) and, with
 bias estimation, its state (:mod:`~mhtrack.pipeline.registration_state`) and the
-tracking options the run was started with (:func:`options_record`) — under
-``meta["extra"]``. A run resumed from it
+tracking options the run was started with, ``--sector-frames`` among them
+(:func:`options_record`) — under ``meta["extra"]``. A run resumed from it
 therefore makes the same frames as a run never stopped, given the same datagrams after
 the checkpoint; a run resumed with other tracking options is refused
-(:func:`check_options`: the saved tracker would silently keep the old ones).
+(:func:`check_options`: the saved tracker would silently keep the old ones; the plots
+held were cut with or without their sectors), and so is a checkpoint of plots held with
+their sectors but without the counts of crossings (:func:`decode_pending`: written
+before they were kept).
 
 :class:`CheckpointSink` writes one every ``every_s`` seconds **of data time** (the frames'
 times: the same input checkpoints at the same frames) and a final one when the run ends
@@ -79,25 +82,44 @@ class LiveState:
 UNCHECKED_OPTIONS = ("bias_prior",)
 
 
-def options_record(options: TrackOptions) -> dict[str, Any]:
-    """``options`` as JSON (every field but :data:`UNCHECKED_OPTIONS`), as saved in a
-    checkpoint and compared by :func:`check_options`."""
+def options_record(options: TrackOptions, sectors: bool = False) -> dict[str, Any]:
+    """``options`` as JSON (every field but :data:`UNCHECKED_OPTIONS`) and
+    ``sector_frames`` (``live --sector-frames``: ``sectors``), as saved in a checkpoint
+    and compared by :func:`check_options`."""
     import json
 
     fields = {k: v for k, v in asdict(options).items() if k not in UNCHECKED_OPTIONS}
+    fields["sector_frames"] = bool(sectors)
     return dict(json.loads(json.dumps(fields, sort_keys=True, default=str)))
 
 
-def check_options(path: str | Path, state: LiveState, options: TrackOptions) -> None:
+def saved_sectors(state: LiveState) -> bool | None:
+    """Whether the run that wrote ``state`` cut frames at its radars' sectors: its
+    options' ``sector_frames``, else (written before it was kept) whether the plots held
+    carry their ``sector`` column; ``None`` when neither tells (nothing held)."""
+    if state.options is not None and "sector_frames" in state.options:
+        return bool(state.options["sector_frames"])
+    pending = state.pending or {}
+    held = [c for c in (pending.get("framed"), pending.get("held")) if isinstance(c, dict)]
+    return None if not held else any("sector" in c for c in held)
+
+
+def check_options(path: str | Path, state: LiveState, options: TrackOptions,
+                  sectors: bool = False) -> None:
     """An :class:`InputError` in one line naming the checkpoint and each field that
-    differs when ``options`` are not those ``state`` was saved with (a checkpoint
-    without them is not checked)."""
-    if state.options is None:
-        return
-    now = options_record(options)
-    diff = [f"{k} {state.options.get(k)!r} there, {now.get(k)!r} here"
-            for k in sorted(set(now) | set(state.options))
-            if state.options.get(k) != now.get(k)]
+    differs when ``options`` and ``sectors`` (``--sector-frames``) are not those
+    ``state`` was saved with; a checkpoint without options is checked for
+    ``sector_frames`` alone, and that where known (:func:`saved_sectors`)."""
+    now = options_record(options, sectors)
+    was = {} if state.options is None else dict(state.options)
+    keys = set(now) | set(was) if state.options is not None else set()
+    was.pop("sector_frames", None)
+    keys.discard("sector_frames")
+    if (cut := saved_sectors(state)) is not None:
+        was["sector_frames"] = cut
+        keys.add("sector_frames")
+    diff = [f"{k} {was.get(k)!r} there, {now.get(k)!r} here"
+            for k in sorted(keys) if was.get(k) != now.get(k)]
     if diff:
         raise InputError(f"{path}: written with other tracking options ({'; '.join(diff)})"
                          ": resume with the same options, or start afresh without "
@@ -107,7 +129,10 @@ def check_options(path: str | Path, state: LiveState, options: TrackOptions) -> 
 def encode_pending(pending: dict[str, Any] | None) -> dict[str, Any] | None:
     """:meth:`~mhtrack.sources.datagrams.DatagramSource.pending` as JSON: each column a
     list (floats to the bit: JSON keeps Python's shortest round-trip form), the times
-    ``None`` when infinite; ``None`` when no plot is held."""
+    ``None`` when infinite, ``marks`` each radar's count of sweep marks; ``None`` when no
+    row (plot or crossing) is held — the counts are then not needed: the framer only
+    compares a frame's sector with its own radar's later crossings, so with no frame
+    held a resumed run numbering sectors from 0 again cuts the same frames."""
     if pending is None or (pending["framed"] is None and pending["held"] is None):
         return None
     out: dict[str, Any] = {k: None if pending[k] is None or not math.isfinite(pending[k])
@@ -155,12 +180,19 @@ def decode_pending(saved: dict[str, Any] | None) -> dict[str, Any] | None:
     """The plots held, back as columns for ``DatagramSource(pending=...)``; their
     ``file_row`` is ``-1`` (numbers of the earlier run, not of this one's input), and so
     is a sweep mark's ``offset`` (no datagram of this run: ``docs/live.md``, *Health and
-    latency*); ``marks``, each radar's count of sweep marks, by radar id (none in a
-    checkpoint written before they were kept)."""
+    latency*); ``marks``, each radar's count of sweep marks, by radar id. A checkpoint
+    written before the counts were kept has none: refused (``ValueError``) if it holds
+    plots with their sectors (``--sector-frames``: they would be numbered from 0 again,
+    other frames), else read with none."""
     if saved is None:
         return None
     out: dict[str, Any] = {k: -math.inf if saved[k] is None else float(saved[k])
                            for k in ("latest", "released")}
+    if "marks" not in saved and any(isinstance(saved[p], dict) and "sector" in saved[p]
+                                    for p in ("framed", "held")):
+        raise ValueError("pending: plots held with their sectors but no 'marks' (each "
+                         "radar's count of sector crossings): written before sector "
+                         "counts were kept: start afresh without --resume")
     out["marks"] = _marks(saved.get("marks", {}))
     for part in ("framed", "held"):
         cols = saved[part]
@@ -180,16 +212,17 @@ def decode_pending(saved: dict[str, Any] | None) -> dict[str, Any] | None:
 class CheckpointSink(Sink):
     """The tracker (``tracker()``, the one being stepped) and ``state()`` saved to
     ``path`` every ``every_s`` s of data time (``None``: only at the end) and when the
-    run ends, with the run's tracking ``options`` (:func:`options_record`; ``None``: the
-    state's own). :attr:`written` counts the checkpoints."""
+    run ends, with the run's tracking ``options`` and ``sectors`` (``--sector-frames``;
+    :func:`options_record`; ``options`` ``None``: the state's own). :attr:`written`
+    counts the checkpoints."""
 
     def __init__(self, path: str | Path, tracker: Callable[[], MHTTracker],
                  state: Callable[[], LiveState], every_s: float | None = None,
-                 options: TrackOptions | None = None) -> None:
+                 options: TrackOptions | None = None, sectors: bool = False) -> None:
         if every_s is not None and not every_s > 0:
             raise ValueError(f"checkpoint period must be > 0 s, got {every_s!r}")
         self.path, self.tracker, self.state = Path(path), tracker, state
-        self.options = None if options is None else options_record(options)
+        self.options = None if options is None else options_record(options, sectors)
         self.every_s = math.inf if every_s is None else float(every_s)
         self.written = 0
         self._last: float | None = None
@@ -214,11 +247,12 @@ class CheckpointSink(Sink):
         self.save()
 
 
-def read_checkpoint(path: str | Path, options: TrackOptions | None = None
-                    ) -> tuple[MHTTracker, LiveState]:
+def read_checkpoint(path: str | Path, options: TrackOptions | None = None,
+                    sectors: bool = False) -> tuple[MHTTracker, LiveState]:
     """The tracker and the live bookkeeping of a checkpoint written by
     :class:`CheckpointSink`; an :class:`InputError` naming the file otherwise, or when
-    ``options`` are not those it was written with (:func:`check_options`)."""
+    ``options`` and ``sectors`` are not those it was written with
+    (:func:`check_options`; not checked without ``options``)."""
     from mhtrack.build import load_tracker
     from mhtrack.io.asterix.duplicates import stream_filter
     from mhtrack.mht.state import saved_meta
@@ -238,5 +272,5 @@ def read_checkpoint(path: str | Path, options: TrackOptions | None = None
     except (TypeError, ValueError, KeyError, AttributeError) as e:
         raise InputError(f"{path}: member 'meta': field 'extra': {e}", file=str(path)) from None
     if options is not None:
-        check_options(path, state, options)
+        check_options(path, state, options, sectors)
     return load_tracker(path), state

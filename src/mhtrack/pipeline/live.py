@@ -121,7 +121,7 @@ class Live:
         self.stop = threading.Event() if stop is None else stop
         resumed = None
         if live.resume and live.checkpoint is not None and live.checkpoint.exists():
-            resumed = read_checkpoint(live.checkpoint, options)
+            resumed = read_checkpoint(live.checkpoint, options, live.sectors)
         #: The checkpoint resumed from (``None``: a fresh start).
         self.resumed: LiveState | None = None if resumed is None else resumed[1]
         #: The density comes from the first rotations (not given, not resumed).
@@ -261,7 +261,7 @@ class Live:
             outputs = [self.periodic]
         self.checkpoints = None if live.checkpoint is None else CheckpointSink(
             live.checkpoint, lambda: self.pipeline.tracker, self._state,
-            live.checkpoint_every_s, self.pipeline.options)
+            live.checkpoint_every_s, self.pipeline.options, live.sectors)
         #: The live view's tracks (``--view``), or ``None``.
         self.view: ViewSink | None = None if live.view is None else ViewSink(
             lambda: self.pipeline.tracker, frame)  # type: ignore[arg-type]

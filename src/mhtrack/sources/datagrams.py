@@ -51,7 +51,7 @@ from mhtrack.models.radars import SensorSet
 from mhtrack.records import Scan
 from mhtrack.sources.base import CAUGHT_UP, IDLE, Source, SourceStats, Survey
 from mhtrack.sources.gather import Gathered
-from mhtrack.sources.marks import row_place, with_marks
+from mhtrack.sources.marks import restored, row_place, template_of, with_marks
 from mhtrack.sources.positions import local_positions
 from mhtrack.sources.timed import TimedStream
 
@@ -112,8 +112,9 @@ class DatagramSource(Source):
         #: The duplicate filter's blocks of an earlier run (``DuplicateFilter.recent``),
         #: remembered first: a copy received before the stop and again after is taken once.
         self.recent_start = recent
-        #: Each radar's count of sweep marks so far (a plot's ``sector``).
-        self.marks: dict[int, int] = dict((pending or {}).get("marks") or {})
+        #: Each radar's count of sweep marks so far (a plot's ``sector``); the columns of
+        #: the last converted plots (or restored ones): a sweep mark's row has them
+        self.marks, self._template = restored(pending, sectors)
         #: :meth:`file_rows` knows the last ``keep_rows`` plots only (``None``: all; a
         #: live stream without end keeps its memory flat).
         self.keep_rows = keep_rows
@@ -129,8 +130,6 @@ class DatagramSource(Source):
         self._decoder: Decoder | None = None
         self._seen: set[int] = set()  # radars whose site was settled (kept or skipped)
         self._skipped: dict[int, list[int]] = {}  # radar -> [plots, first byte]
-        #: Columns of the last converted plots: a sweep mark's row has them (``sectors``)
-        self._template: dict[str, tuple[np.dtype, tuple[int, ...]]] | None = None
 
     def _datagrams(self, problems: Problems, decoder: Decoder
                    ) -> Iterator[tuple[int, Any, float | None]]:
@@ -163,7 +162,8 @@ class DatagramSource(Source):
         rows: list[tuple[Any, ...]] = []
         times: list[float] = []
         at_rows: list[int] = []
-        self.marks = sector = dict((self.restore or {}).get("marks") or {})
+        self.marks, self._template = restored(self.restore, self.sectors)
+        sector = self.marks
         in_sector: list[int] = []
         marks: list[tuple[float, int, int, int, int]] = []  # (time, radar, sector, place, byte)
         closing = self.sectors and convert  # marks go on with the plots: they close frames
@@ -215,8 +215,7 @@ class DatagramSource(Source):
             return out if convert else p  # type: ignore[return-value]
         if out is not None:
             out["mark"] = np.zeros(out["time"].size, bool)
-            if out["time"].size:
-                self._template = {k: (v.dtype, v.shape[1:]) for k, v in out.items()}
+            self._template = template_of(out) or self._template
         return with_marks(out, marks or [], n0, self._template)
 
     def _convert(self, p: dict[str, np.ndarray]) -> dict[str, np.ndarray]:

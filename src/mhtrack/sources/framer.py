@@ -94,6 +94,12 @@ class Framer:
         self._uses: dict[int, int] = {}
         self._next_batch = 0
 
+    @property
+    def batches_held(self) -> int:
+        """The batches kept for the plots of frames not yet given out (memory): each is
+        freed once its last such frame is out, a batch without plots at once."""
+        return len(self._batches)
+
     def _length(self, sensor: int) -> float:
         f = self.frame_s
         length = f if isinstance(f, int | float) else f.get(sensor, DEFAULT_FRAME_S)
@@ -121,7 +127,10 @@ class Framer:
                 uses += self._with_marks(b, s, rows, t, sector, mark)
                 continue
             uses += self._plots(b, s, rows, t, sector)
-        self._uses[b] = uses
+        if uses:
+            self._uses[b] = uses
+        else:  # no plot of it in a frame (marks only): each closing mark is copied
+            del self._batches[b]
         self.now = float(t[-1])
         yield from self._ready(final=False)
 

@@ -5,6 +5,9 @@ when the antenna leaves its sector (:mod:`~mhtrack.sources.framer`)."""
 
 from __future__ import annotations
 
+from collections.abc import Mapping
+from typing import Any
+
 import numpy as np
 
 #: A chunk's columns: dtype and trailing shape of each.
@@ -40,6 +43,36 @@ def with_marks(out: dict[str, np.ndarray] | None,
                           2 * (n0 + np.array([x[3] for x in marks], np.int64))))
     order = np.argsort(key, kind="stable")
     return {k: np.concatenate((out[k], rows[k]))[order] for k in out}
+
+
+def template_of(cols: Mapping[str, np.ndarray] | None) -> Template | None:
+    """The dtype and trailing shape of each column of ``cols`` (``None`` without rows):
+    what :func:`with_marks` makes a mark's row of."""
+    if cols is None or not len(cols["time"]):
+        return None
+    return {k: (np.asarray(v).dtype, np.shape(v)[1:]) for k, v in cols.items()}
+
+
+def restored(pending: Mapping[str, Any] | None, sectors: bool
+             ) -> tuple[dict[int, int], Template | None]:
+    """From the rows an earlier stream held (``DatagramSource(pending=...)``): each
+    radar's count of marks (a resumed run numbers its sectors on) and the template of the
+    rows held but ``seq`` (the re-order buffer's arrival numbers, added on release): their
+    frames are open, so a mark that comes before this run's first plot must close them
+    (without a template such a mark would be left out: :func:`with_marks`). A
+    ``ValueError`` if the rows were cut with their sectors (a ``sector`` column) and this
+    stream is not (``sectors``), or the other way round: they cannot go on together."""
+    if pending is None:
+        return {}, None
+    held = [pending.get(k) for k in ("held", "framed")]
+    template = next((t for t in map(template_of, held) if t is not None), None)
+    if template is not None:
+        template.pop("seq", None)
+        if ("sector" in template) != sectors:
+            was, now = ("without", "with") if sectors else ("with", "without")
+            raise ValueError(f"pending: rows held cut {was} their sectors, this stream's "
+                             f"{now}")
+    return dict(pending.get("marks") or {}), template
 
 
 def row_place(row: dict[str, object]) -> str:

@@ -23,11 +23,11 @@ pytest.importorskip("asterix.generated", reason="libasterix not installed")
 
 from click.testing import CliRunner
 from recording_table import recording_table
+from tests.helpers.plot_blocks import plot_blocks
 
 from mhtrack.cli.main import cli
 from mhtrack.errors import InputError
 from mhtrack.io.asterix import read_recording
-from mhtrack.io.asterix.encode import encode_blocks, plot_messages
 from mhtrack.io.sensors import read_sensors, write_sensors
 from mhtrack.models.radars import RadarSensor, SensorSet
 from mhtrack.records import Scan
@@ -39,20 +39,9 @@ from .conftest import differences
 N_BLOCKS, PER_BLOCK, RADAR, DT = 20, 3, 258, 0.5
 
 
-def _blocks() -> list[bytes]:
-    """Twenty CAT048 blocks of three plots each from radar SAC 1 / SIC 2, plot ``i`` at
-    ``i · DT`` s (block ``k`` holds plots ``3k … 3k + 2``)."""
-    n = N_BLOCKS * PER_BLOCK
-    msgs = plot_messages(np.arange(n) * DT, np.full(n, RADAR), np.linspace(1e4, 9e4, n),
-                         np.linspace(0, 350, n), {})
-    out = []
-    for k in range(N_BLOCKS):
-        out += [b for _, _, b in encode_blocks(msgs[k * PER_BLOCK:(k + 1) * PER_BLOCK])]
-    assert len(out) == N_BLOCKS
-    return out
-
-
-BLOCKS = _blocks()
+#: Twenty CAT048 blocks of three plots each from radar SAC 1 / SIC 2, plot ``i`` at
+#: ``i · DT`` s (block ``k`` holds plots ``3k … 3k + 2``).
+BLOCKS = plot_blocks(N_BLOCKS, PER_BLOCK, dt=DT, sensor=RADAR, max_range=9e4)
 STARTS = np.cumsum([0] + [len(b) for b in BLOCKS]).tolist()
 
 

@@ -9,10 +9,10 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from tests.helpers.plot_blocks import plot_blocks
 
 from mhtrack.errors import InputError
 from mhtrack.io.asterix import read_recording
-from mhtrack.io.asterix.encode import encode_blocks, plot_messages
 from mhtrack.io.asterix.writer import datagram
 
 N_BLOCKS, PER_BLOCK = 6, 5
@@ -20,15 +20,7 @@ N_BLOCKS, PER_BLOCK = 6, 5
 
 def _blocks() -> list[bytes]:
     """Six CAT048 blocks of five plots each, from radar SAC 1 / SIC 2."""
-    n = N_BLOCKS * PER_BLOCK
-    t = np.arange(n) * 0.5
-    msgs = plot_messages(t, np.full(n, 258), np.linspace(1e4, 2e5, n),
-                         np.linspace(0, 350, n), {})
-    out = []
-    for k in range(N_BLOCKS):
-        out += [b for _, _, b in encode_blocks(msgs[k * PER_BLOCK:(k + 1) * PER_BLOCK])]
-    assert len(out) == N_BLOCKS
-    return out
+    return plot_blocks(N_BLOCKS, PER_BLOCK)
 
 
 def _pcap(frames: list[bytes]) -> bytes:

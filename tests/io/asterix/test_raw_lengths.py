@@ -13,9 +13,10 @@ import pytest
 
 pytest.importorskip("asterix")
 
+from tests.helpers.plot_blocks import plot_blocks
+
 from mhtrack.io.asterix import read_recording
 from mhtrack.io.asterix.decode import Decoder
-from mhtrack.io.asterix.encode import encode_blocks, plot_messages
 from mhtrack.io.asterix.framings import _raw_at, units
 from mhtrack.io.asterix.problems import Problems
 
@@ -24,14 +25,7 @@ N_BLOCKS, PER_BLOCK = 10, 3
 
 def _blocks() -> list[bytes]:
     """Ten CAT048 blocks of three plots each, from radar SAC 1 / SIC 2."""
-    n = N_BLOCKS * PER_BLOCK
-    msgs = plot_messages(np.arange(n) * 0.5, np.full(n, 258), np.linspace(1e4, 2e5, n),
-                         np.linspace(0, 350, n), {})
-    out = []
-    for k in range(N_BLOCKS):
-        out += [b for _, _, b in encode_blocks(msgs[k * PER_BLOCK:(k + 1) * PER_BLOCK])]
-    assert len(out) == N_BLOCKS
-    return out
+    return plot_blocks(N_BLOCKS, PER_BLOCK)
 
 
 def _with_length(blocks: list[bytes], k: int, length: int) -> tuple[bytes, list[int]]:

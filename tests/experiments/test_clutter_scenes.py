@@ -187,3 +187,23 @@ def test_html_without_plotly_fails_before_the_study(tmp_path, monkeypatch):
         'Error: the HTML report needs Plotly: pip install "mhtrack[report]" '
         "(or pip install plotly)"]
     assert ran == [] and not out.exists()
+
+
+def test_view_figures_are_those_of_run_scenario_on_the_same_plots(tiny):
+    """A job's OSPA, coverage, fragmentations and id switches in each view are those of
+    ``run_scenario`` (the path of ``mhtrack run``) with the same tracker, seed and output;
+    its tracker CPU time excludes the probe (so it is below the job's wall time)."""
+    from mhtrack.experiments.pipeline import run_scenario
+    from mhtrack.scenario.scenes import with_clutter_scene
+
+    scenario = with_clutter_scene(preset("radars-clutter", scans=14), "storm")
+    rec = tiny.records["storm"]["gmm"][0]
+    for view in ("history", "online"):
+        s = run_scenario(scenario, rec["seed"], "mht-gmm", output=view, cutoff=500.0,
+                         order=2.0).summary()
+        assert rec[f"ospa_{view}"] == s["ospa_mean"]
+        assert rec[f"coverage_{view}"] == s["coverage"]
+        assert rec[f"fragmentations_{view}"] == s["fragmentations"]
+        assert rec[f"id_switches_{view}"] == s["id_switches"]
+        assert rec[f"ids_{view}"] == s["n_track_ids"]
+    assert 0.0 < rec["t_cpu"] < rec["t_run"]

@@ -21,11 +21,14 @@ and scores:
   the frames;
 * the tracks in both views, collected from the same run (``history``: every confirmed
   track's rows back to its start; ``online``: the rows as reported at each frame),
-  each scored by :func:`mhtrack.metrics.evaluate` (OSPA, HOTA, ids) and counted for
-  **false tracks** (track ids never matched to a target by CLEAR-MOT);
+  each scored by :func:`mhtrack.metrics.evaluate` (OSPA, HOTA, ids, coverage,
+  fragmentations, id switches) and counted for **false tracks** (track ids never matched
+  to a target by CLEAR-MOT);
 * times (not compared): the tracker's mean step ``t_avg``, the estimator's own time per
-  frame ``t_clutter`` (its ``update`` and ``intensity`` calls by the tracker) and the
-  job's wall time ``t_run`` (simulation, tracking, probes and scoring).
+  frame ``t_clutter`` (its ``update`` and ``intensity`` calls by the tracker), the
+  tracker's CPU time over the run ``t_cpu`` (``time.thread_time`` around the tracking, the
+  probe's own removed; the shared machine's load does not inflate it) and the job's wall
+  time ``t_run`` (simulation, tracking, probes and scoring).
 
 Jobs are stored in ``DIR/jobs/<scene>/<method>/run-<i>.json`` (a rerun resumes); the
 result does not depend on the executor or the number of workers.
@@ -115,15 +118,17 @@ class TimedClutter(ClutterEstimator):
 
 
 def _probe(frames: Any, est: ClutterEstimator, truth: Any, cell: float,
-           iae: list[float]) -> Iterator[Scan]:
+           iae: list[float], cpu: list[float]) -> Iterator[Scan]:
     """Yield the frames to the tracker; once it has stepped one, append the clutter error
-    of the frame's radar (module docstring). The truth is computed once per rotation of
-    each radar (the radars' frames interleave)."""
+    of the frame's radar (module docstring), adding the probe's own CPU time
+    (``time.thread_time``) to ``cpu[0]``. The truth is computed once per rotation of each
+    radar (the radars' frames interleave)."""
     cache: dict[int, tuple[float, np.ndarray]] = {}  # radar → (rotation, its truth)
     for f in frames:
         yield f
         if not len(f):
             continue
+        c0 = time.thread_time()
         sid = int(f.sensor[0])
         rotation = truth.rotation_time(sid, float(f.time))
         if sid not in cache or cache[sid][0] != rotation:
@@ -131,6 +136,7 @@ def _probe(frames: Any, est: ClutterEstimator, truth: Any, cell: float,
         cover = truth.coverage(sid)
         kappa_hat = np.asarray(est.intensity(truth.xy), float)
         iae.append(integrated_absolute_error(kappa_hat[cover], cache[sid][1][cover], cell))
+        cpu[0] += time.thread_time() - c0
 
 
 def _view(tracks: Any, sim: Any, cutoff: float, order: float) -> dict[str, float]:
@@ -140,7 +146,8 @@ def _view(tracks: Any, sim: Any, cutoff: float, order: float) -> dict[str, float
     d = ev.to_dict()
     matched = len(np.unique(ev.clear_mot.matching.track_id))
     return {"ospa": d["ospa_mean"], "hota": d["hota"], "ids": d["n_track_ids"],
-            "false_tracks": int(ev.n_tracks - matched)}
+            "false_tracks": int(ev.n_tracks - matched), "coverage": d["coverage"],
+            "fragmentations": d["fragmentations"], "id_switches": d["id_switches"]}
 
 
 def run_job(job: Mapping[str, Any]) -> dict[str, Any]:
@@ -169,14 +176,17 @@ def run_job(job: Mapping[str, Any]) -> dict[str, Any]:
     grid, cell = scenario.region.grid(int(job["resolution"]))
     truth = RadarTruth(scenario, grid)
     iae: list[float] = []
+    probe_cpu = [0.0]
     views = {v: TrackCollector(v) for v in ("history", "online")}
     tracker_log = logging.getLogger("mhtrack.mht.tracker")  # caps are kept in the record
     level = tracker_log.level
     tracker_log.setLevel(logging.ERROR)
     try:
-        frames = _probe(pipe.source, est, truth, cell, iae)
+        frames = _probe(pipe.source, est, truth, cell, iae, probe_cpu)
+        c0 = time.thread_time()
         stats, _ = feed(step_frames(pipe.tracker, frames, name=job["method"]),
                         list(views.values()))
+        t_cpu = time.thread_time() - c0 - probe_cpu[0]
     finally:
         tracker_log.setLevel(level)
     rec: dict[str, Any] = {"scene": job["scene"], "method": job["method"], "run": job["run"],
@@ -188,7 +198,7 @@ def run_job(job: Mapping[str, Any]) -> dict[str, Any]:
     steps = [s.time_s for s in stats]
     rec.update(t_avg=float(np.mean(steps)) if steps else float("nan"),
                t_clutter=timed.seconds / max(len(stats), 1),
-               t_run=time.perf_counter() - t_start,
+               t_run=time.perf_counter() - t_start, t_cpu=t_cpu,
                caps=sorted({k for s in stats for k in s.caps}))
     return rec
 

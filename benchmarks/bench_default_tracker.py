@@ -42,12 +42,14 @@ METRICS = {
 PAIRS = (("mapgmm", "agmm"), ("gmm", "agmm"), ("mapgmm", "gmm"))
 
 
-def jobs(runs: int, seed: int, methods: tuple[str, ...], scans: dict[str, int]) -> list[Job]:
+def jobs(runs: int, seed: int, methods: tuple[str, ...], scans: dict[str, int],
+         presets: tuple[str, ...] = PRESETS, settings: tuple[str, ...] = SETTINGS
+         ) -> list[Job]:
     """Run-major: run 0 of every preset, setting and method, then run 1, …"""
     dicts = {}
-    for p in PRESETS:
+    for p in presets:
         base = preset(p, scans=scans.get(p))
-        for s in SETTINGS:
+        for s in settings:
             dicts[p, s] = (base if s == "none" else with_clutter_scene(base, s)).to_dict()
     out = []
     for i in range(runs):
@@ -68,10 +70,15 @@ def main() -> None:
     ap.add_argument("--method", action="append", default=None)
     ap.add_argument("--scans", action="append", default=[], help="PRESET=N")
     ap.add_argument("--report-only", action="store_true", help="only read DIR/jobs")
+    ap.add_argument("--preset", action="append", choices=PRESETS, default=None,
+                    help="only this preset (repeat) [both]")
+    ap.add_argument("--setting", action="append", choices=SETTINGS, default=None,
+                    help="only this scene setting (repeat) [all]")
     a = ap.parse_args()
     methods = tuple(a.method or ("agmm", "mapgmm", "gmm"))
     scans = {k: int(v) for k, v in (x.split("=") for x in a.scans)}
-    js = jobs(a.runs, a.seed, methods, scans)
+    presets, settings = tuple(a.preset or PRESETS), tuple(a.setting or SETTINGS)
+    js = jobs(a.runs, a.seed, methods, scans, presets, settings)
     store = JobStore(a.out / "jobs", STORE)
     if not a.report_only:
         run_jobs(js, run_job, store, workers=1, progress=True, desc="default-tracker")
@@ -80,8 +87,8 @@ def main() -> None:
         if store.is_done(j):
             pr = j.params
             recs.setdefault((pr["preset"], pr["scene"], pr["method"]), []).append(store.load(j))
-    for p in PRESETS:
-        groups = [("pooled", SETTINGS), *((s, (s,)) for s in SETTINGS)]
+    for p in presets:
+        groups = [("pooled", settings), *((s, (s,)) for s in settings)]
         for label, settings in groups:
             pooled: dict[str, list[dict]] = {}
             for k, s in enumerate(settings):

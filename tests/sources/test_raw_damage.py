@@ -179,3 +179,61 @@ def test_not_a_recording_refused_alike(sensors: SensorSet, tmp_path: Path,
     line = f"{path}: byte 0: not an ASTERIX recording"
     assert [x for x in c.output.splitlines() if line in x] == \
         [x for x in t.output.splitlines() if line in x] != []
+
+
+@pytest.mark.parametrize("case", ["length", "category", "garbage"])
+def test_unnamed_raw_stream_with_a_damaged_first_block(sensors: SensorSet, tmp_path: Path,
+                                                       case: str) -> None:
+    """A raw recording under a name that says nothing (``.dat``) whose first block is
+    damaged — its length covering blocks 1 and 2, its category flipped, or garbage
+    framed like a block before it — is sniffed as a recording by the reading path
+    (:func:`~mhtrack.io.asterix.api.is_recording`: any block found in the first 64
+    KiB), and ``track`` reads it as ``convert`` does (before, the first two were taken
+    for a plots table and refused: ``unknown file type ('.dat')``)."""
+    from mhtrack.io.asterix import is_recording
+
+    data = bytearray(b"".join(BLOCKS))
+    if case == "length":
+        _length(data, 0, STARTS[3])
+    elif case == "category":
+        data[0] ^= 1
+    else:
+        data[:0] = bytes([48, 0, 7, 0, 0, 0, 0])
+    path = tmp_path / "feed.dat"
+    path.write_bytes(bytes(data))
+    assert is_recording(path)
+    ref, got, src = _both(path, sensors)  # the convert path's frames, and track's
+    assert differences(ref, got) == []
+    assert _times(got) == _plots_of(range(1 if case != "garbage" else 0, N_BLOCKS))
+    assert src.problems.first.get("resync") == 0
+    write_sensors(sensors, tmp_path / "s.toml")
+    r = CliRunner().invoke(cli, ["track", str(path), "--sensors", str(tmp_path / "s.toml"),
+                                 "--out", str(tmp_path / "t.csv"), "-q"])
+    assert r.exit_code == 0, r.output
+
+
+def test_tables_and_noise_are_classified_as_before(sensors: SensorSet,
+                                                   tmp_path: Path) -> None:
+    """A real plots table (``convert``'s CSV and Parquet) is no recording, under its own
+    name or ``.dat``; random bytes that start like a raw data block but hold none are no
+    recording either, and ``track`` refuses them with the one line it always did."""
+    from mhtrack.io.asterix import is_recording
+
+    rec = tmp_path / "rec.ast"
+    rec.write_bytes(b"".join(BLOCKS))
+    runner = CliRunner()
+    for name in ("plots.csv", "plots.parquet"):
+        r = runner.invoke(cli, ["convert", str(rec), "--out", str(tmp_path / name), "-q"])
+        assert r.exit_code == 0, r.output
+        alias = tmp_path / f"{name.replace('.', '_')}.dat"
+        alias.write_bytes((tmp_path / name).read_bytes())
+        assert not is_recording(tmp_path / name) and not is_recording(alias), name
+    noise = tmp_path / "noise.dat"  # category 48, a length that fits: framed, no records
+    noise.write_bytes(bytes([48, 0, 16]) + np.random.default_rng(3).bytes(997))
+    assert not is_recording(noise)
+    write_sensors(sensors, tmp_path / "s.toml")
+    r = runner.invoke(cli, ["track", str(noise), "--sensors", str(tmp_path / "s.toml"),
+                            "--out", str(tmp_path / "t.csv")])
+    assert r.exit_code == 2
+    assert r.output.strip().splitlines() == [
+        f"Error: {noise}: unknown file type ('.dat'); use a .csv or .parquet file"]

@@ -55,6 +55,9 @@ WINDOW = 100_000
 MAX_ARRIVALS = 1 << 18
 #: A radar is silent after this many rotation periods without a frame.
 SILENT_PERIODS = 3.0
+#: The counts of what came too late for the re-order window: plots, and (sector frames)
+#: sweep marks; the run's summary line names each when there are any (``LiveResult``).
+LATE = ("late_drops", "late_crossings")
 
 
 class Arrivals:

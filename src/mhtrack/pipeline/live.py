@@ -35,7 +35,7 @@ from mhtrack.pipeline.checkpoint import (
     encode_pending,
     read_checkpoint,
 )
-from mhtrack.pipeline.health import Health
+from mhtrack.pipeline.health import LATE, Health
 from mhtrack.pipeline.live_options import (
     DAY_FROM,
     DEFAULT_STATUS_EVERY_S,
@@ -78,16 +78,18 @@ class LiveResult:
     checkpoints: int = 0
 
     def describe(self) -> str:
-        """One line: datagrams received, the run, CAT062 sent, files, latency."""
+        """One line: datagrams received, late drops and crossings (when any), the run,
+        CAT062 sent, files, latency."""
         files = f", {len(self.files)} CAT062 files" if self.files else ""
-        lat = self.health["latency_s"]
+        h, lat = self.health, self.health["latency_s"]  # late: as the status line, when any
+        late = "".join(f", {h[k]} {k.replace('_', ' ')}" for k in LATE if h.get(k))
         extra = (f"; {self.ticks} ticks" if self.ticks else "") + \
             (f"; {self.checkpoints} checkpoints" if self.checkpoints else "")
         latency = ("" if not lat["count"] else
                    f"; latency p50 {1e3 * lat['p50']:.0f} ms, p99 {1e3 * lat['p99']:.0f} ms "
                    f"({lat['count']} frames)")
         return (f"received {self.reader.datagrams} datagrams "
-                f"({self.reader.queue_dropped} dropped in the queue); {self.run.describe()}; "
+                f"({self.reader.queue_dropped} dropped in the queue){late}; {self.run.describe()}; "
                 f"sent {self.sent_datagrams} CAT062 datagrams ({self.sent_rows} rows){files}"
                 f"{extra}{latency}")
 

@@ -19,12 +19,14 @@ from mhtrack.io.asterix.decode import (
     CHARACTERISTICS,
     FL_M,
     PLOT_COLUMNS,
+    Decoder,
     Recording,
     read_recording,
 )
 from mhtrack.io.asterix.earth import ground_range, slant_range
 from mhtrack.io.asterix.encode import encode_blocks, plot_messages, sweep_messages
 from mhtrack.io.asterix.notplots import PLOT_TYPES
+from mhtrack.io.asterix.problems import Problems
 from mhtrack.io.asterix.writer import write_blocks
 from mhtrack.models.radars import SensorSet
 from mhtrack.names import EXPORT_CATEGORIES
@@ -39,10 +41,9 @@ def is_recording(path: str | Path) -> bool:
     """Whether ``path`` is to be read as an ASTERIX recording: not a ``.csv``/``.parquet``
     table, and its first 64 KiB recognised as a framing
     (:func:`~mhtrack.io.asterix.framings.recognise`: pcap, pcapng, Final, ORADIS, GPS; a
-    raw stream only when its first data block is of a category mhtrack reads and its
-    records decode to exactly its length, :func:`_blocks_chain`) — or named like a
-    recording (``.ast``, ``.pcap``, ...), so that a damaged one gets the decoder's
-    message."""
+    raw stream only when the reading path finds a data block in them,
+    :func:`_finds_blocks`) — or named like a recording (``.ast``, ``.pcap``, ...), so
+    that a damaged one gets the decoder's message."""
     from mhtrack.io.asterix.framings import PCAP_MAGICS, PCAPNG_MAGIC, recognise
 
     p = Path(path)
@@ -53,11 +54,15 @@ def is_recording(path: str | Path) -> bool:
     if head[:4] in PCAP_MAGICS or head[:4] == PCAPNG_MAGIC:
         return True
     try:
-        kind = recognise(head, str(p), _READ)
+        decoder = Decoder(duplicates=None)
+    except _lib.MissingExtra:  # framing alone: the reader then names the missing extra
+        decoder = None
+    try:
+        kind = recognise(head, str(p), _READ if decoder is None else decoder.categories)
     except InputError:
         kind = ""
-    if kind in ("final", "oradis", "gps") or (kind == "raw" and _blocks_chain(
-            head, p.stat().st_size)):
+    if kind in ("final", "oradis", "gps") or (kind == "raw" and (
+            decoder is None or _finds_blocks(decoder, head, str(p)))):
         return True
     return p.suffix.lower() in (".ast", ".asterix", ".pcap", ".pcapng", ".raw", ".ff",
                                 ".gps")
@@ -67,27 +72,11 @@ def is_recording(path: str | Path) -> bool:
 _READ = {1, 2, 21, 34, 48, 62}
 
 
-def _blocks_chain(head: bytes, size: int) -> bool:
-    """The file starts with a data block of a category mhtrack reads (:data:`_READ`),
-    whose length fits in the file and whose records libasterix decodes to exactly that
-    length (without libasterix: the header alone)."""
-    if len(head) < 3 or head[0] not in _READ:
-        return False
-    length = int.from_bytes(head[1:3], "big")
-    if not 3 <= length <= min(size, len(head)):
-        return False
-    try:
-        base, gen = _lib.modules()
-    except _lib.MissingExtra:
-        return True
-    spec = {34: _lib.cat034, 48: _lib.cat048, 62: _lib.cat062}.get(head[0])
-    uap = spec().cv_uap if spec is not None else {
-        1: gen.Cat_001_1_4, 2: gen.Cat_002_1_2, 21: gen.Cat_021_2_6}[head[0]].cv_uap
-    if head[0] == 1:
-        from mhtrack.io.asterix.cat001 import records001
-
-        return not isinstance(records001(head[3:length]), ValueError)
-    return not isinstance(uap.parse(base.Bits.from_bytes(head[3:length])), ValueError)
+def _finds_blocks(decoder: Decoder, head: bytes, name: str) -> bool:
+    """The reading path of every recording (:meth:`Decoder.units`: framing, then each
+    block judged by its content, reading on after damage) finds a data block in ``head``
+    (any one: a damaged first block does not hide the good ones after it)."""
+    return next(iter(decoder.units(head, "raw", name, Problems())), None) is not None
 
 
 def add_ground_range(rec: Recording, sensors: SensorSet) -> np.ndarray:

@@ -72,11 +72,19 @@ def is_recording(path: str | Path) -> bool:
 _READ = {1, 2, 21, 34, 48, 62}
 
 
+#: Bytes of a file's head the raw sniff reads blocks in: a few UDP datagrams' worth, so
+#: that random bytes shaped like a block header are refused in about a second (the
+#: reading path judges every offset after damage; 64 KiB took ~10 s).
+SNIFF_RAW = 1 << 13
+
+
 def _finds_blocks(decoder: Decoder, head: bytes, name: str) -> bool:
     """The reading path of every recording (:meth:`Decoder.units`: framing, then each
-    block judged by its content, reading on after damage) finds a data block in ``head``
-    (any one: a damaged first block does not hide the good ones after it)."""
-    return next(iter(decoder.units(head, "raw", name, Problems())), None) is not None
+    block judged by its content, reading on after damage) finds a data block in the
+    first :data:`SNIFF_RAW` bytes of ``head`` (any one: a damaged first block does not
+    hide the good ones after it)."""
+    units = decoder.units(head[:SNIFF_RAW], "raw", name, Problems())
+    return next(iter(units), None) is not None
 
 
 def add_ground_range(rec: Recording, sensors: SensorSet) -> np.ndarray:

@@ -195,7 +195,7 @@ class Health(Sink):
         if closing is not None and t_mark is None:
             self.untimed += 1
             return
-        t_in = t_plot if t_mark is None else t_mark if t_plot is None else max(t_plot, t_mark)
+        t_in = max(t for t in (t_plot, t_mark) if t is not None)  # the later one known
         self.by_crossing += t_mark is not None and t_mark == t_in
         self._observe(now - t_in, None if t_plot is None else now - t_plot)
 
